@@ -1,0 +1,40 @@
+# selfcal_add_module(NAME <m> SRCS ... [DEPS ...] [PRIVATE_DEPS ...])
+#   One static library per module, target selfcal_<m>, alias selfcal::<m>.
+#   DEPS are public (other selfcal modules or header-level libraries such as Eigen);
+#   PRIVATE_DEPS stay inside the module (Ceres, OpenCV, yaml-cpp ...).
+function(selfcal_add_module)
+  cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS;PRIVATE_DEPS" ${ARGN})
+  set(target selfcal_${ARG_NAME})
+  add_library(${target} STATIC ${ARG_SRCS})
+  add_library(selfcal::${ARG_NAME} ALIAS ${target})
+  target_include_directories(${target} PUBLIC ${PROJECT_SOURCE_DIR}/modules)
+  target_link_libraries(${target} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+  selfcal_set_warnings(${target})
+endfunction()
+
+# selfcal_add_module_test(NAME <m> SRCS ... [DEPS ...] [LABELS ...])
+#   One gtest binary per module, registered test by test with gtest_discover_tests.
+function(selfcal_add_module_test)
+  cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS;LABELS" ${ARGN})
+  if(NOT SELFCAL_BUILD_TESTS)
+    return()
+  endif()
+  set(target ${ARG_NAME}_test)
+  add_executable(${target} ${ARG_SRCS})
+  target_link_libraries(${target} PRIVATE ${ARG_DEPS} selfcal::test_support GTest::gtest GTest::gtest_main)
+  target_compile_definitions(${target} PRIVATE
+    SELFCAL_SOURCE_DIR="${SELFCAL_SOURCE_DIR}"
+    SELFCAL_SHARED_DATA_DIR="${SELFCAL_SHARED_DATA_DIR}")
+  selfcal_set_warnings(${target})
+  if(NOT ARG_LABELS)
+    set(ARG_LABELS unit)
+  endif()
+  gtest_discover_tests(${target} PROPERTIES LABELS "${ARG_LABELS}" DISCOVERY_TIMEOUT 60)
+endfunction()
+
+function(selfcal_set_warnings target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra)
+  if(SELFCAL_WERROR)
+    target_compile_options(${target} PRIVATE -Werror)
+  endif()
+endfunction()

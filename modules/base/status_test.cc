@@ -1,0 +1,43 @@
+#include "base/status.h"
+
+#include <gtest/gtest.h>
+
+namespace selfcal {
+namespace {
+
+TEST(Status, DefaultIsOk) {
+  Status s;
+  EXPECT_TRUE(s.ok());
+  EXPECT_EQ(s.ToString(), "ok");
+}
+
+TEST(Status, ErrorCarriesCodeAndMessage) {
+  Status s = Status::Error(ExitCode::kUsage, "unknown key `max_velocty`");
+  EXPECT_FALSE(s.ok());
+  EXPECT_EQ(static_cast<int>(s.code()), 2);
+  EXPECT_EQ(s.ToString(), "usage_or_config: unknown key `max_velocty`");
+}
+
+TEST(Result, ValueAndErrorAccess) {
+  Result<int> good(42);
+  ASSERT_TRUE(good.ok());
+  EXPECT_EQ(*good, 42);
+  Result<int> bad(Status::Error(ExitCode::kDegenerateData, "planar"));
+  EXPECT_FALSE(bad.ok());
+  EXPECT_EQ(bad.status().code(), ExitCode::kDegenerateData);
+  EXPECT_THROW(bad.value(), InvalidArgument);
+  EXPECT_THROW(Result<int>(Status::Ok()), InvalidArgument);
+}
+
+TEST(Check, ThrowsWithConditionAndMessage) {
+  try {
+    SELFCAL_CHECK(1 + 1 == 3, "arithmetic " << 2);
+    FAIL() << "no throw";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("1 + 1 == 3"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("arithmetic 2"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace selfcal

@@ -1,0 +1,69 @@
+#include "observations/observation_set.h"
+
+#include <cmath>
+#include <set>
+#include <sstream>
+
+namespace selfcal {
+
+const char* PoseRoleName(PoseRole role) {
+  return role == PoseRole::kIdentification ? "identification" : "verification";
+}
+
+std::vector<int> ObservationSet::PosesWithRole(PoseRole role) const {
+  std::vector<int> out;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    if (poses[i].role == role) out.push_back(static_cast<int>(i));
+  }
+  return out;
+}
+
+std::string ObservationSet::Validate() const {
+  std::ostringstream out;
+  out << robot.Validate() << camera.Validate();
+  if (!std::isfinite(pixel_noise_px) || pixel_noise_px <= 0) {
+    out << "pixel_noise_px = " << pixel_noise_px << " must be finite and > 0\n";
+  }
+  std::set<std::string> ids;
+  std::set<int> seen_dots;
+  for (const PoseObservation& pose : poses) {
+    if (!ids.insert(pose.id).second) out << "pose " << pose.id << ": duplicate pose id\n";
+    if (pose.joints_rad.size() != robot.num_joints()) {
+      out << "pose " << pose.id << ": " << pose.joints_rad.size() << " joint values, the robot has "
+          << robot.num_joints() << "\n";
+    }
+    for (int j = 0; j < pose.joints_rad.size(); ++j) {
+      if (!std::isfinite(pose.joints_rad[j])) out << "pose " << pose.id << ": joint " << j + 1 << " is not finite\n";
+    }
+    for (const auto& [dot, px] : pose.dots_px) {
+      if (!px.allFinite()) out << "pose " << pose.id << ", dot " << dot << ": non-finite pixel\n";
+      seen_dots.insert(dot);
+    }
+  }
+  auto check_distance = [&](const KnownDistance& k, const char* what) {
+    if (!std::isfinite(k.length_m) || k.length_m <= 0) {
+      out << what << " " << k.dot_a << "-" << k.dot_b << ": length " << k.length_m << " m must be finite and > 0\n";
+    }
+    if (k.dot_a == k.dot_b) out << what << " " << k.dot_a << "-" << k.dot_b << ": both ends are the same dot\n";
+    for (int dot : {k.dot_a, k.dot_b}) {
+      if (!seen_dots.count(dot)) out << what << " " << k.dot_a << "-" << k.dot_b << ": dot " << dot << " is never observed\n";
+    }
+  };
+  for (const KnownDistance& k : yardsticks) check_distance(k, "yardstick");
+  for (const KnownDistance& k : check_distances) check_distance(k, "check distance");
+  return out.str();
+}
+
+Matches MatchById(const PoseObservation& a, const PoseObservation& b) {
+  Matches m;
+  for (const auto& [dot, px] : a.dots_px) {
+    auto it = b.dots_px.find(dot);
+    if (it == b.dots_px.end()) continue;
+    m.dot_ids.push_back(dot);
+    m.pixels_a.push_back(px);
+    m.pixels_b.push_back(it->second);
+  }
+  return m;
+}
+
+}  // namespace selfcal

@@ -1,0 +1,56 @@
+// What a calibration consumes, independent of where it came from (simulator, session, or a file written
+// by another tool; docs/observations-format.md is the file form): the nominal robot, the camera, and per
+// pose the joint angles and the pixel of each detected dot, by dot id.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "camera/camera.h"
+#include "kinematics/robot_model.h"
+
+namespace selfcal {
+
+enum class PoseRole { kIdentification, kVerification };
+const char* PoseRoleName(PoseRole role);
+
+struct PoseObservation {
+  std::string id;                               // unique within the set (e.g. "p07")
+  PoseRole role = PoseRole::kIdentification;
+  Eigen::VectorXd joints_rad;                   // one per robot joint
+  std::map<int, Eigen::Vector2d> dots_px;       // dot id -> pixel (u right, v down, origin top-left centre)
+};
+
+// A known distance between two dots: the yardstick(s) that fix the metric scale, or held-out checks.
+struct KnownDistance {
+  int dot_a = -1;
+  int dot_b = -1;
+  double length_m = 0;
+};
+
+struct ObservationSet {
+  RobotModel robot;                  // nominal model
+  CameraIntrinsics camera;           // fx_px is the nominal / initial value (f_x is estimated)
+  double pixel_noise_px = 0.5;       // expected std of the centroids, for weights and uncertainty
+  std::vector<KnownDistance> yardsticks;
+  std::vector<KnownDistance> check_distances;  // held out from the solve: verification only
+  std::vector<PoseObservation> poses;
+
+  // Indices of poses with the given role, in file order.
+  std::vector<int> PosesWithRole(PoseRole role) const;
+  // Empty when consistent; otherwise every problem, one per line, naming the pose id and dot id
+  // (joint count, non-finite values, duplicate pose ids, yardstick dots never seen, ...).
+  std::string Validate() const;
+};
+
+// Pixels of the dots seen in both poses, matched by id (D6: correspondence by id, never by index).
+struct Matches {
+  std::vector<int> dot_ids;
+  std::vector<Eigen::Vector2d> pixels_a, pixels_b;
+};
+Matches MatchById(const PoseObservation& a, const PoseObservation& b);
+
+}  // namespace selfcal

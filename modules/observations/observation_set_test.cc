@@ -1,0 +1,48 @@
+#include "observations/observation_set.h"
+
+#include <gtest/gtest.h>
+
+#include "support/test_robots.h"
+
+namespace selfcal {
+namespace {
+
+ObservationSet TwoPoses() {
+  ObservationSet set;
+  set.robot = testing::Puma560();
+  PoseObservation a, b;
+  a.id = "a";
+  b.id = "b";
+  a.joints_rad = b.joints_rad = Eigen::VectorXd::Zero(6);
+  a.dots_px = {{1, {10, 20}}, {2, {30, 40}}, {5, {50, 60}}};
+  b.dots_px = {{2, {31, 41}}, {5, {51, 61}}, {7, {1, 1}}};
+  set.poses = {a, b};
+  return set;
+}
+
+TEST(ObservationSet, MatchByIdNotByIndex) {
+  const ObservationSet set = TwoPoses();
+  const Matches m = MatchById(set.poses[0], set.poses[1]);
+  ASSERT_EQ(m.dot_ids, (std::vector<int>{2, 5}));
+  EXPECT_EQ(m.pixels_a[0], Eigen::Vector2d(30, 40));
+  EXPECT_EQ(m.pixels_b[1], Eigen::Vector2d(51, 61));
+}
+
+TEST(ObservationSet, ValidateNamesPoseAndDot) {
+  ObservationSet set = TwoPoses();
+  EXPECT_EQ(set.Validate(), "");
+  set.poses[1].id = "a";
+  set.poses[0].joints_rad = Eigen::VectorXd::Zero(5);
+  set.poses[1].dots_px[9] = Eigen::Vector2d(std::nan(""), 3);
+  set.yardsticks.push_back({1, 99, 0.3});
+  set.check_distances.push_back({2, 5, -1});
+  const std::string problems = set.Validate();
+  EXPECT_NE(problems.find("pose a: duplicate pose id"), std::string::npos) << problems;
+  EXPECT_NE(problems.find("5 joint values"), std::string::npos) << problems;
+  EXPECT_NE(problems.find("dot 9: non-finite pixel"), std::string::npos) << problems;
+  EXPECT_NE(problems.find("dot 99 is never observed"), std::string::npos) << problems;
+  EXPECT_NE(problems.find("check distance 2-5: length -1"), std::string::npos) << problems;
+}
+
+}  // namespace
+}  // namespace selfcal

@@ -1,0 +1,134 @@
+// Two-view relative pose with an unknown focal length: the paper's refined nonlinear factor method
+// (section 3.1, eq. (8)-(13)), made robust (RANSAC, planar scenes, cheirality, degeneracy outcomes).
+//
+// Convention (eq. (9)): P1 = A [I | 0], P2 = A [R | t], i.e. (R, t) is cam2_from_cam1:
+//   p_in_cam2 = R * p_in_cam1 + t.
+// Only the direction of t is observable; ||translation_direction|| = 1.
+// Intrinsics follow eq. (8): principal point (cx, cy) and mu = fy/fx known, skew zero; f_x is the
+// unknown when options.estimate_focal is true (camera.fx_px is then only the prior used when f_x is
+// unobservable from this pair).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "camera/camera.h"
+#include "geometry/rigid3.h"
+
+namespace selfcal::twoview {
+
+// RELIABILITY.md G1-G10.
+enum class Outcome {
+  kNotRun,
+  kSuccess,
+  kInvalidInput,      // size mismatch, non-finite pixel (D7)
+  kTooFewPoints,      // G1: fewer than options.min_points correspondences (or inliers)
+  kDegenerate,        // rank-deficient design (collinear points, identical images, ...)
+  kPureRotation,      // G3: R valid, translation unobservable (translation_observable = false)
+  kAmbiguousPose,     // G5: no clear cheirality winner
+  kTooManyOutliers,   // G7: inlier ratio below the floor
+  kNoConvergence,     // G9: refinement failed; the linear estimate is kept and flagged
+};
+const char* OutcomeName(Outcome outcome);
+
+struct TwoViewOptions {
+  bool estimate_focal = true;          // paper: f_x unknown, estimated per pair
+  bool refine = true;                  // LM on eq. (13) after the linear factor method
+  double ransac_threshold_px = 1.0;    // on the Sampson distance, in pixels
+  double ransac_confidence = 0.999;
+  int ransac_max_iterations = 2000;    // cap on the adaptive count (G7, G8)
+  int min_points = 8;                  // G1
+  double min_inlier_ratio = 0.3;       // G7
+  double planar_homography_ratio = 0.45;  // G4: R_H = S_H / (S_H + S_F) above this -> homography path
+  double min_parallax_deg = 1.0;       // G3: median parallax below this -> pure rotation
+  double focal_observability_min = 0.05;  // see FocalFromFundamental
+  int max_refine_iterations = 100;
+  uint64_t seed = 1;                   // RANSAC sampling (P9: deterministic)
+
+  // Empty when valid; every problem otherwise, one per line.
+  std::string Validate() const;
+};
+
+struct TwoViewReport {
+  Outcome outcome = Outcome::kNotRun;
+  std::string message;  // why, in words
+
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();       // R of cam2_from_cam1
+  Eigen::Vector3d translation_direction = Eigen::Vector3d::Zero();  // unit t of cam2_from_cam1
+  bool translation_observable = false;
+
+  double fx_px = 0;              // final f_x (estimated, or the prior when !fx_observable)
+  bool fx_observable = false;    // false when the optical axes (nearly) intersect, or f_x was given
+  double fx_linear_px = 0;       // from the fundamental matrix, before refinement (0 if unobservable)
+
+  bool planar = false;           // the homography path was taken (G4)
+  double homography_ratio = 0;   // R_H
+  std::vector<bool> inliers;     // per correspondence
+  int num_inliers = 0;
+  double rms_epipolar_px = -1;   // RMS of the symmetric epipolar distance (eq. 12) over inliers, final
+
+  bool refinement_accepted = false;  // G9: only if cost decreased and result finite
+  std::string refinement_termination;
+  int refinement_iterations = 0;
+
+  Rigid3 cam2_from_cam1() const { return Rigid3(rotation, translation_direction); }
+};
+
+// Task-level estimator: validation, RANSAC on the normalised 8-point fundamental matrix (or homography
+// for planar scenes), f_x from Q, factorisation (Theorem 1) with cheirality, LM refinement of eq. (13)
+// over f_x, R (SO(3) manifold) and the direction of t (sphere manifold).
+// pixels1[k] and pixels2[k] are the same dot (correspondence by index, already matched by id).
+TwoViewReport EstimateTwoView(const TwoViewOptions& options, const CameraIntrinsics& camera,
+                              const std::vector<Eigen::Vector2d>& pixels1,
+                              const std::vector<Eigen::Vector2d>& pixels2);
+
+// ---- Pure math building blocks (no policy) ------------------------------------------------------
+
+// Hartley-normalised 8-point fundamental matrix from >= 8 correspondences (x2^T F x1 = 0), rank 2
+// enforced. Coordinates are whatever the caller passes (pixels or centred pixels).
+Eigen::Matrix3d EightPointFundamental(const std::vector<Eigen::Vector2d>& x1, const std::vector<Eigen::Vector2d>& x2);
+
+// Focal length shared by both views from a fundamental matrix in centred coordinates (principal point at
+// the origin, mu divided out), Bougnoux's formula. Returns false when f is unobservable: f^2 <= 0, or the
+// relative observability measure (written to *observability when non-null, ~0 when the optical axes
+// intersect) is below min_observability.
+bool FocalFromFundamental(const Eigen::Matrix3d& f_centered, double min_observability, double* fx_px,
+                          double* observability = nullptr);
+
+// Theorem 1: the four (R, t) candidates of an essential matrix, t unit.
+std::vector<Rigid3> FactorEssential(const Eigen::Matrix3d& essential);
+
+// Linear triangulation of one point from normalised coordinates in two views (cam2_from_cam1 given);
+// the point in cam1 coordinates.
+Eigen::Vector3d TriangulateTwoView(const Rigid3& cam2_from_cam1, const Eigen::Vector2d& x1, const Eigen::Vector2d& x2);
+
+// Symmetric epipolar distance of eq. (12) for one correspondence, in the units of the coordinates.
+double SymmetricEpipolarDistance(const Eigen::Matrix3d& f, const Eigen::Vector2d& x1, const Eigen::Vector2d& x2);
+
+// ---- Reference and bound -------------------------------------------------------------------------
+
+// OpenCV's findEssentialMat (RANSAC, threshold options.ransac_threshold_px) + recoverPose with the
+// true f_x (camera.fx_px): the comparison row of the study. Outcome kSuccess or a failure outcome.
+TwoViewReport EstimateTwoViewOpenCv(const TwoViewOptions& options, const CameraIntrinsics& camera,
+                                    const std::vector<Eigen::Vector2d>& pixels1,
+                                    const std::vector<Eigen::Vector2d>& pixels2);
+
+// Cramer-Rao bound of the two-view reprojection model: unknowns R (3), direction of t (2), f_x (1 when
+// fx_unknown) and every point (3 each); measurements both images' pixels with i.i.d. N(0, sigma_px^2)
+// per coordinate. Points are marginalised (Schur complement).
+struct TwoViewBound {
+  bool ok = false;
+  std::string message;
+  Eigen::Matrix3d rotation_covariance;          // rad^2, of the rotation-vector error of R
+  Eigen::Matrix3d translation_dir_covariance;   // of the unit direction (rank 2), rad^2
+  double fx_variance = 0;                       // px^2 (0 when f_x known)
+  double rotation_rms_rad() const;              // sqrt(trace)
+  double translation_dir_rms_rad() const;       // sqrt(trace)
+};
+TwoViewBound TwoViewCramerRao(const CameraIntrinsics& camera, const Rigid3& cam2_from_cam1,
+                              const std::vector<Eigen::Vector3d>& points_in_cam1, double sigma_px, bool fx_unknown);
+
+}  // namespace selfcal::twoview
