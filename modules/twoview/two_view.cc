@@ -1,0 +1,460 @@
+// Task-level two-view estimator: the policy that joins RANSAC, model selection (G4), the pure-rotation
+// check (G3), the factor method with cheirality (G5) and the refinement (G9).
+#include "twoview/two_view.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include <Eigen/Dense>
+
+#include "twoview/two_view_internal.h"
+
+namespace selfcal::twoview {
+
+using internal::Finish;
+
+const char* OutcomeName(Outcome outcome) {
+  switch (outcome) {
+    case Outcome::kNotRun:
+      return "not_run";
+    case Outcome::kSuccess:
+      return "success";
+    case Outcome::kInvalidInput:
+      return "invalid_input";
+    case Outcome::kTooFewPoints:
+      return "insufficient_points";  // RELIABILITY.md G1 names it so
+    case Outcome::kDegenerate:
+      return "degenerate";
+    case Outcome::kPureRotation:
+      return "pure_rotation";
+    case Outcome::kAmbiguousPose:
+      return "ambiguous_pose";
+    case Outcome::kTooManyOutliers:
+      return "too_many_outliers";
+    case Outcome::kNoConvergence:
+      return "no_convergence";
+  }
+  return "unknown";
+}
+
+std::string TwoViewOptions::Validate() const {
+  std::ostringstream out;
+  if (!(ransac_threshold_px > 0) || !std::isfinite(ransac_threshold_px)) {
+    out << "ransac_threshold_px = " << ransac_threshold_px << " must be finite and > 0\n";
+  }
+  if (!(ransac_confidence > 0 && ransac_confidence < 1)) {
+    out << "ransac_confidence = " << ransac_confidence << " must lie in (0, 1)\n";
+  }
+  if (ransac_max_iterations < 1) out << "ransac_max_iterations = " << ransac_max_iterations << " must be >= 1\n";
+  if (min_points < 8) out << "min_points = " << min_points << " must be >= 8 (the 8-point algorithm)\n";
+  if (!(min_inlier_ratio >= 0 && min_inlier_ratio <= 1)) {
+    out << "min_inlier_ratio = " << min_inlier_ratio << " must lie in [0, 1]\n";
+  }
+  if (!(planar_homography_ratio >= 0 && planar_homography_ratio <= 1)) {
+    out << "planar_homography_ratio = " << planar_homography_ratio << " must lie in [0, 1]\n";
+  }
+  if (!(min_parallax_deg >= 0 && min_parallax_deg < 90)) {
+    out << "min_parallax_deg = " << min_parallax_deg << " must lie in [0, 90)\n";
+  }
+  if (!(focal_observability_min >= 0 && focal_observability_min < 1)) {
+    out << "focal_observability_min = " << focal_observability_min << " must lie in [0, 1)\n";
+  }
+  if (max_refine_iterations < 0) out << "max_refine_iterations = " << max_refine_iterations << " must be >= 0\n";
+  return out.str();
+}
+
+namespace {
+
+using internal::Correspondences;
+
+// G5: the winner must hold more than half of the inliers in front of both cameras and leave at most 10 %
+// confidently behind (ORB-SLAM2 asks 90 % in front; the slack is for outliers that slipped under the
+// threshold). Every other candidate must be out of the running: either it holds clearly fewer points in
+// front (below 0.7 of the winner, ORB-SLAM2's rule), or it puts clearly more points confidently behind a
+// camera than the winner does: at least max(3, 5 % of the inliers) more. "Confidently" means a
+// triangulation angle of at least two threshold-sized pixel errors, where noise flips a depth sign with
+// probability well under 1 %. The second test matters for planes: the dual decomposition of a lateral
+// motion typically keeps two thirds of the points in front, too many for the ratio, yet puts several
+// clearly behind, which no single plane seen by both cameras can do.
+constexpr double kSecondBestRatio = 0.7;
+constexpr double kMinInFrontFraction = 0.5;
+constexpr double kMaxBehindFraction = 0.1;
+constexpr double kRefutingBehindFraction = 0.05;
+constexpr int kRefutingBehindMin = 3;
+// A focal this far from the prior is a symptom of near-degenerate geometry, not a lens: a linear one is
+// replaced by the prior as the refinement's start, a refined one counts as a diverged refinement (G9).
+constexpr double kMaxFocalRatio = 10.0;
+
+std::vector<int> IndicesOf(const std::vector<bool>& mask) {
+  std::vector<int> out;
+  for (size_t i = 0; i < mask.size(); ++i) {
+    if (mask[i]) out.push_back(static_cast<int>(i));
+  }
+  return out;
+}
+
+void Normalise(const Correspondences& data, double fx_px, std::vector<Eigen::Vector2d>* n1,
+               std::vector<Eigen::Vector2d>* n2) {
+  n1->resize(data.size());
+  n2->resize(data.size());
+  for (int i = 0; i < data.size(); ++i) {
+    (*n1)[i] = data.centred1[i] / fx_px;
+    (*n2)[i] = data.centred2[i] / fx_px;
+  }
+}
+
+Eigen::Vector3d Bearing(const Eigen::Vector2d& n) { return Eigen::Vector3d(n.x(), n.y(), 1).normalized(); }
+
+// Rotation that best aligns the rays of view 1 with those of view 2 (Wahba's problem, SVD solution):
+// the rotation-only model, exact for a pure rotation.
+Eigen::Matrix3d BestRotation(const std::vector<Eigen::Vector2d>& n1, const std::vector<Eigen::Vector2d>& n2,
+                             const std::vector<int>& indices) {
+  Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+  for (int i : indices) m += Bearing(n2[i]) * Bearing(n1[i]).transpose();
+  return NearestRotation(m);
+}
+
+// Median angle between the ray of view 2 and the rotation-compensated ray of view 1.
+double MedianParallaxRad(const Eigen::Matrix3d& r, const std::vector<Eigen::Vector2d>& n1,
+                         const std::vector<Eigen::Vector2d>& n2, const std::vector<int>& indices) {
+  std::vector<double> angles;
+  angles.reserve(indices.size());
+  for (int i : indices) {
+    const Eigen::Vector3d a = r * Bearing(n1[i]), b = Bearing(n2[i]);
+    angles.push_back(std::atan2(a.cross(b).norm(), a.dot(b)));
+  }
+  if (angles.empty()) return 0;
+  auto mid = angles.begin() + static_cast<std::ptrdiff_t>(angles.size() / 2);
+  std::nth_element(angles.begin(), mid, angles.end());
+  return *mid;
+}
+
+// Median distance (px, in image 2) between each inlier and its view-1 pixel mapped by the rotation-only
+// homography K R K^-1 with the prior focal.
+double MedianRotationTransferPx(const CameraIntrinsics& camera, const Eigen::Matrix3d& rotation,
+                                const Correspondences& data, const std::vector<int>& indices) {
+  const Eigen::Matrix3d k = Eigen::Vector3d(camera.fx_px, camera.fx_px, 1).asDiagonal();
+  const Eigen::Matrix3d h = k * rotation * k.inverse();  // centred coordinates
+  std::vector<double> errors;
+  errors.reserve(indices.size());
+  for (int i : indices) {
+    const Eigen::Vector3d mapped = h * Eigen::Vector3d(data.centred1[i].x(), data.centred1[i].y(), 1);
+    if (!(mapped.z() > 0)) {
+      errors.push_back(std::numeric_limits<double>::infinity());
+      continue;
+    }
+    const Eigen::Vector2d d = mapped.head<2>() / mapped.z() - data.centred2[i];
+    errors.push_back(std::hypot(d.x(), camera.mu * d.y()));  // back to raw pixels
+  }
+  if (errors.empty()) return std::numeric_limits<double>::infinity();
+  auto mid = errors.begin() + static_cast<std::ptrdiff_t>(errors.size() / 2);
+  std::nth_element(errors.begin(), mid, errors.end());
+  return *mid;
+}
+
+// Correspondences whose Sampson distance (px) to the epipolar geometry of (f_x, pose) is within the gate.
+std::vector<int> SampsonInliers(const CameraIntrinsics& camera, double fx_px, const Rigid3& cam2_from_cam1,
+                                const Correspondences& data, double threshold_px) {
+  const Eigen::Matrix3d f_px =
+      internal::FundamentalToPixels(camera, internal::FundamentalFromPose(fx_px, cam2_from_cam1));
+  std::vector<int> out;
+  for (int i = 0; i < data.size(); ++i) {
+    if (internal::SampsonSquared(f_px, data.pixels1[i], data.pixels2[i]) <= threshold_px * threshold_px)
+      out.push_back(i);
+  }
+  return out;
+}
+
+struct CheiralityChoice {
+  int best = -1;
+  bool clear = false;
+  int best_in_front = 0;
+  int best_behind = 0;
+  int runner_up_in_front = 0;  // the strongest rival not ruled out, 0 if none
+  int runner_up_behind = 0;
+};
+
+// Candidates that coincide (Faugeras' solutions repeat when two singular values of H are equal) are one
+// hypothesis and must not compete. min_parallax_rad: below it the sign of a depth may be noise.
+CheiralityChoice ChooseByCheirality(const std::vector<Rigid3>& candidates, const std::vector<Eigen::Vector2d>& n1,
+                                    const std::vector<Eigen::Vector2d>& n2, const std::vector<int>& indices,
+                                    double min_parallax_rad) {
+  CheiralityChoice choice;
+  if (candidates.empty()) return choice;
+  std::vector<internal::CheiralityCount> counts;
+  for (const Rigid3& c : candidates) counts.push_back(internal::CountCheirality(c, n1, n2, indices, min_parallax_rad));
+  for (size_t c = 0; c < candidates.size(); ++c) {
+    if (choice.best < 0 || counts[c].in_front > counts[choice.best].in_front) choice.best = static_cast<int>(c);
+  }
+  const double n = static_cast<double>(indices.size());
+  const internal::CheiralityCount& best = counts[choice.best];
+  choice.best_in_front = best.in_front;
+  choice.best_behind = best.behind;
+  choice.clear = best.in_front >= kMinInFrontFraction * n && best.behind <= kMaxBehindFraction * n;
+  for (size_t c = 0; c < candidates.size(); ++c) {
+    const Rigid3& a = candidates[c];
+    const Rigid3& b = candidates[choice.best];
+    const bool same =
+        RotationAngle(a.rotation.transpose() * b.rotation) < 1e-9 && (a.translation - b.translation).norm() < 1e-9;
+    if (same) continue;
+    const double refuting = std::max<double>(kRefutingBehindMin, kRefutingBehindFraction * n);
+    const bool ruled_out =
+        counts[c].in_front < kSecondBestRatio * best.in_front || counts[c].behind - best.behind >= refuting;
+    if (!ruled_out) {
+      choice.clear = false;
+      if (counts[c].in_front > choice.runner_up_in_front) {
+        choice.runner_up_in_front = counts[c].in_front;
+        choice.runner_up_behind = counts[c].behind;
+      }
+    }
+  }
+  return choice;
+}
+
+
+}  // namespace
+
+bool internal::ScreenInput(const TwoViewOptions& options, const CameraIntrinsics& camera,
+                           const std::vector<Eigen::Vector2d>& pixels1, const std::vector<Eigen::Vector2d>& pixels2,
+                           TwoViewReport* report) {
+  report->fx_px = camera.fx_px;
+  const std::string problems = options.Validate() + camera.Validate();
+  if (!problems.empty()) {
+    *report = Finish(*report, Outcome::kInvalidInput, "invalid options or camera:\n" + problems);
+    return false;
+  }
+  if (pixels1.size() != pixels2.size()) {
+    std::ostringstream m;
+    m << "correspondence size mismatch: " << pixels1.size() << " pixels in view 1, " << pixels2.size() << " in view 2";
+    *report = Finish(*report, Outcome::kInvalidInput, m.str());
+    return false;
+  }
+  for (size_t i = 0; i < pixels1.size(); ++i) {
+    if (!pixels1[i].allFinite() || !pixels2[i].allFinite()) {
+      *report = Finish(*report, Outcome::kInvalidInput, "non-finite pixel at correspondence " + std::to_string(i) + " (D7)");
+      return false;
+    }
+  }
+  const int n = static_cast<int>(pixels1.size());
+  report->inliers.assign(n, false);
+  if (n < options.min_points) {
+    std::ostringstream m;
+    m << n << " correspondences, at least " << options.min_points << " needed (G1)";
+    *report = Finish(*report, Outcome::kTooFewPoints, m.str());
+    return false;
+  }
+  return true;
+}
+
+TwoViewReport EstimateTwoView(const TwoViewOptions& options, const CameraIntrinsics& camera,
+                              const std::vector<Eigen::Vector2d>& pixels1,
+                              const std::vector<Eigen::Vector2d>& pixels2) {
+  TwoViewReport report;
+  if (!internal::ScreenInput(options, camera, pixels1, pixels2, &report)) return report;
+  const int n = static_cast<int>(pixels1.size());
+
+  // ---- Both models by RANSAC (G7, G8), then model selection (G4) ----
+  const Correspondences data = internal::MakeCorrespondences(camera, pixels1, pixels2);
+  std::mt19937_64 rng(options.seed);
+  const internal::RansacResult fundamental = internal::RansacFundamental(options, camera, data, &rng);
+  // The homography only matters if it can win the model selection: with own-gate scores R_H stays below
+  // 0.45 unless H explains more than about half of the fundamental inliers (0.52 without noise, more
+  // with), so H-RANSAC may stop once it is confident no such plane was missed. On a 3D scene this is
+  // ~130 iterations instead of the cap.
+  const double useful_h_ratio = fundamental.found ? 0.5 * fundamental.num_inliers / n : 0.0;
+  const internal::RansacResult homography = internal::RansacHomography(options, camera, data, useful_h_ratio, &rng);
+  if (!fundamental.found && !homography.found) {
+    return Finish(report, Outcome::kDegenerate,
+                  "every 8-point and 4-point sample is rank-deficient (collinear or coincident points)");
+  }
+  const double score_f = fundamental.found ? internal::FundamentalScore(options, camera, fundamental.model, data) : 0;
+  const double score_h = homography.found ? internal::HomographyScore(options, camera, homography.model, data) : 0;
+  report.homography_ratio = score_f + score_h > 0 ? score_h / (score_f + score_h) : 0;
+
+  const int most_inliers = std::max(fundamental.num_inliers, homography.num_inliers);
+  if (most_inliers < options.min_inlier_ratio * n) {
+    std::ostringstream m;
+    m << "best model explains " << most_inliers << " of " << n << " correspondences, below the floor "
+      << options.min_inlier_ratio << " (G7; fundamental " << fundamental.num_inliers << " inliers after "
+      << fundamental.iterations << " iterations, homography " << homography.num_inliers << ")";
+    return Finish(report, Outcome::kTooManyOutliers, m.str());
+  }
+  // Without a fundamental matrix (its 8-point design was rank-deficient everywhere) only H remains.
+  const bool use_homography =
+      !fundamental.found || (homography.found && report.homography_ratio > options.planar_homography_ratio);
+  const internal::RansacResult& chosen = use_homography ? homography : fundamental;
+  report.inliers = chosen.inliers;
+  report.num_inliers = chosen.num_inliers;
+  std::vector<int> inliers = IndicesOf(chosen.inliers);
+  if (chosen.num_inliers < options.min_points) {
+    std::ostringstream m;
+    m << chosen.num_inliers << " inliers, at least " << options.min_points << " needed (G1)";
+    return Finish(report, Outcome::kTooFewPoints, m.str());
+  }
+
+  // ---- f_x: Bougnoux from Q when the geometry observes it, else the prior ----
+  double fx = camera.fx_px;
+  bool refine_focal = false;
+  std::ostringstream focal_note;
+  if (use_homography) {
+    focal_note << "f_x = prior (a single planar pair does not determine it)";
+  } else if (!options.estimate_focal) {
+    focal_note << "f_x given";
+  } else {
+    double f_linear = 0, observability = 0;
+    const bool ok = FocalFromFundamental(fundamental.model, options.focal_observability_min, &f_linear, &observability);
+    const bool plausible = ok && f_linear < kMaxFocalRatio * camera.fx_px && f_linear > camera.fx_px / kMaxFocalRatio;
+    // The observability of the geometry, judged with the prior focal: noise can make Bougnoux's f^2
+    // negative for a pair that does determine f, and then the refinement still should estimate it.
+    const double geometric = internal::AxisCoplanaritySine(fundamental.model, camera.fx_px);
+    if (plausible) {
+      fx = f_linear;
+      report.fx_linear_px = f_linear;
+      refine_focal = true;
+      focal_note << "f_x linear " << f_linear << " px (axis coplanarity sine " << observability << ")";
+    } else if (geometric >= options.focal_observability_min) {
+      refine_focal = true;
+      focal_note << "linear f_x failed (" << (ok ? "implausible" : "f^2 <= 0") << "), refined from the prior "
+                 << "(axis coplanarity sine " << geometric << ")";
+    } else {
+      focal_note << "f_x unobservable: optical axes (nearly) intersect, axis coplanarity sine " << geometric << " < "
+                 << options.focal_observability_min << "; prior used";
+    }
+  }
+  report.fx_px = fx;
+  report.planar = use_homography;
+
+  // ---- Candidates (Theorem 1, or the homography decomposition) and cheirality (G5) ----
+  std::vector<Eigen::Vector2d> n1, n2;
+  Normalise(data, fx, &n1, &n2);
+  std::vector<Rigid3> candidates;
+  if (use_homography) {
+    const Eigen::Matrix3d k = Eigen::Vector3d(fx, fx, 1).asDiagonal();
+    candidates = internal::DecomposeHomography(k.inverse() * homography.model * k);
+  } else {
+    const Eigen::Matrix3d a = Eigen::Vector3d(fx, fx, 1).asDiagonal();
+    candidates = FactorEssential(a.transpose() * fundamental.model * a);  // E = A^T Q A
+  }
+  // Depth signs count only for points whose triangulation angle exceeds what two threshold-sized pixel
+  // errors can produce.
+  const double sign_parallax_rad = 2 * options.ransac_threshold_px / fx;
+  const CheiralityChoice choice = ChooseByCheirality(candidates, n1, n2, inliers, sign_parallax_rad);
+  const bool clear_winner = choice.clear;
+
+  // ---- G3: pure rotation or tiny baseline ----
+  // Two signs, either suffices:
+  //  (a) the rotation-only model (Wahba fit of the rays, prior focal: Bougnoux's f means nothing for a
+  //      rotation) transfers the inliers within the homography gate (median): a translation is then not
+  //      needed to explain the data, so it is not observable. This catches pure rotations, where t is
+  //      noise and cheirality a coin toss. R is the Wahba fit, exact for a rotation.
+  //  (b) the cheirality winner's median triangulation angle (the angle between the ray of view 2 and the
+  //      rotated ray of view 1, ORB-SLAM2's parallax) is below min_parallax_deg, checked after the
+  //      refinement. R is the refined pose's: a best-fit rotation would absorb the translation's flow,
+  //      an error as large as the parallax itself.
+  // The Wahba residual is compared with the noise gate, not with min_parallax_deg: it is what is left
+  // after a rotation has absorbed most of a real translation's flow (about 1 deg in the 17 deg test
+  // scene, 0.3 deg for a lateral motion over a plane), small in angle yet far above the noise.
+  std::vector<Eigen::Vector2d> p1, p2;
+  Normalise(data, camera.fx_px, &p1, &p2);
+  const Eigen::Matrix3d rotation_only = BestRotation(p1, p2, inliers);
+  const double rotation_residual_px = MedianRotationTransferPx(camera, rotation_only, data, inliers);
+  std::ostringstream summary;
+  summary << (use_homography ? "homography" : "fundamental") << " path, " << report.num_inliers << "/" << n
+          << " inliers, R_H " << report.homography_ratio << ", rotation-only residual " << rotation_residual_px
+          << " px; " << focal_note.str();
+  if (rotation_residual_px <= internal::HomographyThresholdPx(options)) {
+    report.rotation = rotation_only;
+    report.translation_observable = false;
+    report.translation_direction.setZero();
+    report.fx_observable = false;  // f_x is not estimated when a rotation explains the pair
+    report.fx_px = camera.fx_px;
+    report.fx_linear_px = 0;
+    return Finish(report, Outcome::kPureRotation,
+                  "rotation only: a rotation alone explains the inliers within the noise gate, translation "
+                  "unobservable (G3); " +
+                      summary.str());
+  }
+  if (candidates.empty()) {
+    return Finish(
+        report, Outcome::kDegenerate,
+        "the homography decomposes with no translation, yet no rotation explains the inliers; " + summary.str());
+  }
+  Rigid3 pose = candidates[choice.best];
+  report.rotation = pose.rotation;
+  report.translation_direction = pose.translation;
+  if (!clear_winner) {
+    std::ostringstream m;
+    m << "no clear cheirality winner: best candidate has " << choice.best_in_front << " points in front ("
+      << choice.best_behind << " clearly behind), strongest rival " << choice.runner_up_in_front << " ("
+      << choice.runner_up_behind << ") (G5); " << summary.str();
+    return Finish(report, Outcome::kAmbiguousPose, m.str());
+  }
+  report.translation_observable = true;
+
+  // ---- Refinement of eq. (13) (G9) ----
+  Outcome outcome = Outcome::kSuccess;
+  std::string refinement_note = options.refine ? "" : "not refined";
+  if (options.refine && use_homography) {
+    // Eq. (13) ignores the plane and is poorly conditioned on planar points: in tests it doubled the
+    // error of the homography decomposition, so the planar path keeps the decomposition.
+    report.refinement_termination = "skipped";
+    refinement_note = "not refined (homography path: eq. (13) would discard the plane)";
+  } else if (options.refine) {
+    // Up to two rounds, the second on the inliers of the refined model (local optimisation): the RANSAC
+    // gate was applied with an 8-point model, which loses some inliers and keeps an occasional outlier. Huber's
+    // quadratic zone covers the gate (for a true inlier sqrt(d1^2 + d2^2) is about twice its Sampson distance).
+    const double huber_px = 2 * options.ransac_threshold_px;
+    for (int round = 0; round < 2; ++round) {
+      const internal::RefineResult refined =
+          internal::RefineEpipolar(camera, data, inliers, fx, pose, refine_focal, options.max_refine_iterations,
+                                   huber_px, camera.fx_px / kMaxFocalRatio, camera.fx_px * kMaxFocalRatio);
+      report.refinement_termination = refined.termination;
+      report.refinement_iterations += refined.iterations;
+      refinement_note += (round == 0 ? "refinement " : "; on the updated inliers ") + refined.detail;
+      if (!refined.accepted) {
+        // G9: a failure of the first round keeps the linear estimate, flagged; of the second, the first
+        // round's result.
+        if (refined.failed && round == 0) outcome = Outcome::kNoConvergence;
+        refinement_note += refined.failed ? " (rejected)" : " (no decrease)";
+        break;
+      }
+      report.refinement_accepted = true;
+      fx = refined.fx_px;
+      pose = refined.cam2_from_cam1;
+      const std::vector<int> updated = SampsonInliers(camera, fx, pose, data, options.ransac_threshold_px);
+      if (updated == inliers || static_cast<int>(updated.size()) < options.min_points) break;
+      inliers = updated;
+    }
+    if (outcome == Outcome::kNoConvergence) refinement_note += ": linear estimate kept";
+    // Eq. (13) is even in t; the sign is fixed by cheirality again.
+    Normalise(data, fx, &n1, &n2);
+    const Rigid3 flipped(pose.rotation, -pose.translation);
+    if (internal::CountInFront(flipped, n1, n2, inliers) > internal::CountInFront(pose, n1, n2, inliers)) {
+      pose = flipped;
+    }
+    report.inliers.assign(n, false);
+    for (int i : inliers) report.inliers[i] = true;
+    report.num_inliers = static_cast<int>(inliers.size());
+  }
+  // Observable means estimated from this pair (by Bougnoux and/or an accepted refinement), not the prior.
+  report.fx_observable = refine_focal && (report.refinement_accepted || report.fx_linear_px > 0);
+  report.fx_px = fx;
+  report.rotation = pose.rotation;
+  report.translation_direction = pose.translation.normalized();
+  report.rms_epipolar_px = internal::RmsSymmetricEpipolarPx(camera, fx, pose, data, inliers);
+  const double parallax_deg = RadToDeg(MedianParallaxRad(pose.rotation, n1, n2, inliers));
+  summary << "; median parallax " << parallax_deg << " deg; " << refinement_note;
+  if (outcome == Outcome::kSuccess && parallax_deg < options.min_parallax_deg) {
+    // G3 (b): the rotation stands, the direction of t is too weakly determined to hand out.
+    report.translation_observable = false;
+    report.translation_direction.setZero();
+    return Finish(report, Outcome::kPureRotation,
+                  "rotation only: median parallax below " + std::to_string(options.min_parallax_deg) +
+                      " deg, translation unobservable (G3); " + summary.str());
+  }
+  return Finish(report, outcome, summary.str());
+}
+
+}  // namespace selfcal::twoview
