@@ -2,9 +2,10 @@
 //
 // The measurement of pose i is cam_ref_from_cam_i = base_from_cam(q_ref)^-1 * base_from_cam(q_i), so the
 // base transform cancels, and more. Rather than assume, the rank of the stacked identification Jacobian at
-// the given model and poses decides: columns are normalised, then taken greedily in parameter order,
-// each kept only if it adds rank (relative tolerance). The rest are fixed at their start values, and the
-// null space of the full Jacobian is reported as named combinations.
+// the given model and poses decides: columns are normalised, then taken greedily (scale, camera, base,
+// alpha/a/theta/d joint by joint, betas last; see identifiability.cc), each kept only if it adds rank
+// (relative tolerance). The rest are fixed at their start values, and the null space of the full
+// Jacobian is reported as named combinations.
 #pragma once
 
 #include <string>
@@ -43,7 +44,7 @@ struct IdentifiabilityReport {
   // above 0.05 in magnitude), including "scale" when !scale_known.
   std::vector<std::string> null_combinations;
   Eigen::VectorXd singular_values;         // of the column-normalised full Jacobian, descending
-  double condition_number = 0;             // of the column-normalised Jacobian of the free parameters
+  double condition_number = 0;             // column-normalised Jacobian of the free parameters (+ scale)
 };
 
 IdentifiabilityReport AnalyzeIdentifiability(const RobotModel& model, const Eigen::VectorXd& rho,

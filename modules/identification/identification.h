@@ -43,7 +43,7 @@ struct IdentificationReport {
   Eigen::VectorXd rho;                    // full vector; fixed entries keep their start values
   std::vector<int> free_indices;
   // Per-parameter standard deviation (full size; NaN for fixed parameters or when unavailable), from
-  // the covariance s^2 (J^T J)^-1 of the free parameters with s^2 = final cost / (residuals - free).
+  // the covariance s^2 (J^T J)^-1 of the free parameters with s^2 = 2 final_cost / (residuals - free).
   Eigen::VectorXd stddev;
   bool covariance_available = false;
   std::string covariance_message;         // e.g. "uncertainty unavailable (rank deficient: j3.d)" (K8)
@@ -52,7 +52,9 @@ struct IdentificationReport {
   double initial_cost = 0, final_cost = 0;  // Ceres cost, 0.5 * sum of squared weighted residuals
   int iterations = 0;
   std::string termination;                // Ceres termination type and message
-  double rms_position_m = 0, rms_rotation_rad = 0;  // unweighted residual RMS at the solution
+  // Unweighted, at the solution: RMS over measurements of |t_model - t_meas| (translation-valid ones) and
+  // of the angle of R_model^T R_meas.
+  double rms_position_m = 0, rms_rotation_rad = 0;
 };
 
 IdentificationReport IdentifyFromRelativePoses(const RobotModel& model, const Eigen::VectorXd& rho_start,
