@@ -1,0 +1,300 @@
+#include "io/observations_file.h"
+
+#include <climits>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "io/atomic_file.h"
+#include "io/robot_config.h"
+#include "io/yaml_schema.h"
+#include "io/yaml_writer.h"
+
+namespace selfcal::io {
+
+namespace {
+
+constexpr double kLimitToleranceRad = 1e-9;
+const Range kJointValue = Range::Closed(DegToRad(-720), DegToRad(720));
+const Range kPixel = Range::Closed(-1e5, 1e5);
+
+std::string Short(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.6g", v);
+  return buffer;
+}
+
+std::string DirectoryOf(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? "." : path.substr(0, slash == 0 ? 1 : slash);
+}
+
+// Problems that ObservationSet::Validate() does not see: joints outside the limits (unit confusion, the
+// wrong robot; C4) and dots outside the image (C11). Empty when plausible.
+std::string JointLimitProblem(const RobotModel& robot, int joint, double value_rad) {
+  const JointLimits& l = robot.limits[joint];
+  if (value_rad >= l.min_rad - kLimitToleranceRad && value_rad <= l.max_rad + kLimitToleranceRad) return "";
+  return "is outside joint " + std::to_string(joint + 1) + "'s limits [" + Short(RadToDeg(l.min_rad)) + ", " +
+         Short(RadToDeg(l.max_rad)) + "] deg (degrees written as radians, or the wrong robot?)";
+}
+
+std::string PixelProblem(const CameraIntrinsics& camera, const Eigen::Vector2d& uv) {
+  if (InImage(camera, uv, 0.0)) return "";
+  return "lies outside the " + std::to_string(camera.width_px) + "x" + std::to_string(camera.height_px) +
+         " image (u in [-0.5, " + Short(camera.width_px - 0.5) + "], v in [-0.5, " + Short(camera.height_px - 0.5) + "])";
+}
+
+bool ReadCamera(MapReader* root, Problems* problems, CameraIntrinsics* camera) {
+  const YamlNode* node = root->Required("camera");
+  if (!node) return false;
+  MapReader map(*node, "camera", problems);
+  if (!map.ok()) return false;
+  long long width = 0, height = 0;
+  bool ok = map.Int("width_px", 1, 100000, &width);
+  ok &= map.Int("height_px", 1, 100000, &height);
+  ok &= map.Double("fx_px", Range::Positive(1e6), &camera->fx_px);
+  ok &= map.OptionalDouble("mu", Range::Positive(100), &camera->mu);
+  ok &= map.Double("cx_px", Range::Closed(0, 1e5), &camera->cx_px);
+  ok &= map.Double("cy_px", Range::Closed(0, 1e5), &camera->cy_px);
+  ok &= map.OptionalDouble("k1", Range::Closed(-10, 10), &camera->k1);
+  camera->width_px = static_cast<int>(width);
+  camera->height_px = static_cast<int>(height);
+  if (!ok) return false;
+  // Cross-field checks (principal point inside the image, ...).
+  std::istringstream invalid(camera->Validate());
+  for (std::string line; std::getline(invalid, line);) {
+    problems->Add("`camera` at " + problems->At(node->line) + ": " + line);
+    ok = false;
+  }
+  return ok;
+}
+
+bool ReadDistances(MapReader* root, const std::string& key, bool required, Problems* problems,
+                   std::vector<KnownDistance>* out) {
+  const YamlNode* node = required ? root->Required(key) : root->Optional(key);
+  if (!node) return !required;
+  if (!node->IsSequence()) {
+    problems->Add("`" + key + "` at " + problems->At(node->line) + " must be a sequence of {dot_a, dot_b, length_mm} " +
+                  "(found " + node->KindName() + ")");
+    return false;
+  }
+  bool ok = true;
+  for (size_t i = 0; i < node->items.size(); ++i) {
+    MapReader map(node->items[i], key + "[" + std::to_string(i) + "]", problems);
+    if (!map.ok()) {
+      ok = false;
+      continue;
+    }
+    long long a = -1, b = -1;
+    KnownDistance d;
+    ok &= map.Int("dot_a", 0, INT_MAX, &a);
+    ok &= map.Int("dot_b", 0, INT_MAX, &b);
+    ok &= map.Quantity("length", Unit::kLength, Range::Positive(100.0), &d.length_m);
+    d.dot_a = static_cast<int>(a);
+    d.dot_b = static_cast<int>(b);
+    out->push_back(d);
+  }
+  return ok;
+}
+
+bool ReadDots(const YamlNode& node, const std::string& name, const CameraIntrinsics* camera, Problems* problems,
+              std::map<int, Eigen::Vector2d>* dots) {
+  if (!node.IsSequence()) {
+    problems->Add("`" + name + "` at " + problems->At(node.line) + " must be a sequence of [dot id, u_px, v_px] " +
+                  "(found " + node.KindName() + ")");
+    return false;
+  }
+  bool ok = true;
+  for (size_t i = 0; i < node.items.size(); ++i) {
+    const YamlNode& item = node.items[i];
+    const std::string item_name = name + "[" + std::to_string(i) + "]";
+    if (!item.IsSequence() || item.items.size() != 3) {
+      problems->Add("`" + item_name + "` at " + problems->At(item.line) + " must be [dot id, u_px, v_px]");
+      ok = false;
+      continue;
+    }
+    long long id = -1;
+    Eigen::Vector2d uv;
+    if (!ReadInt(item.items[0], item_name + "[0]", 0, INT_MAX, problems, &id) ||
+        !ReadDouble(item.items[1], item_name + "[1]", kPixel, problems, &uv.x()) ||
+        !ReadDouble(item.items[2], item_name + "[2]", kPixel, problems, &uv.y())) {
+      ok = false;
+      continue;
+    }
+    if (camera) {
+      if (const std::string p = PixelProblem(*camera, uv); !p.empty()) {
+        problems->Add("dot " + std::to_string(id) + " at (" + Short(uv.x()) + ", " + Short(uv.y()) + ") px in `" +
+                      item_name + "` at " + problems->At(item.line) + " " + p);
+        ok = false;
+      }
+    }
+    if (!dots->emplace(static_cast<int>(id), uv).second) {
+      problems->Add("dot " + std::to_string(id) + " appears twice in `" + name + "` (again at " +
+                    problems->At(item.line) + ")");
+      ok = false;
+    }
+  }
+  return ok;
+}
+
+bool ReadPose(const YamlNode& node, const std::string& name, const RobotModel* robot, const CameraIntrinsics* camera,
+              Problems* problems, PoseObservation* pose) {
+  MapReader map(node, name, problems);
+  if (!map.ok()) return false;
+  bool ok = map.String("id", &pose->id);
+  if (ok && pose->id.empty()) {
+    problems->Add("`" + map.Path("id") + "` at " + problems->At(map.KeyLine("id")) + " is empty");
+    ok = false;
+  }
+  std::string role = "identification";
+  if (map.OptionalString("role", &role)) {
+    if (role == "verification") {
+      pose->role = PoseRole::kVerification;
+    } else if (role != "identification") {
+      problems->Add("`" + map.Path("role") + "` = `" + role + "` at " + problems->At(map.KeyLine("role")) +
+                    " must be identification or verification");
+      ok = false;
+    }
+  }
+  std::vector<double> joints;
+  std::vector<int> lines;
+  std::string key;
+  const int num_joints = robot ? robot->num_joints() : -1;
+  if (map.QuantityList("joints", Unit::kAngle, num_joints, kJointValue, &joints, true, &key, &lines)) {
+    pose->joints_rad = Eigen::Map<const Eigen::VectorXd>(joints.data(), static_cast<Eigen::Index>(joints.size()));
+    for (int j = 0; robot && j < num_joints; ++j) {
+      if (const std::string p = JointLimitProblem(*robot, j, joints[j]); !p.empty()) {
+        const bool degrees = key.size() > 4 && key.compare(key.size() - 4, 4, "_deg") == 0;
+        problems->Add("`" + map.Path(key) + "[" + std::to_string(j) + "]` = " +
+                      Short(degrees ? RadToDeg(joints[j]) : joints[j]) + " at " + problems->At(lines[j]) + " " + p);
+        ok = false;
+      }
+    }
+  } else {
+    ok = false;
+  }
+  if (const YamlNode* dots = map.Required("dots")) {
+    ok &= ReadDots(*dots, map.Path("dots"), camera, problems, &pose->dots_px);
+  } else {
+    ok = false;
+  }
+  return ok;
+}
+
+}  // namespace
+
+Result<ObservationSet> ParseObservations(const YamlDocument& doc) {
+  Problems problems(doc.path);
+  MapReader root(doc.root, "", &problems);
+  if (!CheckFormatAndVersion(&root, kObservationsFormat, kObservationsVersion)) {
+    root.Abandon();
+    return problems.ToStatus("observations");
+  }
+  ObservationSet set;
+  bool robot_ok = false;
+  const YamlNode* robot = root.Optional("robot");
+  const YamlNode* robot_file = root.Optional("robot_file");
+  if (robot && robot_file) {
+    problems.Add("both `robot` and `robot_file` given at " + problems.At(root.KeyLine("robot_file")) + "; keep one");
+  } else if (robot) {
+    const size_t before = problems.size();
+    set.robot = ParseRobotModel(*robot, "robot", &problems).model;
+    robot_ok = problems.size() == before;
+  } else if (robot_file) {
+    std::string relative;
+    if (ReadString(*robot_file, "robot_file", &problems, &relative)) {
+      const std::string resolved = !relative.empty() && relative[0] == '/' ? relative : DirectoryOf(doc.path) + "/" + relative;
+      Result<RobotModel> loaded = LoadRobotModel(resolved);
+      if (loaded.ok()) {
+        set.robot = *loaded;
+        robot_ok = true;
+      } else {
+        problems.Add("`robot_file` at " + problems.At(robot_file->line) + ": " + loaded.status().message());
+      }
+    }
+  } else {
+    root.AddMissing("`robot` (or `robot_file`)");
+  }
+  const bool camera_ok = ReadCamera(&root, &problems, &set.camera);
+  root.Double("pixel_noise_px", Range::Positive(100.0), &set.pixel_noise_px);
+  ReadDistances(&root, "yardsticks", /*required=*/true, &problems, &set.yardsticks);
+  ReadDistances(&root, "check_distances", /*required=*/false, &problems, &set.check_distances);
+  if (const YamlNode* poses = root.Required("poses")) {
+    if (!poses->IsSequence()) {
+      problems.Add("`poses` at " + problems.At(poses->line) + " must be a sequence of poses (found " +
+                   poses->KindName() + ")");
+    } else {
+      set.poses.resize(poses->items.size());
+      for (size_t i = 0; i < poses->items.size(); ++i) {
+        ReadPose(poses->items[i], "poses[" + std::to_string(i) + "]", robot_ok ? &set.robot : nullptr,
+                 camera_ok ? &set.camera : nullptr, &problems, &set.poses[i]);
+      }
+    }
+  }
+  root.Finish();
+  if (problems.empty()) {
+    std::istringstream invalid(set.Validate());
+    for (std::string line; std::getline(invalid, line);) problems.Add(doc.path + ": " + line);
+  }
+  if (!problems.empty()) return problems.ToStatus("observations");
+  return set;
+}
+
+Result<ObservationSet> LoadObservations(const std::string& path) {
+  Result<YamlDocument> doc = LoadYamlFile(path);
+  if (!doc.ok()) return doc.status();
+  return ParseObservations(*doc);
+}
+
+Status SaveObservations(const ObservationSet& set, const std::string& path) {
+  std::string problems = set.Validate();
+  if (problems.empty()) {
+    for (const PoseObservation& pose : set.poses) {
+      for (int j = 0; j < pose.joints_rad.size(); ++j) {
+        const std::string p = JointLimitProblem(set.robot, j, pose.joints_rad[j]);
+        if (!p.empty()) problems += "pose " + pose.id + ": joint value " + Short(pose.joints_rad[j]) + " rad " + p + "\n";
+      }
+      for (const auto& [dot, uv] : pose.dots_px) {
+        const std::string p = PixelProblem(set.camera, uv);
+        if (!p.empty()) problems += "pose " + pose.id + ", dot " + std::to_string(dot) + ": " + p + "\n";
+      }
+    }
+  }
+  if (!problems.empty()) {
+    return Status::Error(ExitCode::kUsage, "refusing to write invalid observations to " + path + ":\n" + problems);
+  }
+  const CameraIntrinsics& c = set.camera;
+  std::ostringstream out;
+  out << "# selfcal observations (docs/observations-format.md), written in SI units (m, rad) so that the\n"
+      << "# file loads back bit-identical. Pixels: origin at the centre of the top-left pixel, u right, v down.\n"
+      << "format: " << kObservationsFormat << "\n"
+      << "version: " << kObservationsVersion << "\n"
+      << "robot:\n"
+      << RobotModelYaml(set.robot, TransformStyle::kExact, 2)
+      << "camera: {width_px: " << c.width_px << ", height_px: " << c.height_px << ", fx_px: " << YamlNumber(c.fx_px)
+      << ", mu: " << YamlNumber(c.mu) << ", cx_px: " << YamlNumber(c.cx_px) << ", cy_px: " << YamlNumber(c.cy_px)
+      << ", k1: " << YamlNumber(c.k1) << "}\n"
+      << "pixel_noise_px: " << YamlNumber(set.pixel_noise_px) << "\n";
+  const auto distances = [&](const char* key, const std::vector<KnownDistance>& list) {
+    out << key << ":" << (list.empty() ? " []\n" : "\n");
+    for (const KnownDistance& d : list) {
+      out << "  - {dot_a: " << d.dot_a << ", dot_b: " << d.dot_b << ", length_m: " << YamlNumber(d.length_m) << "}\n";
+    }
+  };
+  distances("yardsticks", set.yardsticks);
+  distances("check_distances", set.check_distances);
+  out << "poses:" << (set.poses.empty() ? " []\n" : "\n");
+  for (const PoseObservation& pose : set.poses) {
+    out << "  - id: " << YamlQuoted(pose.id) << "\n"
+        << "    role: " << PoseRoleName(pose.role) << "\n"
+        << "    joints_rad: " << YamlNumberList(pose.joints_rad) << "\n    # joints_deg (rounded): [";
+    for (int j = 0; j < pose.joints_rad.size(); ++j) out << (j ? ", " : "") << Short(RadToDeg(pose.joints_rad[j]));
+    out << "]\n    dots:" << (pose.dots_px.empty() ? " []\n" : "\n");
+    for (const auto& [dot, uv] : pose.dots_px) {
+      out << "      - [" << dot << ", " << YamlNumber(uv.x()) << ", " << YamlNumber(uv.y()) << "]\n";
+    }
+  }
+  return WriteFileAtomically(path, out.str());
+}
+
+}  // namespace selfcal::io

@@ -1,0 +1,44 @@
+// Observations files: what a calibration consumes (observations/observation_set.h) in a form that other
+// tools can write. The format is specified in docs/observations-format.md:
+//
+//   format: selfcal-observations
+//   version: 1
+//   robot: {...keys of a robot config...}     # or robot_file: path (relative to this file)
+//   camera: {width_px: 640, height_px: 480, fx_px: 1000.0, mu: 1.0, cx_px: 319.5, cy_px: 239.5, k1: 0.0}
+//   pixel_noise_px: 0.2
+//   yardsticks: [{dot_a: 3, dot_b: 17, length_mm: 250.0}]
+//   check_distances: [{dot_a: 1, dot_b: 40, length_mm: 512.3}]    # optional, held out
+//   poses:
+//     - id: p00
+//       role: identification                   # or verification; default identification
+//       joints_deg: [0, -30, 120, 0, 45, 0]    # or joints_rad
+//       dots: [[0, 312.25, 240.5], [1, 100.0, 20.0]]   # [dot id, u_px, v_px]
+//
+// Pixels: origin at the centre of the top-left pixel, u right, v down.
+#pragma once
+
+#include <string>
+
+#include "base/status.h"
+#include "io/yaml_reader.h"
+#include "observations/observation_set.h"
+
+namespace selfcal::io {
+
+inline constexpr const char* kObservationsFormat = "selfcal-observations";
+inline constexpr int kObservationsVersion = 1;
+
+// Reads and validates an observations file: schema (C1-C3), versions (P8), ObservationSet::Validate(),
+// joint values inside the robot's limits and dots inside the image. Every problem is reported together
+// (ExitCode::kUsage), naming the file, line and key.
+Result<ObservationSet> LoadObservations(const std::string& path);
+
+// The same for a document already parsed; robot_file is resolved relative to doc.path's directory.
+Result<ObservationSet> ParseObservations(const YamlDocument& doc);
+
+// Writes the set atomically (P4) in SI units (joints_rad, length_m, robot in exact form) with
+// shortest round-trip numbers, so that LoadObservations returns a bit-identical set. Refuses a set
+// that LoadObservations would refuse.
+Status SaveObservations(const ObservationSet& set, const std::string& path);
+
+}  // namespace selfcal::io

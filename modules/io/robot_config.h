@@ -1,0 +1,73 @@
+// Robot description files (config/robots/*.yaml) and calibrated-model files.
+//
+// A robot config (mm and degrees in the file, SI inside; keys carry their unit, and either unit of a
+// pair may be used: `a_mm` or `a_m`, `alpha_deg` or `alpha_rad`):
+//
+//   name: puma560
+//   source: "Corke, Robotics Toolbox for MATLAB, mdl_puma560 (standard DH)"   # optional
+//   dh_convention: standard        # standard | modified | modified_hayati
+//   joints:                        # one row per joint, base to flange
+//     - {a_mm: 0.0, alpha_deg: 90.0, d_mm: 0.0, theta_offset_deg: 0.0, min_deg: -160, max_deg: 160}
+//   base_from_link0: {xyz_mm: [0, 0, 0], rpy_deg: [0, 0, 0]}       # optional, identity by default
+//   flange_from_cam: {xyz_mm: [40, 0, 60], rpy_deg: [0, 0, 90]}    # required: nominal hand-eye
+//   link_n_from_flange: {...}      # optional, modified and modified_hayati only
+//
+// Conventions (kinematics/robot_model.h): standard rows are Rz(q+theta) Tz(d) Tx(a) Rx(alpha);
+// modified rows are Rx(alpha) Tx(a) Rz(q+theta) Tz(d); modified_hayati rows add `beta` (optional,
+// default 0): Rx(alpha) Tx(a) Ry(beta) Rz(q+theta) Tz(d). `theta_offset` is optional (default 0).
+// Transforms and rpy: io/transform_yaml.h. Every problem of the file is reported together (C1-C3).
+//
+// A calibrated model (SaveCalibratedModel) is a robot config with dh_convention: modified_hayati plus
+// `format: selfcal-calibrated-model`, `version: 1`, and the optional keys `fx_px`, `parameters` and
+// `provenance`; LoadRobotModel reads it too. docs/calibrated-model-format.md describes both.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "base/status.h"
+#include "io/transform_yaml.h"
+#include "io/yaml_schema.h"
+#include "kinematics/robot_model.h"
+
+namespace selfcal::io {
+
+inline constexpr const char* kRobotFormat = "selfcal-robot";
+inline constexpr const char* kCalibratedModelFormat = "selfcal-calibrated-model";
+inline constexpr int kCalibratedModelVersion = 1;
+
+struct CalibratedModel {
+  RobotModel model;            // calibrated (e.g. ApplyParameters(nominal, rho)); SI
+  std::string source;          // free text, e.g. which session produced it; optional
+  double fx_px = 0;            // identified focal length; 0 = not stored
+  Eigen::VectorXd parameters;  // rho (SI) in KinematicParameters order; empty = not stored
+  std::vector<std::pair<std::string, std::string>> provenance;  // P7: software, hashes, session id ...
+};
+
+// Reads a robot config or a calibrated-model file. Errors: ExitCode::kUsage, naming file, line, key
+// and value of every problem.
+Result<RobotModel> LoadRobotModel(const std::string& path);
+
+// Reads a calibrated-model file (`format: selfcal-calibrated-model` required).
+Result<CalibratedModel> LoadCalibratedModel(const std::string& path);
+
+// Writes `calibrated` atomically as YAML in mm / degrees (alpha_deg, a_mm, beta_deg, theta_offset_deg,
+// d_mm per joint; transforms as xyz_mm / rpy_deg), with 17 significant digits where needed so that
+// reading it back reproduces the forward kinematics to ~1e-15 m. Refuses an invalid model.
+Status SaveCalibratedModel(const CalibratedModel& calibrated, const std::string& path);
+
+// Parses a robot description held in `node` (a document root, or the `robot:` block of an observations
+// file), recording problems under the key path `name`. The returned model is meaningful only when no
+// problem was added. Calibrated-model keys are accepted when the map has
+// `format: selfcal-calibrated-model`.
+CalibratedModel ParseRobotModel(const YamlNode& node, const std::string& name, Problems* problems);
+
+// The robot as a YAML block of `indent` spaces (keys name, dh_convention: modified_hayati, joints,
+// base_from_link0, link_n_from_flange, flange_from_cam). kExact writes SI values and rotation matrices
+// so that ParseRobotModel gives back the identical model bit for bit; kMillimetreDegree is for people.
+std::string RobotModelYaml(const RobotModel& model, TransformStyle style, int indent);
+
+}  // namespace selfcal::io

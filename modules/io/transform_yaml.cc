@@ -1,0 +1,113 @@
+#include "io/transform_yaml.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include <Eigen/Dense>
+
+#include "io/yaml_writer.h"
+
+namespace selfcal::io {
+
+namespace {
+
+constexpr double kMaxTranslationM = 10.0;
+constexpr double kRotationTolerance = 1e-9;
+
+bool ReadRotationMatrix(const YamlNode& node, const std::string& name, Problems* problems, Eigen::Matrix3d* out) {
+  if (!node.IsSequence() || node.items.size() != 3) {
+    problems->Add("`" + name + "` at " + problems->At(node.line) + " must be 3 rows of 3 numbers: [[r00, r01, r02], " +
+                  "[r10, r11, r12], [r20, r21, r22]]");
+    return false;
+  }
+  Eigen::Matrix3d r;
+  bool ok = true;
+  for (int i = 0; i < 3; ++i) {
+    std::vector<double> row;
+    if (ReadDoubleList(node.items[i], name + "[" + std::to_string(i) + "]", 3, Range::Closed(-1.0 - kRotationTolerance, 1.0 + kRotationTolerance), problems, &row)) {
+      r.row(i) << row[0], row[1], row[2];
+    } else {
+      ok = false;
+    }
+  }
+  if (!ok) return false;
+  const double orthogonality = (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  const double det = r.determinant();
+  if (orthogonality > kRotationTolerance || std::abs(det - 1.0) > kRotationTolerance) {
+    char detail[96];
+    std::snprintf(detail, sizeof(detail), "max |R^T R - I| = %.3g, det R = %.12g", orthogonality, det);
+    problems->Add("`" + name + "` at " + problems->At(node.line) + " is not a rotation matrix (" + detail + ")");
+    return false;
+  }
+  *out = r;
+  return true;
+}
+
+}  // namespace
+
+Eigen::Matrix3d RotationFromRpy(double roll_rad, double pitch_rad, double yaw_rad) {
+  return RotZ(yaw_rad) * RotY(pitch_rad) * RotX(roll_rad);
+}
+
+Eigen::Vector3d RpyFromRotation(const Eigen::Matrix3d& r) {
+  // R = Rz(y) Ry(p) Rx(r): first column (cy cp, sy cp, -sp), last row (-sp, cp sr, cp cr).
+  const double cos_pitch = std::hypot(r(0, 0), r(1, 0));
+  const double pitch = std::atan2(-r(2, 0), cos_pitch);
+  if (cos_pitch < 1e-12) {
+    // Gimbal lock: only roll - yaw (pitch = +pi/2) or roll + yaw (-pi/2) is defined; set yaw = 0.
+    // Then rows 0 and 1 read (0, sp sr, sp cr) and (0, cr, -sr).
+    return Eigen::Vector3d(std::atan2(-r(1, 2), r(1, 1)), pitch, 0.0);
+  }
+  return Eigen::Vector3d(std::atan2(r(2, 1), r(2, 2)), pitch, std::atan2(r(1, 0), r(0, 0)));
+}
+
+bool ReadTransform(MapReader* parent, const std::string& key, bool required, Rigid3* out) {
+  const YamlNode* node = required ? parent->Required(key) : parent->Optional(key);
+  if (!node) return !required;
+  MapReader map(*node, parent->Path(key), parent->problems());
+  if (!map.ok()) return false;
+  Problems* problems = parent->problems();
+  std::vector<double> xyz, rpy;
+  bool ok = map.QuantityList("xyz", Unit::kLength, 3, Range::Closed(-kMaxTranslationM, kMaxTranslationM), &xyz);
+  std::string rpy_key;
+  const bool rpy_ok = map.QuantityList("rpy", Unit::kAngle, 3, Range::Closed(DegToRad(-360), DegToRad(360)), &rpy,
+                                       /*required=*/false, &rpy_key);
+  const YamlNode* matrix_node = map.Optional("rotation");
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  if (matrix_node && !rpy_key.empty()) {
+    problems->Add("`" + map.Path("rotation") + "` and `" + map.Path(rpy_key) + "` at " +
+                  problems->At(map.KeyLine("rotation")) + " both give the rotation; keep one");
+    ok = false;
+  } else if (matrix_node) {
+    ok &= ReadRotationMatrix(*matrix_node, map.Path("rotation"), problems, &rotation);
+  } else if (!rpy_key.empty()) {
+    ok &= rpy_ok;
+    if (rpy_ok) rotation = RotationFromRpy(rpy[0], rpy[1], rpy[2]);
+  } else {
+    map.AddMissing("`rpy_deg` (or `rpy_rad`, or `rotation`)");
+    ok = false;
+  }
+  map.Finish();
+  if (!ok) return false;
+  *out = Rigid3(rotation, Eigen::Vector3d(xyz[0], xyz[1], xyz[2]));
+  return true;
+}
+
+std::string TransformYaml(const Rigid3& transform, TransformStyle style) {
+  const Eigen::Vector3d& t = transform.translation;
+  if (style == TransformStyle::kExact) {
+    std::string text = "{xyz_m: " + YamlNumberList(std::vector<double>{t.x(), t.y(), t.z()}) + ", rotation: [";
+    for (int i = 0; i < 3; ++i) {
+      const Eigen::Matrix3d& r = transform.rotation;
+      text += (i ? ", " : "") + YamlNumberList(std::vector<double>{r(i, 0), r(i, 1), r(i, 2)});
+    }
+    return text + "]}";
+  }
+  // For people: "+ 0.0" turns -0 into 0.
+  const Eigen::Vector3d rpy = RpyFromRotation(transform.rotation);
+  const Eigen::Vector3d mm = t * 1000.0;
+  return "{xyz_mm: " + YamlNumberList(std::vector<double>{mm.x() + 0.0, mm.y() + 0.0, mm.z() + 0.0}) +
+         ", rpy_deg: " + YamlNumberList(std::vector<double>{RadToDeg(rpy[0]) + 0.0, RadToDeg(rpy[1]) + 0.0, RadToDeg(rpy[2]) + 0.0}) + "}";
+}
+
+}  // namespace selfcal::io

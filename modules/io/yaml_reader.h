@@ -1,0 +1,58 @@
+// Strict YAML reading: the only way selfcal reads a YAML file (C1-C3, C8, P8).
+//
+// Two layers:
+//  1. LoadYamlFile / ParseYamlText turn bytes into a YamlNode tree with 1-based line numbers. Before
+//     yaml-cpp sees the text, the file is checked for size (<= kMaxYamlBytes, from stat, before
+//     reading), UTF-8 validity and control bytes; a UTF-8 BOM is dropped and CRLF / CR line ends become
+//     LF. A pre-scan refuses flow nesting deeper than kMaxYamlDepth, and the event handler that builds
+//     the tree refuses deeper block nesting before yaml-cpp recurses further, anchors and aliases (no
+//     alias bombs), explicit tags, non-scalar or duplicate map keys, more than kMaxYamlNodes nodes, and
+//     more than one document. Every yaml-cpp exception becomes a Status; the code is always
+//     ExitCode::kUsage and the message names the file (and the line when known).
+//  2. Problems and MapReader (yaml_schema.h) check a tree against a schema.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "base/status.h"
+
+namespace selfcal::io {
+
+inline constexpr std::size_t kMaxYamlBytes = 10u * 1024u * 1024u;  // 10 MiB
+inline constexpr int kMaxYamlDepth = 64;                           // nested sequences and maps
+inline constexpr std::size_t kMaxYamlNodes = 1000000;
+
+struct YamlNode {
+  enum class Kind { kNull, kScalar, kSequence, kMap };
+  Kind kind = Kind::kNull;
+  int line = 0;    // 1-based; for an empty map value, the line of its key
+  int column = 0;  // 1-based
+  std::string scalar;  // kScalar: the text (quotes and escapes already resolved)
+  bool plain = true;   // kScalar: unquoted, so it may be read as a number
+  std::vector<YamlNode> items;    // kSequence: the elements; kMap: the values, parallel to keys
+  std::vector<std::string> keys;  // kMap: unique scalar keys, in file order
+  std::vector<int> key_lines;     // kMap: 1-based line of each key
+
+  bool IsMap() const { return kind == Kind::kMap; }
+  bool IsSequence() const { return kind == Kind::kSequence; }
+  bool IsScalar() const { return kind == Kind::kScalar; }
+  bool IsNull() const { return kind == Kind::kNull; }
+  // "map", "sequence", "string", "number-like scalar" or "empty value": for messages.
+  const char* KindName() const;
+};
+
+struct YamlDocument {
+  std::string path;  // as given; named in every message
+  YamlNode root;     // kNull for a document without content
+};
+
+// Reads and parses one file. Errors (kUsage): missing or unreadable file, not a regular file, too large,
+// not UTF-8, empty, malformed YAML, limits above exceeded.
+Result<YamlDocument> LoadYamlFile(const std::string& path);
+
+// Parses text already in memory; `name` stands for the file in messages. Same checks as LoadYamlFile.
+Result<YamlDocument> ParseYamlText(const std::string& text, const std::string& name);
+
+}  // namespace selfcal::io
