@@ -1,0 +1,193 @@
+#include "sim/sim_world.h"
+
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include "identification/identifiability.h"
+
+namespace selfcal::sim {
+
+std::string SimOptions::Validate() const {
+  std::ostringstream out;
+  out << camera.Validate();
+  auto non_negative = [&](double v, const char* name) {
+    if (!std::isfinite(v) || v < 0) out << name << " = " << v << " must be finite and >= 0\n";
+  };
+  non_negative(length_error_std_m, "length_error_std_m");
+  non_negative(angle_error_std_rad, "angle_error_std_rad");
+  non_negative(cam_length_error_std_m, "cam_length_error_std_m");
+  non_negative(cam_angle_error_std_rad, "cam_angle_error_std_rad");
+  non_negative(fx_relative_error_std, "fx_relative_error_std");
+  non_negative(pixel_noise_px, "pixel_noise_px");
+  if (!(fx_nominal_px > 0)) out << "fx_nominal_px = " << fx_nominal_px << " must be > 0\n";
+  if (num_dots < 8) out << "num_dots = " << num_dots << " must be >= 8\n";
+  if (!(yardstick_length_m > 0)) out << "yardstick_length_m must be > 0\n";
+  if (num_identification_poses < 2) out << "num_identification_poses must be >= 2\n";
+  return out.str();
+}
+
+namespace {
+
+bool Visible(const CameraIntrinsics& camera, const Rigid3& base_from_cam, const Eigen::Vector3d& p_in_base,
+             double margin_px, double min_depth_m) {
+  const Eigen::Vector3d p_in_cam = base_from_cam.Inverse() * p_in_base;
+  if (p_in_cam.z() < min_depth_m) return false;
+  const auto uv = Project(camera, p_in_cam);
+  return uv && InImage(camera, *uv, margin_px);
+}
+
+// Least-squares point closest to all optical axes: where the cameras look.
+Eigen::Vector3d ConvergencePoint(const std::vector<Rigid3>& cams) {
+  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (const Rigid3& c : cams) {
+    const Eigen::Vector3d z = c.rotation.col(2);
+    const Eigen::Matrix3d p = Eigen::Matrix3d::Identity() - z * z.transpose();
+    a += p;
+    b += p * c.translation;
+  }
+  return a.ldlt().solve(b);
+}
+
+ObservationSet Observe(const SimResult& world, const std::vector<Eigen::VectorXd>& joints, double noise_px,
+                       uint64_t noise_seed, int num_identification) {
+  ObservationSet set;
+  set.robot = world.truth.nominal;
+  set.camera = world.truth.camera_true;
+  set.camera.fx_px = world.observations.camera.fx_px;  // the prior, not the truth
+  set.pixel_noise_px = noise_px > 0 ? noise_px : 0.1;
+  set.yardsticks = world.observations.yardsticks;
+  set.check_distances = world.observations.check_distances;
+  std::mt19937_64 rng(noise_seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (size_t i = 0; i < joints.size(); ++i) {
+    PoseObservation pose;
+    pose.id = (i < 10 ? "p0" : "p") + std::to_string(i);
+    pose.role = static_cast<int>(i) < num_identification ? PoseRole::kIdentification : PoseRole::kVerification;
+    pose.joints_rad = joints[i];
+    const Rigid3 cam_from_base = world.truth.base_from_cam[i].Inverse();
+    for (size_t d = 0; d < world.truth.dots_in_base.size(); ++d) {
+      const auto uv = Project(world.truth.camera_true, cam_from_base * world.truth.dots_in_base[d]);
+      const double du = noise(rng), dv = noise(rng);  // drawn for every dot: same stream at any level
+      pose.dots_px[static_cast<int>(d)] = *uv + noise_px * Eigen::Vector2d(du, dv);
+    }
+    set.poses.push_back(std::move(pose));
+  }
+  return set;
+}
+
+}  // namespace
+
+std::vector<KnownDistance> CheckPairs(const std::vector<Eigen::Vector3d>& dots) {
+  std::vector<KnownDistance> pairs;
+  const int half = static_cast<int>(dots.size()) / 2;
+  for (int i = 0; i < half; ++i) pairs.push_back({i, i + half, (dots[i] - dots[i + half]).norm()});
+  return pairs;
+}
+
+SimResult Simulate(const RobotModel& nominal, const std::vector<Eigen::VectorXd>& trajectory,
+                   const SimOptions& options) {
+  SimResult result;
+  const std::string problems = options.Validate();
+  if (!problems.empty()) {
+    result.message = "invalid simulation options:\n" + problems;
+    return result;
+  }
+  if (static_cast<int>(trajectory.size()) <= options.num_identification_poses) {
+    result.message = "the trajectory has " + std::to_string(trajectory.size()) + " poses; more than " +
+                     std::to_string(options.num_identification_poses) + " are needed (identification + verification)";
+    return result;
+  }
+  for (size_t i = 0; i < trajectory.size(); ++i) {
+    if (!WithinLimits(nominal, trajectory[i])) {
+      result.message = "trajectory pose " + std::to_string(i) + " is outside the joint limits";
+      return result;
+    }
+  }
+  std::mt19937_64 rng(options.world_seed);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  SimTruth& truth = result.truth;
+  truth.nominal = nominal;
+  truth.nominal.flange_from_cam = nominal.flange_from_cam;
+
+  // Hidden kinematic errors, on the identifiable parameters unless asked otherwise.
+  const KinematicParameters params(nominal.num_joints());
+  const Eigen::VectorXd rho_nominal = KinematicParameters::Nominal(nominal);
+  std::vector<int> to_perturb;
+  if (options.perturb_gauge_parameters) {
+    for (int i = 0; i < params.size(); ++i) to_perturb.push_back(i);
+  } else {
+    std::vector<Eigen::VectorXd> id_poses(trajectory.begin(), trajectory.begin() + options.num_identification_poses);
+    identification::IdentifiabilityOptions id_options;
+    to_perturb = identification::AnalyzeIdentifiability(nominal, rho_nominal, id_poses, 0, id_options).free_indices;
+  }
+  truth.rho_true = rho_nominal;
+  std::vector<double> draws(params.size());
+  for (double& d : draws) d = gauss(rng);  // one draw per parameter whatever is perturbed: stable streams
+  for (int i : to_perturb) {
+    const bool cam = i >= params.CamOffset();
+    const bool length = params.kind(i) == ParameterKind::kLength;
+    const double std_dev = cam ? (length ? options.cam_length_error_std_m : options.cam_angle_error_std_rad)
+                               : (length ? options.length_error_std_m : options.angle_error_std_rad);
+    truth.rho_true[i] += std_dev * draws[i];
+  }
+  truth.perturbed_indices = to_perturb;
+  truth.camera_true = options.camera;
+  truth.camera_true.fx_px = options.fx_nominal_px * (1.0 + options.fx_relative_error_std * gauss(rng));
+
+  for (const Eigen::VectorXd& q : trajectory) truth.base_from_cam.push_back(BaseFromCam(nominal, truth.rho_true, q));
+
+  // Scene: rejection sampling in a box around where the cameras look, every dot in every view.
+  const Eigen::Vector3d centre = ConvergencePoint(truth.base_from_cam);
+  const double half_size = 0.3;
+  std::uniform_real_distribution<double> uniform(-half_size, half_size);
+  auto visible_everywhere = [&](const Eigen::Vector3d& p) {
+    for (const Rigid3& c : truth.base_from_cam) {
+      if (!Visible(truth.camera_true, c, p, options.image_margin_px, options.min_depth_m)) return false;
+    }
+    return true;
+  };
+  const int max_tries = 200000;
+  int tries = 0;
+  // The yardstick: dots 0 and 1, yardstick_length_m apart along a random direction through the centre.
+  while (truth.dots_in_base.size() < 2 && tries < max_tries) {
+    ++tries;
+    const Eigen::Vector3d mid = centre + 0.3 * Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
+    const Eigen::Vector3d dir = Eigen::Vector3d(gauss(rng), gauss(rng), 0.3 * gauss(rng)).normalized();
+    const Eigen::Vector3d a = mid - 0.5 * options.yardstick_length_m * dir;
+    const Eigen::Vector3d b = mid + 0.5 * options.yardstick_length_m * dir;
+    if (visible_everywhere(a) && visible_everywhere(b)) truth.dots_in_base = {a, b};
+  }
+  while (static_cast<int>(truth.dots_in_base.size()) < options.num_dots && tries < max_tries) {
+    ++tries;
+    const Eigen::Vector3d p = centre + Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
+    if (visible_everywhere(p)) truth.dots_in_base.push_back(p);
+  }
+  if (static_cast<int>(truth.dots_in_base.size()) < options.num_dots) {
+    result.message = "could not place " + std::to_string(options.num_dots) +
+                     " dots in view of every pose: the views share too little of the scene";
+    return result;
+  }
+
+  result.observations.camera = truth.camera_true;
+  result.observations.camera.fx_px = options.fx_nominal_px;
+  result.observations.yardsticks = {{0, 1, options.yardstick_length_m}};
+  result.observations.check_distances = CheckPairs(truth.dots_in_base);
+  result.observations = Observe(result, trajectory, options.pixel_noise_px, options.noise_seed,
+                                options.num_identification_poses);
+  result.ok = true;
+  return result;
+}
+
+ObservationSet Reobserve(const SimResult& world, double pixel_noise_px, uint64_t noise_seed) {
+  std::vector<Eigen::VectorXd> joints;
+  int num_identification = 0;
+  for (const PoseObservation& p : world.observations.poses) {
+    joints.push_back(p.joints_rad);
+    if (p.role == PoseRole::kIdentification) ++num_identification;
+  }
+  return Observe(world, joints, pixel_noise_px, noise_seed, num_identification);
+}
+
+}  // namespace selfcal::sim

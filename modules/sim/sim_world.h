@@ -1,0 +1,72 @@
+// The simulated world of DESIGN.md section 6: a true robot (nominal + hidden errors drawn from a seed),
+// a hidden flange-to-camera transform and focal length, a scene of non-coplanar dots in view of every
+// pose, a yardstick, and image points projected with Gaussian pixel noise. The solver only ever sees the
+// ObservationSet; the SimTruth is for scoring.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "camera/camera.h"
+#include "geometry/rigid3.h"
+#include "kinematics/robot_model.h"
+#include "observations/observation_set.h"
+
+namespace selfcal::sim {
+
+struct SimOptions {
+  uint64_t world_seed = 1;          // robot errors, camera, scene
+  uint64_t noise_seed = 1;          // pixel noise
+  // Hidden kinematic errors (DESIGN.md section 6): lengths ~ N(0, 1 mm), angles ~ N(0, 0.2 deg).
+  double length_error_std_m = 1e-3;
+  double angle_error_std_rad = DegToRad(0.2);
+  // Hidden hand-eye error relative to the nominal flange_from_cam.
+  double cam_length_error_std_m = 2e-3;
+  double cam_angle_error_std_rad = DegToRad(0.5);
+  // Parameters the relative measurements cannot see (base, joint 1, redundant ones) are a gauge: any
+  // value yields identical images once the unknown dots are re-expressed. false leaves them at nominal
+  // so that parameters can be compared one by one with the truth; true perturbs them as well.
+  bool perturb_gauge_parameters = false;
+  double fx_nominal_px = 1000.0;    // what the user believes (the prior)
+  double fx_relative_error_std = 0.01;  // true f_x = nominal * (1 + N(0, this))
+  CameraIntrinsics camera;          // size, mu, principal point, k1 of the true camera
+  int num_dots = 80;
+  double image_margin_px = 10.0;    // every dot at least this far inside every image
+  double min_depth_m = 0.3;
+  double yardstick_length_m = 0.2;  // dots 0 and 1 are placed this far apart
+  double pixel_noise_px = 0.2;      // Gaussian, std per coordinate (the paper's Table 1, read as a std)
+  int num_identification_poses = 15;  // the first ones; the rest are verification poses
+  std::string Validate() const;
+};
+
+struct SimTruth {
+  RobotModel nominal;                       // what the solver is given
+  Eigen::VectorXd rho_true;                 // hidden, in the nominal model's parameterisation
+  std::vector<int> perturbed_indices;       // which entries of rho carry hidden errors
+  CameraIntrinsics camera_true;             // hidden f_x
+  std::vector<Eigen::Vector3d> dots_in_base;  // dot id = index
+  std::vector<Rigid3> base_from_cam;        // true camera pose per pose
+};
+
+struct SimResult {
+  bool ok = false;
+  std::string message;
+  ObservationSet observations;
+  SimTruth truth;
+};
+
+// Simulates a session on `trajectory` (joint angles, rad). Fails (ok = false, message) if the trajectory
+// leaves the joint limits or no scene of num_dots dots fits in every view.
+SimResult Simulate(const RobotModel& nominal, const std::vector<Eigen::VectorXd>& trajectory,
+                   const SimOptions& options);
+
+// Re-draws only the pixel noise of an existing simulation (same world, new noise_seed / level).
+ObservationSet Reobserve(const SimResult& world, double pixel_noise_px, uint64_t noise_seed);
+
+// The check distances used to score verification: pairs (i, i + n/2) of the scene, known lengths.
+std::vector<KnownDistance> CheckPairs(const std::vector<Eigen::Vector3d>& dots_in_base);
+
+}  // namespace selfcal::sim

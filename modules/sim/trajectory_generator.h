@@ -1,0 +1,40 @@
+// A smooth measurement trajectory around a scene: the paper's "initial" trajectory (section 4.2: "the
+// initial measurement samples were generated along a smooth path in the workspace of the robot").
+// The camera centre sweeps an arc around a target point, looking at it with a slowly wandering aim point
+// and roll so that no two optical axes intersect (f_x would be unobservable from such a pair, DESIGN.md
+// section 4). Joint angles come from inverse kinematics of the nominal model, continued pose to pose.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "kinematics/robot_model.h"
+
+namespace selfcal::sim {
+
+struct ArcTrajectoryOptions {
+  int num_poses = 25;
+  // The camera looks at a target distance_m ahead of where it is at these joint angles (the PUMA 560's
+  // forearm-down, wrist-tilted pose by default); the arc sweeps around that target.
+  std::vector<double> home_joints_deg = {0.0, 20.0, 160.0, 0.0, 45.0, 0.0};
+  double distance_m = 0.65;          // camera centre to target, mean
+  double distance_swing_m = 0.08;
+  double azimuth_start_deg = -35.0;  // viewing direction about the vertical through the target, from home
+  double azimuth_end_deg = 35.0;
+  double elevation_swing_deg = 10.0; // viewing direction's elevation about home's
+  double aim_wander_m = 0.04;        // radius of the aim point's circle around the target
+  double roll_swing_deg = 25.0;
+  double joint_margin_rad = DegToRad(5.0);
+};
+
+struct GeneratedTrajectory {
+  bool ok = false;
+  std::string message;
+  std::vector<Eigen::VectorXd> joints;  // rad
+};
+
+GeneratedTrajectory MakeArcTrajectory(const RobotModel& nominal, const ArcTrajectoryOptions& options);
+
+}  // namespace selfcal::sim
