@@ -1,0 +1,101 @@
+#include "pipeline/paper_pipeline.h"
+
+#include <gtest/gtest.h>
+
+#include "sim/sim_world.h"
+#include "sim/trajectory_generator.h"
+#include "support/test_robots.h"
+
+namespace selfcal::pipeline {
+namespace {
+
+sim::SimResult World(double noise_px, uint64_t seed = 1) {
+  const RobotModel puma = testing::Puma560();
+  const sim::GeneratedTrajectory trajectory = sim::MakeArcTrajectory(puma, sim::ArcTrajectoryOptions());
+  EXPECT_TRUE(trajectory.ok) << trajectory.message;
+  sim::SimOptions options;
+  options.pixel_noise_px = noise_px;
+  options.world_seed = seed;
+  options.noise_seed = seed;
+  sim::SimResult world = sim::Simulate(puma, trajectory.joints, options);
+  EXPECT_TRUE(world.ok) << world.message;
+  return world;
+}
+
+// Noise-free: the factor method is exact, and the only error left in the measured relative poses is the
+// bias of eq. (21) (nominal position ratios standing in for the true ones), which we can predict exactly.
+TEST(PaperPipeline, NoiseFreeTwoViewIsExactAndPositionErrorIsTheEq21Bias) {
+  const sim::SimResult world = World(0.0);
+  const PaperPipelineReport report = RunPaperPipeline(world.observations, PaperPipelineOptions());
+  ASSERT_EQ(report.outcome, Outcome::kSuccess) << report.message;
+  ASSERT_EQ(report.measurements.size(), 14u);
+  const Rigid3 ref_from_base = world.truth.base_from_cam[report.reference_pose].Inverse();
+  const double fx_true = world.truth.camera_true.fx_px;
+  double first_true_norm = 0, first_nominal_norm = 0;
+  double max_bias_m = 0;
+  int fx_pairs = 0;
+  for (const PoseMeasurement& m : report.measurements) {
+    ASSERT_TRUE(m.used) << m.pose_id << ": " << m.two_view.message;
+    const Rigid3 truth = ref_from_base * world.truth.base_from_cam[m.pose_index];
+    EXPECT_LT(RotationAngle(m.measured_cam_ref_from_cam.rotation.transpose() * truth.rotation), 1e-9) << m.pose_id;
+    const Eigen::Vector3d direction = m.measured_cam_ref_from_cam.translation.normalized();
+    EXPECT_LT((direction - truth.translation.normalized()).norm(), 1e-9) << m.pose_id;
+    // Exact either from this pair or, where its optical axes nearly intersect, from the other pairs.
+    EXPECT_LT(std::abs(m.two_view.fx_px - fx_true), 1e-9 * fx_true) << m.pose_id;
+    EXPECT_NE(m.two_view.fx_observable, m.fx_from_other_pairs) << m.pose_id;
+    if (m.two_view.fx_observable) ++fx_pairs;
+    if (first_true_norm == 0) {
+      first_true_norm = truth.translation.norm();
+      first_nominal_norm = m.nominal_translation.norm();
+    }
+    // With k_1 from the true first motion, eq. (21) predicts ||t_i|| * (nominal ratio / true ratio).
+    const double predicted_norm = m.nominal_translation.norm() / first_nominal_norm * first_true_norm;
+    const Eigen::Vector3d t_meas = (first_true_norm / first_nominal_norm) * m.measured_cam_ref_from_cam.translation;
+    EXPECT_NEAR(t_meas.norm(), predicted_norm, 1e-12);
+    EXPECT_NEAR((t_meas - truth.translation).norm(), std::abs(predicted_norm - truth.translation.norm()), 1e-9);
+    max_bias_m = std::max(max_bias_m, (t_meas - truth.translation).norm());
+  }
+  EXPECT_GE(fx_pairs, 3);
+  EXPECT_NEAR(report.fx_px, fx_true, 1e-9 * fx_true);
+  // The nominal model is wrong by about a millimetre per link: the bias is there and measurable.
+  EXPECT_GT(max_bias_m, 1e-5);
+  std::cout << "[ figure ] eq. (21) bias on the arc trajectory, noise 0: max position error " << max_bias_m * 1e3
+            << " mm\n";
+}
+
+TEST(PaperPipeline, CalibrationBeatsTheNominalModelOnHeldOutDistancesWithoutNoise) {
+  const sim::SimResult world = World(0.0);
+  const PaperPipelineReport report = RunPaperPipeline(world.observations, PaperPipelineOptions());
+  ASSERT_EQ(report.outcome, Outcome::kSuccess) << report.message;
+  ASSERT_EQ(report.verification_calibrated.num_ok, 40);
+  std::cout << "[ figure ] 3-D error, noise 0: nominal " << report.verification_nominal.rms_error_m * 1e3
+            << " mm RMS, calibrated " << report.verification_calibrated.rms_error_m * 1e3 << " mm RMS\n";
+  EXPECT_LT(report.verification_calibrated.rms_error_m, report.verification_nominal.rms_error_m);
+}
+
+TEST(PaperPipeline, InvalidInputNamesThePose) {
+  sim::SimResult world = World(0.2);
+  world.observations.poses[3].dots_px[5] = Eigen::Vector2d(std::nan(""), 1.0);
+  const PaperPipelineReport report = RunPaperPipeline(world.observations, PaperPipelineOptions());
+  EXPECT_EQ(report.outcome, Outcome::kInvalidInput);
+  EXPECT_NE(report.message.find("pose p03, dot 5"), std::string::npos) << report.message;
+}
+
+TEST(PaperPipeline, TooFewPosesIsDegenerate) {
+  sim::SimResult world = World(0.2);
+  world.observations.poses.resize(4);  // 4 identification poses: 3 measurements < 6
+  const PaperPipelineReport report = RunPaperPipeline(world.observations, PaperPipelineOptions());
+  EXPECT_EQ(report.outcome, Outcome::kDegenerate) << report.message;
+}
+
+TEST(PaperPipeline, YardstickSeenOnceLeavesScaleUnresolved) {
+  sim::SimResult world = World(0.2);
+  // S1: keep yardstick end 1 in a single identification view (and in the verification views).
+  for (int i = 1; i < 15; ++i) world.observations.poses[i].dots_px.erase(1);
+  const PaperPipelineReport report = RunPaperPipeline(world.observations, PaperPipelineOptions());
+  EXPECT_EQ(report.outcome, Outcome::kScaleUnresolved) << report.message;
+  EXPECT_FALSE(report.yardstick.ok);
+}
+
+}  // namespace
+}  // namespace selfcal::pipeline

@@ -1,0 +1,192 @@
+#include "pipeline/study.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+namespace selfcal::pipeline {
+
+double Stat::Mean() const {
+  if (values.empty()) return std::nan("");
+  return std::accumulate(values.begin(), values.end(), 0.0) / values.size();
+}
+double Stat::Sd() const {
+  if (values.size() < 2) return std::nan("");
+  const double m = Mean();
+  double s = 0;
+  for (double v : values) s += (v - m) * (v - m);
+  return std::sqrt(s / (values.size() - 1));
+}
+double Stat::Rms() const {
+  if (values.empty()) return std::nan("");
+  double s = 0;
+  for (double v : values) s += v * v;
+  return std::sqrt(s / values.size());
+}
+double Stat::Max() const {
+  if (values.empty()) return std::nan("");
+  return *std::max_element(values.begin(), values.end());
+}
+double Stat::Percentile(double p) const {
+  if (values.empty()) return std::nan("");
+  std::vector<double> sorted = values;
+  std::sort(sorted.begin(), sorted.end());
+  const double pos = p / 100.0 * (sorted.size() - 1);
+  const size_t lo = static_cast<size_t>(std::floor(pos));
+  const size_t hi = std::min(lo + 1, sorted.size() - 1);
+  return sorted[lo] + (pos - lo) * (sorted[hi] - sorted[lo]);
+}
+
+namespace {
+
+constexpr double kMm = 1e3;
+constexpr double k1e4 = 1e4;
+
+// Scores one pipeline run against the simulator's truth and adds to the cell.
+void ScoreRun(const sim::SimResult& world, const ObservationSet& obs, const PaperPipelineReport& report,
+              const StudyOptions& options, StudyCell* cell) {
+  const sim::SimTruth& truth = world.truth;
+  const int ref = report.reference_pose;
+  const Rigid3 true_ref_from_base = truth.base_from_cam[ref].Inverse();
+  // k_1 from the true first motion: the pipeline used ||tbar_1||, rescale by ||t_1|| / ||tbar_1||.
+  double k_correction = 1.0;
+  for (const PoseMeasurement& m : report.measurements) {
+    if (!m.used) continue;
+    const Rigid3 true_rel = true_ref_from_base * truth.base_from_cam[m.pose_index];
+    k_correction = true_rel.translation.norm() / m.nominal_translation.norm();
+    break;
+  }
+  double ratio_first_true = 0, ratio_first_nominal = 0;
+  bool first = true;
+  std::vector<Eigen::Vector3d> dots_in_ref;
+  for (const Eigen::Vector3d& p : truth.dots_in_base) dots_in_ref.push_back(true_ref_from_base * p);
+  for (const PoseMeasurement& m : report.measurements) {
+    const Rigid3 true_rel = true_ref_from_base * truth.base_from_cam[m.pose_index];  // cam_ref_from_cam_i
+    if (m.used) {
+      const Eigen::Vector3d t_meas = k_correction * m.measured_cam_ref_from_cam.translation;
+      cell->position_mm.Add(kMm * (t_meas - true_rel.translation).norm());
+      const Eigen::Vector3d t_true_scale = true_rel.translation.norm() * m.measured_cam_ref_from_cam.translation.normalized();
+      cell->position_true_scale_mm.Add(kMm * (t_true_scale - true_rel.translation).norm());
+      cell->orientation_1e4rad.Add(k1e4 * RotationAngle(m.measured_cam_ref_from_cam.rotation.transpose() * true_rel.rotation));
+      if (m.two_view.fx_observable) cell->fx_px.Add(std::abs(m.two_view.fx_px - truth.camera_true.fx_px));
+      if (first) {
+        ratio_first_true = true_rel.translation.norm();
+        ratio_first_nominal = m.nominal_translation.norm();
+        first = false;
+      } else {
+        const double nominal_ratio = m.nominal_translation.norm() / ratio_first_nominal;
+        const double true_ratio = true_rel.translation.norm() / ratio_first_true;
+        cell->scale_ratio_error.Add(std::abs(nominal_ratio / true_ratio - 1.0));
+      }
+    }
+    if (options.with_opencv && obs.poses.size() > 0) {
+      CameraIntrinsics camera = obs.camera;
+      camera.fx_px = truth.camera_true.fx_px;
+      const Matches matches = MatchById(obs.poses[ref], obs.poses[m.pose_index]);
+      twoview::TwoViewOptions cv_options = options.pipeline.two_view;
+      const twoview::TwoViewReport cv = twoview::EstimateTwoViewOpenCv(cv_options, camera, matches.pixels_a, matches.pixels_b);
+      if (cv.outcome == twoview::Outcome::kSuccess) {
+        const Eigen::Matrix3d r = cv.rotation.transpose();
+        const Eigen::Vector3d dir = -(r * cv.translation_direction).normalized();
+        const Eigen::Vector3d t_meas = k_correction * m.nominal_translation.norm() * dir;
+        cell->opencv_position_mm.Add(kMm * (t_meas - true_rel.translation).norm());
+        cell->opencv_position_true_scale_mm.Add(kMm * (true_rel.translation.norm() * dir - true_rel.translation).norm());
+        cell->opencv_orientation_1e4rad.Add(k1e4 * RotationAngle(r.transpose() * true_rel.rotation));
+      }
+    }
+    if (options.with_bound && obs.pixel_noise_px > 0 && cell->noise_px > 0) {
+      const Rigid3 cam_i_from_ref = true_rel.Inverse();
+      for (bool fx_unknown : {true, false}) {
+        const twoview::TwoViewBound bound =
+            twoview::TwoViewCramerRao(truth.camera_true, cam_i_from_ref, dots_in_ref, cell->noise_px, fx_unknown);
+        if (!bound.ok) continue;
+        // Position error of the measurement cam_ref_from_cam_i = -R^T t: with ||t|| exact, its direction
+        // error has the same angle as t's (rotation error enters too; the t term dominates).
+        const double position = kMm * true_rel.translation.norm() * bound.translation_dir_rms_rad();
+        const double orientation = k1e4 * bound.rotation_rms_rad();
+        if (fx_unknown) {
+          cell->bound_position_mm_fx_unknown.Add(position);
+          cell->bound_orientation_1e4rad_fx_unknown.Add(orientation);
+          cell->bound_fx_px.Add(std::sqrt(bound.fx_variance));
+        } else {
+          cell->bound_position_mm_fx_known.Add(position);
+          cell->bound_orientation_1e4rad_fx_known.Add(orientation);
+        }
+      }
+    }
+  }
+  for (const DistanceCheck& c : report.verification_nominal.checks) {
+    if (c.ok) cell->error3d_nominal_mm.Add(kMm * c.error_m);
+  }
+  for (const DistanceCheck& c : report.verification_calibrated.checks) {
+    if (c.ok) cell->error3d_calibrated_mm.Add(kMm * c.error_m);
+  }
+  const Eigen::VectorXd rho_nominal = KinematicParameters::Nominal(obs.robot);
+  const Rigid3 nominal_ref_from_base = BaseFromCam(obs.robot, rho_nominal, obs.poses[ref].joints_rad).Inverse();
+  const Rigid3 calibrated_ref_from_base =
+      BaseFromCam(report.calibrated_robot, report.calibrated_rho, obs.poses[ref].joints_rad).Inverse();
+  for (int v : obs.PosesWithRole(PoseRole::kVerification)) {
+    const Rigid3 true_rel = true_ref_from_base * truth.base_from_cam[v];
+    const Rigid3 nominal_rel = nominal_ref_from_base * BaseFromCam(obs.robot, rho_nominal, obs.poses[v].joints_rad);
+    const Rigid3 calibrated_rel = calibrated_ref_from_base *
+                                  BaseFromCam(report.calibrated_robot, report.calibrated_rho, obs.poses[v].joints_rad);
+    const PoseDifference before = ComparePoses(true_rel, nominal_rel);
+    const PoseDifference after = ComparePoses(true_rel, calibrated_rel);
+    cell->pose_position_nominal_mm.Add(kMm * before.position_m);
+    cell->pose_position_calibrated_mm.Add(kMm * after.position_m);
+    cell->pose_orientation_nominal_1e4rad.Add(k1e4 * before.rotation_rad);
+    cell->pose_orientation_calibrated_1e4rad.Add(k1e4 * after.rotation_rad);
+  }
+  cell->fx_final_error_px.Add(std::abs(report.fx_px - truth.camera_true.fx_px));
+  // The measurements carried lengths 1/k_correction times the truth; a right yardstick scale undoes that.
+  if (report.yardstick.ok) cell->yardstick_scale_error.Add(std::abs(report.yardstick.scale / k_correction - 1.0));
+  cell->seconds_per_calibration.Add(report.seconds_total);
+}
+
+}  // namespace
+
+StudyReport RunStudy(const RobotModel& nominal, const std::vector<TrajectorySpec>& trajectories,
+                     const StudyOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  StudyReport study;
+  for (const TrajectorySpec& trajectory : trajectories) {
+    std::vector<StudyCell> cells(options.noise_levels_px.size());
+    for (size_t l = 0; l < cells.size(); ++l) {
+      cells[l].trajectory = trajectory.name;
+      cells[l].noise_px = options.noise_levels_px[l];
+    }
+    for (int run = 0; run < options.runs; ++run) {
+      sim::SimOptions sim_options = options.sim;
+      sim_options.world_seed = options.seed + static_cast<uint64_t>(run);
+      const sim::SimResult world = sim::Simulate(nominal, trajectory.joints, sim_options);
+      for (size_t l = 0; l < cells.size(); ++l) {
+        StudyCell& cell = cells[l];
+        ++cell.runs;
+        if (!world.ok) {
+          ++cell.runs_failed;
+          if (cell.failures.size() < 5) cell.failures.push_back("simulation: " + world.message);
+          continue;
+        }
+        const ObservationSet obs =
+            sim::Reobserve(world, cell.noise_px, options.seed * 7919 + 1000003ULL * static_cast<uint64_t>(run) + l);
+        PaperPipelineReport report = RunPaperPipeline(obs, options.pipeline);
+        if (report.outcome != Outcome::kSuccess) {
+          ++cell.runs_failed;
+          if (cell.failures.size() < 5) cell.failures.push_back(std::string(OutcomeName(report.outcome)) + ": " + report.message);
+          if (report.measurements.empty() || report.calibrated_rho.size() == 0) continue;
+        }
+        if (study.identifiable_parameters == 0) {
+          study.identifiable_parameters = report.identifiability.rank;
+          study.fixed_parameters = report.identifiability.fixed_names;
+        }
+        ScoreRun(world, obs, report, options, &cell);
+      }
+    }
+    study.cells.insert(study.cells.end(), cells.begin(), cells.end());
+  }
+  study.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return study;
+}
+
+}  // namespace selfcal::pipeline
