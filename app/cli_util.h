@@ -1,0 +1,26 @@
+// Small helpers shared by the subcommands: default file lookup, exit-code mapping, printing.
+#pragma once
+
+#include <string>
+
+#include "base/status.h"
+#include "pipeline/paper_pipeline.h"
+
+namespace selfcal::app {
+
+// `path` as given if it exists, else relative to the source tree's root (so that the shipped defaults
+// under config/ work from any directory of a build tree).
+std::string ResolveDataPath(const std::string& path);
+
+// Prints "selfcal: <code name>: message" to stderr and returns the exit code.
+int Fail(const Status& status);
+
+ExitCode ExitCodeFor(pipeline::Outcome outcome);
+
+// 64-bit FNV-1a of a file's bytes as 16 hex digits ("" if unreadable): provenance in reports (P7).
+std::string FileHash(const std::string& path);
+
+// Creates the directory (and parents). Refuses an existing non-directory.
+Status EnsureDirectory(const std::string& path);
+
+}  // namespace selfcal::app

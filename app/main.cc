@@ -1,0 +1,38 @@
+// selfcal: self-calibration of a camera-equipped robot arm (Meng & Zhuang). Subcommands only.
+#include <exception>
+#include <iostream>
+
+#include "app/commands.h"
+#include "base/status.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"selfcal: self-calibration of a camera-equipped robot arm from images of unknown dots"};
+  app.set_version_flag("--version", SELFCAL_VERSION);
+  app.require_subcommand(1);
+  const selfcal::app::Command calibrate = selfcal::app::AddCalibrateCommand(app);
+  const selfcal::app::Command simulate = selfcal::app::AddSimulateCommand(app);
+  const selfcal::app::Command study = selfcal::app::AddStudyCommand(app);
+  const selfcal::app::Command identifiability = selfcal::app::AddIdentifiabilityCommand(app);
+  const selfcal::app::Command make_trajectory = selfcal::app::AddMakeTrajectoryCommand(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // CLI11 exits 0 for --help and --version; every real usage error maps to exit code 2 (C9).
+    const int code = app.exit(e);
+    return code == 0 ? 0 : static_cast<int>(selfcal::ExitCode::kUsage);
+  }
+  try {
+    for (const auto& [name, command] :
+         {std::pair{"calibrate", calibrate}, {"simulate", simulate}, {"study", study},
+          {"identifiability", identifiability}, {"make-trajectory", make_trajectory}}) {
+      if (app.got_subcommand(name)) return command();
+    }
+  } catch (const selfcal::InvalidArgument& e) {
+    std::cerr << "selfcal: internal error: " << e.what() << "\n";
+    return static_cast<int>(selfcal::ExitCode::kSolverFailure);
+  } catch (const std::exception& e) {
+    std::cerr << "selfcal: unexpected error: " << e.what() << "\n";
+    return static_cast<int>(selfcal::ExitCode::kSolverFailure);
+  }
+  return static_cast<int>(selfcal::ExitCode::kUsage);
+}

@@ -1,0 +1,256 @@
+#include "app/report_format.h"
+
+#include <cmath>
+#include <cstdio>
+#include <iomanip>
+
+namespace selfcal::app {
+
+namespace {
+
+constexpr double kMm = 1e3;
+
+nlohmann::json Finite(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+nlohmann::json VerificationJson(const pipeline::VerificationSummary& v) {
+  nlohmann::json checks = nlohmann::json::array();
+  for (const pipeline::DistanceCheck& c : v.checks) {
+    checks.push_back({{"dot_a", c.known.dot_a}, {"dot_b", c.known.dot_b}, {"known_mm", c.known.length_m * kMm},
+                      {"ok", c.ok}, {"measured_mm", c.measured_m * kMm}, {"error_mm", c.error_m * kMm}});
+  }
+  return {{"num_ok", v.num_ok}, {"mean_error_mm", v.mean_error_m * kMm}, {"rms_error_mm", v.rms_error_m * kMm},
+          {"max_error_mm", v.max_error_m * kMm}, {"checks", checks}};
+}
+
+// A parameter value in report units: mm for lengths, degrees for angles.
+double InReportUnits(const KinematicParameters& params, int i, double v) {
+  return params.kind(i) == ParameterKind::kLength ? v * kMm : RadToDeg(v);
+}
+
+nlohmann::json StatJson(const pipeline::Stat& s) {
+  return {{"n", s.count()}, {"mean", Finite(s.Mean())}, {"sd", Finite(s.Sd())}, {"rms", Finite(s.Rms())},
+          {"p90", Finite(s.Percentile(90))}, {"max", Finite(s.Max())}};
+}
+
+}  // namespace
+
+nlohmann::json CalibrationReportJson(const ObservationSet& obs, const pipeline::PaperPipelineReport& r) {
+  nlohmann::json j;
+  j["format"] = "selfcal-calibration-report";
+  j["version"] = 1;
+  j["software_version"] = SELFCAL_VERSION;
+  j["method"] = "paper pipeline (Meng & Zhuang 2001): factor method, eq. (21) scale, LM identification, yardstick";
+  j["outcome"] = pipeline::OutcomeName(r.outcome);
+  j["message"] = r.message;
+  j["reference_pose"] = r.reference_pose >= 0 ? obs.poses[r.reference_pose].id : "";
+  j["fx_px"] = r.fx_px;
+  j["fx_pairs"] = r.fx_pairs;
+  j["pixel_noise_px"] = obs.pixel_noise_px;
+  j["pixel_noise_note"] = "standard deviation per coordinate (the paper's N(0, s) read as a std)";
+
+  nlohmann::json measurements = nlohmann::json::array();
+  for (const pipeline::PoseMeasurement& m : r.measurements) {
+    measurements.push_back({{"pose", m.pose_id},
+                            {"outcome", twoview::OutcomeName(m.two_view.outcome)},
+                            {"message", m.two_view.message},
+                            {"used", m.used},
+                            {"fx_px", m.two_view.fx_px},
+                            {"fx_observable", m.two_view.fx_observable},
+                            {"planar", m.two_view.planar},
+                            {"inliers", m.two_view.num_inliers},
+                            {"rms_epipolar_px", m.two_view.rms_epipolar_px},
+                            {"eq21_scale_mm", m.scale * kMm},
+                            {"refinement", m.two_view.refinement_termination}});
+  }
+  j["pose_measurements"] = measurements;
+
+  const identification::IdentifiabilityReport& id = r.identifiability;
+  j["identifiability"] = {{"num_parameters", id.num_parameters}, {"identifiable", id.rank},
+                          {"free", id.free_names},           {"fixed", id.fixed_names},
+                          {"null_combinations", id.null_combinations},
+                          {"condition_number", Finite(id.condition_number)}};
+
+  const identification::IdentificationReport& ident = r.identification;
+  nlohmann::json parameters = nlohmann::json::array();
+  if (ident.rho.size() == obs.robot.num_parameters()) {
+    const KinematicParameters params(obs.robot.num_joints());
+    const Eigen::VectorXd nominal = KinematicParameters::Nominal(obs.robot);
+    for (int i = 0; i < params.size(); ++i) {
+      const bool free = std::count(ident.free_indices.begin(), ident.free_indices.end(), i) > 0;
+      const char* unit = params.kind(i) == ParameterKind::kLength ? "mm" : "deg";
+      parameters.push_back({{"name", params.name(i)},
+                            {"unit", unit},
+                            {"free", free},
+                            {"nominal", InReportUnits(params, i, nominal[i])},
+                            {"identified_before_yardstick", InReportUnits(params, i, ident.rho[i])},
+                            {"stddev", Finite(ident.stddev.size() > i ? InReportUnits(params, i, ident.stddev[i]) : NAN)}});
+    }
+  }
+  j["identification"] = {{"outcome", identification::OutcomeName(ident.outcome)},
+                         {"message", ident.message},
+                         {"termination", ident.termination},
+                         {"iterations", ident.iterations},
+                         {"initial_cost", ident.initial_cost},
+                         {"final_cost", ident.final_cost},
+                         {"rms_position_mm", ident.rms_position_m * kMm},
+                         {"rms_rotation_deg", RadToDeg(ident.rms_rotation_rad)},
+                         {"covariance_available", ident.covariance_available},
+                         {"covariance_message", ident.covariance_message},
+                         {"parameters", parameters}};
+  nlohmann::json lengths = nlohmann::json::array();
+  for (double l : r.yardstick.measured_lengths_m) lengths.push_back(l * kMm);
+  j["yardstick"] = {{"ok", r.yardstick.ok},
+                    {"message", r.yardstick.message},
+                    {"scale", r.yardstick.scale},
+                    {"scale_sigma", r.yardstick.scale_sigma},
+                    {"measured_lengths_before_scale_mm", lengths}};
+  j["verification"] = {{"poses", obs.PosesWithRole(PoseRole::kVerification).size()},
+                       {"nominal_model", VerificationJson(r.verification_nominal)},
+                       {"calibrated_model", VerificationJson(r.verification_calibrated)}};
+  j["timing_s"] = {{"two_view", r.seconds_two_view}, {"identification", r.seconds_identification},
+                   {"total", r.seconds_total}};
+  return j;
+}
+
+void PrintCalibrationSummary(const pipeline::PaperPipelineReport& r, std::ostream& out) {
+  out << "outcome: " << pipeline::OutcomeName(r.outcome);
+  if (!r.message.empty()) out << " (" << r.message << ")";
+  out << "\n";
+  int used = 0;
+  for (const auto& m : r.measurements) used += m.used ? 1 : 0;
+  out << "pose measurements: " << used << " of " << r.measurements.size() << " pairs used; f_x = " << std::fixed
+      << std::setprecision(3) << r.fx_px << " px from " << r.fx_pairs << " pairs\n";
+  out << "identifiable parameters: " << r.identifiability.rank << " of " << r.identifiability.num_parameters
+      << " (condition number " << std::setprecision(1) << r.identifiability.condition_number << ")\n";
+  out << "identification: " << identification::OutcomeName(r.identification.outcome) << ", "
+      << r.identification.iterations << " iterations, residual RMS " << std::setprecision(3)
+      << r.identification.rms_position_m * kMm << " mm / " << RadToDeg(r.identification.rms_rotation_rad) << " deg\n";
+  if (r.yardstick.ok) {
+    out << "yardstick scale: " << std::setprecision(6) << r.yardstick.scale << " +- " << r.yardstick.scale_sigma << "\n";
+  } else {
+    out << "yardstick: " << r.yardstick.message << "\n";
+  }
+  if (r.verification_calibrated.num_ok > 0) {
+    out << "3-D error on " << r.verification_calibrated.num_ok << " held-out distances: nominal model "
+        << std::setprecision(3) << r.verification_nominal.rms_error_m * kMm << " mm RMS, calibrated "
+        << r.verification_calibrated.rms_error_m * kMm << " mm RMS (max " << r.verification_calibrated.max_error_m * kMm
+        << " mm)\n";
+  }
+  out << "time: " << std::setprecision(1) << r.seconds_total * 1e3 << " ms\n";
+  out.unsetf(std::ios::floatfield);
+}
+
+nlohmann::json StudyJson(const pipeline::StudyReport& study, const pipeline::StudyOptions& options) {
+  nlohmann::json j;
+  j["format"] = "selfcal-study";
+  j["version"] = 1;
+  j["software_version"] = SELFCAL_VERSION;
+  j["runs_per_cell"] = options.runs;
+  j["seed"] = options.seed;
+  j["pixel_noise_note"] = "std per coordinate in px (the paper's N(0, s) read as a std)";
+  j["hidden_errors"] = {{"length_std_mm", options.sim.length_error_std_m * kMm},
+                        {"angle_std_deg", RadToDeg(options.sim.angle_error_std_rad)},
+                        {"cam_length_std_mm", options.sim.cam_length_error_std_m * kMm},
+                        {"cam_angle_std_deg", RadToDeg(options.sim.cam_angle_error_std_rad)},
+                        {"fx_relative_std", options.sim.fx_relative_error_std}};
+  j["identifiable_parameters"] = study.identifiable_parameters;
+  j["fixed_parameters"] = study.fixed_parameters;
+  j["paper_table2"] = {
+      {{"trajectory", "initial"}, {"noise_px", 0.2}, {"position_mm", {3.0427, 1.1051}}, {"orientation_1e4rad", {1.4918, 2.5354}}, {"fx_px", {0.2249, 0.2374}}},
+      {{"trajectory", "optimal"}, {"noise_px", 0.2}, {"position_mm", {0.2809, 0.2452}}, {"orientation_1e4rad", {1.0701, 1.4532}}, {"fx_px", {0.1539, 0.2128}}},
+      {{"trajectory", "initial"}, {"noise_px", 0.5}, {"position_mm", {6.9837, 2.6475}}, {"orientation_1e4rad", {4.0876, 7.1762}}, {"fx_px", {0.6181, 0.7324}}},
+      {{"trajectory", "optimal"}, {"noise_px", 0.5}, {"position_mm", {0.3035, 0.2826}}, {"orientation_1e4rad", {2.4016, 3.2432}}, {"fx_px", {0.3458, 0.4791}}}};
+  nlohmann::json cells = nlohmann::json::array();
+  for (const pipeline::StudyCell& c : study.cells) {
+    cells.push_back({{"trajectory", c.trajectory},
+                     {"noise_px", c.noise_px},
+                     {"runs", c.runs},
+                     {"runs_failed", c.runs_failed},
+                     {"failures", c.failures},
+                     {"paper_pipeline", {{"position_mm", StatJson(c.position_mm)},
+                                         {"position_true_scale_mm", StatJson(c.position_true_scale_mm)},
+                                         {"orientation_1e4rad", StatJson(c.orientation_1e4rad)},
+                                         {"fx_px", StatJson(c.fx_px)},
+                                         {"eq21_ratio_error", StatJson(c.scale_ratio_error)}}},
+                     {"opencv_true_fx", {{"position_mm", StatJson(c.opencv_position_mm)},
+                                         {"position_true_scale_mm", StatJson(c.opencv_position_true_scale_mm)},
+                                         {"orientation_1e4rad", StatJson(c.opencv_orientation_1e4rad)}}},
+                     {"cramer_rao_fx_unknown", {{"position_mm_rms", StatJson(c.bound_position_mm_fx_unknown)},
+                                                {"orientation_1e4rad_rms", StatJson(c.bound_orientation_1e4rad_fx_unknown)},
+                                                {"fx_px_rms", StatJson(c.bound_fx_px)}}},
+                     {"cramer_rao_fx_known", {{"position_mm_rms", StatJson(c.bound_position_mm_fx_known)},
+                                              {"orientation_1e4rad_rms", StatJson(c.bound_orientation_1e4rad_fx_known)}}},
+                     {"fig6_3d_error_mm", {{"nominal_model", StatJson(c.error3d_nominal_mm)},
+                                           {"calibrated", StatJson(c.error3d_calibrated_mm)}}},
+                     {"verification_pose_error", {{"position_nominal_mm", StatJson(c.pose_position_nominal_mm)},
+                                                  {"position_calibrated_mm", StatJson(c.pose_position_calibrated_mm)},
+                                                  {"orientation_nominal_1e4rad", StatJson(c.pose_orientation_nominal_1e4rad)},
+                                                  {"orientation_calibrated_1e4rad", StatJson(c.pose_orientation_calibrated_1e4rad)}}},
+                     {"fx_final_error_px", StatJson(c.fx_final_error_px)},
+                     {"yardstick_scale_error", StatJson(c.yardstick_scale_error)},
+                     {"seconds_per_calibration", StatJson(c.seconds_per_calibration)}});
+  }
+  j["cells"] = cells;
+  j["seconds_total"] = study.seconds_total;
+  return j;
+}
+
+void PrintStudyTables(const pipeline::StudyReport& study, std::ostream& out) {
+  char line[512];
+  out << "Table 2 reproduction: pose measurement errors, mean / SD over pose pairs and runs\n";
+  out << "(position with the eq. (21) scale and k_1 from the true first motion; bound rows are RMS)\n";
+  std::snprintf(line, sizeof(line), "%-10s %-6s %-28s %9s %9s %10s %10s %8s %8s %6s\n", "trajectory", "noise",
+                "method", "pos M mm", "pos SD", "ori M e-4", "ori SD", "fx M px", "fx SD", "runs");
+  out << line;
+  auto row = [&](const pipeline::StudyCell& c, const char* method, const pipeline::Stat& p, const pipeline::Stat& o,
+                 const pipeline::Stat* f, bool rms) {
+    std::snprintf(line, sizeof(line), "%-10s %-6.2f %-28s %9.4f %9.4f %10.4f %10.4f %8.4f %8.4f %6d\n",
+                  c.trajectory.c_str(), c.noise_px, method, rms ? p.Rms() : p.Mean(), rms ? NAN : p.Sd(),
+                  rms ? o.Rms() : o.Mean(), rms ? NAN : o.Sd(), f ? (rms ? f->Rms() : f->Mean()) : NAN,
+                  f && !rms ? f->Sd() : NAN, c.runs - c.runs_failed);
+    out << line;
+  };
+  for (const pipeline::StudyCell& c : study.cells) {
+    row(c, "paper pipeline", c.position_mm, c.orientation_1e4rad, &c.fx_px, false);
+    row(c, "paper pipeline, true scale", c.position_true_scale_mm, c.orientation_1e4rad, nullptr, false);
+    if (c.opencv_position_mm.count() > 0) {
+      row(c, "OpenCV E+recoverPose true fx", c.opencv_position_mm, c.opencv_orientation_1e4rad, nullptr, false);
+    }
+    if (c.bound_position_mm_fx_unknown.count() > 0) {
+      row(c, "CRB fx unknown (RMS)", c.bound_position_mm_fx_unknown, c.bound_orientation_1e4rad_fx_unknown,
+          &c.bound_fx_px, true);
+      row(c, "CRB fx known (RMS)", c.bound_position_mm_fx_known, c.bound_orientation_1e4rad_fx_known, nullptr, true);
+    }
+  }
+  out << "\nFig. 6 and 'does calibration help?': verification poses, nominal model vs calibrated\n";
+  std::snprintf(line, sizeof(line), "%-10s %-6s %14s %14s %14s %14s %14s %14s\n", "trajectory", "noise",
+                "3-D nom mm", "3-D cal mm", "3-D cal p90", "pose nom mm", "pose cal mm", "ori cal e-4");
+  out << line;
+  for (const pipeline::StudyCell& c : study.cells) {
+    std::snprintf(line, sizeof(line), "%-10s %-6.2f %14.4f %14.4f %14.4f %14.4f %14.4f %14.4f\n", c.trajectory.c_str(),
+                  c.noise_px, c.error3d_nominal_mm.Mean(), c.error3d_calibrated_mm.Mean(),
+                  c.error3d_calibrated_mm.Percentile(90), c.pose_position_nominal_mm.Mean(),
+                  c.pose_position_calibrated_mm.Mean(), c.pose_orientation_calibrated_1e4rad.Mean());
+    out << line;
+  }
+  out << "\neq. (21) bias: |nominal ratio / true ratio - 1| per pose, mean (max)\n";
+  for (const pipeline::StudyCell& c : study.cells) {
+    if (c.noise_px != 0) continue;
+    std::snprintf(line, sizeof(line), "%-10s %.3e (%.3e); position error at noise 0: %.4f mm mean, %.4f mm max\n",
+                  c.trajectory.c_str(), c.scale_ratio_error.Mean(), c.scale_ratio_error.Max(), c.position_mm.Mean(),
+                  c.position_mm.Max());
+    out << line;
+  }
+  for (const pipeline::StudyCell& c : study.cells) {
+    if (c.runs_failed > 0) {
+      out << c.trajectory << " noise " << c.noise_px << ": " << c.runs_failed << " of " << c.runs << " runs failed";
+      if (!c.failures.empty()) out << " (first: " << c.failures.front() << ")";
+      out << "\n";
+    }
+  }
+  std::snprintf(line, sizeof(line), "identifiable parameters: %d; total time %.1f s\n", study.identifiable_parameters,
+                study.seconds_total);
+  out << line;
+}
+
+}  // namespace selfcal::app

@@ -1,0 +1,22 @@
+// JSON and on-screen forms of the pipeline and study reports. mm and degrees only here, with the unit
+// in every key; SI everywhere else.
+#pragma once
+
+#include <ostream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "observations/observation_set.h"
+#include "pipeline/paper_pipeline.h"
+#include "pipeline/study.h"
+
+namespace selfcal::app {
+
+nlohmann::json CalibrationReportJson(const ObservationSet& observations, const pipeline::PaperPipelineReport& report);
+void PrintCalibrationSummary(const pipeline::PaperPipelineReport& report, std::ostream& out);
+
+nlohmann::json StudyJson(const pipeline::StudyReport& study, const pipeline::StudyOptions& options);
+void PrintStudyTables(const pipeline::StudyReport& study, std::ostream& out);
+
+}  // namespace selfcal::app

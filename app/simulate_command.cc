@@ -1,0 +1,191 @@
+// selfcal simulate: a seeded simulated robot with hidden errors, its observations written to a file, the
+// calibration run from that file, and the result compared with the hidden truth.
+// selfcal make-trajectory: writes the smooth "initial" trajectory around the simulated scene.
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+
+#include "app/cli_util.h"
+#include "app/commands.h"
+#include "app/report_format.h"
+#include "io/report_json.h"
+#include "io/observations_file.h"
+#include "io/robot_config.h"
+#include "io/trajectory_file.h"
+#include "sim/sim_world.h"
+#include "sim/trajectory_generator.h"
+
+namespace selfcal::app {
+
+int CalibrateAndWrite(const ObservationSet& obs, const std::string& source_path, const std::string& out_dir,
+                      uint64_t seed, pipeline::PaperPipelineReport* report_out);
+
+namespace {
+
+struct SimulateArgs {
+  std::string robot = "config/robots/puma560.yaml";
+  std::string trajectory = "config/trajectories/initial_puma560.yaml";
+  std::string out = "out/simulate";
+  double noise_px = 0.2;
+  uint64_t seed = 1;
+  bool perturb_gauge = false;
+};
+
+nlohmann::json TruthJson(const sim::SimResult& world) {
+  const KinematicParameters params(world.truth.nominal.num_joints());
+  nlohmann::json rho = nlohmann::json::object();
+  for (int i = 0; i < params.size(); ++i) {
+    const double v = world.truth.rho_true[i];
+    rho[params.name(i) + (params.kind(i) == ParameterKind::kLength ? "_mm" : "_deg")] =
+        params.kind(i) == ParameterKind::kLength ? v * 1e3 : RadToDeg(v);
+  }
+  nlohmann::json dots = nlohmann::json::array();
+  for (const Eigen::Vector3d& p : world.truth.dots_in_base) dots.push_back({p.x() * 1e3, p.y() * 1e3, p.z() * 1e3});
+  return {{"format", "selfcal-sim-truth"},
+          {"version", 1},
+          {"note", "hidden from the solver; rho in the nominal model's parameterisation (corrections for base and cam)"},
+          {"fx_px", world.truth.camera_true.fx_px},
+          {"rho", rho},
+          {"dots_in_base_mm", dots}};
+}
+
+// Calibrated vs true, in the quantities that do not depend on the gauge.
+nlohmann::json CompareWithTruth(const sim::SimResult& world, const ObservationSet& obs,
+                                const pipeline::PaperPipelineReport& report, std::ostream& out) {
+  const RobotModel true_robot = ApplyParameters(world.truth.nominal, world.truth.rho_true);
+  const RobotModel& nominal = world.truth.nominal;
+  const RobotModel& calibrated = report.calibrated_robot;
+  nlohmann::json links = nlohmann::json::array();
+  out << "\nkinematic parameters (free ones), nominal / true / calibrated, error of calibrated:\n";
+  const KinematicParameters params(nominal.num_joints());
+  for (int i = 0; i < nominal.num_joints(); ++i) {
+    const LinkParameters* ls[3] = {&nominal.links[i], &true_robot.links[i], &calibrated.links[i]};
+    for (int k = 0; k < 5; ++k) {
+      const int index = KinematicParameters::JointOffset(i) + k;
+      if (std::count(report.identifiability.free_indices.begin(), report.identifiability.free_indices.end(), index) == 0) {
+        continue;
+      }
+      double v[3];
+      for (int m = 0; m < 3; ++m) {
+        const double raw[5] = {ls[m]->alpha, ls[m]->a, ls[m]->beta, ls[m]->theta, ls[m]->d};
+        v[m] = (k == 1 || k == 4) ? raw[k] * 1e3 : RadToDeg(raw[k]);
+      }
+      out << "  " << std::left << std::setw(10) << params.name(index) << std::right << std::fixed << std::setprecision(4)
+          << std::setw(12) << v[0] << std::setw(12) << v[1] << std::setw(12) << v[2] << "   error " << std::setw(9)
+          << v[2] - v[1] << " " << (k == 1 || k == 4 ? "mm" : "deg") << "\n";
+      links.push_back({{"name", params.name(index)}, {"unit", k == 1 || k == 4 ? "mm" : "deg"}, {"nominal", v[0]},
+                       {"true", v[1]}, {"calibrated", v[2]}, {"error", v[2] - v[1]}});
+    }
+  }
+  const PoseDifference cam_error = ComparePoses(true_robot.flange_from_cam, calibrated.flange_from_cam);
+  const PoseDifference cam_nominal = ComparePoses(true_robot.flange_from_cam, nominal.flange_from_cam);
+  out << "flange_from_cam error: nominal " << cam_nominal.position_m * 1e3 << " mm / "
+      << RadToDeg(cam_nominal.rotation_rad) << " deg, calibrated " << cam_error.position_m * 1e3 << " mm / "
+      << RadToDeg(cam_error.rotation_rad) << " deg (includes what the fixed joint-6 offsets absorb)\n";
+  out << "f_x: nominal " << obs.camera.fx_px << ", true " << world.truth.camera_true.fx_px << ", calibrated "
+      << report.fx_px << " px\n";
+  // Relative poses reference -> verification pose: predicted vs true.
+  const int ref = report.reference_pose;
+  const Eigen::VectorXd rho0 = KinematicParameters::Nominal(nominal);
+  double before = 0, after = 0, before_rot = 0, after_rot = 0;
+  int n = 0;
+  for (int v : obs.PosesWithRole(PoseRole::kVerification)) {
+    const Rigid3 truth_rel = world.truth.base_from_cam[ref].Inverse() * world.truth.base_from_cam[v];
+    const Rigid3 nominal_rel = BaseFromCam(nominal, rho0, obs.poses[ref].joints_rad).Inverse() *
+                               BaseFromCam(nominal, rho0, obs.poses[v].joints_rad);
+    const Rigid3 cal_rel = BaseFromCam(calibrated, report.calibrated_rho, obs.poses[ref].joints_rad).Inverse() *
+                           BaseFromCam(calibrated, report.calibrated_rho, obs.poses[v].joints_rad);
+    const PoseDifference b = ComparePoses(truth_rel, nominal_rel), a = ComparePoses(truth_rel, cal_rel);
+    before += b.position_m;
+    after += a.position_m;
+    before_rot += b.rotation_rad;
+    after_rot += a.rotation_rad;
+    ++n;
+  }
+  if (n > 0) {
+    out << "verification relative poses, mean error: nominal " << before / n * 1e3 << " mm / "
+        << RadToDeg(before_rot / n) << " deg; calibrated " << after / n * 1e3 << " mm / " << RadToDeg(after_rot / n)
+        << " deg\n";
+  }
+  out.unsetf(std::ios::floatfield);
+  return {{"links", links},
+          {"flange_from_cam_error_mm", cam_error.position_m * 1e3},
+          {"flange_from_cam_error_deg", RadToDeg(cam_error.rotation_rad)},
+          {"fx_true_px", world.truth.camera_true.fx_px},
+          {"fx_calibrated_px", report.fx_px},
+          {"verification_pose_error_mean_mm", {{"nominal", n ? before / n * 1e3 : 0}, {"calibrated", n ? after / n * 1e3 : 0}}},
+          {"verification_pose_error_mean_deg", {{"nominal", n ? RadToDeg(before_rot / n) : 0}, {"calibrated", n ? RadToDeg(after_rot / n) : 0}}}};
+}
+
+}  // namespace
+
+Command AddSimulateCommand(CLI::App& app) {
+  auto args = std::make_shared<SimulateArgs>();
+  CLI::App* cmd = app.add_subcommand("simulate", "Simulated robot with hidden errors: observe, calibrate, compare");
+  cmd->add_option("--robot", args->robot, "Nominal robot config");
+  cmd->add_option("--trajectory", args->trajectory, "Trajectory file");
+  cmd->add_option("--out", args->out, "Output directory");
+  cmd->add_option("--noise-px", args->noise_px, "Pixel noise std (px)")->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--seed", args->seed, "World and noise seed");
+  cmd->add_flag("--perturb-gauge", args->perturb_gauge, "Also perturb the parameters the measurements cannot see");
+  return [args]() {
+    Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(args->robot));
+    if (!robot.ok()) return Fail(robot.status());
+    Result<std::vector<Eigen::VectorXd>> joints = io::LoadTrajectory(ResolveDataPath(args->trajectory), robot->num_joints());
+    if (!joints.ok()) return Fail(joints.status());
+    if (Status s = EnsureDirectory(args->out); !s.ok()) return Fail(s);
+    sim::SimOptions options;
+    options.world_seed = options.noise_seed = args->seed;
+    options.pixel_noise_px = args->noise_px;
+    options.perturb_gauge_parameters = args->perturb_gauge;
+    const sim::SimResult world = sim::Simulate(*robot, *joints, options);
+    if (!world.ok) return Fail(Status::Error(ExitCode::kDegenerateData, "simulation: " + world.message));
+    std::cout << "simulated " << world.observations.poses.size() << " poses x " << world.truth.dots_in_base.size()
+              << " dots, pixel noise " << args->noise_px << " px (std), hidden errors: lengths N(0, "
+              << options.length_error_std_m * 1e3 << " mm), angles N(0, " << RadToDeg(options.angle_error_std_rad)
+              << " deg), hand-eye N(0, " << options.cam_length_error_std_m * 1e3 << " mm / "
+              << RadToDeg(options.cam_angle_error_std_rad) << " deg), f_x " << world.truth.camera_true.fx_px
+              << " px (nominal " << options.fx_nominal_px << ")\n";
+    const std::filesystem::path out(args->out);
+    const std::string obs_path = (out / "observations.yaml").string();
+    if (Status s = io::SaveObservations(world.observations, obs_path); !s.ok()) return Fail(s);
+    if (Status s = io::WriteJsonFile(TruthJson(world), (out / "truth.json").string()); !s.ok()) return Fail(s);
+    // Calibrate from the file, as any user's data would be.
+    Result<ObservationSet> obs = io::LoadObservations(obs_path);
+    if (!obs.ok()) return Fail(obs.status());
+    pipeline::PaperPipelineReport report;
+    const int code = CalibrateAndWrite(*obs, obs_path, args->out, args->seed, &report);
+    if (report.calibrated_rho.size() > 0) {
+      const nlohmann::json comparison = CompareWithTruth(world, *obs, report, std::cout);
+      if (Status s = io::WriteJsonFile(comparison, (out / "comparison_with_truth.json").string()); !s.ok()) return Fail(s);
+    }
+    std::cout << "results in " << args->out << "/: observations.yaml, truth.json, report.json"
+              << (code == 0 ? ", calibrated_model.yaml" : "") << ", comparison_with_truth.json\n";
+    return code;
+  };
+}
+
+Command AddMakeTrajectoryCommand(CLI::App& app) {
+  auto robot_path = std::make_shared<std::string>("config/robots/puma560.yaml");
+  auto out_path = std::make_shared<std::string>();
+  auto poses = std::make_shared<int>(25);
+  CLI::App* cmd = app.add_subcommand("make-trajectory", "Write the smooth initial trajectory around the simulated scene");
+  cmd->add_option("--robot", *robot_path, "Robot config");
+  cmd->add_option("--out", *out_path, "Trajectory file to write")->required();
+  cmd->add_option("--poses", *poses, "Number of poses")->check(CLI::Range(3, 1000));
+  return [robot_path, out_path, poses]() {
+    Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(*robot_path));
+    if (!robot.ok()) return Fail(robot.status());
+    sim::ArcTrajectoryOptions options;
+    options.num_poses = *poses;
+    const sim::GeneratedTrajectory t = sim::MakeArcTrajectory(*robot, options);
+    if (!t.ok) return Fail(Status::Error(ExitCode::kDegenerateData, t.message));
+    const std::string description =
+        "smooth arc around the simulated scene (sim::MakeArcTrajectory defaults): the paper's 'initial' trajectory";
+    if (Status s = io::SaveTrajectory(t.joints, *out_path, robot->name, description); !s.ok()) return Fail(s);
+    std::cout << "wrote " << t.joints.size() << " poses to " << *out_path << "\n";
+    return 0;
+  };
+}
+
+}  // namespace selfcal::app

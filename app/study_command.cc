@@ -1,0 +1,68 @@
+// selfcal study: Monte Carlo reproduction of the paper's Table 2 and Fig. 6 (pipeline/study.h).
+#include <iostream>
+
+#include "app/cli_util.h"
+#include "app/commands.h"
+#include "app/report_format.h"
+#include "io/report_json.h"
+#include "io/robot_config.h"
+#include "io/trajectory_file.h"
+
+namespace selfcal::app {
+
+namespace {
+struct StudyArgs {
+  std::string robot = "config/robots/puma560.yaml";
+  std::vector<std::string> trajectories = {"initial=config/trajectories/initial_puma560.yaml"};
+  int runs = 200;
+  std::vector<double> noise = {0.0, 0.2, 0.5};
+  uint64_t seed = 1;
+  std::string out = "out/study.json";
+  bool no_opencv = false;
+  bool no_bound = false;
+};
+}  // namespace
+
+Command AddStudyCommand(CLI::App& app) {
+  auto args = std::make_shared<StudyArgs>();
+  CLI::App* cmd = app.add_subcommand("study", "Monte Carlo: the paper's Table 2 and Fig. 6 on the simulator");
+  cmd->add_option("--robot", args->robot, "Nominal robot config");
+  cmd->add_option("--trajectory", args->trajectories, "NAME=FILE, repeatable");
+  cmd->add_option("--runs", args->runs, "Runs per cell")->check(CLI::Range(1, 100000));
+  cmd->add_option("--noise-px", args->noise, "Pixel noise levels (std, px)")->delimiter(',');
+  cmd->add_option("--seed", args->seed, "Base seed");
+  cmd->add_option("--out", args->out, "JSON output file");
+  cmd->add_flag("--no-opencv", args->no_opencv, "Skip the OpenCV comparison row");
+  cmd->add_flag("--no-bound", args->no_bound, "Skip the Cramer-Rao rows");
+  return [args]() {
+    Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(args->robot));
+    if (!robot.ok()) return Fail(robot.status());
+    std::vector<pipeline::TrajectorySpec> trajectories;
+    for (const std::string& spec : args->trajectories) {
+      const size_t eq = spec.find('=');
+      if (eq == std::string::npos || eq == 0) {
+        return Fail(Status::Error(ExitCode::kUsage, "--trajectory `" + spec + "`: expected NAME=FILE"));
+      }
+      Result<std::vector<Eigen::VectorXd>> joints =
+          io::LoadTrajectory(ResolveDataPath(spec.substr(eq + 1)), robot->num_joints());
+      if (!joints.ok()) return Fail(joints.status());
+      trajectories.push_back({spec.substr(0, eq), *joints});
+    }
+    for (double n : args->noise) {
+      if (!(n >= 0 && n < 10)) return Fail(Status::Error(ExitCode::kUsage, "--noise-px: " + std::to_string(n) + " is not in [0, 10)"));
+    }
+    pipeline::StudyOptions options;
+    options.runs = args->runs;
+    options.noise_levels_px = args->noise;
+    options.seed = args->seed;
+    options.with_opencv = !args->no_opencv;
+    options.with_bound = !args->no_bound;
+    const pipeline::StudyReport study = pipeline::RunStudy(*robot, trajectories, options);
+    PrintStudyTables(study, std::cout);
+    if (Status s = io::WriteJsonFile(StudyJson(study, options), args->out); !s.ok()) return Fail(s);
+    std::cout << "JSON: " << args->out << "\n";
+    return 0;
+  };
+}
+
+}  // namespace selfcal::app

@@ -1,0 +1,57 @@
+// Speed of the numerical core on the simulated PUMA 560: 25 poses x 80 dots (15 identification + 10
+// verification), pixel noise 0.2 px.
+#include <benchmark/benchmark.h>
+
+#include "pipeline/paper_pipeline.h"
+#include "pipeline/study.h"
+#include "sim/sim_world.h"
+#include "sim/trajectory_generator.h"
+#include "support/test_robots.h"
+
+namespace selfcal {
+namespace {
+
+const sim::SimResult& World() {
+  static const sim::SimResult world = [] {
+    const RobotModel puma = testing::Puma560();
+    sim::SimOptions options;
+    options.pixel_noise_px = 0.2;
+    return sim::Simulate(puma, sim::MakeArcTrajectory(puma, sim::ArcTrajectoryOptions()).joints, options);
+  }();
+  return world;
+}
+
+void BM_TwoViewPair80Dots(benchmark::State& state) {
+  const ObservationSet& obs = World().observations;
+  const Matches m = MatchById(obs.poses[0], obs.poses[10]);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(twoview::EstimateTwoView(twoview::TwoViewOptions(), obs.camera, m.pixels_a, m.pixels_b));
+  }
+}
+BENCHMARK(BM_TwoViewPair80Dots)->Unit(benchmark::kMillisecond);
+
+void BM_PaperPipeline25Poses80Dots(benchmark::State& state) {
+  const ObservationSet& obs = World().observations;
+  for (auto _ : state) {
+    const pipeline::PaperPipelineReport report = pipeline::RunPaperPipeline(obs, pipeline::PaperPipelineOptions());
+    if (report.outcome != pipeline::Outcome::kSuccess) state.SkipWithError(report.message.c_str());
+  }
+}
+BENCHMARK(BM_PaperPipeline25Poses80Dots)->Unit(benchmark::kMillisecond);
+
+void BM_Study200Runs(benchmark::State& state) {
+  const RobotModel puma = testing::Puma560();
+  const pipeline::TrajectorySpec trajectory{"initial", sim::MakeArcTrajectory(puma, sim::ArcTrajectoryOptions()).joints};
+  pipeline::StudyOptions options;
+  options.runs = 200;
+  options.noise_levels_px = {0.2};
+  options.with_opencv = state.range(0) != 0;
+  options.with_bound = state.range(0) != 0;
+  for (auto _ : state) benchmark::DoNotOptimize(pipeline::RunStudy(puma, {trajectory}, options));
+}
+BENCHMARK(BM_Study200Runs)->Arg(0)->Arg(1)->ArgName("with_opencv_and_bound")->Iterations(1)->Unit(benchmark::kSecond);
+
+}  // namespace
+}  // namespace selfcal
+
+BENCHMARK_MAIN();

@@ -1,0 +1,132 @@
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "io/observations_file.h"
+#include "io/robot_config.h"
+#include "io/trajectory_file.h"
+#include "sim/trajectory_generator.h"
+
+namespace selfcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Runs the selfcal binary with arguments; returns its exit code, output in *output.
+int RunSelfcal(const std::string& arguments, std::string* output = nullptr) {
+  const fs::path log = fs::temp_directory_path() / ("selfcal_cli_" + std::to_string(::getpid()) + ".log");
+  const std::string command = std::string(SELFCAL_BINARY) + " " + arguments + " > " + log.string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  if (output != nullptr) {
+    std::ifstream in(log);
+    std::stringstream s;
+    s << in.rdbuf();
+    *output = s.str();
+  }
+  fs::remove(log);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+fs::path FreshDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("selfcal_it_" + std::to_string(::getpid()) + "_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+nlohmann::json ReadJson(const fs::path& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+TEST(Cli, SimulateEndToEndThenCalibrateTheSameFileIsDeterministic) {
+  const fs::path dir = FreshDir("simulate");
+  std::string output;
+  ASSERT_EQ(RunSelfcal("simulate --out " + dir.string() + " --seed 3", &output), 0) << output;
+  for (const char* file : {"observations.yaml", "truth.json", "report.json", "calibrated_model.yaml",
+                           "comparison_with_truth.json"}) {
+    EXPECT_TRUE(fs::exists(dir / file)) << file << "\n" << output;
+  }
+  const nlohmann::json first = ReadJson(dir / "report.json");
+  EXPECT_EQ(first["outcome"], "success");
+  EXPECT_TRUE(first["accepted"].get<bool>());
+  // The calibrated model is a robot config selfcal reads back.
+  EXPECT_TRUE(io::LoadRobotModel((dir / "calibrated_model.yaml").string()).ok());
+  // P9/F9: the same observations and seed give the same numbers.
+  const fs::path again = dir / "again";
+  ASSERT_EQ(RunSelfcal("calibrate " + (dir / "observations.yaml").string() + " --seed 3 --out " + again.string(), &output), 0)
+      << output;
+  nlohmann::json second = ReadJson(again / "report.json");
+  nlohmann::json a = first, b = second;
+  for (nlohmann::json* j : {&a, &b}) {
+    j->erase("timing_s");
+    j->erase("input");
+  }
+  EXPECT_EQ(a.dump(), b.dump());
+  fs::remove_all(dir);
+}
+
+TEST(Cli, ConfigErrorsExitWithCode2AndNameTheFile) {
+  const fs::path dir = FreshDir("bad");
+  std::string output;
+  EXPECT_EQ(RunSelfcal("calibrate " + (dir / "missing.yaml").string() + " --out " + dir.string(), &output), 2) << output;
+  EXPECT_NE(output.find("missing.yaml"), std::string::npos) << output;
+  const fs::path bad = dir / "bad.yaml";
+  std::ofstream(bad) << "format: selfcal-observations\nversion: 1\nposez: []\n";
+  EXPECT_EQ(RunSelfcal("calibrate " + bad.string() + " --out " + dir.string(), &output), 2) << output;
+  EXPECT_NE(output.find("bad.yaml"), std::string::npos) << output;
+  EXPECT_EQ(RunSelfcal("calibrate", &output), 2) << output;                  // missing argument
+  EXPECT_EQ(RunSelfcal("no-such-command", &output), 2) << output;
+  EXPECT_EQ(RunSelfcal("study --runs 0", &output), 2) << output;             // out of range
+  fs::remove_all(dir);
+}
+
+TEST(Cli, DegenerateDataExitsWithCode3AndWritesNoModel) {
+  // Keep only four identification poses: three pose measurements are too few.
+  const fs::path dir = FreshDir("degenerate");
+  std::string output;
+  ASSERT_EQ(RunSelfcal("simulate --out " + dir.string(), &output), 0) << output;
+  Result<ObservationSet> obs = io::LoadObservations((dir / "observations.yaml").string());
+  ASSERT_TRUE(obs.ok()) << obs.status().ToString();
+  ObservationSet few = *obs;
+  few.poses.erase(few.poses.begin() + 4, few.poses.begin() + 15);
+  const fs::path few_path = dir / "few.yaml";
+  ASSERT_TRUE(io::SaveObservations(few, few_path.string()).ok());
+  const fs::path out = dir / "few_out";
+  EXPECT_EQ(RunSelfcal("calibrate " + few_path.string() + " --out " + out.string(), &output), 3) << output;
+  EXPECT_TRUE(fs::exists(out / "report.json"));
+  EXPECT_FALSE(fs::exists(out / "calibrated_model.yaml"));
+  EXPECT_FALSE(ReadJson(out / "report.json")["accepted"].get<bool>());
+  fs::remove_all(dir);
+}
+
+TEST(Cli, ShippedInitialTrajectoryIsTheGeneratorsOutput) {
+  Result<RobotModel> puma = io::LoadRobotModel(std::string(SELFCAL_SOURCE_DIR) + "/config/robots/puma560.yaml");
+  ASSERT_TRUE(puma.ok()) << puma.status().ToString();
+  Result<std::vector<Eigen::VectorXd>> shipped =
+      io::LoadTrajectory(std::string(SELFCAL_SOURCE_DIR) + "/config/trajectories/initial_puma560.yaml", 6);
+  ASSERT_TRUE(shipped.ok()) << shipped.status().ToString();
+  const sim::GeneratedTrajectory generated = sim::MakeArcTrajectory(*puma, sim::ArcTrajectoryOptions());
+  ASSERT_TRUE(generated.ok) << generated.message;
+  ASSERT_EQ(shipped->size(), generated.joints.size());
+  for (size_t i = 0; i < generated.joints.size(); ++i) {
+    EXPECT_LT(((*shipped)[i] - generated.joints[i]).cwiseAbs().maxCoeff(), 1e-9) << "pose " << i;
+  }
+}
+
+TEST(Cli, IdentifiabilityNamesTheFixedParameters) {
+  std::string output;
+  ASSERT_EQ(RunSelfcal("identifiability", &output), 0) << output;
+  EXPECT_NE(output.find("metric relative poses"), std::string::npos) << output;
+  EXPECT_NE(output.find("base.tx"), std::string::npos) << output;
+  EXPECT_NE(output.find("j1.theta"), std::string::npos) << output;
+}
+
+}  // namespace
+}  // namespace selfcal
