@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "observations/observation_set.h"
+#include "pipeline/bound_sweep.h"
 #include "pipeline/paper_pipeline.h"
 #include "pipeline/study.h"
 
@@ -18,5 +19,8 @@ void PrintCalibrationSummary(const pipeline::PaperPipelineReport& report, std::o
 
 nlohmann::json StudyJson(const pipeline::StudyReport& study, const pipeline::StudyOptions& options);
 void PrintStudyTables(const pipeline::StudyReport& study, std::ostream& out);
+
+nlohmann::json BoundSweepJson(const std::vector<pipeline::BoundPoint>& sweep);
+void PrintBoundSweep(const std::vector<pipeline::BoundPoint>& sweep, std::ostream& out);
 
 }  // namespace selfcal::app

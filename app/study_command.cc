@@ -20,6 +20,7 @@ struct StudyArgs {
   std::string out = "out/study.json";
   bool no_opencv = false;
   bool no_bound = false;
+  bool bound_sweep = false;
 };
 }  // namespace
 
@@ -34,6 +35,8 @@ Command AddStudyCommand(CLI::App& app) {
   cmd->add_option("--out", args->out, "JSON output file");
   cmd->add_flag("--no-opencv", args->no_opencv, "Skip the OpenCV comparison row");
   cmd->add_flag("--no-bound", args->no_bound, "Skip the Cramer-Rao rows");
+  cmd->add_flag("--bound-sweep", args->bound_sweep,
+                "Also sweep the two-view Cramer-Rao bound over field of view, depth spread and baseline");
   return [args]() {
     Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(args->robot));
     if (!robot.ok()) return Fail(robot.status());
@@ -59,7 +62,17 @@ Command AddStudyCommand(CLI::App& app) {
     options.with_bound = !args->no_bound;
     const pipeline::StudyReport study = pipeline::RunStudy(*robot, trajectories, options);
     PrintStudyTables(study, std::cout);
-    if (Status s = io::WriteJsonFile(StudyJson(study, options), args->out); !s.ok()) return Fail(s);
+    nlohmann::json json = StudyJson(study, options);
+    if (args->bound_sweep) {
+      for (double noise : args->noise) {
+        if (noise <= 0) continue;
+        const std::vector<pipeline::BoundPoint> sweep =
+            pipeline::SweepTwoViewBound(pipeline::DefaultBoundGrid(noise), args->seed);
+        PrintBoundSweep(sweep, std::cout);
+        json["bound_sweep"].push_back(BoundSweepJson(sweep));
+      }
+    }
+    if (Status s = io::WriteJsonFile(json, args->out); !s.ok()) return Fail(s);
     std::cout << "JSON: " << args->out << "\n";
     return 0;
   };

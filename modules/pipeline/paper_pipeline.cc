@@ -200,8 +200,23 @@ PaperPipelineReport RunPaperPipeline(const ObservationSet& obs, const PaperPipel
     report.message = "no kinematic parameter is identifiable from these poses";
     return report;
   }
+  identification::IdentificationOptions id_options = options.identification;
   report.identification = identification::IdentifyFromRelativePoses(
-      robot, rho_nominal, report.identifiability.free_indices, joints, ref_in_joints, relative, options.identification);
+      robot, rho_nominal, report.identifiability.free_indices, joints, ref_in_joints, relative, id_options);
+  for (int round = 0; round < options.reweighting_rounds; ++round) {
+    const identification::IdentificationReport& last = report.identification;
+    if (last.outcome != identification::Outcome::kConverged || !(last.rms_position_m > 0) ||
+        !(last.rms_rotation_rad > 0)) {
+      break;
+    }
+    // Floors keep noise-free data from driving a weight to infinity.
+    id_options.sigma_position_m = std::max(last.rms_position_m, 1e-9);
+    id_options.sigma_rotation_rad = std::max(last.rms_rotation_rad, 1e-12);
+    identification::IdentificationReport reweighted = identification::IdentifyFromRelativePoses(
+        robot, rho_nominal, report.identifiability.free_indices, joints, ref_in_joints, relative, id_options);
+    if (reweighted.outcome != identification::Outcome::kConverged) break;  // keep the converged solve
+    report.identification = std::move(reweighted);
+  }
   report.seconds_identification = SecondsSince(start_identification);
   if (report.identification.outcome == identification::Outcome::kFailure ||
       report.identification.outcome == identification::Outcome::kInvalidInput) {

@@ -36,7 +36,12 @@ struct PaperPipelineOptions {
   identification::IdentificationOptions identification;
   identification::IdentifiabilityOptions identifiability;
   double yardstick_max_relative_sigma = 0.05;
-  int min_pose_measurements = 6;  // 6m > n: the paper's section 4.2 count, checked again by the rank
+  int min_pose_measurements = 6;
+  // Variance-component re-weighting: after a solve, the position and rotation weights are set to the
+  // residual RMS of each kind and the solve repeated (0 = the fixed weights of `identification`). The
+  // factor method's rotations and translations have very different accuracies from one setup to the next,
+  // so fixed weights would let the worse kind dominate.
+  int reweighting_rounds = 2;  // 6m > n: the paper's section 4.2 count, checked again by the rank
 };
 
 // One measured relative pose (reference -> pose), the factor method's output and the eq. (21) scale.
