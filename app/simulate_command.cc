@@ -169,15 +169,19 @@ Command AddMakeTrajectoryCommand(CLI::App& app) {
   auto robot_path = std::make_shared<std::string>("config/robots/puma560.yaml");
   auto out_path = std::make_shared<std::string>();
   auto poses = std::make_shared<int>(25);
+  auto home_deg = std::make_shared<std::vector<double>>(sim::ArcTrajectoryOptions().home_joints_deg);
   CLI::App* cmd = app.add_subcommand("make-trajectory", "Write the smooth initial trajectory around the simulated scene");
   cmd->add_option("--robot", *robot_path, "Robot config");
   cmd->add_option("--out", *out_path, "Trajectory file to write")->required();
   cmd->add_option("--poses", *poses, "Number of poses")->check(CLI::Range(3, 1000));
-  return [robot_path, out_path, poses]() {
+  cmd->add_option("--home-deg", *home_deg, "Joint angles (deg, comma-separated) where the camera looks at the scene")
+      ->delimiter(',');
+  return [robot_path, out_path, poses, home_deg]() {
     Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(*robot_path));
     if (!robot.ok()) return Fail(robot.status());
     sim::ArcTrajectoryOptions options;
     options.num_poses = *poses;
+    options.home_joints_deg = *home_deg;
     const sim::GeneratedTrajectory t = sim::MakeArcTrajectory(*robot, options);
     if (!t.ok) return Fail(Status::Error(ExitCode::kDegenerateData, t.message));
     const std::string description =

@@ -21,7 +21,7 @@ struct RelativePoseMeasurement {
 struct IdentificationOptions {
   double sigma_position_m = 1e-3;      // residual weights (and the a-priori measurement std)
   double sigma_rotation_rad = 1e-4;
-  int max_iterations = 100;
+  int max_iterations = 200;  // the UR5e-class arm needs up to ~90 from the nominal start
   double function_tolerance = 1e-15;
   double gradient_tolerance = 1e-15;
   double parameter_tolerance = 1e-15;

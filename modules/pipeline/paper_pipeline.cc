@@ -117,6 +117,24 @@ PaperPipelineReport RunPaperPipeline(const ObservationSet& obs, const PaperPipel
   report.reference_pose = ref;
   const Rigid3 nominal_ref_from_base = BaseFromCam(robot, rho_nominal, obs.poses[ref].joints_rad).Inverse();
 
+  // K3: excitation is a property of the joint angles alone: check it before any image is used.
+  {
+    std::vector<Eigen::VectorXd> all_joints;
+    for (int i : id_poses) all_joints.push_back(obs.poses[i].joints_rad);
+    const identification::IdentifiabilityReport excitation =
+        identification::AnalyzeIdentifiability(robot, rho_nominal, all_joints, 0, options.identifiability);
+    if (!(excitation.condition_number <= options.max_condition_number)) {
+      report.identifiability = excitation;
+      report.outcome = Outcome::kDegenerate;
+      std::ostringstream msg;
+      msg << "insufficient excitation (K3): the identification poses give a condition number of "
+          << excitation.condition_number << " (limit " << options.max_condition_number
+          << "); move the joints further apart between poses";
+      report.message = msg.str();
+      return report;
+    }
+  }
+
   // Step 2: the factor method on each pair (reference, i), eq. (21) for the scales.
   const auto start_two_view = Clock::now();
   double fx_sum = 0;

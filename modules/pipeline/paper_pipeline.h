@@ -37,6 +37,9 @@ struct PaperPipelineOptions {
   identification::IdentifiabilityOptions identifiability;
   double yardstick_max_relative_sigma = 0.05;
   int min_pose_measurements = 6;
+  // K3: refuse (kDegenerate, "insufficient excitation") when the column-normalised identification
+  // Jacobian of the identification poses is worse conditioned than this, before any image is processed.
+  double max_condition_number = 1e4;
   // Variance-component re-weighting: after a solve, the position and rotation weights are set to the
   // residual RMS of each kind and the solve repeated (0 = the fixed weights of `identification`). The
   // factor method's rotations and translations have very different accuracies from one setup to the next,
