@@ -281,12 +281,12 @@ void PrintBoundSweep(const std::vector<pipeline::BoundPoint>& sweep, std::ostrea
                 "optimal: 1.07e-4 rad, 0.28 mm, 0.15 px at noise I\n",
                 sweep.front().setup.num_points, sweep.front().setup.sigma_px, sweep.front().setup.depth_m * kMm);
   out << line;
-  std::snprintf(line, sizeof(line), "%7s %7s %7s %9s | %12s %10s %8s | %12s %10s\n", "fx px", "FOV deg", "spread",
-                "base mm", "ori e-4 (f?)", "pos mm", "fx px", "ori e-4 (f)", "pos mm");
+  std::snprintf(line, sizeof(line), "%7s %7s %7s %9s %6s | %12s %10s %8s | %12s %10s\n", "fx px", "FOV deg", "spread",
+                "base mm", "dots", "ori e-4 (f?)", "pos mm", "fx px", "ori e-4 (f)", "pos mm");
   out << line;
   for (const pipeline::BoundPoint& p : sweep) {
-    std::snprintf(line, sizeof(line), "%7.0f %7.1f %7.2f %9.0f | %12.3f %10.4f %8.3f | %12.3f %10.4f%s\n",
-                  p.setup.fx_px, p.horizontal_fov_deg, p.setup.depth_spread_ratio, p.baseline_m * kMm,
+    std::snprintf(line, sizeof(line), "%7.0f %7.1f %7.2f %9.0f %6d | %12.3f %10.4f %8.3f | %12.3f %10.4f%s\n",
+                  p.setup.fx_px, p.horizontal_fov_deg, p.setup.depth_spread_ratio, p.baseline_m * kMm, p.setup.num_points,
                   p.orientation_rad_fx_unknown * 1e4, p.position_m_fx_unknown * kMm, p.fx_px,
                   p.orientation_rad_fx_known * 1e4, p.position_m_fx_known * kMm,
                   p.ok_fx_unknown ? "" : "  (f_x unobservable)");

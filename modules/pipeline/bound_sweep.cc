@@ -22,6 +22,26 @@ std::vector<BoundSetup> DefaultBoundGrid(double sigma_px) {
       }
     }
   }
+  // Beyond the grid: a 94 deg lens, and more dots (the bound falls as 1/sqrt(N)) on the best setup.
+  for (double fx : {300.0}) {
+    for (double baseline : {0.3, 1.0}) {
+      BoundSetup s;
+      s.fx_px = fx;
+      s.depth_spread_ratio = 0.7;
+      s.baseline_ratio = baseline;
+      s.sigma_px = sigma_px;
+      grid.push_back(s);
+    }
+  }
+  for (int n : {800, 8000}) {
+    BoundSetup s;
+    s.fx_px = 500;
+    s.depth_spread_ratio = 0.7;
+    s.baseline_ratio = 0.3;
+    s.num_points = n;
+    s.sigma_px = sigma_px;
+    grid.push_back(s);
+  }
   return grid;
 }
 
@@ -49,7 +69,7 @@ std::vector<BoundPoint> SweepTwoViewBound(const std::vector<BoundSetup>& setups,
     std::uniform_real_distribution<double> unit(-1.0, 1.0);
     std::vector<Eigen::Vector3d> points;
     const double half_u = 0.4 * camera.width_px / setup.fx_px, half_v = 0.4 * camera.height_px / setup.fx_px;
-    for (int tries = 0; tries < 100000 && static_cast<int>(points.size()) < setup.num_points; ++tries) {
+    for (int tries = 0; tries < 100 * setup.num_points + 100000 && static_cast<int>(points.size()) < setup.num_points; ++tries) {
       const double depth = z * (1.0 + 0.5 * setup.depth_spread_ratio * unit(rng));
       const Eigen::Vector3d p(depth * half_u * unit(rng), depth * half_v * unit(rng), depth);
       const auto uv = Project(camera, cam2_from_cam1 * p);

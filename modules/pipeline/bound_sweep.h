@@ -35,7 +35,8 @@ struct BoundPoint {
 
 std::vector<BoundPoint> SweepTwoViewBound(const std::vector<BoundSetup>& setups, uint64_t seed);
 
-// The default grid: fx {500, 1000, 2000, 4000} x spread {0.05, 0.3, 0.7} x baseline {0.1, 0.3, 0.6, 1.0}.
+// The default grid: fx {500, 1000, 2000, 4000} x spread {0.05, 0.3, 0.7} x baseline {0.1, 0.3, 0.6, 1.0},
+// then fx 300 (94 deg) at spread 0.7, baseline 0.3 and 1.0, and 800 and 8000 dots at fx 500, spread 0.7, 0.3.
 std::vector<BoundSetup> DefaultBoundGrid(double sigma_px);
 
 }  // namespace selfcal::pipeline

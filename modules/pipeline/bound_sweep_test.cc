@@ -1,5 +1,7 @@
 #include "pipeline/bound_sweep.h"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 namespace selfcal::pipeline {
@@ -28,9 +30,21 @@ TEST(BoundSweep, NarrowerFieldOfViewWeakensTheRotationBound) {
   EXPECT_NEAR(r[0].horizontal_fov_deg, 65.24, 0.01);
 }
 
+TEST(BoundSweep, TenTimesTheDotsDivideTheBoundBySqrtTen) {
+  BoundSetup few, many;
+  many.num_points = 800;
+  const std::vector<BoundPoint> r = SweepTwoViewBound({few, many}, 3);
+  ASSERT_TRUE(r[0].ok_fx_known && r[1].ok_fx_known);
+  // The 800 dots include the 80 (same seed) plus 720 more of the same distribution, so the ratio is only
+  // about sqrt(10) = 3.16 (seed 3 gives 4.18: the extra dots happen to reach further out).
+  const double ratio = r[0].orientation_rad_fx_known / r[1].orientation_rad_fx_known;
+  EXPECT_GT(ratio, 2.5);
+  EXPECT_LT(ratio, 4.5);
+}
+
 TEST(BoundSweep, DefaultGridIsComplete) {
   const std::vector<BoundSetup> grid = DefaultBoundGrid(0.2);
-  EXPECT_EQ(grid.size(), 48u);
+  EXPECT_EQ(grid.size(), 52u);
   for (const BoundPoint& p : SweepTwoViewBound(grid, 1)) EXPECT_TRUE(p.ok_fx_known) << p.setup.fx_px;
 }
 
