@@ -60,6 +60,9 @@ nlohmann::json CalibrationReportJson(const ObservationSet& obs, const pipeline::
                             {"inliers", m.two_view.num_inliers},
                             {"rms_epipolar_px", m.two_view.rms_epipolar_px},
                             {"eq21_scale_mm", m.scale * kMm},
+                            {"fx_from_other_pairs", m.fx_from_other_pairs},
+                            {"far_point_fraction", m.two_view.far_point_fraction},
+                            {"warnings", m.two_view.warnings},
                             {"refinement", m.two_view.refinement_termination}});
   }
   j["pose_measurements"] = measurements;

@@ -1,5 +1,6 @@
 // Task-level two-view estimator: the policy that joins RANSAC, model selection (G4), the pure-rotation
-// check (G3), the factor method with cheirality (G5) and the refinement (G9).
+// check (G3), the factor method with cheirality (G5), the refinement (G9), the far-point check (G6) and
+// the diagnostics on the final residuals (G10).
 #include "twoview/two_view.h"
 
 #include <algorithm>
@@ -29,6 +30,8 @@ const char* OutcomeName(Outcome outcome) {
       return "degenerate";
     case Outcome::kPureRotation:
       return "pure_rotation";
+    case Outcome::kLowDepthVariation:
+      return "low_depth_variation";
     case Outcome::kAmbiguousPose:
       return "ambiguous_pose";
     case Outcome::kTooManyOutliers:
@@ -58,6 +61,9 @@ std::string TwoViewOptions::Validate() const {
   if (!(min_parallax_deg >= 0 && min_parallax_deg < 90)) {
     out << "min_parallax_deg = " << min_parallax_deg << " must lie in [0, 90)\n";
   }
+  if (!(max_far_point_fraction >= 0 && max_far_point_fraction <= 1)) {
+    out << "max_far_point_fraction = " << max_far_point_fraction << " must lie in [0, 1]\n";
+  }
   if (!(focal_observability_min >= 0 && focal_observability_min < 1)) {
     out << "focal_observability_min = " << focal_observability_min << " must lie in [0, 1)\n";
   }
@@ -86,6 +92,63 @@ constexpr int kRefutingBehindMin = 3;
 // A focal this far from the prior is a symptom of near-degenerate geometry, not a lens: a linear one is
 // replaced by the prior as the refinement's start, a refined one counts as a diverged refinement (G9).
 constexpr double kMaxFocalRatio = 10.0;
+
+// G10, inlier ratio: at the noise a RANSAC threshold is chosen for (sigma at most half of it) a correct
+// model keeps about 95 % of clean correspondences, so fewer than 80 % means mismatches or a model that
+// does not fit, such as wrong intrinsics.
+constexpr double kWarnInlierRatio = 0.8;
+// G10, radial distortion (internal::ScoreRadialDistortion). The test runs on the correspondences within
+// kRadialTestGate times the RANSAC threshold of the final model, not on the inliers only: the outermost
+// points, which carry most of a distortion's signature, are the first the RANSAC gate drops, while 3x
+// still keeps out gross mismatches. A warning needs
+//  - |z| > kRadialTestMinZ (two-sided p = 5e-4 for a Gaussian z). Measured at 0.5 px over 1000 seeded
+//    scenes per layout (two_view_test.cc, DISABLED_G10RadialWarningStudy), the 80 points within
+//    r < 260 px / filling the image (r < 400 px): clean 0 / 1 warnings, with 10 % random mismatches
+//    0 / 2, with 40 % 7 / 1. With k1 = -0.15 left uncorrected: 117 / 299 of 300 warned. Near the
+//    centre the distortion moves a point at most 2.6 px and f_x and the pose absorb most of it, so
+//    the test has little power there; over the whole image it is reliable;
+//  - the implied displacement at the outermost point, |k1| r^3 / f_x^2, of at least
+//    kRadialTestMinDisplacement times the RANSAC threshold: a distortion too small to matter at the
+//    noise the threshold is set for is not worth a warning, and exact data (residuals that are
+//    rounding errors with any z) stay quiet;
+//  - at least kRadialTestMinPoints points, so that the t statistic is close to Gaussian.
+constexpr double kRadialTestGate = 3.0;
+constexpr double kRadialTestMinZ = 3.5;
+constexpr double kRadialTestMinDisplacement = 0.25;
+constexpr int kRadialTestMinPoints = 30;
+
+void WarnIfFewInliers(int num_inliers, int n, TwoViewReport* report) {
+  const double ratio = n > 0 ? static_cast<double>(num_inliers) / n : 0;
+  if (ratio >= kWarnInlierRatio) return;
+  std::ostringstream m;
+  m << "inlier ratio " << ratio << ": outliers or wrong intrinsics (" << num_inliers << " of " << n
+    << " correspondences fit the final model, below " << kWarnInlierRatio << "; G10)";
+  report->warnings.push_back(m.str());
+}
+
+void WarnIfRadialDistortion(const TwoViewOptions& options, const CameraIntrinsics& camera, double fx_px,
+                            const Rigid3& cam2_from_cam1, const Correspondences& data, TwoViewReport* report) {
+  const Eigen::Matrix3d f_px =
+      internal::FundamentalToPixels(camera, internal::FundamentalFromPose(fx_px, cam2_from_cam1));
+  const double gate_px = kRadialTestGate * options.ransac_threshold_px;
+  std::vector<int> tested;
+  for (int i = 0; i < data.size(); ++i) {
+    if (internal::SampsonSquared(f_px, data.pixels1[i], data.pixels2[i]) <= gate_px * gate_px) tested.push_back(i);
+  }
+  if (static_cast<int>(tested.size()) < kRadialTestMinPoints) return;
+  const internal::RadialDistortionScore score =
+      internal::ScoreRadialDistortion(camera, fx_px, cam2_from_cam1, data, tested);
+  if (!score.observable || !(std::abs(score.z) > kRadialTestMinZ) ||
+      !(score.max_displacement_px >= kRadialTestMinDisplacement * options.ransac_threshold_px)) {
+    return;
+  }
+  std::ostringstream m;
+  m << "intrinsics/distortion suspect: residuals grow with radius (a radial term k1 = " << score.k1
+    << " explains them with z = " << score.z << ", |z| > " << kRadialTestMinZ << ", over " << score.n
+    << " correspondences within " << gate_px << " px; it moves the outermost point by " << score.max_displacement_px
+    << " px; G10)";
+  report->warnings.push_back(m.str());
+}
 
 std::vector<int> IndicesOf(const std::vector<bool>& mask) {
   std::vector<int> out;
@@ -288,10 +351,15 @@ TwoViewReport EstimateTwoView(const TwoViewOptions& options, const CameraIntrins
   report.inliers = chosen.inliers;
   report.num_inliers = chosen.num_inliers;
   std::vector<int> inliers = IndicesOf(chosen.inliers);
+  // Every outcome from here on has a final inlier set, so G10's inlier-ratio check applies to all.
+  auto finish = [&](Outcome outcome, const std::string& message) {
+    WarnIfFewInliers(report.num_inliers, n, &report);
+    return Finish(report, outcome, message);
+  };
   if (chosen.num_inliers < options.min_points) {
     std::ostringstream m;
     m << chosen.num_inliers << " inliers, at least " << options.min_points << " needed (G1)";
-    return Finish(report, Outcome::kTooFewPoints, m.str());
+    return finish(Outcome::kTooFewPoints, m.str());
   }
 
   // ---- f_x: Bougnoux from Q when the geometry observes it, else the prior ----
@@ -371,14 +439,14 @@ TwoViewReport EstimateTwoView(const TwoViewOptions& options, const CameraIntrins
     report.fx_observable = false;  // f_x is not estimated when a rotation explains the pair
     report.fx_px = camera.fx_px;
     report.fx_linear_px = 0;
-    return Finish(report, Outcome::kPureRotation,
+    return finish(Outcome::kPureRotation,
                   "rotation only: a rotation alone explains the inliers within the noise gate, translation "
                   "unobservable (G3); " +
                       summary.str());
   }
   if (candidates.empty()) {
-    return Finish(
-        report, Outcome::kDegenerate,
+    return finish(
+        Outcome::kDegenerate,
         "the homography decomposes with no translation, yet no rotation explains the inliers; " + summary.str());
   }
   Rigid3 pose = candidates[choice.best];
@@ -389,7 +457,7 @@ TwoViewReport EstimateTwoView(const TwoViewOptions& options, const CameraIntrins
     m << "no clear cheirality winner: best candidate has " << choice.best_in_front << " points in front ("
       << choice.best_behind << " clearly behind), strongest rival " << choice.runner_up_in_front << " ("
       << choice.runner_up_behind << ") (G5); " << summary.str();
-    return Finish(report, Outcome::kAmbiguousPose, m.str());
+    return finish(Outcome::kAmbiguousPose, m.str());
   }
   report.translation_observable = true;
 
@@ -445,16 +513,33 @@ TwoViewReport EstimateTwoView(const TwoViewOptions& options, const CameraIntrins
   report.translation_direction = pose.translation.normalized();
   report.rms_epipolar_px = internal::RmsSymmetricEpipolarPx(camera, fx, pose, data, inliers);
   const double parallax_deg = RadToDeg(MedianParallaxRad(pose.rotation, n1, n2, inliers));
-  summary << "; median parallax " << parallax_deg << " deg; " << refinement_note;
+  report.far_point_fraction = internal::FarPointFraction(pose, n1, n2, inliers);
+  WarnIfRadialDistortion(options, camera, fx, pose, data, &report);
+  summary << "; median parallax " << parallax_deg << " deg, " << 100 * report.far_point_fraction
+          << " % of inliers farther than " << internal::kFarDepthBaselines << " baselines; " << refinement_note;
+  // G3 (b) before G6: pure-rotation detection has priority. A point farther than 50 baselines has a
+  // triangulation angle below 1/50 rad (1.15 deg), so when more than half of the inliers are far the
+  // median parallax is below 1.15 deg too: with the default min_parallax_deg of 1, G6 is left the pairs
+  // in the 1-1.15 deg band (near points and noise can put them there), and everything once
+  // min_parallax_deg is lowered. In both the rotation stands and the direction of t is too weakly
+  // determined to hand out.
   if (outcome == Outcome::kSuccess && parallax_deg < options.min_parallax_deg) {
-    // G3 (b): the rotation stands, the direction of t is too weakly determined to hand out.
     report.translation_observable = false;
     report.translation_direction.setZero();
-    return Finish(report, Outcome::kPureRotation,
-                  "rotation only: median parallax below " + std::to_string(options.min_parallax_deg) +
-                      " deg, translation unobservable (G3); " + summary.str());
+    return finish(Outcome::kPureRotation, "rotation only: median parallax below " +
+                                              std::to_string(options.min_parallax_deg) +
+                                              " deg, translation unobservable (G3); " + summary.str());
   }
-  return Finish(report, outcome, summary.str());
+  if (outcome == Outcome::kSuccess && report.far_point_fraction > options.max_far_point_fraction) {
+    report.translation_observable = false;
+    report.translation_direction.setZero();
+    std::ostringstream m;
+    m << "low depth variation: " << 100 * report.far_point_fraction << " % of the inliers lie farther than "
+      << internal::kFarDepthBaselines << " baselines (limit " << 100 * options.max_far_point_fraction
+      << " %), translation direction unreliable (G6); " << summary.str();
+    return finish(Outcome::kLowDepthVariation, m.str());
+  }
+  return finish(outcome, summary.str());
 }
 
 }  // namespace selfcal::twoview

@@ -24,13 +24,14 @@ namespace selfcal::twoview {
 enum class Outcome {
   kNotRun,
   kSuccess,
-  kInvalidInput,      // size mismatch, non-finite pixel (D7)
-  kTooFewPoints,      // G1: fewer than options.min_points correspondences (or inliers)
-  kDegenerate,        // rank-deficient design (collinear points, identical images, ...)
-  kPureRotation,      // G3: R valid, translation unobservable (translation_observable = false)
-  kAmbiguousPose,     // G5: no clear cheirality winner
-  kTooManyOutliers,   // G7: inlier ratio below the floor
-  kNoConvergence,     // G9: refinement failed; the linear estimate is kept and flagged
+  kInvalidInput,       // size mismatch, non-finite pixel (D7)
+  kTooFewPoints,       // G1: fewer than options.min_points correspondences (or inliers)
+  kDegenerate,         // rank-deficient design (collinear points, identical images, ...)
+  kPureRotation,       // G3: R valid, translation unobservable (translation_observable = false)
+  kLowDepthVariation,  // G6: most points farther than 50 baselines: translation direction unreliable
+  kAmbiguousPose,      // G5: no clear cheirality winner
+  kTooManyOutliers,    // G7: inlier ratio below the floor
+  kNoConvergence,      // G9: refinement failed; the linear estimate is kept and flagged
 };
 const char* OutcomeName(Outcome outcome);
 
@@ -44,6 +45,11 @@ struct TwoViewOptions {
   double min_inlier_ratio = 0.3;       // G7
   double planar_homography_ratio = 0.45;  // G4: R_H = S_H / (S_H + S_F) above this -> homography path
   double min_parallax_deg = 1.0;       // G3: median parallax below this -> pure rotation
+  // G6: fraction of inliers triangulated farther than 50 baselines above this -> kLowDepthVariation.
+  // A point that far has a triangulation angle below 1/50 rad (1.15 deg), so with the default
+  // min_parallax_deg the G3 test, which is checked first, usually catches such a pair already; this
+  // one matters when min_parallax_deg is lowered.
+  double max_far_point_fraction = 0.5;
   double focal_observability_min = 0.05;  // see FocalFromFundamental
   int max_refine_iterations = 100;
   uint64_t seed = 1;                   // RANSAC sampling (P9: deterministic)
@@ -73,6 +79,21 @@ struct TwoViewReport {
   bool refinement_accepted = false;  // G9: only if cost decreased and result finite
   std::string refinement_termination;
   int refinement_iterations = 0;
+
+  // G6: fraction of the final inliers that triangulate farther than 50 baselines (|t| = 1) along either
+  // camera's axis, on either side (a far point's depth sign is noise): OpenCV recoverPose's
+  // distanceThresh rule. Computed whenever a full pose was estimated (kSuccess, kNoConvergence,
+  // kPureRotation by the parallax test, kLowDepthVariation); 0 otherwise.
+  double far_point_fraction = 0;
+
+  // G10: diagnostics that do not change the outcome, one sentence each:
+  //  - "inlier ratio X: outliers or wrong intrinsics" when fewer than 80 % of the correspondences are
+  //    final inliers (any outcome that got as far as choosing a model, except kTooManyOutliers);
+  //  - "intrinsics/distortion suspect: residuals grow with radius (...)" when a radial distortion term
+  //    k1 (camera.h's model) explains the signed epipolar residuals of the final model significantly
+  //    better than f_x and the pose alone (a score test; statistic and thresholds in two_view.cc),
+  //    checked whenever a full pose was estimated and >= 30 correspondences lie near the model.
+  std::vector<std::string> warnings;
 
   Rigid3 cam2_from_cam1() const { return Rigid3(rotation, translation_direction); }
 };
@@ -112,6 +133,10 @@ double SymmetricEpipolarDistance(const Eigen::Matrix3d& f, const Eigen::Vector2d
 
 // OpenCV's findEssentialMat (RANSAC, threshold options.ransac_threshold_px) + recoverPose with the
 // true f_x (camera.fx_px): the comparison row of the study. Outcome kSuccess or a failure outcome.
+// Should OpenCV return several stacked solutions (G2), each 3x3 candidate is scored by its own inliers
+// in front of both cameras and one is chosen explicitly. Inliers are OpenCV's RANSAC inliers that are
+// also within the threshold of the chosen E by our own Sampson distance (G8) and pass recoverPose's
+// cheirality and 50-baseline test. far_point_fraction and warnings are not filled.
 TwoViewReport EstimateTwoViewOpenCv(const TwoViewOptions& options, const CameraIntrinsics& camera,
                                     const std::vector<Eigen::Vector2d>& pixels1,
                                     const std::vector<Eigen::Vector2d>& pixels2);

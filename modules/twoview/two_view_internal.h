@@ -149,6 +149,62 @@ RefineResult RefineEpipolar(const CameraIntrinsics& camera, const Correspondence
                             bool refine_focal, int max_iterations, double huber_px, double min_focal_px,
                             double max_focal_px);
 
+// ---- Diagnostics (G6, G10) ----------------------------------------------------------------------
+
+// G6, OpenCV recoverPose's distanceThresh: with |t| = 1 depths are in baselines, and a point deeper than
+// this along either camera's axis counts as far.
+constexpr double kFarDepthBaselines = 50.0;
+
+// Fraction of the listed correspondences (normalised coordinates) whose (midpoint) triangulation lies
+// at least kFarDepthBaselines * |t| deep in either camera, in front or behind (for such a point the sign
+// of the depth is noise), or at infinity. 0 for an empty list.
+double FarPointFraction(const Rigid3& cam2_from_cam1, const std::vector<Eigen::Vector2d>& n1,
+                        const std::vector<Eigen::Vector2d>& n2, const std::vector<int>& indices);
+
+// G10: score test of a radial distortion k1 = 0 against k1 != 0 (x_d = x (1 + k1 r^2) on normalised
+// coordinates, as camera.h), given the fitted f_x and pose. The signed Sampson distances (raw px) of
+// the listed correspondences are regressed on their derivative with respect to k1 after projecting out
+// their derivatives with respect to 1/f_x, R and the direction of t (central differences): the
+// t statistic z of that regression is about N(0, 1) without distortion, whatever the pose, and k1 is
+// the Gauss-Newton estimate. This looks at the signed residuals, whose pattern a radial term fixes,
+// where |residual| against r^2 does not: f_x and the pose absorb most of a radial distortion, and
+// what is left is comparable to the noise in magnitude yet coherent in sign.
+struct RadialDistortionScore {
+  int n = 0;
+  bool observable = false;         // k1 is not a combination of f_x and pose changes here
+  double k1 = 0;                   // one Gauss-Newton step from 0, camera.h's convention
+  double z = 0;                    // k1 over its standard error (t with n - 7 degrees of freedom)
+  double max_displacement_px = 0;  // |k1| r^3 / f_x^2 at the outermost listed point
+};
+RadialDistortionScore ScoreRadialDistortion(const CameraIntrinsics& camera, double fx_px, const Rigid3& cam2_from_cam1,
+                                            const Correspondences& data, const std::vector<int>& indices);
+
+// ---- OpenCV reference (G2) -------------------------------------------------------------------------
+
+// G2: OpenCV's 5-point solver stacks its up to 10 solutions into one 3N x 3 matrix, and recoverPose
+// asserts on anything but 3 x 3. This scores each 3 x 3 block of `stacked` (essential matrices for
+// known f = camera.fx_px, normalised coordinates) and chooses one explicitly:
+//   inliers: correspondences allowed by `mask` (empty: all) whose Sampson distance (raw px) to the
+//            candidate is within threshold_px, recomputed here rather than trusted (G8);
+//   good:    those of its inliers that cv::recoverPose puts in front of both cameras (and nearer than
+//            50 baselines) for its best decomposition.
+// The candidate with the most good points wins; ties keep the first. Non-finite or zero blocks are
+// skipped. index = -1 with a message when stacked is empty, not 3N x 3 or no candidate has a good point.
+struct EssentialChoice {
+  int index = -1;
+  int num_candidates = 0;
+  std::vector<int> num_inliers;                            // per candidate (0 for a skipped one)
+  std::vector<int> num_good;                               // per candidate
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // of the winner, cam2_from_cam1
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();   // unit
+  std::vector<bool> good;                                  // per correspondence, the winner's good points
+  std::string message;
+};
+EssentialChoice ChooseEssentialCandidate(const Eigen::MatrixXd& stacked, const CameraIntrinsics& camera,
+                                         const std::vector<Eigen::Vector2d>& pixels1,
+                                         const std::vector<Eigen::Vector2d>& pixels2, const std::vector<bool>& mask,
+                                         double threshold_px);
+
 // Sets the outcome and message of a report and returns it.
 inline TwoViewReport Finish(TwoViewReport report, Outcome outcome, const std::string& message) {
   report.outcome = outcome;

@@ -6,8 +6,11 @@
 #include <iostream>
 #include <limits>
 #include <random>
+#include <sstream>
 
 #include <gtest/gtest.h>
+
+#include "twoview/two_view_internal.h"
 
 namespace selfcal::twoview {
 namespace {
@@ -38,6 +41,8 @@ struct SceneSpec {
   bool planar = false;
   Eigen::Vector3d plane_normal{0.25, -0.15, -1.0};  // towards cam1, tilted
   bool pure_rotation = false;                       // centre2 ignored, cam2 at the origin
+  Eigen::Vector3d box_centre{0, 0, 0.75};           // of the non-planar points, in cam1
+  Eigen::Vector3d box_half{0.15, 0.125, 0.1};       // half extents of that box
 };
 
 struct Scene {
@@ -73,10 +78,11 @@ Scene MakeScene(const SceneSpec& spec, std::mt19937_64* rng) {
   while (static_cast<int>(scene.points.size()) < spec.num_points) {
     EXPECT_LT(++attempts, 100 * spec.num_points) << "scene generator cannot fill the view";
     if (attempts >= 100 * spec.num_points) break;
-    const Eigen::Vector3d p =
-        spec.planar
-            ? Eigen::Vector3d(centre + 0.15 * unit(*rng) * e1 + 0.12 * unit(*rng) * e2)
-            : Eigen::Vector3d(centre + Eigen::Vector3d(0.15 * unit(*rng), 0.125 * unit(*rng), 0.1 * unit(*rng)));
+    const Eigen::Vector3d p = spec.planar
+                                  ? Eigen::Vector3d(centre + 0.15 * unit(*rng) * e1 + 0.12 * unit(*rng) * e2)
+                                  : Eigen::Vector3d(spec.box_centre + Eigen::Vector3d(spec.box_half.x() * unit(*rng),
+                                                                                      spec.box_half.y() * unit(*rng),
+                                                                                      spec.box_half.z() * unit(*rng)));
     const auto uv1 = Project(scene.camera, p);
     const auto uv2 = Project(scene.camera, scene.cam2_from_cam1 * p);
     if (!uv1 || !uv2 || !InImage(scene.camera, *uv1, 5) || !InImage(scene.camera, *uv2, 5)) continue;
@@ -194,6 +200,8 @@ TEST(TwoView, NoiseFreeRecoversPoseAndFocalExactly) {
   EXPECT_NEAR(report.fx_linear_px, 1000.0, 1e-6);  // Bougnoux alone, before refinement
   EXPECT_LT(report.rms_epipolar_px, 1e-9);
   EXPECT_NEAR(report.translation_direction.norm(), 1.0, 1e-12);
+  EXPECT_EQ(report.far_point_fraction, 0);
+  EXPECT_TRUE(report.warnings.empty());
   std::cout << "[ figures  ] noise-free: rotation error " << rotation_error << " rad, direction error "
             << direction_error << " rad, fx error " << report.fx_px - 1000.0 << " px (linear "
             << report.fx_linear_px - 1000.0 << " px)\n";
@@ -638,6 +646,349 @@ TEST(TwoView, SameSeedGivesBitwiseIdenticalResults) {
   EXPECT_EQ(std::memcmp(&a.rms_epipolar_px, &b.rms_epipolar_px, sizeof(double)), 0);
   EXPECT_EQ(a.inliers, b.inliers);
   EXPECT_EQ(a.message, b.message);
+}
+
+// ---- G6: far points -----------------------------------------------------------------------------------
+
+// The far-scene geometry: 0.5 m of mostly lateral baseline, cam2 aimed 50 m ahead.
+SceneSpec FarSpec() {
+  SceneSpec spec;
+  spec.box_centre = Eigen::Vector3d(0, 0, 50);
+  spec.box_half = Eigen::Vector3d(14, 10, 10);  // 40-60 m deep, filling the view
+  spec.centre2 = 0.5 * Eigen::Vector3d(0.45, 0.1, 0.19).normalized();
+  spec.target2 = Eigen::Vector3d(-1.5, 2, 50);
+  return spec;
+}
+
+// 40-60 m away with a 0.5 m baseline, every point 80-120 baselines deep. The decision (G3 has priority):
+// such a pair is a pure rotation, because a rotation absorbs the translation's 8-12 px of flow up to a
+// median of about 1 px, inside the 1.25 px rotation-only gate, whatever min_parallax_deg says. The
+// translation is indeed not observable from it.
+TEST(TwoViewDegenerate, G6FarSceneIsCaughtAsPureRotationFirst) {
+  std::mt19937_64 rng(30);
+  for (double sigma : {0.0, 0.2, 0.5}) {
+    Scene scene = MakeScene(FarSpec(), &rng);
+    AddNoise(sigma, &rng, &scene.pixels1);
+    AddNoise(sigma, &rng, &scene.pixels2);
+    for (double min_parallax_deg : {1.0, 0.0}) {
+      TwoViewOptions options = Options();
+      options.min_parallax_deg = min_parallax_deg;
+      const TwoViewReport report = EstimateTwoView(options, scene.camera, scene.pixels1, scene.pixels2);
+      EXPECT_EQ(report.outcome, Outcome::kPureRotation) << report.message;
+      EXPECT_NE(report.message.find("a rotation alone explains the inliers"), std::string::npos) << report.message;
+      // The rotation-only fit absorbs the translation's flow, b / D <= 0.5 / 40 rad.
+      EXPECT_LT(RotationError(scene.cam2_from_cam1.rotation, report.rotation), 0.5 / 40);
+      EXPECT_FALSE(report.translation_observable);
+    }
+  }
+}
+
+// 56 points 40-60 m away and 24 at 2-5 m: the near ones rule out a rotation-only model and make the
+// pose well determined, but 70 % of the points are far. With the default min_parallax_deg the median
+// parallax (0.5 deg, a far point's) reports it as a pure rotation first (G3 b), with the far fraction
+// filled; with min_parallax_deg lowered, G6 decides, and max_far_point_fraction is the switch.
+Scene MostlyFarScene(double sigma_px, std::mt19937_64* rng) {
+  SceneSpec far_spec = FarSpec();
+  far_spec.num_points = 56;
+  SceneSpec near_spec = FarSpec();
+  near_spec.box_centre = Eigen::Vector3d(0, 0, 3.5);
+  near_spec.box_half = Eigen::Vector3d(1.0, 0.8, 1.5);
+  near_spec.num_points = 24;
+  Scene scene = MakeScene(far_spec, rng);
+  const Scene near = MakeScene(near_spec, rng);
+  scene.points.insert(scene.points.end(), near.points.begin(), near.points.end());
+  scene.pixels1.insert(scene.pixels1.end(), near.pixels1.begin(), near.pixels1.end());
+  scene.pixels2.insert(scene.pixels2.end(), near.pixels2.begin(), near.pixels2.end());
+  AddNoise(sigma_px, rng, &scene.pixels1);
+  AddNoise(sigma_px, rng, &scene.pixels2);
+  return scene;
+}
+
+TEST(TwoViewDegenerate, G6MostlyFarPointsGiveLowDepthVariation) {
+  std::mt19937_64 rng(31);
+  for (double sigma : {0.0, 0.2, 0.5}) {
+    const Scene scene = MostlyFarScene(sigma, &rng);
+    const TwoViewReport by_parallax = EstimateTwoView(Options(), scene.camera, scene.pixels1, scene.pixels2);
+    EXPECT_EQ(by_parallax.outcome, Outcome::kPureRotation) << by_parallax.message;
+    EXPECT_NE(by_parallax.message.find("median parallax below"), std::string::npos) << by_parallax.message;
+
+    TwoViewOptions options = Options();
+    options.min_parallax_deg = 0.25;
+    const TwoViewReport report = EstimateTwoView(options, scene.camera, scene.pixels1, scene.pixels2);
+    ASSERT_EQ(report.outcome, Outcome::kLowDepthVariation) << report.message;
+    EXPECT_STREQ(OutcomeName(report.outcome), "low_depth_variation");
+    EXPECT_NE(report.message.find("(G6)"), std::string::npos) << report.message;
+    EXPECT_FALSE(report.translation_observable);
+    EXPECT_EQ(report.translation_direction, Eigen::Vector3d::Zero());
+    EXPECT_LT(RotationError(scene.cam2_from_cam1.rotation, report.rotation), sigma == 0 ? 1e-9 : 5e-3);
+    // Exactly the 56 far points without noise; noise moves a few across the gate or out of the inliers.
+    if (sigma == 0) {
+      EXPECT_EQ(report.num_inliers, 80);
+      EXPECT_DOUBLE_EQ(report.far_point_fraction, 0.7);
+    } else {
+      EXPECT_NEAR(report.far_point_fraction, 0.7, 0.05);
+    }
+    EXPECT_DOUBLE_EQ(by_parallax.far_point_fraction, report.far_point_fraction);  // same estimate
+    std::cout << "[ figures  ] mostly far, sigma " << sigma << ": far fraction " << report.far_point_fraction
+              << ", rotation error " << RotationError(scene.cam2_from_cam1.rotation, report.rotation) << " rad\n";
+
+    options.max_far_point_fraction = 0.8;
+    const TwoViewReport tolerant = EstimateTwoView(options, scene.camera, scene.pixels1, scene.pixels2);
+    EXPECT_EQ(tolerant.outcome, Outcome::kSuccess) << tolerant.message;
+  }
+  TwoViewOptions bad = Options();
+  bad.max_far_point_fraction = 1.5;
+  EXPECT_EQ(bad.Validate(), "max_far_point_fraction = 1.5 must lie in [0, 1]\n");
+}
+
+// The simulator's regime, dots 0.5-1 m away, baselines 5 and 30 cm, and the test scene (20 cm at
+// 0.65-0.85 m): no point is anywhere near 50 baselines deep. (At 2 cm a dot 1 m away is exactly 50
+// baselines deep, so there a part of the farthest dots counts as far.)
+TEST(TwoView, G6NormalScenesHaveNoFarPoints) {
+  std::mt19937_64 rng(32);
+  Scene scene = MakeScene(SceneSpec{}, &rng);
+  AddNoise(0.5, &rng, &scene.pixels1);
+  AddNoise(0.5, &rng, &scene.pixels2);
+  const TwoViewReport report = EstimateTwoView(Options(), scene.camera, scene.pixels1, scene.pixels2);
+  ASSERT_EQ(report.outcome, Outcome::kSuccess) << report.message;
+  EXPECT_EQ(report.far_point_fraction, 0);
+  for (double baseline_m : {0.05, 0.3}) {
+    for (int trial = 0; trial < 5; ++trial) {
+      SceneSpec spec;
+      spec.box_half = Eigen::Vector3d(0.2, 0.15, 0.25);  // 0.5-1 m deep
+      spec.centre2 = baseline_m * Eigen::Vector3d(1, 0.2, 0.1).normalized();
+      Scene near = MakeScene(spec, &rng);
+      AddNoise(0.5, &rng, &near.pixels1);
+      AddNoise(0.5, &rng, &near.pixels2);
+      const TwoViewReport r = EstimateTwoView(Options(), near.camera, near.pixels1, near.pixels2);
+      ASSERT_EQ(r.outcome, Outcome::kSuccess) << "baseline " << baseline_m << ": " << r.message;
+      EXPECT_EQ(r.far_point_fraction, 0) << "baseline " << baseline_m;
+    }
+  }
+}
+
+// ---- G10: diagnostics -------------------------------------------------------------------------------
+
+// Points filling the 640 x 480 image (r up to 400 px), where a lens distortion shows most.
+SceneSpec WideSpec() {
+  SceneSpec spec;
+  spec.box_half = Eigen::Vector3d(0.25, 0.19, 0.1);
+  return spec;
+}
+
+bool HasWarning(const TwoViewReport& report, const std::string& prefix) {
+  for (const std::string& w : report.warnings) {
+    if (w.rfind(prefix, 0) == 0) return true;
+  }
+  return false;
+}
+const char kRadialWarning[] = "intrinsics/distortion suspect: residuals grow with radius (";
+const char kInlierWarning[] = "inlier ratio ";
+
+// Clean data, fresh scene and noise per trial, two layouts: the requirement is no warning of any kind
+// in at least 99 % of trials (two_view.cc quotes the rate over 1000 trials per layout).
+TEST(TwoViewDiagnostics, G10CleanDataRaisesNoWarning) {
+  constexpr int kTrials = 250;
+  for (bool wide : {false, true}) {
+    std::mt19937_64 rng(wide ? 41 : 40);
+    int warned = 0;
+    for (int trial = 0; trial < kTrials; ++trial) {
+      Scene scene = MakeScene(wide ? WideSpec() : SceneSpec{}, &rng);
+      AddNoise(0.5, &rng, &scene.pixels1);
+      AddNoise(0.5, &rng, &scene.pixels2);
+      const TwoViewReport report = EstimateTwoView(Options(), scene.camera, scene.pixels1, scene.pixels2);
+      ASSERT_EQ(report.outcome, Outcome::kSuccess) << report.message;
+      if (!report.warnings.empty()) {
+        ++warned;
+        std::cout << "[ figures  ] false alarm: " << report.warnings.front() << "\n";
+      }
+    }
+    std::cout << "[ figures  ] G10 clean, 0.5 px, " << (wide ? "points filling the image" : "test scene") << ": "
+              << warned << " of " << kTrials << " trials warned\n";
+    EXPECT_LE(warned, kTrials / 100);
+  }
+  // Exact data: residuals are rounding errors and must not look like a trend.
+  std::mt19937_64 rng(42);
+  for (bool wide : {false, true}) {
+    const Scene scene = MakeScene(wide ? WideSpec() : SceneSpec{}, &rng);
+    const TwoViewReport report = EstimateTwoView(Options(), scene.camera, scene.pixels1, scene.pixels2);
+    ASSERT_EQ(report.outcome, Outcome::kSuccess) << report.message;
+    EXPECT_TRUE(report.warnings.empty()) << report.warnings.front();
+  }
+}
+
+// Pixels of a lens with k1 = -0.15 (9.6 px of barrel distortion in the image corners) handed over as if
+// undistorted. f_x and the pose absorb most of it (the focal came out 4-60 % too long in trials), the residual
+// RMS barely changes, yet the signed residuals keep a radial signature.
+TEST(TwoViewDiagnostics, G10UncorrectedRadialDistortionIsFlagged) {
+  constexpr int kTrials = 60;
+  std::mt19937_64 rng(43);
+  const CameraIntrinsics assumed = TestCamera();  // k1 = 0
+  for (double sigma : {0.0, 0.5}) {
+    int flagged = 0;
+    for (int trial = 0; trial < (sigma == 0 ? 3 : kTrials); ++trial) {
+      SceneSpec spec = WideSpec();
+      spec.camera.k1 = -0.15;
+      Scene scene = MakeScene(spec, &rng);
+      AddNoise(sigma, &rng, &scene.pixels1);
+      AddNoise(sigma, &rng, &scene.pixels2);
+      const TwoViewReport report = EstimateTwoView(Options(), assumed, scene.pixels1, scene.pixels2);
+      ASSERT_EQ(report.outcome, Outcome::kSuccess) << report.message;
+      if (HasWarning(report, kRadialWarning)) {
+        ++flagged;
+        // The estimated k1 has the right sign.
+        EXPECT_NE(report.warnings.front().find("k1 = -0."), std::string::npos) << report.warnings.front();
+      }
+      if (trial == 0 && !report.warnings.empty()) std::cout << "[ figures  ] " << report.warnings.front() << "\n";
+    }
+    const int trials = sigma == 0 ? 3 : kTrials;
+    std::cout << "[ figures  ] G10 k1 = -0.15 uncorrected, sigma " << sigma << ": " << flagged << " of " << trials
+              << " flagged\n";
+    // The study (DISABLED_G10RadialWarningStudy) measured 299 of 300 at 0.5 px; 95 % leaves room.
+    EXPECT_GE(flagged, sigma == 0 ? trials : (95 * trials) / 100);
+  }
+}
+
+// The study behind the figures quoted in two_view.cc (about 15 s; run with
+// --gtest_also_run_disabled_tests): radial warnings per 1000 trials at 0.5 px for both layouts, clean,
+// with 10 % and 40 % random mismatches, and with k1 = -0.15 left uncorrected.
+TEST(TwoViewDiagnostics, DISABLED_G10RadialWarningStudy) {
+  struct Case {
+    double k1, outlier_fraction;
+    int trials;
+  };
+  for (const Case& c : {Case{0, 0, 1000}, Case{0, 0.1, 1000}, Case{0, 0.4, 1000}, Case{-0.15, 0, 300}}) {
+    for (bool wide : {false, true}) {
+      std::mt19937_64 rng(wide ? 51 : 50);
+      std::uniform_real_distribution<double> u(0, 639), v(0, 479);
+      int runs = 0, flagged = 0;
+      for (int trial = 0; trial < c.trials; ++trial) {
+        SceneSpec spec = wide ? WideSpec() : SceneSpec{};
+        spec.camera.k1 = c.k1;
+        Scene scene = MakeScene(spec, &rng);
+        AddNoise(0.5, &rng, &scene.pixels1);
+        AddNoise(0.5, &rng, &scene.pixels2);
+        const int num_outliers = static_cast<int>(c.outlier_fraction * scene.points.size());
+        for (int i = 0; i < num_outliers; ++i) scene.pixels2[i] = Eigen::Vector2d(u(rng), v(rng));
+        const TwoViewReport report = EstimateTwoView(Options(), TestCamera(), scene.pixels1, scene.pixels2);
+        if (report.outcome != Outcome::kSuccess) continue;
+        ++runs;
+        flagged += HasWarning(report, kRadialWarning);
+      }
+      std::cout << "[ figures  ] k1 " << c.k1 << ", " << 100 * c.outlier_fraction << " % mismatches, "
+                << (wide ? "points filling the image" : "test scene") << ": " << flagged << " of " << runs
+                << " successful trials warned (" << c.trials - runs << " not successful)\n";
+    }
+  }
+}
+
+TEST(TwoViewDiagnostics, G10LowInlierRatioIsFlagged) {
+  std::mt19937_64 rng(44);
+  std::uniform_real_distribution<double> u(0, 639), v(0, 479);
+  Scene scene = MakeScene(SceneSpec{}, &rng);
+  AddNoise(0.2, &rng, &scene.pixels1);
+  AddNoise(0.2, &rng, &scene.pixels2);
+  const TwoViewReport clean = EstimateTwoView(Options(), scene.camera, scene.pixels1, scene.pixels2);
+  ASSERT_EQ(clean.outcome, Outcome::kSuccess) << clean.message;
+  EXPECT_FALSE(HasWarning(clean, kInlierWarning));
+  for (int i = 0; i < 24; ++i) scene.pixels2[i] = Eigen::Vector2d(u(rng), v(rng));  // 30 % mismatches
+  const TwoViewReport report = EstimateTwoView(Options(), scene.camera, scene.pixels1, scene.pixels2);
+  ASSERT_EQ(report.outcome, Outcome::kSuccess) << report.message;
+  ASSERT_TRUE(HasWarning(report, kInlierWarning));
+  const double ratio = static_cast<double>(report.num_inliers) / 80;
+  EXPECT_LT(ratio, 0.8);
+  std::ostringstream expected;
+  expected << "inlier ratio " << ratio << ": outliers or wrong intrinsics";
+  EXPECT_EQ(report.warnings.front().rfind(expected.str(), 0), 0u) << report.warnings.front();
+}
+
+// ---- G2: stacked essential matrices -----------------------------------------------------------------
+
+Eigen::Vector2d ProjectAnyDepth(const CameraIntrinsics& camera, const Eigen::Vector3d& p) {
+  // Also for a point behind the camera, which images through the centre like any other.
+  return Eigen::Vector2d(camera.fx_px * p.x() / p.z() + camera.cx_px,
+                         camera.fx_px * camera.mu * p.y() / p.z() + camera.cy_px);
+}
+
+Eigen::Matrix3d EssentialOf(const Rigid3& cam2_from_cam1) {
+  return Skew<double>(cam2_from_cam1.translation) * cam2_from_cam1.rotation;
+}
+
+// Three stacked candidates, as OpenCV's 5-point solver returns them. 40 correspondences come from the
+// true pose (points in front), 50 from another pose B whose points lie in front of camera 1 but half of
+// them behind camera 2: E_B has the most inliers (50 > 40), but no decomposition of it puts more than
+// about half of them in front of both cameras. Candidate 0 is the truth with R off by 5 deg.
+TEST(TwoViewOpenCv, G2StackedCandidatesChooseByInliersAndCheirality) {
+  std::mt19937_64 rng(45);
+  SceneSpec spec;
+  spec.num_points = 40;
+  const Scene scene = MakeScene(spec, &rng);
+  std::vector<Eigen::Vector2d> pixels1 = scene.pixels1, pixels2 = scene.pixels2;
+  const Rigid3 pose_b(RotY(0.1), Eigen::Vector3d(0.1, 0.02, -0.75));
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  int behind_cam2 = 0;
+  for (int k = 0; k < 50; ++k) {
+    const double depth = (k % 2 == 0 ? 0.525 : 0.975) + 0.075 * unit(rng);
+    const Eigen::Vector3d p(0.15 * unit(rng), 0.12 * unit(rng), depth);
+    const Eigen::Vector3d p2 = pose_b * p;
+    if (p2.z() < 0) ++behind_cam2;
+    pixels1.push_back(ProjectAnyDepth(scene.camera, p));
+    pixels2.push_back(ProjectAnyDepth(scene.camera, p2));
+  }
+  ASSERT_EQ(behind_cam2, 25);
+
+  Eigen::MatrixXd stacked(9, 3);
+  stacked.middleRows<3>(0) =
+      EssentialOf(Rigid3(ExpSO3<double>(Eigen::Vector3d(0, 0, DegToRad(5))) * scene.cam2_from_cam1.rotation,
+                         scene.cam2_from_cam1.translation));
+  stacked.middleRows<3>(3) = EssentialOf(pose_b);
+  stacked.middleRows<3>(6) = -3.0 * EssentialOf(scene.cam2_from_cam1);  // scale and sign are free
+  const internal::EssentialChoice choice =
+      internal::ChooseEssentialCandidate(stacked, scene.camera, pixels1, pixels2, {}, 1.0);
+  ASSERT_EQ(choice.index, 2) << choice.message;
+  EXPECT_EQ(choice.num_candidates, 3);
+  EXPECT_GT(choice.num_inliers[1], choice.num_inliers[2]);  // inliers alone would pick E_B
+  EXPECT_GE(choice.num_inliers[1], 50);
+  EXPECT_LE(choice.num_good[1], 30);
+  EXPECT_LT(choice.num_inliers[0], 10);
+  EXPECT_GE(choice.num_good[2], 40);
+  for (int i = 0; i < 40; ++i) EXPECT_TRUE(choice.good[i]) << i;
+  EXPECT_LT(RotationError(scene.cam2_from_cam1.rotation, choice.rotation), 1e-9);
+  EXPECT_LT(DirectionError(scene.cam2_from_cam1.translation, choice.translation), 1e-9);
+  std::cout << "[ figures  ] G2 candidates: inliers " << choice.num_inliers[0] << "/" << choice.num_inliers[1] << "/"
+            << choice.num_inliers[2] << ", in front " << choice.num_good[0] << "/" << choice.num_good[1] << "/"
+            << choice.num_good[2] << "; " << choice.message << "\n";
+
+  // A RANSAC mask restricts the points each candidate may count.
+  std::vector<bool> only_b(pixels1.size(), false);
+  for (size_t i = 40; i < only_b.size(); ++i) only_b[i] = true;
+  EXPECT_EQ(internal::ChooseEssentialCandidate(stacked, scene.camera, pixels1, pixels2, only_b, 1.0).index, 1);
+}
+
+TEST(TwoViewOpenCv, G2MalformedOrNonFiniteCandidatesAreNeverPassedOn) {
+  std::mt19937_64 rng(46);
+  const Scene scene = MakeScene(SceneSpec{}, &rng);
+  const Eigen::Matrix3d e = EssentialOf(scene.cam2_from_cam1);
+  for (const Eigen::MatrixXd& bad : {Eigen::MatrixXd(0, 3), Eigen::MatrixXd(Eigen::MatrixXd::Ones(4, 3)),
+                                     Eigen::MatrixXd(Eigen::MatrixXd::Ones(3, 4))}) {
+    const internal::EssentialChoice choice =
+        internal::ChooseEssentialCandidate(bad, scene.camera, scene.pixels1, scene.pixels2, {}, 1.0);
+    EXPECT_EQ(choice.index, -1);
+    EXPECT_EQ(choice.num_candidates, 0);
+    EXPECT_NE(choice.message.find("is not 3N x 3 (G2)"), std::string::npos) << choice.message;
+  }
+  Eigen::MatrixXd stacked(9, 3);
+  stacked.middleRows<3>(0).setConstant(std::numeric_limits<double>::quiet_NaN());
+  stacked.middleRows<3>(3).setZero();
+  stacked.middleRows<3>(6) = e;
+  const internal::EssentialChoice choice =
+      internal::ChooseEssentialCandidate(stacked, scene.camera, scene.pixels1, scene.pixels2, {}, 1.0);
+  ASSERT_EQ(choice.index, 2) << choice.message;
+  EXPECT_EQ(choice.num_good[2], 80);
+  EXPECT_NE(choice.message.find("(2 non-finite or rejected by recoverPose)"), std::string::npos) << choice.message;
+  // Nothing usable at all.
+  stacked.middleRows<3>(6).setZero();
+  EXPECT_EQ(internal::ChooseEssentialCandidate(stacked, scene.camera, scene.pixels1, scene.pixels2, {}, 1.0).index, -1);
 }
 
 }  // namespace
