@@ -1,0 +1,468 @@
+#include "bundle/bundle_adjustment.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <utility>
+
+#include <Eigen/Dense>
+#include <ceres/ceres.h>
+
+#include "bundle/bundle_problem.h"
+#include "identification/identifiability.h"
+#include "identification/triangulation.h"
+
+namespace selfcal::bundle {
+
+using internal::BundleData;
+using internal::BundleState;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Camera pose per pose and its derivatives, recomputed only when the free parameters change and shared
+// by every residual block of that pose. Keyed by the values Ceres passes in, so it is right whatever
+// memory Ceres evaluates in (solver state, user state, Problem::Evaluate). Filled from const Evaluate:
+// single-threaded use only.
+class PoseCacheSet {
+ public:
+  PoseCacheSet(const BundleData* data, const Eigen::VectorXd& rho, std::vector<int> free)
+      : data_(data), rho_(rho), free_(std::move(free)), entries_(data->joints.size()) {}
+
+  const internal::PoseCache& Get(int pose, const double* free_values, bool derivatives) const {
+    Entry& e = entries_[pose];
+    const int m = static_cast<int>(free_.size());
+    if (!e.valid || (derivatives && !e.derivatives) || !std::equal(free_values, free_values + m, e.values.begin())) {
+      for (int k = 0; k < m; ++k) rho_[free_[k]] = free_values[k];
+      internal::ComputePoseCache(data_->robot, rho_.data(), data_->joints[pose], free_, derivatives, &e.cache);
+      e.values.assign(free_values, free_values + m);
+      e.valid = true;
+      e.derivatives = derivatives;
+    }
+    return e.cache;
+  }
+  int num_free() const { return static_cast<int>(free_.size()); }
+
+ private:
+  struct Entry {
+    bool valid = false, derivatives = false;
+    std::vector<double> values;
+    internal::PoseCache cache;
+  };
+  const BundleData* data_;
+  mutable Eigen::VectorXd rho_;  // fixed entries at their start values; free ones overwritten per call
+  std::vector<int> free_;
+  mutable std::vector<Entry> entries_;
+};
+
+// One observation: blocks the free kinematic parameters, f_x, k1, the dot. Only the free parameters are
+// a block (not rho with a SubsetManifold): Ceres then never multiplies 2 x |rho| Jacobians by the
+// manifold's, which was a fifth of the solve. Analytic Jacobian from the pose cache by the chain rule.
+class ReprojectionCost final : public ceres::CostFunction {
+ public:
+  ReprojectionCost(std::shared_ptr<const PoseCacheSet> caches, const BundleData* data, int observation)
+      : caches_(std::move(caches)), data_(data), observation_(data->observations[observation]) {
+    set_num_residuals(2);
+    *mutable_parameter_block_sizes() = {caches_->num_free(), 1, 1, 3};
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const bool kinematic_jacobian = jacobians != nullptr && jacobians[0] != nullptr;
+    const internal::PoseCache& cache = caches_->Get(observation_.pose, parameters[0], kinematic_jacobian);
+    const Eigen::Map<const Eigen::Vector3d> dot(parameters[3]);
+    return internal::EvaluateReprojection(data_->camera, data_->sigma_px, cache, parameters[1][0], parameters[2][0], dot,
+                                          observation_.pixel, residuals, kinematic_jacobian ? jacobians[0] : nullptr,
+                                          jacobians != nullptr ? jacobians[1] : nullptr,
+                                          jacobians != nullptr ? jacobians[2] : nullptr,
+                                          jacobians != nullptr ? jacobians[3] : nullptr);
+  }
+
+ private:
+  std::shared_ptr<const PoseCacheSet> caches_;
+  const BundleData* data_;
+  internal::Observation observation_;
+};
+
+struct YardstickResidual {
+  YardstickResidual(double length_m, double sigma_m) : length_m(length_m), inv_sigma(1.0 / sigma_m) {}
+  template <typename T>
+  bool operator()(const T* a, const T* b, T* residual) const {
+    using std::sqrt;
+    const T dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
+    residual[0] = (sqrt(dx * dx + dy * dy + dz * dz) - T(length_m)) * T(inv_sigma);
+    return true;
+  }
+  double length_m, inv_sigma;
+};
+
+// One Levenberg-Marquardt solve of the current problem in place.
+ceres::Solver::Summary Solve(const BundleData& data, const std::vector<int>& free, const BundleOptions& options,
+                             bool robust, BundleState* state) {
+  auto caches = std::make_shared<const PoseCacheSet>(&data, state->rho, free);
+  std::vector<double> x(free.size());
+  for (size_t k = 0; k < free.size(); ++k) x[k] = state->rho[free[k]];
+  // Residuals are whitened, so the Huber threshold is huber_px in units of sigma. Declared before the
+  // problem, which holds non-owning wrappers of it.
+  ceres::HuberLoss huber(options.huber_px / data.sigma_px);
+  ceres::Problem problem;
+  problem.AddParameterBlock(x.data(), static_cast<int>(x.size()));
+  problem.AddParameterBlock(&state->fx_px, 1);
+  problem.AddParameterBlock(&state->k1, 1);
+  if (!options.estimate_fx) problem.SetParameterBlockConstant(&state->fx_px);
+  if (!options.estimate_k1) problem.SetParameterBlockConstant(&state->k1);
+  for (size_t k = 0; k < data.observations.size(); ++k) {
+    problem.AddResidualBlock(new ReprojectionCost(caches, &data, static_cast<int>(k)),
+                             robust ? new ceres::LossFunctionWrapper(&huber, ceres::DO_NOT_TAKE_OWNERSHIP) : nullptr,
+                             x.data(), &state->fx_px, &state->k1, state->dots[data.observations[k].dot].data());
+  }
+  std::vector<bool> in_yardstick(data.dot_ids.size(), false);
+  for (const internal::Yardstick& y : data.yardsticks) {
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<YardstickResidual, 1, 3, 3>(
+                                 new YardstickResidual(y.length_m, data.yardstick_sigma_m)),
+                             nullptr, state->dots[y.dot_a].data(), state->dots[y.dot_b].data());
+    in_yardstick[y.dot_a] = in_yardstick[y.dot_b] = true;
+  }
+  // Schur: the dots are eliminated, except the yardstick's ends (their length residual couples two dots,
+  // and an eliminated block may appear in a residual only with non-eliminated ones).
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  for (size_t d = 0; d < data.dot_ids.size(); ++d) ordering->AddElementToGroup(state->dots[d].data(), in_yardstick[d] ? 1 : 0);
+  ordering->AddElementToGroup(x.data(), 1);
+  ordering->AddElementToGroup(&state->fx_px, 1);
+  ordering->AddElementToGroup(&state->k1, 1);
+
+  ceres::Solver::Options solver_options;
+  solver_options.minimizer_type = ceres::TRUST_REGION;
+  solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
+  solver_options.linear_solver_ordering = ordering;
+  solver_options.num_threads = 1;  // the pose cache is filled from Evaluate; also deterministic (P9)
+  solver_options.logging_type = ceres::SILENT;
+  solver_options.minimizer_progress_to_stdout = false;
+  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.function_tolerance = options.function_tolerance;
+  solver_options.gradient_tolerance = options.gradient_tolerance;
+  solver_options.parameter_tolerance = options.parameter_tolerance;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+  for (size_t k = 0; k < free.size(); ++k) state->rho[free[k]] = x[k];
+  return summary;
+}
+
+// |r| in pixels per observation at `state` (NaN where it cannot be evaluated).
+std::vector<double> ReprojectionErrors(const BundleData& data, const BundleState& state) {
+  std::vector<internal::PoseCache> caches(data.joints.size());
+  for (size_t p = 0; p < data.joints.size(); ++p) {
+    internal::ComputePoseCache(data.robot, state.rho.data(), data.joints[p], {}, false, &caches[p]);
+  }
+  std::vector<double> errors;
+  for (const internal::Observation& o : data.observations) {
+    double r[2];
+    const bool ok = internal::EvaluateReprojection(data.camera, 1.0, caches[o.pose], state.fx_px, state.k1,
+                                                   state.dots[o.dot], o.pixel, r, nullptr, nullptr, nullptr, nullptr);
+    errors.push_back(ok ? std::hypot(r[0], r[1]) : std::numeric_limits<double>::quiet_NaN());
+  }
+  return errors;
+}
+
+// The observations flagged in `keep`, the dots left with two or more views (renumbered; dot_map[c] is
+// the index in `full` of dot c) and the yardsticks with both ends among them.
+void Subset(const BundleData& full, const BundleState& full_state, const std::vector<bool>& keep, BundleData* data,
+            BundleState* state, std::vector<int>* dot_map) {
+  std::vector<int> views(full.dot_ids.size(), 0);
+  for (size_t k = 0; k < keep.size(); ++k) views[full.observations[k].dot] += keep[k] ? 1 : 0;
+  std::vector<int> new_index(full.dot_ids.size(), -1);
+  *data = full;
+  data->dot_ids.clear();
+  data->observations.clear();
+  data->yardsticks.clear();
+  *state = full_state;
+  state->dots.clear();
+  dot_map->clear();
+  for (size_t d = 0; d < full.dot_ids.size(); ++d) {
+    if (views[d] < 2) continue;
+    new_index[d] = static_cast<int>(data->dot_ids.size());
+    data->dot_ids.push_back(full.dot_ids[d]);
+    state->dots.push_back(full_state.dots[d]);
+    dot_map->push_back(static_cast<int>(d));
+  }
+  for (size_t k = 0; k < keep.size(); ++k) {
+    internal::Observation o = full.observations[k];
+    if (!keep[k] || new_index[o.dot] < 0) continue;
+    o.dot = new_index[o.dot];
+    data->observations.push_back(o);
+  }
+  for (internal::Yardstick y : full.yardsticks) {
+    if (new_index[y.dot_a] < 0 || new_index[y.dot_b] < 0) continue;
+    y.dot_a = new_index[y.dot_a];
+    y.dot_b = new_index[y.dot_b];
+    data->yardsticks.push_back(y);
+  }
+}
+
+// Free kinematic count of the relative-pose model at random joint angles: what generic poses identify.
+int GenericRank(const RobotModel& robot, const Eigen::VectorXd& rho, double rank_tolerance) {
+  std::mt19937_64 rng(20240607);
+  std::vector<Eigen::VectorXd> poses;
+  const int count = std::max(12, robot.num_parameters() / 2);
+  for (int p = 0; p < count; ++p) {
+    Eigen::VectorXd q(robot.num_joints());
+    for (int j = 0; j < robot.num_joints(); ++j) {
+      std::uniform_real_distribution<double> u(robot.limits[j].min_rad, robot.limits[j].max_rad);
+      q[j] = u(rng);
+    }
+    poses.push_back(q);
+  }
+  identification::IdentifiabilityOptions options;
+  options.rank_tolerance = rank_tolerance;
+  options.scale_known = true;  // the yardstick
+  return identification::AnalyzeIdentifiability(robot, rho, poses, 0, options).rank;
+}
+
+std::string Join(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& s : names) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+}  // namespace
+
+BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen::VectorXd& rho_start,
+                                 double fx_start, const BundleOptions& options) {
+  const auto start = Clock::now();
+  BundleReport report;
+  report.rho = rho_start;
+  report.fx_px = fx_start;
+  report.k1 = observations.camera.k1;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  report.stddev = Eigen::VectorXd::Constant(std::max<Eigen::Index>(rho_start.size(), 0), nan);
+  report.fx_stddev = report.k1_stddev = nan;
+  auto finish = [&](Outcome outcome, const std::string& message) {
+    report.outcome = outcome;
+    report.message = message;
+    report.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    return report;
+  };
+
+  std::ostringstream problems;
+  problems << options.Validate() << observations.Validate();
+  if (rho_start.size() != observations.robot.num_parameters()) {
+    problems << "rho_start has " << rho_start.size() << " entries, the robot needs "
+             << observations.robot.num_parameters() << "\n";
+  } else if (!rho_start.allFinite()) {
+    problems << "rho_start is not finite\n";
+  }
+  if (!std::isfinite(fx_start) || fx_start <= 0) problems << "fx_start = " << fx_start << " must be finite and > 0\n";
+  if (!problems.str().empty()) return finish(Outcome::kInvalidInput, "invalid input:\n" + problems.str());
+
+  const int num_poses = static_cast<int>(observations.PosesWithRole(PoseRole::kIdentification).size());
+  if (num_poses < options.min_identification_poses) {
+    return finish(Outcome::kDegenerate, "only " + std::to_string(num_poses) + " identification poses (need " +
+                                            std::to_string(options.min_identification_poses) + ")");
+  }
+  if (observations.yardsticks.empty()) {
+    return finish(Outcome::kScaleUnresolved, "no yardstick: the metric scale is unobservable from images alone");
+  }
+  BundleData data = internal::MakeBundleData(observations, options.yardstick_sigma_m);
+  {
+    std::map<int, int> views;
+    for (int p : observations.PosesWithRole(PoseRole::kIdentification)) {
+      for (const auto& entry : observations.poses[p].dots_px) ++views[entry.first];
+    }
+    for (const auto& [dot, count] : views) {
+      if (count < 2) report.dropped_dots.push_back(dot);
+    }
+  }
+  BundleState state;
+  state.rho = rho_start;
+  state.fx_px = fx_start;
+  state.k1 = observations.camera.k1;
+
+  // Dots from the start model; a dot that cannot be triangulated there (behind a camera, no parallax)
+  // is dropped and named.
+  {
+    std::vector<Rigid3> base_from_cam;
+    for (const Eigen::VectorXd& q : data.joints) base_from_cam.push_back(BaseFromCam(data.robot, rho_start, q));
+    std::vector<identification::PointTrack> tracks(data.dot_ids.size());
+    for (const internal::Observation& o : data.observations) {
+      tracks[o.dot].base_from_cam.push_back(base_from_cam[o.pose]);
+      tracks[o.dot].pixels.push_back(o.pixel);
+    }
+    state.dots.resize(data.dot_ids.size());
+    std::vector<bool> ok(data.dot_ids.size());
+    for (size_t d = 0; d < tracks.size(); ++d) {
+      const identification::TriangulationResult t =
+          identification::TriangulatePoint(data.camera, fx_start, tracks[d], data.sigma_px);
+      ok[d] = t.ok && t.point.allFinite();
+      state.dots[d] = t.point;
+      if (!ok[d]) report.dropped_dots.push_back(data.dot_ids[d]);
+    }
+    std::vector<bool> keep(data.observations.size());
+    for (size_t k = 0; k < keep.size(); ++k) keep[k] = ok[data.observations[k].dot];
+    const BundleData all = data;
+    const BundleState all_state = state;
+    std::vector<int> dot_map;
+    Subset(all, all_state, keep, &data, &state, &dot_map);
+  }
+  if (data.yardsticks.empty()) {
+    return finish(Outcome::kScaleUnresolved,
+                  "no yardstick has both ends seen (and triangulable) in two or more identification poses (S1)");
+  }
+
+  // K1: the gauge and the free set, from the rank of this problem's reduced Jacobian.
+  // Evaluated at the nominal model, where nominally parallel axes are exactly parallel: at a perturbed
+  // start the d offsets of a parallel pair look independent (rank is a tolerance game there) and would
+  // run off to tens of metres (K2).
+  internal::Gauge gauge;
+  {
+    BundleState nominal = state;
+    nominal.rho = KinematicParameters::Nominal(data.robot);
+    if (!internal::AnalyzeGauge(data, nominal, options.estimate_fx, options.estimate_k1, options.rank_tolerance,
+                                &gauge) &&
+        !internal::AnalyzeGauge(data, state, options.estimate_fx, options.estimate_k1, options.rank_tolerance, &gauge)) {
+      return finish(Outcome::kFailure, "the start model puts a triangulated dot behind a camera (K5)");
+    }
+  }
+  report.free_indices = gauge.free_kinematic;
+  report.free_names = gauge.free_names;
+  report.fixed_names = gauge.fixed_names;
+  report.null_combinations = gauge.null_combinations;
+  report.condition_number = gauge.condition_number;
+  report.generic_rank = GenericRank(data.robot, KinematicParameters::Nominal(data.robot), options.rank_tolerance);
+  if (options.estimate_fx && !gauge.fx_identifiable) {
+    return finish(Outcome::kDegenerate, "f_x is not identifiable from these poses (null directions: " +
+                                            Join(gauge.null_combinations) + ")");
+  }
+  if (options.estimate_k1 && !gauge.k1_identifiable) {
+    return finish(Outcome::kDegenerate, "k1 is not identifiable from these poses");
+  }
+  if (gauge.free_kinematic.empty() ||
+      (options.require_generic_rank && static_cast<int>(gauge.free_kinematic.size()) < report.generic_rank)) {
+    std::ostringstream msg;
+    msg << "insufficient excitation (K3): these " << num_poses << " identification poses identify "
+        << gauge.free_kinematic.size() << " kinematic parameters, generic poses of this robot "
+        << report.generic_rank << "; fixed here: " << Join(gauge.fixed_names);
+    return finish(Outcome::kDegenerate, msg.str());
+  }
+
+  // Robust solve, screen, refit (K7). Every round judges every observation against the current
+  // solution, so one wrongly removed early (while outliers still pulled the fit) comes back.
+  const BundleData full = data;
+  BundleState full_state = state;
+  std::vector<bool> keep(full.observations.size(), true);
+  std::vector<int> dot_map;
+  auto write_back = [&]() {
+    full_state.rho = state.rho;
+    full_state.fx_px = state.fx_px;
+    full_state.k1 = state.k1;
+    for (size_t c = 0; c < dot_map.size(); ++c) full_state.dots[dot_map[c]] = state.dots[c];
+  };
+  ceres::Solver::Summary summary;
+  for (int round = 0;; ++round) {
+    Subset(full, full_state, keep, &data, &state, &dot_map);
+    if (data.yardsticks.empty()) {
+      return finish(Outcome::kScaleUnresolved, "the residual screen removed the yardstick's views (S1)");
+    }
+    summary = Solve(data, gauge.free_kinematic, options, true, &state);
+    if (round == 0) report.initial_cost = summary.initial_cost;
+    report.iterations += static_cast<int>(summary.iterations.size()) - 1;
+    if (summary.termination_type == ceres::FAILURE || summary.termination_type == ceres::USER_FAILURE) break;
+    write_back();
+    if (round == options.max_screen_rounds) break;
+    const std::vector<double> errors = ReprojectionErrors(full, full_state);
+    std::vector<double> sorted;
+    for (double e : errors) {
+      if (std::isfinite(e)) sorted.push_back(e);
+    }
+    std::sort(sorted.begin(), sorted.end());
+    // Median of a 2-D Gaussian's norm: sigma sqrt(2 ln 2).
+    const double robust_sigma = sorted.empty() ? 0.0 : sorted[sorted.size() / 2] / std::sqrt(2.0 * std::log(2.0));
+    const double threshold = options.screen_sigma * std::max(data.sigma_px, robust_sigma);
+    std::vector<bool> next(errors.size());
+    for (size_t k = 0; k < errors.size(); ++k) next[k] = errors[k] <= threshold;  // NaN is removed too
+    if (next == keep) break;
+    keep = std::move(next);
+  }
+  // The final fit is plain least squares unless the Huber loss was inactive at the robust solution.
+  if (summary.termination_type == ceres::CONVERGENCE || summary.termination_type == ceres::NO_CONVERGENCE) {
+    const std::vector<double> errors = ReprojectionErrors(data, state);
+    if (!errors.empty() && *std::max_element(errors.begin(), errors.end()) > options.huber_px) {
+      summary = Solve(data, gauge.free_kinematic, options, false, &state);
+      report.iterations += static_cast<int>(summary.iterations.size()) - 1;
+      write_back();
+    }
+  }
+  {
+    const std::vector<double> errors = ReprojectionErrors(full, full_state);
+    for (size_t k = 0; k < keep.size(); ++k) {
+      if (keep[k]) continue;
+      const internal::Observation& o = full.observations[k];
+      report.removed.push_back({full.pose_ids[o.pose], full.dot_ids[o.dot], errors[k]});
+    }
+    std::vector<bool> in_solve(full.dot_ids.size(), false);
+    for (int d : dot_map) in_solve[d] = true;
+    for (size_t d = 0; d < full.dot_ids.size(); ++d) {
+      if (!in_solve[d]) report.dropped_dots.push_back(full.dot_ids[d]);
+    }
+  }
+  report.final_cost = summary.final_cost;
+  report.termination = std::string(ceres::TerminationTypeToString(summary.termination_type)) + ": " + summary.message;
+  if (summary.termination_type != ceres::CONVERGENCE && summary.termination_type != ceres::NO_CONVERGENCE) {
+    return finish(Outcome::kFailure, "solver failed: " + report.termination);
+  }
+  report.rho = state.rho;
+  report.fx_px = state.fx_px;
+  report.k1 = state.k1;
+  for (size_t d = 0; d < data.dot_ids.size(); ++d) report.dots_in_base[data.dot_ids[d]] = state.dots[d];
+  report.num_observations = static_cast<int>(data.observations.size());
+  {
+    double sum2 = 0;
+    for (double e : ReprojectionErrors(data, state)) sum2 += e * e;
+    report.rms_reprojection_px = report.num_observations > 0 ? std::sqrt(sum2 / report.num_observations) : 0.0;
+  }
+
+  // Covariance of the free globals, dots as nuisance (K8).
+  internal::GlobalColumns columns;
+  columns.kinematic = gauge.free_kinematic;
+  columns.fx = options.estimate_fx;
+  columns.k1 = options.estimate_k1;
+  const int num_unknowns = columns.size() + 3 * static_cast<int>(data.dot_ids.size());
+  const int dof = 2 * report.num_observations + static_cast<int>(data.yardsticks.size()) - num_unknowns;
+  Eigen::MatrixXd reduced, covariance;
+  if (dof <= 0) {
+    report.covariance_message = "uncertainty unavailable (no redundancy)";
+  } else if (!internal::ReducedJacobian(data, state, columns, &reduced)) {
+    report.covariance_message = "uncertainty unavailable (a dot ended behind a camera)";
+  } else if (internal::CovarianceFromJacobian(reduced, internal::GlobalNames(columns, data.robot.num_joints()),
+                                              &covariance, &report.covariance_message)) {
+    const double s2 = 2.0 * summary.final_cost / dof;
+    report.covariance_free = s2 * covariance;
+    report.covariance_available = true;
+    const Eigen::VectorXd sd = report.covariance_free.diagonal().array().sqrt();
+    report.correlation_free = report.covariance_free;
+    for (int i = 0; i < sd.size(); ++i) {
+      for (int j = 0; j < sd.size(); ++j) {
+        report.correlation_free(i, j) = sd[i] > 0 && sd[j] > 0 ? report.covariance_free(i, j) / (sd[i] * sd[j]) : 0.0;
+      }
+    }
+    const int nk = static_cast<int>(columns.kinematic.size());
+    for (int k = 0; k < nk; ++k) report.stddev[columns.kinematic[k]] = sd[k];
+    if (columns.fx) report.fx_stddev = sd[nk];
+    if (columns.k1) report.k1_stddev = sd[nk + (columns.fx ? 1 : 0)];
+  }
+
+  std::ostringstream msg;
+  msg << (summary.termination_type == ceres::CONVERGENCE ? "converged" : "not converged") << ": "
+      << report.num_observations << " observations of " << data.dot_ids.size() << " dots in " << num_poses
+      << " poses, " << report.free_indices.size() << " free kinematic parameters, " << report.removed.size()
+      << " observations removed by the screen, RMS " << report.rms_reprojection_px << " px";
+  return finish(summary.termination_type == ceres::CONVERGENCE ? Outcome::kConverged : Outcome::kNoConvergence,
+                msg.str());
+}
+
+}  // namespace selfcal::bundle

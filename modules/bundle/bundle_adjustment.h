@@ -1,0 +1,174 @@
+// Kinematic bundle adjustment (DESIGN.md section 5): one least-squares problem over every identification
+// image, beyond the paper's pipeline (which only initialises it).
+//
+// Residual of dot j seen at identification pose i (pixels, whitened by sigma = pixel_noise_px):
+//
+//   r_ij = ( project(fx, k1, cam_i_from_base * p_j_in_base) - pixel_ij ) / sigma,
+//   cam_i_from_base = base_from_cam(q_i; rho)^-1          (kinematics/robot_model.h, camera/camera.h)
+//
+// and, per yardstick (dots a, b, known length L), the length constraint
+//
+//   r_L = ( |p_a_in_base - p_b_in_base| - L ) / yardstick_sigma_m
+//
+// a soft constraint with a tiny sigma (1e-6 m by default) rather than a hard parameterisation: it keeps
+// every dot an ordinary 3-vector, is exactly satisfied by noise-free data (so exact recovery stays exact),
+// and its variance is ~1e4 times below what the images alone give for a length (they know it to ~0.1 mm). Its two dots stay out of
+// the Schur-eliminated group (a residual may touch only one eliminated block).
+//
+// Unknowns: the identifiable entries of rho (camera correction included), f_x (and k1 when asked), and
+// every dot seen in at least two identification poses (p_j in the base frame, m). Gauge: with unknown
+// dots a rigid motion of the whole scene is invisible, so the base correction and joint 1's parameters
+// cannot be seen; the yardstick fixes the scale. Nothing is assumed: the rank of the reduced Jacobian
+// (the dots eliminated: J_g^T (I - P_dots) J_g with J_g the columns of rho, f_x, k1) decides, evaluated
+// at the nominal model (where nominally parallel axes are exactly parallel; at a perturbed start the d
+// offsets of a parallel pair would look independent, K2) with the dots triangulated from the start.
+// Columns are taken greedily in the order f_x, k1, camera, base, alpha/a/theta/d joint by joint, betas
+// last (the order of identification/identifiability.h, so that the same representative of each
+// dependent set is kept). Everything else is held at its start value and reported by name. For the
+// PUMA 560 on the arc trajectory this frees 24 kinematic parameters + f_x and fixes the base, joint 1,
+// j2.beta, j3.d, j4-j6.beta, j6.theta and j6.d: the same set as the relative-pose analysis with known
+// scale.
+//
+// Solver: Levenberg-Marquardt (Ceres), DENSE_SCHUR with the dots eliminated; one residual block per
+// observation with an analytic Jacobian (per pose, cam_from_base and its derivative with respect to the
+// free parameters are computed once per evaluation point by forward-mode autodiff and shared by the
+// pose's dots). About 20-30 ms for 15 poses x 80 dots.
+//
+// Frames and units: rho in m and rad (robot_model.h); dots in the base frame of the model (the gauge is
+// the start's base and joint-1 parameters); pixels as in camera/camera.h; f_x in px.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "kinematics/robot_model.h"
+#include "observations/observation_set.h"
+
+namespace selfcal::bundle {
+
+struct BundleOptions {
+  bool estimate_fx = true;
+  bool estimate_k1 = false;   // false: k1 held at observations.camera.k1
+  // Huber loss on each observation's 2-D reprojection error, in pixels (the loss acts on the whitened
+  // residual at huber_px / pixel_noise_px standard deviations). Used while outliers are screened; the
+  // final fit is plain least squares on the kept observations.
+  double huber_px = 2.0;
+  // Post-fit screen (K7): after each robust solve every observation is judged against the solution;
+  // those with reprojection error |r| (2-D norm, px) above screen_sigma * sigma are left out of the next
+  // solve (and earlier exclusions that now pass come back), until the set is stable or max_screen_rounds
+  // refits were made. sigma = max(pixel_noise_px, median(|r|) / sqrt(2 ln 2)), so an understated noise
+  // level does not strip inliers.
+  double screen_sigma = 4.0;
+  int max_screen_rounds = 5;
+  int max_iterations = 100;
+  double function_tolerance = 1e-12;
+  double gradient_tolerance = 1e-12;
+  double parameter_tolerance = 1e-12;
+  double yardstick_sigma_m = 1e-6;
+  double rank_tolerance = 1e-8;        // relative, on the column-normalised reduced Jacobian
+  int min_identification_poses = 3;    // fewer: kDegenerate before anything else
+  // K3: refuse (kDegenerate) when these poses identify fewer kinematic parameters than generic poses of
+  // the same robot do (too few poses, or poses that do not excite some joint).
+  bool require_generic_rank = true;
+  // Empty when valid; otherwise every problem, one per line.
+  std::string Validate() const;
+};
+
+enum class Outcome {
+  kNotRun,
+  kConverged,        // Ceres CONVERGENCE (K4)
+  kNoConvergence,    // result kept but not to be applied
+  kFailure,          // solver failure, non-finite start (K5)
+  kInvalidInput,     // the observation set or the arguments fail validation (names pose and dot)
+  kScaleUnresolved,  // no yardstick with both ends seen from two identification poses (S1)
+  kDegenerate,       // too few poses, insufficient excitation, f_x unidentifiable
+};
+const char* OutcomeName(Outcome outcome);
+
+struct RemovedObservation {
+  std::string pose_id;
+  int dot_id = -1;
+  double residual_px = 0;  // |r| at the final solution
+};
+
+struct BundleReport {
+  Outcome outcome = Outcome::kNotRun;
+  std::string message;
+  Eigen::VectorXd rho;                        // full; fixed entries keep their start values
+  double fx_px = 0;
+  double k1 = 0;
+  std::map<int, Eigen::Vector3d> dots_in_base;  // every dot that entered the solve
+  std::vector<int> free_indices;              // kinematic, in rho order
+  std::vector<std::string> free_names, fixed_names;
+  std::vector<std::string> null_combinations; // "1.00 base.tx", "0.71 j2.d - 0.71 j3.d", ...
+  int generic_rank = 0;                       // free kinematic count for generic poses of this robot
+  double condition_number = 0;                // column-normalised reduced Jacobian of the free set
+  // Marginal standard deviations, dots as nuisance: s^2 (J_g^T (I - P_dots) J_g)^-1 over the free
+  // columns, s^2 = 2 final_cost / (residuals - unknowns). NaN for fixed entries or when unavailable (K8).
+  Eigen::VectorXd stddev;                     // rho size
+  double fx_stddev = 0, k1_stddev = 0;        // NaN when not estimated or unavailable
+  bool covariance_available = false;
+  std::string covariance_message;
+  // Order: free_indices, then f_x, then k1 (each when estimated).
+  Eigen::MatrixXd covariance_free, correlation_free;
+  std::vector<RemovedObservation> removed;    // by the screen
+  std::vector<int> dropped_dots;              // seen fewer than twice, or not triangulable at the start
+  int num_observations = 0;                   // used in the final fit
+  double rms_reprojection_px = 0;             // RMS of |r| over them
+  double initial_cost = 0, final_cost = 0;    // Ceres cost of the first and the final solve
+  int iterations = 0;                         // over every solve
+  std::string termination;                    // of the final solve
+  double seconds = 0;
+};
+
+// Runs the bundle adjustment on the identification poses of `observations`. The start: rho_start on the
+// model observations.robot (e.g. the nominal rho, or the paper pipeline's result via ExpressOnModel) and
+// fx_start; k1 starts at observations.camera.k1; the dots are triangulated from the start model
+// (identification/triangulation.h). Single-threaded and deterministic.
+BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen::VectorXd& rho_start,
+                                 double fx_start, const BundleOptions& options);
+
+// The rho on `target` (same joint count) that gives the same base_from_cam(q) for every q as `source_rho`
+// on `source`: joint parameters copied, base and camera corrections re-expressed against target's
+// constant transforms (exact). E.g. the paper pipeline's metric calibrated model on the nominal model.
+Eigen::VectorXd ExpressOnModel(const RobotModel& target, const RobotModel& source, const Eigen::VectorXd& source_rho);
+
+// The truth (or any point) of the bundle problem, for the bound.
+struct BundleTruth {
+  Eigen::VectorXd rho;                          // on observations.robot
+  double fx_px = 0;
+  double k1 = 0;
+  std::map<int, Eigen::Vector3d> dots_in_base;  // at least every dot seen twice in identification poses
+};
+
+struct CramerRaoReport {
+  bool ok = false;
+  std::string message;
+  std::vector<int> free_indices;  // as the solve would choose them at this point
+  std::vector<std::string> fixed_names;
+  // (J_g^T (I - P_dots) J_g)^-1 with pixel std sigma_px, the yardstick as in the solve; order as in
+  // BundleReport::covariance_free.
+  Eigen::MatrixXd covariance_free;
+  Eigen::VectorXd stddev;         // rho size, NaN for fixed
+  double fx_stddev = 0, k1_stddev = 0;
+  // Propagated to the predicted relative pose cam_ref_from_cam_v (ref = first identification pose) of
+  // every verification pose: RMS position error bound sqrt(trace cov_t) (m) and orientation bound
+  // sqrt(trace cov_w) (rad, small-angle vector).
+  std::vector<std::string> verification_pose_ids;
+  std::vector<double> position_bound_m, orientation_bound_rad;
+  double rms_position_bound_m = 0, rms_orientation_bound_rad = 0;
+};
+
+// Cramer-Rao bound of the bundle adjustment's free parameters at `truth`: the Fisher information of the
+// reprojection model with the dots marginalised (Schur complement), the gauge fixed as in the solve (free
+// set chosen at the nominal model), the yardstick as the same stiff length residual, pixel std sigma_px
+// per coordinate. `geometry` supplies
+// the robot, camera, yardsticks, joint angles and which dots each identification pose sees (the pixel
+// values are not used).
+CramerRaoReport BundleCramerRao(const ObservationSet& geometry, const BundleTruth& truth, double sigma_px,
+                                const BundleOptions& options);
+
+}  // namespace selfcal::bundle

@@ -1,0 +1,377 @@
+#include "bundle/bundle_adjustment.h"
+
+#include <cmath>
+#include <iostream>
+#include <random>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "bundle/bundle_problem.h"
+#include "bundle/bundle_test_util.h"
+#include "identification/identifiability.h"
+#include "kinematics/autodiff_jacobian.h"
+#include "pipeline/paper_pipeline.h"
+
+namespace selfcal::bundle {
+namespace {
+
+using testing::FlatSheet;
+using testing::Truth;
+using testing::VerificationPoseErrors;
+using testing::World;
+
+constexpr double kExact = 1e-9;
+
+// Every free parameter, f_x and every dot against the truth (same gauge: base and joint 1 at nominal).
+void ExpectExact(const BundleReport& r, const sim::SimResult& world, const char* label) {
+  ASSERT_EQ(r.outcome, Outcome::kConverged) << label << ": " << r.message;
+  const KinematicParameters params(6);
+  double max_param = 0, max_dot = 0;
+  for (int i : r.free_indices) {
+    EXPECT_NEAR(r.rho[i], world.truth.rho_true[i], kExact) << label << " " << params.name(i);
+    max_param = std::max(max_param, std::abs(r.rho[i] - world.truth.rho_true[i]));
+  }
+  const double fx_true = world.truth.camera_true.fx_px;
+  EXPECT_NEAR(r.fx_px, fx_true, kExact * fx_true) << label;
+  ASSERT_EQ(r.dots_in_base.size(), world.truth.dots_in_base.size());
+  for (const auto& [id, p] : r.dots_in_base) {
+    EXPECT_LT((p - world.truth.dots_in_base[id]).norm(), kExact) << label << " dot " << id;
+    max_dot = std::max(max_dot, (p - world.truth.dots_in_base[id]).norm());
+  }
+  std::cout << "[ figure ] " << label << ": max parameter error " << max_param << ", f_x error "
+            << std::abs(r.fx_px - fx_true) << " px, max dot error " << max_dot << " m, " << r.iterations
+            << " iterations, " << r.seconds * 1e3 << " ms\n";
+}
+
+// K1: the gauge is computed for this problem and named; it agrees with the relative-pose analysis with
+// known scale (the yardstick), which is what the simulator perturbs.
+TEST(BundleAdjustment, NoiseFreeFromNominalRecoversTheTruthWithTheComputedGauge) {
+  const sim::SimResult world = World(0.0);
+  const ObservationSet& obs = world.observations;
+  const BundleReport r = RunBundleAdjustment(obs, KinematicParameters::Nominal(obs.robot), obs.camera.fx_px, {});
+  ExpectExact(r, world, "noise 0, nominal start");
+  EXPECT_EQ(r.free_indices.size(), 24u);
+  EXPECT_EQ(r.generic_rank, 24);
+  EXPECT_EQ(r.free_indices, world.truth.perturbed_indices);
+  std::vector<Eigen::VectorXd> joints;
+  for (int i : obs.PosesWithRole(PoseRole::kIdentification)) joints.push_back(obs.poses[i].joints_rad);
+  const auto relative = identification::AnalyzeIdentifiability(obs.robot, KinematicParameters::Nominal(obs.robot),
+                                                                joints, 0, {});
+  EXPECT_EQ(r.free_indices, relative.free_indices);
+  EXPECT_EQ(r.fixed_names, relative.fixed_names);
+  for (const char* name : {"base.tx", "base.rz", "j1.alpha", "j1.a", "j1.beta", "j1.theta", "j1.d"}) {
+    EXPECT_NE(std::find(r.fixed_names.begin(), r.fixed_names.end(), name), r.fixed_names.end()) << name;
+  }
+  EXPECT_EQ(r.null_combinations.size(), r.fixed_names.size());
+  std::cout << "[ figure ] BA gauge: " << r.free_indices.size() << " free kinematic + f_x; fixed:";
+  for (const std::string& n : r.fixed_names) std::cout << " " << n;
+  std::cout << "\n";
+  ASSERT_TRUE(r.covariance_available) << r.covariance_message;
+  EXPECT_EQ(r.covariance_free.rows(), 25);
+  for (int i = 0; i < r.stddev.size(); ++i) {
+    const bool free = std::find(r.free_indices.begin(), r.free_indices.end(), i) != r.free_indices.end();
+    EXPECT_EQ(std::isnan(r.stddev[i]), !free) << i;
+  }
+}
+
+TEST(BundleAdjustment, NoiseFreeFromAPerturbedStartWithTheGaugeOfTheNominalModel) {
+  const sim::SimResult world = World(0.0, 2, 2);
+  const ObservationSet& obs = world.observations;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const KinematicParameters params(6);
+  Eigen::VectorXd rho = world.truth.rho_true;
+  for (int i : world.truth.perturbed_indices) {
+    rho[i] += (params.kind(i) == ParameterKind::kLength ? 3e-3 : DegToRad(0.5)) * gauss(rng);
+  }
+  const BundleReport r = RunBundleAdjustment(obs, rho, 1.03 * world.truth.camera_true.fx_px, {});
+  ExpectExact(r, world, "noise 0, perturbed start (3 mm, 0.5 deg, 3 % f_x)");
+  // The gauge is analysed at the nominal model: at the perturbed start joints 2 and 3 are not exactly
+  // parallel, and a rank taken there would free j3.d, which then runs off to tens of metres (K2).
+  EXPECT_EQ(r.free_indices, world.truth.perturbed_indices);
+}
+
+// The paper pipeline's metric model as the start: its fixed entries carry its yardstick scale, so the
+// gauge differs from the truth's; gauge-invariant quantities must still be exact.
+TEST(BundleAdjustment, NoiseFreeFromThePaperPipelineStart) {
+  const sim::SimResult world = World(0.0);
+  const ObservationSet& obs = world.observations;
+  const pipeline::PaperPipelineReport paper = pipeline::RunPaperPipeline(obs, pipeline::PaperPipelineOptions());
+  ASSERT_EQ(paper.outcome, pipeline::Outcome::kSuccess) << paper.message;
+  const Eigen::VectorXd start = ExpressOnModel(obs.robot, paper.calibrated_robot, paper.calibrated_rho);
+  const BundleReport r = RunBundleAdjustment(obs, start, paper.fx_px, {});
+  ASSERT_EQ(r.outcome, Outcome::kConverged) << r.message;
+  const testing::PoseErrors e = VerificationPoseErrors(world, obs, obs.robot, r.rho);
+  EXPECT_LT(e.MaxPosition(), kExact);
+  EXPECT_LT(e.MaxRotation(), kExact);
+  EXPECT_NEAR(r.fx_px, world.truth.camera_true.fx_px, kExact * world.truth.camera_true.fx_px);
+  // Dots in the reference camera frame: gauge-free.
+  const int ref = obs.PosesWithRole(PoseRole::kIdentification).front();
+  const Rigid3 model_ref_from_base = BaseFromCam(obs.robot, r.rho, obs.poses[ref].joints_rad).Inverse();
+  const Rigid3 true_ref_from_base = world.truth.base_from_cam[ref].Inverse();
+  double max_dot = 0;
+  for (const auto& [id, p] : r.dots_in_base) {
+    max_dot = std::max(max_dot, (model_ref_from_base * p - true_ref_from_base * world.truth.dots_in_base[id]).norm());
+  }
+  EXPECT_LT(max_dot, kExact);
+  const testing::PoseErrors paper_e = VerificationPoseErrors(world, obs, paper.calibrated_robot, paper.calibrated_rho);
+  std::cout << "[ figure ] noise 0, paper-pipeline start: verification pose error " << e.MaxPosition() << " m / "
+            << e.MaxRotation() << " rad (paper pipeline alone: " << paper_e.MaxPosition() * 1e3 << " mm / "
+            << paper_e.MaxRotation() << " rad), dots " << max_dot << " m, " << r.seconds * 1e3 << " ms\n";
+}
+
+TEST(BundleAdjustment, EstimatesK1WhenAsked) {
+  const sim::SimResult world = World(0.0, 3, 3);
+  BundleOptions options;
+  options.estimate_k1 = true;
+  const ObservationSet& obs = world.observations;
+  const BundleReport r = RunBundleAdjustment(obs, KinematicParameters::Nominal(obs.robot), obs.camera.fx_px, options);
+  ExpectExact(r, world, "noise 0, k1 estimated");
+  EXPECT_NEAR(r.k1, world.truth.camera_true.k1, kExact);
+  EXPECT_EQ(r.covariance_free.rows(), 26);
+}
+
+TEST(BundleAdjustment, ExpressOnModelReproducesTheCameraPoses) {
+  const RobotModel nominal = selfcal::testing::Puma560();
+  Eigen::VectorXd rho = KinematicParameters::Nominal(nominal);
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> gauss(0.0, 1e-2);
+  for (int i = 0; i < rho.size(); ++i) rho[i] += gauss(rng);
+  RobotModel scaled = nominal;
+  ScaleLengths(1.07, &scaled, &rho);
+  const Eigen::VectorXd on_nominal = ExpressOnModel(nominal, scaled, rho);
+  for (int k = 0; k < 5; ++k) {
+    Eigen::VectorXd q(6);
+    for (int j = 0; j < 6; ++j) q[j] = 10 * gauss(rng);
+    EXPECT_TRUE(selfcal::testing::RigidNear(BaseFromCam(scaled, rho, q), BaseFromCam(nominal, on_nominal, q), 1e-12, 1e-12));
+  }
+}
+
+// The analytic chain rule (pose cache + projection) against central differences, with k1 != 0.
+TEST(BundleAdjustment, ReprojectionJacobianMatchesNumericDifferentiation) {
+  const RobotModel robot = selfcal::testing::Puma560();
+  CameraIntrinsics camera;
+  camera.mu = 1.02;
+  const int n = robot.num_parameters();
+  std::vector<int> columns(n);
+  for (int i = 0; i < n; ++i) columns[i] = i;
+  Eigen::VectorXd q(6);
+  q << 0.1, 0.4, 2.6, 0.2, 0.7, -0.3;
+  Eigen::VectorXd x(n + 5);  // rho, f_x, k1, dot
+  x.head(n) = KinematicParameters::Nominal(robot);
+  const Rigid3 base_from_cam = BaseFromCam(robot, Eigen::VectorXd(x.head(n)), q);
+  x.tail(5) << 1000.0, -0.08, 0, 0, 0;
+  x.tail(3) = base_from_cam * Eigen::Vector3d(0.1, -0.05, 0.6);
+  const Eigen::Vector2d pixel(300, 250);
+  auto f = [&](const double* v, double* out) {
+    internal::PoseCache cache;
+    internal::ComputePoseCache(robot, v, q, {}, false, &cache);
+    internal::EvaluateReprojection(camera, 0.5, cache, v[n], v[n + 1], Eigen::Vector3d(v[n + 2], v[n + 3], v[n + 4]),
+                                   pixel, out, nullptr, nullptr, nullptr, nullptr);
+  };
+  const Eigen::MatrixXd numeric = NumericJacobian(f, x, 2, 1e-7);
+  internal::PoseCache cache;
+  internal::ComputePoseCache(robot, x.data(), q, columns, true, &cache);
+  double residual[2], d_fx[2], d_k1[2], d_dot[6];
+  std::vector<double> d_columns(2 * n);
+  ASSERT_TRUE(internal::EvaluateReprojection(camera, 0.5, cache, x[n], x[n + 1], x.tail<3>(), pixel, residual,
+                                             d_columns.data(), d_fx, d_k1, d_dot));
+  for (int r = 0; r < 2; ++r) {
+    for (int c = 0; c < n; ++c) EXPECT_NEAR(d_columns[r * n + c], numeric(r, c), 1e-5 * (1 + std::abs(numeric(r, c)))) << c;
+    EXPECT_NEAR(d_fx[r], numeric(r, n), 1e-6);
+    EXPECT_NEAR(d_k1[r], numeric(r, n + 1), 1e-4);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(d_dot[3 * r + c], numeric(r, n + 2 + c), 1e-4 * (1 + std::abs(numeric(r, n + 2 + c))));
+  }
+}
+
+// The reduced Jacobian's Gram matrix is the Schur complement of the dots in the dense normal matrix.
+TEST(BundleAdjustment, ReducedJacobianIsTheSchurComplementOfTheDots) {
+  const sim::SimResult world = World(0.0);
+  ObservationSet obs = world.observations;
+  obs.poses.resize(5);
+  for (PoseObservation& p : obs.poses) {
+    for (auto it = p.dots_px.begin(); it != p.dots_px.end();) it = it->first >= 8 ? p.dots_px.erase(it) : std::next(it);
+  }
+  const internal::BundleData data = internal::MakeBundleData(obs, 1e-3);
+  ASSERT_EQ(data.yardsticks.size(), 1u);
+  internal::BundleState state{world.truth.rho_true, world.truth.camera_true.fx_px, 0.0, {}};
+  for (int id : data.dot_ids) state.dots.push_back(world.truth.dots_in_base[id]);
+  internal::GlobalColumns columns;
+  columns.kinematic = world.truth.perturbed_indices;
+  columns.fx = true;
+  const int ng = columns.size(), nx = 3 * static_cast<int>(data.dot_ids.size());
+  Eigen::MatrixXd reduced;
+  ASSERT_TRUE(internal::ReducedJacobian(data, state, columns, &reduced));
+  // Dense Jacobian by central differences of the whitened residuals.
+  auto residuals = [&](const Eigen::VectorXd& x) {
+    internal::BundleState s = state;
+    for (size_t k = 0; k < columns.kinematic.size(); ++k) s.rho[columns.kinematic[k]] = x[k];
+    s.fx_px = x[ng - 1];
+    for (size_t d = 0; d < s.dots.size(); ++d) s.dots[d] = x.segment<3>(ng + 3 * d);
+    Eigen::VectorXd out(2 * data.observations.size() + 1);
+    for (size_t k = 0; k < data.observations.size(); ++k) {
+      const internal::Observation& o = data.observations[k];
+      internal::PoseCache cache;
+      internal::ComputePoseCache(data.robot, s.rho.data(), data.joints[o.pose], {}, false, &cache);
+      internal::EvaluateReprojection(data.camera, data.sigma_px, cache, s.fx_px, s.k1, s.dots[o.dot], o.pixel,
+                                     out.data() + 2 * k, nullptr, nullptr, nullptr, nullptr);
+    }
+    const auto& y = data.yardsticks[0];
+    out[out.size() - 1] = ((s.dots[y.dot_a] - s.dots[y.dot_b]).norm() - y.length_m) / data.yardstick_sigma_m;
+    return out;
+  };
+  Eigen::VectorXd x(ng + nx);
+  for (size_t k = 0; k < columns.kinematic.size(); ++k) x[k] = state.rho[columns.kinematic[k]];
+  x[ng - 1] = state.fx_px;
+  for (size_t d = 0; d < state.dots.size(); ++d) x.segment<3>(ng + 3 * d) = state.dots[d];
+  Eigen::MatrixXd j(residuals(x).size(), x.size());
+  for (int c = 0; c < x.size(); ++c) {
+    const double h = 1e-6 * std::max(1.0, std::abs(x[c]));
+    Eigen::VectorXd xp = x, xm = x;
+    xp[c] += h;
+    xm[c] -= h;
+    j.col(c) = (residuals(xp) - residuals(xm)) / (2 * h);
+  }
+  const Eigen::MatrixXd jg = j.leftCols(ng), jx = j.rightCols(nx);
+  const Eigen::MatrixXd schur =
+      jg.transpose() * jg - jg.transpose() * jx * (jx.transpose() * jx).ldlt().solve(jx.transpose() * jg);
+  const Eigen::MatrixXd gram = reduced.transpose() * reduced;
+  EXPECT_LT((gram - schur).norm(), 1e-5 * schur.norm()) << (gram - schur).norm() << " vs " << schur.norm();
+}
+
+TEST(BundleAdjustment, CovarianceRefusesARankDeficientJacobianByName) {
+  Eigen::MatrixXd j = Eigen::MatrixXd::Random(10, 3);
+  j.col(2) = 2 * j.col(0) - j.col(1);
+  Eigen::MatrixXd covariance;
+  std::string message;
+  EXPECT_FALSE(internal::CovarianceFromJacobian(j, {"a", "b", "c"}, &covariance, &message));
+  EXPECT_NE(message.find("rank deficient: a, b, c"), std::string::npos) << message;
+}
+
+// Outliers (K7): 2 % of the observations replaced by random pixels.
+TEST(BundleAdjustment, OutliersAreRemovedByPoseAndDotAndTheResultHolds) {
+  const sim::SimResult world = World(0.2, 4, 4);
+  ObservationSet obs = world.observations;
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(0, obs.camera.width_px - 1), v(0, obs.camera.height_px - 1);
+  std::set<std::pair<std::string, int>> corrupted;
+  const std::vector<int> id_poses = obs.PosesWithRole(PoseRole::kIdentification);
+  std::uniform_int_distribution<int> pick_pose(0, static_cast<int>(id_poses.size()) - 1), pick_dot(0, 79);
+  while (corrupted.size() < 24) {  // 2 % of 15 x 80
+    PoseObservation& pose = obs.poses[id_poses[pick_pose(rng)]];
+    const int dot = pick_dot(rng);
+    if (corrupted.insert({pose.id, dot}).second) pose.dots_px[dot] = Eigen::Vector2d(u(rng), v(rng));
+  }
+  const BundleReport r = RunBundleAdjustment(obs, KinematicParameters::Nominal(obs.robot), obs.camera.fx_px, {});
+  ASSERT_EQ(r.outcome, Outcome::kConverged) << r.message;
+  std::set<std::pair<std::string, int>> removed;
+  for (const RemovedObservation& o : r.removed) removed.insert({o.pose_id, o.dot_id});
+  for (const auto& c : corrupted) EXPECT_TRUE(removed.count(c)) << "not removed: pose " << c.first << ", dot " << c.second;
+  EXPECT_LE(removed.size(), corrupted.size() + 2);  // at most two inliers lost
+  ASSERT_TRUE(r.covariance_available) << r.covariance_message;
+  int worst = -1;
+  double worst_z = 0;
+  for (int i : r.free_indices) {
+    const double z = std::abs(r.rho[i] - world.truth.rho_true[i]) / r.stddev[i];
+    if (z > worst_z) worst_z = z, worst = i;
+  }
+  EXPECT_LT(worst_z, 3.0) << KinematicParameters(6).name(worst);
+  EXPECT_LT(std::abs(r.fx_px - world.truth.camera_true.fx_px), 3 * r.fx_stddev);
+  std::cout << "[ figure ] outliers: " << corrupted.size() << " corrupted, " << r.removed.size()
+            << " removed; worst free parameter at " << worst_z << " sigma; " << r.seconds * 1e3 << " ms\n";
+}
+
+// All dots on one plane: the factor method's 8-point estimate is degenerate there, the BA is not.
+TEST(BundleAdjustment, FlatDotSheetConvergesFromTheNominalStart) {
+  const sim::SimResult world = World(0.0, 5, 5);
+  std::map<int, Eigen::Vector3d> flat;
+  for (double noise : {0.0, 0.2}) {
+    const ObservationSet obs = FlatSheet(world, noise, 9, &flat);
+    const BundleReport r = RunBundleAdjustment(obs, KinematicParameters::Nominal(obs.robot), obs.camera.fx_px, {});
+    ASSERT_EQ(r.outcome, Outcome::kConverged) << r.message;
+    EXPECT_EQ(r.free_indices, world.truth.perturbed_indices);
+    double max_z = 0, max_err = 0;
+    int worst = -1;
+    for (int i : r.free_indices) {
+      const double error = std::abs(r.rho[i] - world.truth.rho_true[i]);
+      max_err = std::max(max_err, error);
+      if (error / r.stddev[i] > max_z) max_z = error / r.stddev[i], worst = i;
+    }
+    if (noise == 0) {
+      EXPECT_LT(max_err, kExact);
+      EXPECT_NEAR(r.fx_px, world.truth.camera_true.fx_px, kExact * world.truth.camera_true.fx_px);
+      for (const auto& [id, p] : r.dots_in_base) EXPECT_LT((p - flat[id]).norm(), kExact) << id;
+    } else {
+      EXPECT_LT(max_z, 4.0) << KinematicParameters(6).name(worst);
+      EXPECT_LT(std::abs(r.fx_px - world.truth.camera_true.fx_px), 4 * r.fx_stddev);
+    }
+    const testing::PoseErrors pose = VerificationPoseErrors(world, obs, obs.robot, r.rho);
+    const pipeline::PaperPipelineReport paper = pipeline::RunPaperPipeline(obs, pipeline::PaperPipelineOptions());
+    std::cout << "[ figure ] flat sheet, noise " << noise << " px: BA " << OutcomeName(r.outcome) << ", "
+              << r.num_observations << " observations, max parameter error " << max_err;
+    if (noise > 0) std::cout << " (worst " << KinematicParameters(6).name(worst) << " at " << max_z << " sigma)";
+    std::cout << ", f_x error " << std::abs(r.fx_px - world.truth.camera_true.fx_px) << " px, max verification pose error "
+              << pose.MaxPosition() * 1e3 << " mm, " << r.seconds * 1e3 << " ms; paper pipeline: "
+              << pipeline::OutcomeName(paper.outcome);
+    if (paper.calibrated_rho.size() == obs.robot.num_parameters()) {
+      std::cout << ", verification pose error "
+                << VerificationPoseErrors(world, obs, paper.calibrated_robot, paper.calibrated_rho).MaxPosition() * 1e3
+                << " mm";
+    } else {
+      std::cout << " (" << paper.message.substr(0, 80) << ")";
+    }
+    std::cout << "\n";
+  }
+}
+
+TEST(BundleAdjustment, MissingYardstickLeavesTheScaleUnresolved) {
+  sim::SimResult world = World(0.2);
+  const Eigen::VectorXd rho0 = KinematicParameters::Nominal(world.observations.robot);
+  ObservationSet obs = world.observations;
+  obs.yardsticks.clear();
+  EXPECT_EQ(RunBundleAdjustment(obs, rho0, obs.camera.fx_px, {}).outcome, Outcome::kScaleUnresolved);
+  obs = world.observations;  // S1: one end seen in a single identification view
+  for (int i = 1; i < 15; ++i) obs.poses[i].dots_px.erase(1);
+  const BundleReport r = RunBundleAdjustment(obs, rho0, obs.camera.fx_px, {});
+  EXPECT_EQ(r.outcome, Outcome::kScaleUnresolved) << r.message;
+}
+
+TEST(BundleAdjustment, NanPixelIsInvalidInputNamingPoseAndDot) {
+  sim::SimResult world = World(0.2);
+  world.observations.poses[3].dots_px[5] = Eigen::Vector2d(std::nan(""), 1.0);
+  const BundleReport r = RunBundleAdjustment(world.observations, KinematicParameters::Nominal(world.observations.robot),
+                                             world.observations.camera.fx_px, {});
+  EXPECT_EQ(r.outcome, Outcome::kInvalidInput);
+  EXPECT_NE(r.message.find("pose p03, dot 5"), std::string::npos) << r.message;
+}
+
+TEST(BundleAdjustment, BadOptionsAndStartAreInvalidInputListingEveryProblem) {
+  const sim::SimResult world = World(0.2);
+  const ObservationSet& obs = world.observations;
+  BundleOptions options;
+  options.huber_px = -1;
+  options.rank_tolerance = 2;
+  const BundleReport r = RunBundleAdjustment(obs, Eigen::VectorXd::Zero(5), std::nan(""), options);
+  EXPECT_EQ(r.outcome, Outcome::kInvalidInput);
+  for (const char* what : {"huber_px", "rank_tolerance", "rho_start has 5 entries", "fx_start"}) {
+    EXPECT_NE(r.message.find(what), std::string::npos) << what << " in: " << r.message;
+  }
+}
+
+TEST(BundleAdjustment, TooFewPosesAreDegenerate) {
+  sim::SimResult world = World(0.2);
+  const Eigen::VectorXd rho0 = KinematicParameters::Nominal(world.observations.robot);
+  ObservationSet obs = world.observations;
+  obs.poses.resize(2);
+  EXPECT_EQ(RunBundleAdjustment(obs, rho0, obs.camera.fx_px, {}).outcome, Outcome::kDegenerate);
+  obs = world.observations;
+  obs.poses.resize(4);  // 3 motions, 18 constraints: fewer than the 24 generic parameters (K3)
+  const BundleReport r = RunBundleAdjustment(obs, rho0, obs.camera.fx_px, {});
+  EXPECT_EQ(r.outcome, Outcome::kDegenerate);
+  EXPECT_NE(r.message.find("insufficient excitation"), std::string::npos) << r.message;
+  std::cout << "[ figure ] 4 poses: " << r.message << "\n";
+}
+
+}  // namespace
+}  // namespace selfcal::bundle

@@ -1,0 +1,67 @@
+// Options validation, outcome names, and re-expressing a model's parameters on another model.
+#include <cmath>
+#include <sstream>
+
+#include "base/status.h"
+#include "bundle/bundle_adjustment.h"
+
+namespace selfcal::bundle {
+
+std::string BundleOptions::Validate() const {
+  std::ostringstream out;
+  auto positive = [&](double v, const char* name) {
+    if (!std::isfinite(v) || v <= 0) out << name << " = " << v << " must be finite and > 0\n";
+  };
+  positive(huber_px, "huber_px");
+  positive(screen_sigma, "screen_sigma");
+  positive(yardstick_sigma_m, "yardstick_sigma_m");
+  if (max_screen_rounds < 0) out << "max_screen_rounds = " << max_screen_rounds << " must be >= 0\n";
+  if (max_iterations < 1) out << "max_iterations = " << max_iterations << " must be >= 1\n";
+  if (!(function_tolerance >= 0)) out << "function_tolerance = " << function_tolerance << " must be >= 0\n";
+  if (!(gradient_tolerance >= 0)) out << "gradient_tolerance = " << gradient_tolerance << " must be >= 0\n";
+  if (!(parameter_tolerance >= 0)) out << "parameter_tolerance = " << parameter_tolerance << " must be >= 0\n";
+  if (!(rank_tolerance > 0 && rank_tolerance < 1)) out << "rank_tolerance = " << rank_tolerance << " must lie in (0, 1)\n";
+  if (min_identification_poses < 2) {
+    out << "min_identification_poses = " << min_identification_poses << " must be >= 2\n";
+  }
+  return out.str();
+}
+
+const char* OutcomeName(Outcome outcome) {
+  switch (outcome) {
+    case Outcome::kNotRun: return "not_run";
+    case Outcome::kConverged: return "converged";
+    case Outcome::kNoConvergence: return "unconverged";
+    case Outcome::kFailure: return "failure";
+    case Outcome::kInvalidInput: return "invalid_input";
+    case Outcome::kScaleUnresolved: return "scale_unresolved";
+    case Outcome::kDegenerate: return "degenerate";
+  }
+  return "unknown";
+}
+
+Eigen::VectorXd ExpressOnModel(const RobotModel& target, const RobotModel& source, const Eigen::VectorXd& source_rho) {
+  SELFCAL_CHECK(target.num_joints() == source.num_joints(),
+                "models with " << target.num_joints() << " and " << source.num_joints() << " joints");
+  SELFCAL_CHECK(source_rho.size() == source.num_parameters(), "rho has " << source_rho.size() << " entries");
+  const KinematicParameters params(target.num_joints());
+  auto as_vector = [](const Rigid3& t, double* out) {
+    const Eigen::Vector3d w = LogSO3(t.rotation);
+    for (int k = 0; k < 3; ++k) {
+      out[k] = t.translation[k];
+      out[3 + k] = w[k];
+    }
+  };
+  Eigen::VectorXd rho = source_rho;
+  // base_from_link0_t Exp(b_t) = base_from_link0_s Exp(b_s).
+  as_vector(target.base_from_link0.Inverse() * source.base_from_link0 * RigidFromTranslationRotvec(source_rho.data()),
+            rho.data());
+  // link_n_from_flange_t flange_from_cam_t Exp(c_t) = link_n_from_flange_s flange_from_cam_s Exp(c_s).
+  const int cam = params.CamOffset();
+  as_vector((target.link_n_from_flange * target.flange_from_cam).Inverse() * source.link_n_from_flange *
+                source.flange_from_cam * RigidFromTranslationRotvec(source_rho.data() + cam),
+            rho.data() + cam);
+  return rho;
+}
+
+}  // namespace selfcal::bundle

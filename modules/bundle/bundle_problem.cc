@@ -1,0 +1,327 @@
+#include "bundle/bundle_problem.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <numeric>
+
+#include <Eigen/Dense>
+#include <ceres/jet.h>
+
+namespace selfcal::bundle::internal {
+
+void ComputePoseCache(const RobotModel& model, const double* rho, const Eigen::VectorXd& q,
+                      const std::vector<int>& columns, bool derivatives, PoseCache* out) {
+  const int m = static_cast<int>(columns.size());
+  if (!derivatives || m == 0) {
+    const Rigid3 cam_from_base = BaseFromCam<double>(model, rho, q.data()).Inverse();
+    out->rotation = cam_from_base.rotation;
+    out->translation = cam_from_base.translation;
+    out->d_rotation.assign(derivatives ? m : 0, Eigen::Matrix3d::Zero());
+    out->d_translation.assign(derivatives ? m : 0, Eigen::Vector3d::Zero());
+    return;
+  }
+  // Only the requested columns carry derivatives: 8 per pass of the forward kinematics, so ~24 free
+  // parameters cost three passes per pose and evaluation, shared by every dot that pose sees.
+  constexpr int kStride = 8;
+  using Jet = ceres::Jet<double, kStride>;
+  const int n = model.num_parameters();
+  std::vector<Jet> rho_jet(n), q_jet(q.size());
+  for (int j = 0; j < q.size(); ++j) q_jet[j] = Jet(q[j]);
+  out->d_rotation.resize(m);
+  out->d_translation.resize(m);
+  for (int start = 0; start < m; start += kStride) {
+    for (int i = 0; i < n; ++i) rho_jet[i] = Jet(rho[i]);
+    const int count = std::min(kStride, m - start);
+    for (int k = 0; k < count; ++k) rho_jet[columns[start + k]].v[k] = 1.0;
+    const Rigid3T<Jet> cam_from_base = BaseFromCam<Jet>(model, rho_jet.data(), q_jet.data()).Inverse();
+    if (start == 0) {
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) out->rotation(r, c) = cam_from_base.rotation(r, c).a;
+        out->translation[r] = cam_from_base.translation[r].a;
+      }
+    }
+    for (int k = 0; k < count; ++k) {
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) out->d_rotation[start + k](r, c) = cam_from_base.rotation(r, c).v[k];
+        out->d_translation[start + k][r] = cam_from_base.translation[r].v[k];
+      }
+    }
+  }
+}
+
+bool EvaluateReprojection(const CameraIntrinsics& camera, double sigma_px, const PoseCache& cache, double fx,
+                          double k1, const Eigen::Vector3d& dot, const Eigen::Vector2d& pixel, double* residual,
+                          double* d_columns, double* d_fx, double* d_k1, double* d_dot) {
+  const Eigen::Vector3d p = cache.rotation * dot + cache.translation;
+  if (!(p.z() > 0) || !p.allFinite()) return false;
+  const double inv_z = 1.0 / p.z();
+  const double x = p.x() * inv_z, y = p.y() * inv_z;
+  const double r2 = x * x + y * y;
+  const double radial = 1.0 + k1 * r2;
+  const double mu = camera.mu;
+  const double inv_sigma = 1.0 / sigma_px;
+  const double u = fx * x * radial + camera.cx_px;
+  const double v = fx * mu * y * radial + camera.cy_px;
+  const double r0 = (u - pixel.x()) * inv_sigma, r1 = (v - pixel.y()) * inv_sigma;
+  if (!std::isfinite(r0) || !std::isfinite(r1)) return false;
+  residual[0] = r0;
+  residual[1] = r1;
+  if (d_fx != nullptr) {
+    d_fx[0] = x * radial * inv_sigma;
+    d_fx[1] = mu * y * radial * inv_sigma;
+  }
+  if (d_k1 != nullptr) {
+    d_k1[0] = fx * x * r2 * inv_sigma;
+    d_k1[1] = fx * mu * y * r2 * inv_sigma;
+  }
+  if (d_columns == nullptr && d_dot == nullptr) return true;
+  Eigen::Matrix2d d_uv_d_xy;
+  d_uv_d_xy << fx * (radial + 2 * k1 * x * x), fx * 2 * k1 * x * y, fx * mu * 2 * k1 * x * y,
+      fx * mu * (radial + 2 * k1 * y * y);
+  Eigen::Matrix<double, 2, 3> d_xy_d_p;
+  d_xy_d_p << inv_z, 0, -x * inv_z, 0, inv_z, -y * inv_z;
+  const Eigen::Matrix<double, 2, 3> d_p = inv_sigma * d_uv_d_xy * d_xy_d_p;
+  if (d_dot != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> out(d_dot);
+    out = d_p * cache.rotation;
+  }
+  if (d_columns != nullptr) {
+    const int m = static_cast<int>(cache.d_rotation.size());
+    for (int c = 0; c < m; ++c) {
+      const Eigen::Vector2d d = d_p * (cache.d_rotation[c] * dot + cache.d_translation[c]);
+      d_columns[c] = d[0];
+      d_columns[m + c] = d[1];
+    }
+  }
+  return true;
+}
+
+namespace {
+
+int FindRoot(std::vector<int>* parent, int i) {
+  while ((*parent)[i] != i) i = (*parent)[i] = (*parent)[(*parent)[i]];
+  return i;
+}
+
+}  // namespace
+
+bool ReducedJacobian(const BundleData& data, const BundleState& state, const GlobalColumns& columns,
+                     Eigen::MatrixXd* reduced) {
+  const int num_poses = static_cast<int>(data.joints.size());
+  const int num_dots = static_cast<int>(data.dot_ids.size());
+  const int num_kinematic = static_cast<int>(columns.kinematic.size());
+  const int num_global = columns.size();
+  std::vector<PoseCache> caches(num_poses);
+  for (int p = 0; p < num_poses; ++p) {
+    ComputePoseCache(data.robot, state.rho.data(), data.joints[p], columns.kinematic, true, &caches[p]);
+  }
+  // Dots joined by a yardstick share a residual, so they are eliminated together.
+  std::vector<int> parent(num_dots);
+  std::iota(parent.begin(), parent.end(), 0);
+  for (const Yardstick& y : data.yardsticks) parent[FindRoot(&parent, y.dot_a)] = FindRoot(&parent, y.dot_b);
+  std::vector<int> group_of(num_dots, -1), slot_of(num_dots, -1);
+  std::vector<int> group_size;
+  for (int d = 0; d < num_dots; ++d) {
+    const int root = FindRoot(&parent, d);
+    if (group_of[root] < 0) {
+      group_of[root] = static_cast<int>(group_size.size());
+      group_size.push_back(0);
+    }
+    group_of[d] = group_of[root];
+    slot_of[d] = group_size[group_of[d]]++;
+  }
+  const int num_groups = static_cast<int>(group_size.size());
+  std::vector<std::vector<int>> group_observations(num_groups), group_yardsticks(num_groups);
+  for (size_t k = 0; k < data.observations.size(); ++k) {
+    group_observations[group_of[data.observations[k].dot]].push_back(static_cast<int>(k));
+  }
+  for (size_t k = 0; k < data.yardsticks.size(); ++k) {
+    group_yardsticks[group_of[data.yardsticks[k].dot_a]].push_back(static_cast<int>(k));
+  }
+
+  std::vector<Eigen::MatrixXd> blocks;
+  int total_rows = 0;
+  std::vector<double> d_columns(2 * std::max(num_kinematic, 1));
+  for (int g = 0; g < num_groups; ++g) {
+    const int rows = 2 * static_cast<int>(group_observations[g].size()) + static_cast<int>(group_yardsticks[g].size());
+    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(rows, 3 * group_size[g]);
+    Eigen::MatrixXd b = Eigen::MatrixXd::Zero(rows, num_global);
+    int row = 0;
+    for (int k : group_observations[g]) {
+      const Observation& o = data.observations[k];
+      double residual[2], d_fx[2], d_k1[2], d_dot[6];
+      if (!EvaluateReprojection(data.camera, data.sigma_px, caches[o.pose], state.fx_px, state.k1, state.dots[o.dot],
+                                o.pixel, residual, d_columns.data(), d_fx, d_k1, d_dot)) {
+        return false;
+      }
+      for (int r = 0; r < 2; ++r) {
+        for (int c = 0; c < num_kinematic; ++c) b(row + r, c) = d_columns[r * num_kinematic + c];
+        int col = num_kinematic;
+        if (columns.fx) b(row + r, col++) = d_fx[r];
+        if (columns.k1) b(row + r, col++) = d_k1[r];
+        for (int c = 0; c < 3; ++c) a(row + r, 3 * slot_of[o.dot] + c) = d_dot[3 * r + c];
+      }
+      row += 2;
+    }
+    for (int k : group_yardsticks[g]) {
+      const Yardstick& y = data.yardsticks[k];
+      const Eigen::Vector3d diff = state.dots[y.dot_a] - state.dots[y.dot_b];
+      const double norm = diff.norm();
+      if (!(norm > 0)) return false;
+      const Eigen::Vector3d d = diff / (norm * data.yardstick_sigma_m);
+      a.block<1, 3>(row, 3 * slot_of[y.dot_a]) += d.transpose();
+      a.block<1, 3>(row, 3 * slot_of[y.dot_b]) -= d.transpose();
+      ++row;
+    }
+    // (I - P_a) b in the coordinates of Q: the rows of Q^T b below the rank of a.
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(a);
+    const int rank = static_cast<int>(qr.rank());
+    if (rows <= rank) continue;
+    const Eigen::MatrixXd qtb = qr.householderQ().adjoint() * b;
+    blocks.push_back(qtb.bottomRows(rows - rank));
+    total_rows += rows - rank;
+  }
+  Eigen::MatrixXd stacked(total_rows, num_global);
+  int row = 0;
+  for (const Eigen::MatrixXd& block : blocks) {
+    stacked.middleRows(row, block.rows()) = block;
+    row += static_cast<int>(block.rows());
+  }
+  if (total_rows <= num_global) {
+    *reduced = stacked;
+    return true;
+  }
+  // Same Gram matrix, num_global rows: the rank analysis and the covariance work on a small matrix.
+  Eigen::HouseholderQR<Eigen::MatrixXd> qr(stacked);
+  *reduced = qr.matrixQR().topRows(num_global).triangularView<Eigen::Upper>();
+  return true;
+}
+
+std::vector<std::string> GlobalNames(const GlobalColumns& columns, int num_joints) {
+  const KinematicParameters params(num_joints);
+  std::vector<std::string> names;
+  for (int i : columns.kinematic) names.push_back(params.name(i));
+  if (columns.fx) names.push_back("fx");
+  if (columns.k1) names.push_back("k1");
+  return names;
+}
+
+std::vector<int> SelectionOrder(int num_joints, bool fx, bool k1) {
+  const int n = KinematicParameters(num_joints).size();
+  std::vector<int> order;
+  if (fx) order.push_back(n);
+  if (k1) order.push_back(n + (fx ? 1 : 0));
+  for (int c : identification::PreferredParameterOrder(num_joints)) order.push_back(c);
+  return order;
+}
+
+bool CovarianceFromJacobian(const Eigen::MatrixXd& jacobian, const std::vector<std::string>& names,
+                            Eigen::MatrixXd* covariance, std::string* message) {
+  // Tighter than the rank selection's tolerance: a column kept there may still be too weak to invert.
+  constexpr double kTolerance = 1e-10;
+  const int cols = static_cast<int>(jacobian.cols());
+  if (jacobian.rows() < cols || cols == 0) {
+    *message = "uncertainty unavailable (fewer reduced rows than unknowns)";
+    return false;
+  }
+  Eigen::VectorXd norms;
+  std::vector<bool> zero;
+  const Eigen::MatrixXd normalized = identification::NormalizeColumns(jacobian, kTolerance, &norms, &zero);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(normalized, Eigen::ComputeThinV);
+  const Eigen::VectorXd sv = svd.singularValues();
+  std::vector<bool> involved(cols, false);
+  for (int k = 0; k < cols; ++k) {
+    if (sv[k] > kTolerance * sv[0]) continue;
+    for (int j = 0; j < cols; ++j) involved[j] = involved[j] || std::abs(svd.matrixV()(j, k)) > 0.05;
+  }
+  std::string deficient;
+  for (int j = 0; j < cols; ++j) {
+    if (involved[j] || zero[j]) deficient += (deficient.empty() ? "" : ", ") + names[j];
+  }
+  if (!deficient.empty()) {
+    *message = "uncertainty unavailable (rank deficient: " + deficient + ")";
+    return false;
+  }
+  const Eigen::MatrixXd v = svd.matrixV();
+  const Eigen::VectorXd inv_sv2 = sv.array().square().inverse();
+  const Eigen::VectorXd inv_norms = norms.array().inverse();
+  *covariance = inv_norms.asDiagonal() * (v * inv_sv2.asDiagonal() * v.transpose()) * inv_norms.asDiagonal();
+  if (!covariance->allFinite()) {
+    *message = "uncertainty unavailable (non-finite covariance)";
+    return false;
+  }
+  *message = "ok";
+  return true;
+}
+
+BundleData MakeBundleData(const ObservationSet& observations, double yardstick_sigma_m) {
+  BundleData data;
+  data.robot = observations.robot;
+  data.camera = observations.camera;
+  data.sigma_px = observations.pixel_noise_px;
+  data.yardstick_sigma_m = yardstick_sigma_m;
+  std::map<int, int> views;
+  for (int p : observations.PosesWithRole(PoseRole::kIdentification)) {
+    data.pose_ids.push_back(observations.poses[p].id);
+    data.joints.push_back(observations.poses[p].joints_rad);
+    for (const auto& entry : observations.poses[p].dots_px) ++views[entry.first];
+  }
+  std::map<int, int> index_of;
+  for (const auto& [dot, count] : views) {
+    if (count < 2) continue;
+    index_of[dot] = static_cast<int>(data.dot_ids.size());
+    data.dot_ids.push_back(dot);
+  }
+  int pose = 0;
+  for (int p : observations.PosesWithRole(PoseRole::kIdentification)) {
+    for (const auto& [dot, pixel] : observations.poses[p].dots_px) {
+      auto it = index_of.find(dot);
+      if (it != index_of.end()) data.observations.push_back({pose, it->second, pixel});
+    }
+    ++pose;
+  }
+  for (const KnownDistance& k : observations.yardsticks) {
+    auto a = index_of.find(k.dot_a);
+    auto b = index_of.find(k.dot_b);
+    if (a != index_of.end() && b != index_of.end()) data.yardsticks.push_back({a->second, b->second, k.length_m});
+  }
+  return data;
+}
+
+bool AnalyzeGauge(const BundleData& data, const BundleState& state, bool estimate_fx, bool estimate_k1,
+                  double rank_tolerance, Gauge* gauge) {
+  const int num_joints = data.robot.num_joints();
+  const int n = data.robot.num_parameters();
+  GlobalColumns columns;
+  columns.kinematic.resize(n);
+  std::iota(columns.kinematic.begin(), columns.kinematic.end(), 0);
+  columns.fx = estimate_fx;
+  columns.k1 = estimate_k1;
+  Eigen::MatrixXd reduced;
+  if (!ReducedJacobian(data, state, columns, &reduced)) return false;
+  const std::vector<std::string> names = GlobalNames(columns, num_joints);
+  const identification::RankSelection selection =
+      identification::SelectColumns(reduced, SelectionOrder(num_joints, estimate_fx, estimate_k1), rank_tolerance, names);
+  *gauge = Gauge();
+  for (int c : selection.kept) {
+    if (c < n) {
+      gauge->free_kinematic.push_back(c);
+      gauge->free_names.push_back(names[c]);
+    } else if (names[c] == "fx") {
+      gauge->fx_identifiable = true;
+    } else {
+      gauge->k1_identifiable = true;
+    }
+  }
+  for (int c : selection.dependent) {
+    if (c < n) gauge->fixed_names.push_back(names[c]);
+  }
+  gauge->null_combinations = selection.null_combinations;
+  gauge->condition_number = selection.condition_number;
+  return true;
+}
+
+}  // namespace selfcal::bundle::internal

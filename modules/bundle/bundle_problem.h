@@ -1,0 +1,112 @@
+// Internal to the bundle module: the reprojection model with its analytic Jacobian, the reduced
+// (dots-eliminated) Jacobian, and the rank selection. Shared by the solver, the covariance, the
+// Cramer-Rao bound and the tests; Ceres stays out of this header.
+//
+// Global columns: entries of rho (a chosen subset), then f_x and k1 when present. Rows are whitened:
+// pixel residuals divided by sigma_px, yardstick residuals by yardstick_sigma_m.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "camera/camera.h"
+#include "identification/rank_selection.h"
+#include "kinematics/robot_model.h"
+#include "observations/observation_set.h"
+
+namespace selfcal::bundle::internal {
+
+struct Observation {
+  int pose = -1;  // index into BundleData::joints
+  int dot = -1;   // index into BundleData::dot_ids
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();
+};
+
+struct Yardstick {
+  int dot_a = -1, dot_b = -1;  // indices into BundleData::dot_ids
+  double length_m = 0;
+};
+
+// The fixed inputs of one problem, poses and dots by index.
+struct BundleData {
+  RobotModel robot;
+  CameraIntrinsics camera;
+  double sigma_px = 1;
+  double yardstick_sigma_m = 1e-6;
+  std::vector<std::string> pose_ids;
+  std::vector<Eigen::VectorXd> joints;  // identification poses
+  std::vector<int> dot_ids;
+  std::vector<Observation> observations;
+  std::vector<Yardstick> yardsticks;
+};
+
+// A point of the problem.
+struct BundleState {
+  Eigen::VectorXd rho;
+  double fx_px = 0;
+  double k1 = 0;
+  std::vector<Eigen::Vector3d> dots;  // by dot index, base frame
+};
+
+struct GlobalColumns {
+  std::vector<int> kinematic;  // rho indices
+  bool fx = false;
+  bool k1 = false;
+  int size() const { return static_cast<int>(kinematic.size()) + (fx ? 1 : 0) + (k1 ? 1 : 0); }
+};
+
+// cam_from_base of one pose and its derivative with respect to rho[columns[c]] (forward-mode autodiff
+// through BaseFromCam, 8 columns per pass).
+struct PoseCache {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Matrix3d> d_rotation;
+  std::vector<Eigen::Vector3d> d_translation;
+};
+void ComputePoseCache(const RobotModel& model, const double* rho, const Eigen::VectorXd& q,
+                      const std::vector<int>& columns, bool derivatives, PoseCache* out);
+
+// Whitened residual (project(fx, k1, R p + t) - pixel) / sigma of one observation. Derivatives (each
+// optional, row-major): d_columns 2 x cache.d_rotation.size(), d_fx 2, d_k1 2, d_dot 2 x 3. Returns false
+// (outputs untouched) when the point is not in front of the camera or anything is non-finite.
+bool EvaluateReprojection(const CameraIntrinsics& camera, double sigma_px, const PoseCache& cache, double fx,
+                          double k1, const Eigen::Vector3d& dot, const Eigen::Vector2d& pixel, double* residual,
+                          double* d_columns, double* d_fx, double* d_k1, double* d_dot);
+
+// Compressed reduced Jacobian: a matrix Rd with gc.size() columns and Rd^T Rd = J_g^T (I - P_dots) J_g,
+// the Schur complement of the dots in the whitened normal matrix (J_g: global columns, P_dots: projection
+// onto the dots' columns). Dots are eliminated group by group (dots joined by a yardstick form one
+// group). Returns false when an observation cannot be evaluated at `state`.
+bool ReducedJacobian(const BundleData& data, const BundleState& state, const GlobalColumns& columns,
+                     Eigen::MatrixXd* reduced);
+
+// Names of the global columns when kinematic = all of rho: rho names, then "fx", then "k1".
+std::vector<std::string> GlobalNames(const GlobalColumns& columns, int num_joints);
+
+// Greedy column order over all global columns (rho entries 0..n-1, f_x at n, k1 after it): f_x, k1,
+// camera, base, alpha/a/theta/d joint by joint, betas last (as identification/identifiability.cc).
+std::vector<int> SelectionOrder(int num_joints, bool fx, bool k1);
+
+// Inverse of jacobian^T jacobian through the SVD of the column-normalised matrix. Returns false, with a
+// message naming the columns involved in the null space (K8), when it is rank deficient.
+bool CovarianceFromJacobian(const Eigen::MatrixXd& jacobian, const std::vector<std::string>& names,
+                            Eigen::MatrixXd* covariance, std::string* message);
+
+// The identification poses of `observations`, every dot seen in at least two of them (dot ids
+// ascending), their observations, and the yardsticks with both ends among those dots.
+BundleData MakeBundleData(const ObservationSet& observations, double yardstick_sigma_m);
+
+// The gauge and the free set of the problem at `state` (DESIGN.md section 4, K1): SelectColumns on the
+// reduced Jacobian of every rho entry plus f_x / k1 when estimated.
+struct Gauge {
+  std::vector<int> free_kinematic;  // rho indices, ascending
+  std::vector<std::string> free_names, fixed_names, null_combinations;
+  bool fx_identifiable = false, k1_identifiable = false;
+  double condition_number = 0;
+};
+bool AnalyzeGauge(const BundleData& data, const BundleState& state, bool estimate_fx, bool estimate_k1,
+                  double rank_tolerance, Gauge* gauge);
+
+}  // namespace selfcal::bundle::internal

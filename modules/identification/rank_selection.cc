@@ -1,0 +1,147 @@
+#include "identification/rank_selection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numeric>
+
+#include <Eigen/QR>
+#include <Eigen/SVD>
+
+#include "kinematics/robot_model.h"
+
+namespace selfcal::identification {
+
+namespace {
+
+// "0.71 j2.d - 0.71 j3.d": terms above 0.05 in magnitude, largest first, leading sign positive.
+std::string FormatCombination(const Eigen::VectorXd& v, const std::vector<std::string>& names) {
+  std::vector<int> order(v.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return std::abs(v[a]) > std::abs(v[b]); });
+  const double sign = (!order.empty() && v[order[0]] < 0) ? -1.0 : 1.0;
+  std::string out;
+  for (int idx : order) {
+    const double c = sign * v[idx];
+    if (std::abs(c) <= 0.05) break;
+    char buf[32];
+    if (out.empty()) {
+      std::snprintf(buf, sizeof(buf), "%.2f ", c);
+    } else {
+      std::snprintf(buf, sizeof(buf), " %c %.2f ", c < 0 ? '-' : '+', std::abs(c));
+    }
+    out += buf;
+    out += names[idx];
+  }
+  return out;
+}
+
+}  // namespace
+
+Eigen::MatrixXd NormalizeColumns(const Eigen::MatrixXd& j, double tolerance, Eigen::VectorXd* norms,
+                                 std::vector<bool>* zero) {
+  *norms = j.colwise().norm().transpose();
+  const double max_norm = norms->size() > 0 ? norms->maxCoeff() : 0.0;
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(j.rows(), j.cols());
+  zero->assign(j.cols(), true);
+  for (int c = 0; c < j.cols(); ++c) {
+    if (max_norm > 0 && (*norms)[c] > tolerance * max_norm) {
+      out.col(c) = j.col(c) / (*norms)[c];
+      (*zero)[c] = false;
+    }
+  }
+  return out;
+}
+
+// Plain rho order would fix poor representatives: d_i instead of beta_i for a non-parallel pair with a
+// small common normal (PUMA joint 4, where theta_3 + beta_4 then shows only through a_4 = 20 mm and the
+// kept set is ~30x worse conditioned), and two camera parameters instead of the last joint's theta and d.
+// So: the camera correction, the base, then alpha, a, theta, d joint by joint, and the Hayati betas last,
+// which keeps the betas only where they are needed (nominally parallel axes) and lets the camera absorb
+// the last joint's offsets.
+std::vector<int> PreferredParameterOrder(int num_joints) {
+  const KinematicParameters params(num_joints);
+  std::vector<int> order;
+  for (int k = 0; k < 6; ++k) order.push_back(params.CamOffset() + k);
+  for (int k = 0; k < 6; ++k) order.push_back(KinematicParameters::BaseOffset() + k);
+  const int kAlpha = 0, kA = 1, kBeta = 2, kTheta = 3, kD = 4;
+  for (int j = 0; j < num_joints; ++j) {
+    for (int k : {kAlpha, kA, kTheta, kD}) order.push_back(KinematicParameters::JointOffset(j) + k);
+  }
+  for (int j = 0; j < num_joints; ++j) order.push_back(KinematicParameters::JointOffset(j) + kBeta);
+  return order;
+}
+
+RankSelection SelectColumns(const Eigen::MatrixXd& jacobian, const std::vector<int>& order, double tolerance,
+                            const std::vector<std::string>& names) {
+  const int rows = static_cast<int>(jacobian.rows()), cols = static_cast<int>(jacobian.cols());
+  Eigen::VectorXd norms;
+  std::vector<bool> zero;
+  const Eigen::MatrixXd normalized = NormalizeColumns(jacobian, tolerance, &norms, &zero);
+  RankSelection out;
+  Eigen::VectorXd sv;
+  Eigen::MatrixXd v_full;
+  if (rows > 0 && cols > 0) {
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(normalized, Eigen::ComputeFullV);
+    sv = svd.singularValues();
+    v_full = svd.matrixV();
+  }
+  out.singular_values = sv;
+  const double sigma_max = sv.size() > 0 ? sv[0] : 0.0;
+  const double threshold = tolerance * sigma_max;
+  Eigen::MatrixXd basis(rows, std::min(rows, cols));
+  int num_basis = 0;
+  for (int c : order) {
+    bool keep = false;
+    if (!zero[c] && sigma_max > 0 && num_basis < rows) {
+      Eigen::VectorXd v = normalized.col(c);
+      for (int pass = 0; pass < 2; ++pass) {  // re-orthogonalised once
+        const auto q = basis.leftCols(num_basis);
+        v -= q * (q.transpose() * v);
+      }
+      const double residual = v.norm();
+      if (residual > threshold) {
+        basis.col(num_basis++) = v / residual;
+        keep = true;
+      }
+    }
+    (keep ? out.kept : out.dependent).push_back(c);
+  }
+  std::sort(out.kept.begin(), out.kept.end());
+  std::sort(out.dependent.begin(), out.dependent.end());
+  if (!out.kept.empty()) {
+    Eigen::MatrixXd sub(rows, out.kept.size());
+    for (size_t k = 0; k < out.kept.size(); ++k) sub.col(k) = normalized.col(out.kept[k]);
+    const Eigen::VectorXd s = Eigen::JacobiSVD<Eigen::MatrixXd>(sub).singularValues();
+    out.condition_number =
+        s[s.size() - 1] > 0 ? s[0] / s[s.size() - 1] : std::numeric_limits<double>::infinity();
+  } else {
+    out.condition_number = std::numeric_limits<double>::infinity();
+  }
+  // One readable null direction per dependent column (itself minus its expansion on the kept ones) when
+  // the SVD agrees on the dimension; otherwise the SVD's own basis.
+  int svd_rank = 0;
+  for (int k = 0; k < sv.size(); ++k) svd_rank += sv[k] > threshold ? 1 : 0;
+  std::vector<Eigen::VectorXd> null_vectors;
+  if (cols - svd_rank == static_cast<int>(out.dependent.size())) {
+    Eigen::MatrixXd sub(rows, out.kept.size());
+    for (size_t k = 0; k < out.kept.size(); ++k) sub.col(k) = normalized.col(out.kept[k]);
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(sub);
+    for (int c : out.dependent) {
+      Eigen::VectorXd x = Eigen::VectorXd::Zero(cols);
+      x[c] = 1.0;
+      if (!out.kept.empty() && !zero[c]) {
+        const Eigen::VectorXd a = qr.solve(normalized.col(c));
+        for (size_t k = 0; k < out.kept.size(); ++k) x[out.kept[k]] = -a[k];
+      }
+      null_vectors.push_back(x.normalized());
+    }
+  } else if (v_full.size() > 0) {
+    for (int k = svd_rank; k < cols; ++k) null_vectors.push_back(v_full.col(k));
+  }
+  for (const Eigen::VectorXd& x : null_vectors) out.null_combinations.push_back(FormatCombination(x, names));
+  return out;
+}
+
+}  // namespace selfcal::identification

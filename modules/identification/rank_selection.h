@@ -1,0 +1,34 @@
+// Which columns of a Jacobian carry independent information, decided greedily in a preferred order, with
+// the dependent ones written as named null-space combinations (DESIGN.md section 4, RELIABILITY.md K1).
+// Shared by the relative-pose identifiability analysis and the kinematic bundle adjustment's gauge.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace selfcal::identification {
+
+struct RankSelection {
+  std::vector<int> kept, dependent;          // column indices, ascending
+  std::vector<std::string> null_combinations;
+  double condition_number = 0;               // of the kept, column-normalised columns
+  Eigen::VectorXd singular_values;           // of the column-normalised matrix, descending
+};
+// Gram-Schmidt in `order` on the column-normalised matrix: a column is kept when its part orthogonal to
+// the kept ones exceeds tolerance * (largest singular value). Columns below tolerance * (largest norm)
+// count as zero (round-off of an exact gauge).
+RankSelection SelectColumns(const Eigen::MatrixXd& jacobian, const std::vector<int>& order, double tolerance,
+                            const std::vector<std::string>& names);
+
+// Columns scaled to unit norm (norms written to *norms); those below tolerance * (largest norm) are set
+// to zero and flagged in *zero: the round-off of an exact gauge would otherwise become a fake direction.
+Eigen::MatrixXd NormalizeColumns(const Eigen::MatrixXd& j, double tolerance, Eigen::VectorXd* norms,
+                                 std::vector<bool>* zero);
+
+// rho indices (KinematicParameters layout) in the order the greedy selection prefers to keep them:
+// camera correction, base, then alpha, a, theta, d joint by joint, the Hayati betas last.
+std::vector<int> PreferredParameterOrder(int num_joints);
+
+}  // namespace selfcal::identification
