@@ -32,6 +32,19 @@ ExitCode ExitCodeFor(pipeline::Outcome outcome) {
   return ExitCode::kSolverFailure;
 }
 
+ExitCode ExitCodeFor(bundle::Outcome outcome) {
+  switch (outcome) {
+    case bundle::Outcome::kConverged: return ExitCode::kOk;
+    case bundle::Outcome::kInvalidInput: return ExitCode::kUsage;
+    case bundle::Outcome::kDegenerate:
+    case bundle::Outcome::kScaleUnresolved: return ExitCode::kDegenerateData;
+    case bundle::Outcome::kNoConvergence:
+    case bundle::Outcome::kFailure:
+    case bundle::Outcome::kNotRun: return ExitCode::kSolverFailure;
+  }
+  return ExitCode::kSolverFailure;
+}
+
 std::string FileHash(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return "";

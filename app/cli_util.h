@@ -4,6 +4,7 @@
 #include <string>
 
 #include "base/status.h"
+#include "bundle/bundle_adjustment.h"
 #include "pipeline/paper_pipeline.h"
 
 namespace selfcal::app {
@@ -16,6 +17,8 @@ std::string ResolveDataPath(const std::string& path);
 int Fail(const Status& status);
 
 ExitCode ExitCodeFor(pipeline::Outcome outcome);
+// kConverged 0; kScaleUnresolved, kDegenerate 3; kInvalidInput 2; anything else 5.
+ExitCode ExitCodeFor(bundle::Outcome outcome);
 
 // 64-bit FNV-1a of a file's bytes as 16 hex digits ("" if unreadable): provenance in reports (P7).
 std::string FileHash(const std::string& path);

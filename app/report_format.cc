@@ -1,5 +1,6 @@
 #include "app/report_format.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iomanip>
@@ -30,6 +31,37 @@ double InReportUnits(const KinematicParameters& params, int i, double v) {
 nlohmann::json StatJson(const pipeline::Stat& s) {
   return {{"n", s.count()}, {"mean", Finite(s.Mean())}, {"sd", Finite(s.Sd())}, {"rms", Finite(s.Rms())},
           {"p90", Finite(s.Percentile(90))}, {"max", Finite(s.Max())}};
+}
+
+// A failure message cut for a table line (the JSON keeps it whole).
+std::string Shortened(const std::string& message) {
+  return message.size() <= 160 ? message : message.substr(0, 157) + "...";
+}
+
+double Ratio(double a, double b) { return std::isfinite(a) && std::isfinite(b) && b > 0 ? a / b : NAN; }
+
+nlohmann::json BundleCellJson(const pipeline::StudyCell& c) {
+  return {{"runs", c.bundle_runs},
+          {"runs_failed", c.bundle_runs_failed},
+          {"failures", c.bundle_failures},
+          {"relative_pose_identification", {{"position_mm", StatJson(c.bundle_position_mm)},
+                                            {"orientation_1e4rad", StatJson(c.bundle_orientation_1e4rad)},
+                                            {"fx_px", StatJson(c.bundle_fx_px)}}},
+          {"cramer_rao", {{"position_mm_rms", StatJson(c.bundle_bound_position_mm)},
+                          {"orientation_1e4rad_rms", StatJson(c.bundle_bound_orientation_1e4rad)},
+                          {"fx_px_rms", StatJson(c.bundle_bound_fx_px)},
+                          {"verification_position_mm_rms", StatJson(c.bundle_bound_pose_position_mm)},
+                          {"verification_orientation_1e4rad_rms", StatJson(c.bundle_bound_pose_orientation_1e4rad)}}},
+          {"rms_over_bound", {{"position", Finite(Ratio(c.bundle_position_mm.Rms(), c.bundle_bound_position_mm.Rms()))},
+                              {"orientation", Finite(Ratio(c.bundle_orientation_1e4rad.Rms(), c.bundle_bound_orientation_1e4rad.Rms()))},
+                              {"fx", Finite(Ratio(c.bundle_fx_px.Rms(), c.bundle_bound_fx_px.Rms()))}}},
+          {"fig6_3d_error_mm", StatJson(c.bundle_error3d_mm)},
+          {"verification_pose_error", {{"position_mm", StatJson(c.bundle_pose_position_mm)},
+                                       {"orientation_1e4rad", StatJson(c.bundle_pose_orientation_1e4rad)}}},
+          {"coverage_2sigma", {{"intervals", c.bundle_intervals},
+                               {"covered", c.bundle_covered},
+                               {"fraction", Finite(c.BundleCoverage())}}},
+          {"seconds_per_solve", StatJson(c.bundle_seconds)}};
 }
 
 }  // namespace
@@ -143,6 +175,83 @@ void PrintCalibrationSummary(const pipeline::PaperPipelineReport& r, std::ostrea
   out.unsetf(std::ios::floatfield);
 }
 
+nlohmann::json BundleReportJson(const ObservationSet& obs, const pipeline::BundleStageReport& stage) {
+  const bundle::BundleReport& b = stage.bundle;
+  nlohmann::json removed = nlohmann::json::array();
+  for (const bundle::RemovedObservation& o : b.removed) {
+    removed.push_back({{"pose", o.pose_id}, {"dot", o.dot_id}, {"residual_px", o.residual_px}});
+  }
+  nlohmann::json parameters = nlohmann::json::array();
+  if (b.rho.size() == obs.robot.num_parameters()) {
+    const KinematicParameters params(obs.robot.num_joints());
+    const Eigen::VectorXd nominal = KinematicParameters::Nominal(obs.robot);
+    for (int i = 0; i < params.size(); ++i) {
+      const bool free = std::count(b.free_indices.begin(), b.free_indices.end(), i) > 0;
+      const std::string unit = params.kind(i) == ParameterKind::kLength ? "_mm" : "_deg";
+      const double sd = b.stddev.size() > i ? b.stddev[i] : NAN;
+      parameters.push_back({{"name", params.name(i)},
+                            {"free", free},
+                            {"nominal" + unit, InReportUnits(params, i, nominal[i])},
+                            {"value" + unit, InReportUnits(params, i, b.rho[i])},
+                            {"correction" + unit, InReportUnits(params, i, b.rho[i] - nominal[i])},
+                            {"stddev" + unit, Finite(InReportUnits(params, i, sd))}});
+    }
+  }
+  return {{"description", "kinematic bundle adjustment (DESIGN.md section 5): reprojection of every dot in every "
+                          "identification image over the free kinematic parameters, hand-eye, f_x and the dots; "
+                          "yardstick as a length constraint"},
+          {"outcome", bundle::OutcomeName(b.outcome)},
+          {"message", b.message},
+          {"start", pipeline::BundleStartName(stage.start)},
+          {"start_note", stage.start_note},
+          {"fx_start_px", stage.fx_start_px},
+          {"termination", b.termination},
+          {"iterations", b.iterations},
+          {"initial_cost", b.initial_cost},
+          {"final_cost", b.final_cost},
+          {"num_observations", b.num_observations},
+          {"rms_reprojection_px", b.rms_reprojection_px},
+          {"removed_observations", removed},
+          {"dropped_dots", b.dropped_dots},
+          {"free", b.free_names},
+          {"fixed", b.fixed_names},
+          {"null_combinations", b.null_combinations},
+          {"generic_rank", b.generic_rank},
+          {"condition_number", Finite(b.condition_number)},
+          {"covariance_available", b.covariance_available},
+          {"covariance_message", b.covariance_message},
+          {"parameters", parameters},
+          {"fx_px", b.fx_px},
+          {"fx_stddev_px", Finite(b.fx_stddev)},
+          {"k1", b.k1},
+          {"k1_stddev", Finite(b.k1_stddev)},
+          {"verification", {{"poses", obs.PosesWithRole(PoseRole::kVerification).size()},
+                            {"nominal_model", VerificationJson(stage.verification_nominal)},
+                            {"calibrated_model", VerificationJson(stage.verification)}}}};
+}
+
+void PrintBundleSummary(const pipeline::BundleStageReport& stage, std::ostream& out) {
+  const bundle::BundleReport& b = stage.bundle;
+  out << "kinematic bundle adjustment: " << bundle::OutcomeName(b.outcome);
+  if (!b.message.empty()) out << " (" << b.message << ")";
+  out << "\n  start: " << stage.start_note << "\n";
+  if (b.rho.size() == 0) return;
+  out << "  " << b.free_names.size() << " free kinematic parameters + f_x, " << b.fixed_names.size()
+      << " fixed; " << b.num_observations << " observations, " << b.removed.size() << " removed by the screen, "
+      << b.dropped_dots.size() << " dots dropped\n";
+  out << "  " << b.iterations << " iterations (" << b.termination << "), reprojection RMS " << std::setprecision(4)
+      << b.rms_reprojection_px << " px; f_x = " << std::fixed << std::setprecision(3) << b.fx_px << " +- "
+      << b.fx_stddev << " px\n";
+  out.unsetf(std::ios::floatfield);
+  if (stage.verification.num_ok > 0) {
+    out << "  3-D error on " << stage.verification.num_ok << " held-out distances: nominal model " << std::fixed
+        << std::setprecision(3) << stage.verification_nominal.rms_error_m * kMm << " mm RMS, bundle "
+        << stage.verification.rms_error_m * kMm << " mm RMS (max " << stage.verification.max_error_m * kMm << " mm)\n";
+  }
+  out << "  time: " << std::fixed << std::setprecision(1) << b.seconds * 1e3 << " ms\n";
+  out.unsetf(std::ios::floatfield);
+}
+
 nlohmann::json StudyJson(const pipeline::StudyReport& study, const pipeline::StudyOptions& options) {
   nlohmann::json j;
   j["format"] = "selfcal-study";
@@ -158,6 +267,9 @@ nlohmann::json StudyJson(const pipeline::StudyReport& study, const pipeline::Stu
                         {"fx_relative_std", options.sim.fx_relative_error_std}};
   j["identifiable_parameters"] = study.identifiable_parameters;
   j["fixed_parameters"] = study.fixed_parameters;
+  j["flat_sheet"] = study.flat_sheet;
+  j["bundle_free_parameters"] = study.bundle_free_parameters;
+  j["bundle_fixed_parameters"] = study.bundle_fixed_parameters;
   j["paper_table2"] = {
       {{"trajectory", "initial"}, {"noise_px", 0.2}, {"position_mm", {3.0427, 1.1051}}, {"orientation_1e4rad", {1.4918, 2.5354}}, {"fx_px", {0.2249, 0.2374}}},
       {{"trajectory", "optimal"}, {"noise_px", 0.2}, {"position_mm", {0.2809, 0.2452}}, {"orientation_1e4rad", {1.0701, 1.4532}}, {"fx_px", {0.1539, 0.2128}}},
@@ -191,7 +303,8 @@ nlohmann::json StudyJson(const pipeline::StudyReport& study, const pipeline::Stu
                                                   {"orientation_calibrated_1e4rad", StatJson(c.pose_orientation_calibrated_1e4rad)}}},
                      {"fx_final_error_px", StatJson(c.fx_final_error_px)},
                      {"yardstick_scale_error", StatJson(c.yardstick_scale_error)},
-                     {"seconds_per_calibration", StatJson(c.seconds_per_calibration)}});
+                     {"seconds_per_calibration", StatJson(c.seconds_per_calibration)},
+                     {"kinematic_bundle", BundleCellJson(c)}});
   }
   j["cells"] = cells;
   j["seconds_total"] = study.seconds_total;
@@ -200,6 +313,11 @@ nlohmann::json StudyJson(const pipeline::StudyReport& study, const pipeline::Stu
 
 void PrintStudyTables(const pipeline::StudyReport& study, std::ostream& out) {
   char line[512];
+  if (study.flat_sheet) {
+    out << "FLAT DOT SHEET: every dot on one plane. The paper's factor method is degenerate there: the paper\n"
+           "pipeline rows below count only the runs it completed ('runs' column; failures listed at the end),\n"
+           "nan where it completed none. The kinematic bundle adjustment starts from the nominal model then.\n\n";
+  }
   out << "Table 2 reproduction: pose measurement errors, mean / SD over pose pairs and runs\n";
   out << "(position with the eq. (21) scale and k_1 from the true first motion; bound rows are RMS)\n";
   std::snprintf(line, sizeof(line), "%-10s %-6s %-28s %9s %9s %10s %10s %8s %8s %6s\n", "trajectory", "noise",
@@ -236,6 +354,60 @@ void PrintStudyTables(const pipeline::StudyReport& study, std::ostream& out) {
                   c.pose_position_calibrated_mm.Mean(), c.pose_orientation_calibrated_1e4rad.Mean());
     out << line;
   }
+  const bool any_bundle = std::any_of(study.cells.begin(), study.cells.end(),
+                                      [](const pipeline::StudyCell& c) { return c.bundle_runs > 0; });
+  if (any_bundle) {
+    out << "\nBeyond the paper: kinematic bundle adjustment (BA), same runs. Relative poses reference -> identification\n"
+           "pose i predicted by the BA model vs truth (the poses of the Table 2 rows), mean / SD; CRB rows: the BA's own\n"
+           "Cramer-Rao bound at the truth, RMS; 'runs' = converged BA runs\n";
+    std::snprintf(line, sizeof(line), "%-10s %-6s %-28s %9s %9s %10s %10s %8s %8s %6s\n", "trajectory", "noise",
+                  "method", "pos M mm", "pos SD", "ori M e-4", "ori SD", "fx M px", "fx SD", "runs");
+    out << line;
+    for (const pipeline::StudyCell& c : study.cells) {
+      if (c.bundle_runs == 0) continue;
+      const int ok = c.bundle_runs - c.bundle_runs_failed;
+      std::snprintf(line, sizeof(line), "%-10s %-6.2f %-28s %9.4f %9.4f %10.4f %10.4f %8.4f %8.4f %6d\n",
+                    c.trajectory.c_str(), c.noise_px, "kinematic BA", c.bundle_position_mm.Mean(),
+                    c.bundle_position_mm.Sd(), c.bundle_orientation_1e4rad.Mean(), c.bundle_orientation_1e4rad.Sd(),
+                    c.bundle_fx_px.Mean(), c.bundle_fx_px.Sd(), ok);
+      out << line;
+      if (c.bundle_bound_position_mm.count() > 0) {
+        std::snprintf(line, sizeof(line), "%-10s %-6.2f %-28s %9.4f %9s %10.4f %10s %8.4f %8s %6d\n",
+                      c.trajectory.c_str(), c.noise_px, "BA CRB (RMS)", c.bundle_bound_position_mm.Rms(), "",
+                      c.bundle_bound_orientation_1e4rad.Rms(), "", c.bundle_bound_fx_px.Rms(), "", ok);
+        out << line;
+      }
+    }
+    out << "\nBA against its bound: RMS error / RMS bound; coverage: free parameters and f_x whose truth lies within\n"
+           "+-2 reported sigma (pooled over runs)\n";
+    std::snprintf(line, sizeof(line), "%-10s %-6s %10s %10s %7s %10s %10s %7s %9s %9s %7s %9s %9s\n", "trajectory",
+                  "noise", "pos RMS mm", "CRB mm", "ratio", "ori RMS e-4", "CRB e-4", "ratio", "fx RMS px", "CRB px",
+                  "ratio", "cover 2s", "ms/solve");
+    out << line;
+    for (const pipeline::StudyCell& c : study.cells) {
+      if (c.bundle_runs == 0) continue;
+      const double p = c.bundle_position_mm.Rms(), pb = c.bundle_bound_position_mm.Rms();
+      const double o = c.bundle_orientation_1e4rad.Rms(), ob = c.bundle_bound_orientation_1e4rad.Rms();
+      const double f = c.bundle_fx_px.Rms(), fb = c.bundle_bound_fx_px.Rms();
+      std::snprintf(line, sizeof(line), "%-10s %-6.2f %10.4f %10.4f %7.3f %10.4f %10.4f %7.3f %9.4f %9.4f %7.3f %8.1f%% %9.1f\n",
+                    c.trajectory.c_str(), c.noise_px, p, pb, Ratio(p, pb), o, ob, Ratio(o, ob), f, fb, Ratio(f, fb),
+                    100 * c.BundleCoverage(), 1e3 * c.bundle_seconds.Mean());
+      out << line;
+    }
+    out << "\nFig. 6 with the BA model: verification poses (paper pipeline's calibrated model beside it)\n";
+    std::snprintf(line, sizeof(line), "%-10s %-6s %14s %14s %14s %14s %14s %14s %14s\n", "trajectory", "noise",
+                  "3-D paper mm", "3-D BA mm", "3-D BA p90", "pose paper mm", "pose BA mm", "pose CRB mm", "ori BA e-4");
+    out << line;
+    for (const pipeline::StudyCell& c : study.cells) {
+      if (c.bundle_runs == 0) continue;
+      std::snprintf(line, sizeof(line), "%-10s %-6.2f %14.4f %14.4f %14.4f %14.4f %14.4f %14.4f %14.4f\n",
+                    c.trajectory.c_str(), c.noise_px, c.error3d_calibrated_mm.Mean(), c.bundle_error3d_mm.Mean(),
+                    c.bundle_error3d_mm.Percentile(90), c.pose_position_calibrated_mm.Mean(),
+                    c.bundle_pose_position_mm.Mean(), c.bundle_bound_pose_position_mm.Rms(),
+                    c.bundle_pose_orientation_1e4rad.Mean());
+      out << line;
+    }
+  }
   out << "\neq. (21) bias: |nominal ratio / true ratio - 1| per pose, mean (max)\n";
   for (const pipeline::StudyCell& c : study.cells) {
     if (c.noise_px != 0) continue;
@@ -247,12 +419,20 @@ void PrintStudyTables(const pipeline::StudyReport& study, std::ostream& out) {
   for (const pipeline::StudyCell& c : study.cells) {
     if (c.runs_failed > 0) {
       out << c.trajectory << " noise " << c.noise_px << ": " << c.runs_failed << " of " << c.runs << " runs failed";
-      if (!c.failures.empty()) out << " (first: " << c.failures.front() << ")";
+      if (!c.failures.empty()) out << " (first: " << Shortened(c.failures.front()) << ")";
       out << "\n";
     }
   }
-  std::snprintf(line, sizeof(line), "identifiable parameters: %d; total time %.1f s\n", study.identifiable_parameters,
-                study.seconds_total);
+  for (const pipeline::StudyCell& c : study.cells) {
+    if (c.bundle_runs_failed > 0) {
+      out << c.trajectory << " noise " << c.noise_px << ": bundle adjustment did not converge in " << c.bundle_runs_failed
+          << " of " << c.bundle_runs << " runs";
+      if (!c.bundle_failures.empty()) out << " (first: " << Shortened(c.bundle_failures.front()) << ")";
+      out << "\n";
+    }
+  }
+  std::snprintf(line, sizeof(line), "identifiable parameters: paper pipeline %d, bundle adjustment %d (+ f_x); total time %.1f s\n",
+                study.identifiable_parameters, study.bundle_free_parameters, study.seconds_total);
   out << line;
 }
 

@@ -1,10 +1,12 @@
 // selfcal simulate: a seeded simulated robot with hidden errors, its observations written to a file, the
 // calibration run from that file, and the result compared with the hidden truth.
 // selfcal make-trajectory: writes the smooth "initial" trajectory around the simulated scene.
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 
+#include "app/calibrate_command.h"
 #include "app/cli_util.h"
 #include "app/commands.h"
 #include "app/report_format.h"
@@ -17,9 +19,6 @@
 
 namespace selfcal::app {
 
-int CalibrateAndWrite(const ObservationSet& obs, const std::string& source_path, const std::string& out_dir,
-                      uint64_t seed, pipeline::PaperPipelineReport* report_out);
-
 namespace {
 
 struct SimulateArgs {
@@ -29,6 +28,8 @@ struct SimulateArgs {
   double noise_px = 0.2;
   uint64_t seed = 1;
   bool perturb_gauge = false;
+  std::string method = "bundle";
+  bool flat_sheet = false;
 };
 
 nlohmann::json TruthJson(const sim::SimResult& world) {
@@ -117,6 +118,81 @@ nlohmann::json CompareWithTruth(const sim::SimResult& world, const ObservationSe
           {"verification_pose_error_mean_deg", {{"nominal", n ? RadToDeg(before_rot / n) : 0}, {"calibrated", n ? RadToDeg(after_rot / n) : 0}}}};
 }
 
+// The bundle adjustment's result against the truth: every free parameter with its reported sigma (the
+// bundle's gauge is the nominal model's, as the simulator's truth is unless --perturb-gauge), f_x, the
+// verification relative poses and the held-out 3-D errors before and after.
+nlohmann::json CompareBundleWithTruth(const sim::SimResult& world, const ObservationSet& obs,
+                                      const pipeline::BundleStageReport& stage, bool gauge_perturbed, std::ostream& out) {
+  const bundle::BundleReport& b = stage.bundle;
+  const RobotModel& nominal = world.truth.nominal;
+  const KinematicParameters params(nominal.num_joints());
+  const Eigen::VectorXd rho0 = KinematicParameters::Nominal(nominal);
+  auto unit = [&](int i) { return params.kind(i) == ParameterKind::kLength ? "mm" : "deg"; };
+  auto report_units = [&](int i, double v) { return params.kind(i) == ParameterKind::kLength ? v * 1e3 : RadToDeg(v); };
+  out << "\nkinematic bundle adjustment vs truth: free parameters, nominal / true / bundle, error +- sigma (reported)";
+  if (gauge_perturbed) out << "\n  (--perturb-gauge: the truth is in another gauge, parameter errors are not comparable)";
+  out << ":\n";
+  nlohmann::json parameters = nlohmann::json::array();
+  int within_2_sigma = 0, count = 0;
+  for (int i : b.free_indices) {
+    const double error = b.rho[i] - world.truth.rho_true[i];
+    const double sigma = b.stddev.size() > i ? b.stddev[i] : NAN;
+    const double z = std::abs(error) / sigma;
+    ++count;
+    within_2_sigma += z <= 2 ? 1 : 0;
+    out << "  " << std::left << std::setw(10) << params.name(i) << std::right << std::fixed << std::setprecision(4)
+        << std::setw(12) << report_units(i, rho0[i]) << std::setw(12) << report_units(i, world.truth.rho_true[i])
+        << std::setw(12) << report_units(i, b.rho[i]) << "   error " << std::setw(9) << report_units(i, error) << " +- "
+        << std::setw(7) << report_units(i, sigma) << " " << unit(i) << std::setprecision(1) << "  (" << z << " sigma)\n";
+    const std::string u = std::string("_") + unit(i);
+    parameters.push_back({{"name", params.name(i)},
+                          {"nominal" + u, report_units(i, rho0[i])},
+                          {"true" + u, report_units(i, world.truth.rho_true[i])},
+                          {"bundle" + u, report_units(i, b.rho[i])},
+                          {"error" + u, report_units(i, error)},
+                          {"stddev" + u, std::isfinite(sigma) ? nlohmann::json(report_units(i, sigma)) : nlohmann::json()}});
+  }
+  const double fx_true = world.truth.camera_true.fx_px;
+  out << std::setprecision(4) << "f_x: nominal " << obs.camera.fx_px << ", true " << fx_true << ", bundle " << b.fx_px
+      << " +- " << b.fx_stddev << " px (error " << b.fx_px - fx_true << " px)\n";
+  out << within_2_sigma << " of " << count << " free parameters within 2 sigma of the truth\n";
+  // Relative poses reference -> verification pose: gauge-free.
+  const int ref = obs.PosesWithRole(PoseRole::kIdentification).front();
+  double before = 0, after = 0, before_rot = 0, after_rot = 0;
+  int n = 0;
+  for (int v : obs.PosesWithRole(PoseRole::kVerification)) {
+    const Rigid3 truth_rel = world.truth.base_from_cam[ref].Inverse() * world.truth.base_from_cam[v];
+    const Rigid3 nominal_rel = BaseFromCam(nominal, rho0, obs.poses[ref].joints_rad).Inverse() *
+                               BaseFromCam(nominal, rho0, obs.poses[v].joints_rad);
+    const Rigid3 ba_rel = BaseFromCam(nominal, b.rho, obs.poses[ref].joints_rad).Inverse() *
+                          BaseFromCam(nominal, b.rho, obs.poses[v].joints_rad);
+    const PoseDifference d0 = ComparePoses(truth_rel, nominal_rel), d1 = ComparePoses(truth_rel, ba_rel);
+    before += d0.position_m;
+    after += d1.position_m;
+    before_rot += d0.rotation_rad;
+    after_rot += d1.rotation_rad;
+    ++n;
+  }
+  if (n > 0) {
+    out << "verification relative poses, mean error: nominal " << before / n * 1e3 << " mm / " << RadToDeg(before_rot / n)
+        << " deg; bundle " << after / n * 1e3 << " mm / " << RadToDeg(after_rot / n) << " deg\n";
+  }
+  out << "3-D error of the held-out distances, RMS: nominal " << stage.verification_nominal.rms_error_m * 1e3
+      << " mm, bundle " << stage.verification.rms_error_m * 1e3 << " mm (max " << stage.verification.max_error_m * 1e3
+      << " mm)\n";
+  out.unsetf(std::ios::floatfield);
+  return {{"parameters", parameters},
+          {"gauge_perturbed", gauge_perturbed},
+          {"free_within_2_sigma", within_2_sigma},
+          {"free_count", count},
+          {"fx_true_px", fx_true},
+          {"fx_bundle_px", b.fx_px},
+          {"fx_stddev_px", std::isfinite(b.fx_stddev) ? nlohmann::json(b.fx_stddev) : nlohmann::json()},
+          {"verification_pose_error_mean_mm", {{"nominal", n ? before / n * 1e3 : 0}, {"bundle", n ? after / n * 1e3 : 0}}},
+          {"verification_pose_error_mean_deg", {{"nominal", n ? RadToDeg(before_rot / n) : 0}, {"bundle", n ? RadToDeg(after_rot / n) : 0}}},
+          {"error3d_rms_mm", {{"nominal", stage.verification_nominal.rms_error_m * 1e3}, {"bundle", stage.verification.rms_error_m * 1e3}}}};
+}
+
 }  // namespace
 
 Command AddSimulateCommand(CLI::App& app) {
@@ -128,6 +204,9 @@ Command AddSimulateCommand(CLI::App& app) {
   cmd->add_option("--noise-px", args->noise_px, "Pixel noise std (px)")->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--seed", args->seed, "World and noise seed");
   cmd->add_flag("--perturb-gauge", args->perturb_gauge, "Also perturb the parameters the measurements cannot see");
+  cmd->add_flag("--flat-sheet", args->flat_sheet,
+                "Put every dot on one plane (the paper's factor method is degenerate there, the bundle is not)");
+  AddMethodOption(cmd, &args->method);
   return [args]() {
     Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(args->robot));
     if (!robot.ok()) return Fail(robot.status());
@@ -138,6 +217,7 @@ Command AddSimulateCommand(CLI::App& app) {
     options.world_seed = options.noise_seed = args->seed;
     options.pixel_noise_px = args->noise_px;
     options.perturb_gauge_parameters = args->perturb_gauge;
+    options.flat_sheet = args->flat_sheet;
     const sim::SimResult world = sim::Simulate(*robot, *joints, options);
     if (!world.ok) return Fail(Status::Error(ExitCode::kDegenerateData, "simulation: " + world.message));
     std::cout << "simulated " << world.observations.poses.size() << " poses x " << world.truth.dots_in_base.size()
@@ -153,14 +233,22 @@ Command AddSimulateCommand(CLI::App& app) {
     // Calibrate from the file, as any user's data would be.
     Result<ObservationSet> obs = io::LoadObservations(obs_path);
     if (!obs.ok()) return Fail(obs.status());
-    pipeline::PaperPipelineReport report;
-    const int code = CalibrateAndWrite(*obs, obs_path, args->out, args->seed, &report);
-    if (report.calibrated_rho.size() > 0) {
-      const nlohmann::json comparison = CompareWithTruth(world, *obs, report, std::cout);
+    CalibrationResult result;
+    const int code = CalibrateAndWrite(*obs, obs_path, args->out, args->seed, ParseMethod(args->method), &result);
+    nlohmann::json comparison = nlohmann::json::object();
+    if (result.paper.calibrated_rho.size() > 0) {
+      std::cout << "\npaper pipeline vs truth:";
+      comparison = CompareWithTruth(world, *obs, result.paper, std::cout);
+    }
+    if (result.bundle_run && result.bundle.bundle.rho.size() == obs->robot.num_parameters()) {
+      comparison["bundle"] = CompareBundleWithTruth(world, *obs, result.bundle, args->perturb_gauge, std::cout);
+    }
+    if (!comparison.empty()) {
       if (Status s = io::WriteJsonFile(comparison, (out / "comparison_with_truth.json").string()); !s.ok()) return Fail(s);
     }
     std::cout << "results in " << args->out << "/: observations.yaml, truth.json, report.json"
-              << (code == 0 ? ", calibrated_model.yaml" : "") << ", comparison_with_truth.json\n";
+              << (code == 0 ? ", calibrated_model.yaml" : "") << (comparison.empty() ? "" : ", comparison_with_truth.json")
+              << "\n";
     return code;
   };
 }

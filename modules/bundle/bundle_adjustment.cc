@@ -105,36 +105,49 @@ struct YardstickResidual {
 ceres::Solver::Summary Solve(const BundleData& data, const std::vector<int>& free, const BundleOptions& options,
                              bool robust, BundleState* state) {
   auto caches = std::make_shared<const PoseCacheSet>(&data, state->rho, free);
-  std::vector<double> x(free.size());
-  for (size_t k = 0; k < free.size(); ++k) x[k] = state->rho[free[k]];
+  // Every parameter block lives in one buffer, in a fixed layout [free rho | f_x | k1 | dots]: Ceres
+  // orders the blocks of an elimination group by address, so blocks scattered over the heap and the
+  // stack would make the arithmetic, and the last bits of the result, depend on the process (P9).
+  const size_t n = free.size();
+  std::vector<double> buffer(n + 2 + 3 * state->dots.size());
+  double* const x = buffer.data();
+  double* const fx = x + n;
+  double* const k1 = fx + 1;
+  auto dot = [&](int d) { return k1 + 1 + 3 * d; };
+  for (size_t k = 0; k < n; ++k) x[k] = state->rho[free[k]];
+  *fx = state->fx_px;
+  *k1 = state->k1;
+  for (size_t d = 0; d < state->dots.size(); ++d) Eigen::Map<Eigen::Vector3d>(dot(static_cast<int>(d))) = state->dots[d];
   // Residuals are whitened, so the Huber threshold is huber_px in units of sigma. Declared before the
   // problem, which holds non-owning wrappers of it.
   ceres::HuberLoss huber(options.huber_px / data.sigma_px);
   ceres::Problem problem;
-  problem.AddParameterBlock(x.data(), static_cast<int>(x.size()));
-  problem.AddParameterBlock(&state->fx_px, 1);
-  problem.AddParameterBlock(&state->k1, 1);
-  if (!options.estimate_fx) problem.SetParameterBlockConstant(&state->fx_px);
-  if (!options.estimate_k1) problem.SetParameterBlockConstant(&state->k1);
+  problem.AddParameterBlock(x, static_cast<int>(n));
+  problem.AddParameterBlock(fx, 1);
+  problem.AddParameterBlock(k1, 1);
+  if (!options.estimate_fx) problem.SetParameterBlockConstant(fx);
+  if (!options.estimate_k1) problem.SetParameterBlockConstant(k1);
   for (size_t k = 0; k < data.observations.size(); ++k) {
     problem.AddResidualBlock(new ReprojectionCost(caches, &data, static_cast<int>(k)),
                              robust ? new ceres::LossFunctionWrapper(&huber, ceres::DO_NOT_TAKE_OWNERSHIP) : nullptr,
-                             x.data(), &state->fx_px, &state->k1, state->dots[data.observations[k].dot].data());
+                             x, fx, k1, dot(data.observations[k].dot));
   }
   std::vector<bool> in_yardstick(data.dot_ids.size(), false);
   for (const internal::Yardstick& y : data.yardsticks) {
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<YardstickResidual, 1, 3, 3>(
                                  new YardstickResidual(y.length_m, data.yardstick_sigma_m)),
-                             nullptr, state->dots[y.dot_a].data(), state->dots[y.dot_b].data());
+                             nullptr, dot(y.dot_a), dot(y.dot_b));
     in_yardstick[y.dot_a] = in_yardstick[y.dot_b] = true;
   }
   // Schur: the dots are eliminated, except the yardstick's ends (their length residual couples two dots,
   // and an eliminated block may appear in a residual only with non-eliminated ones).
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-  for (size_t d = 0; d < data.dot_ids.size(); ++d) ordering->AddElementToGroup(state->dots[d].data(), in_yardstick[d] ? 1 : 0);
-  ordering->AddElementToGroup(x.data(), 1);
-  ordering->AddElementToGroup(&state->fx_px, 1);
-  ordering->AddElementToGroup(&state->k1, 1);
+  for (size_t d = 0; d < data.dot_ids.size(); ++d) {
+    ordering->AddElementToGroup(dot(static_cast<int>(d)), in_yardstick[d] ? 1 : 0);
+  }
+  ordering->AddElementToGroup(x, 1);
+  ordering->AddElementToGroup(fx, 1);
+  ordering->AddElementToGroup(k1, 1);
 
   ceres::Solver::Options solver_options;
   solver_options.minimizer_type = ceres::TRUST_REGION;
@@ -150,7 +163,10 @@ ceres::Solver::Summary Solve(const BundleData& data, const std::vector<int>& fre
   solver_options.parameter_tolerance = options.parameter_tolerance;
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, &problem, &summary);
-  for (size_t k = 0; k < free.size(); ++k) state->rho[free[k]] = x[k];
+  for (size_t k = 0; k < n; ++k) state->rho[free[k]] = x[k];
+  state->fx_px = *fx;
+  state->k1 = *k1;
+  for (size_t d = 0; d < state->dots.size(); ++d) state->dots[d] = Eigen::Map<const Eigen::Vector3d>(dot(static_cast<int>(d)));
   return summary;
 }
 

@@ -144,12 +144,115 @@ void ScoreRun(const sim::SimResult& world, const ObservationSet& obs, const Pape
   cell->seconds_per_calibration.Add(report.seconds_total);
 }
 
+// The bundle's Cramer-Rao bound at the truth. Its propagation covers the held-out poses of the geometry;
+// copies of the identification poses (ref excluded) appended as held-out poses give the bound of the
+// relative poses the Table 2 rows measure (the bound reads only their joint angles).
+bundle::CramerRaoReport BundleBound(const sim::SimResult& world, const ObservationSet& obs, double sigma_px,
+                                    const bundle::BundleOptions& options, int* num_identification_copies) {
+  ObservationSet geometry = obs;
+  const std::vector<int> id_poses = obs.PosesWithRole(PoseRole::kIdentification);
+  *num_identification_copies = 0;
+  for (size_t k = 1; k < id_poses.size(); ++k) {
+    PoseObservation copy;
+    copy.id = "identification:" + obs.poses[id_poses[k]].id;
+    copy.role = PoseRole::kVerification;
+    copy.joints_rad = obs.poses[id_poses[k]].joints_rad;
+    geometry.poses.push_back(std::move(copy));
+    ++*num_identification_copies;
+  }
+  bundle::BundleTruth truth;
+  truth.rho = world.truth.rho_true;
+  truth.fx_px = world.truth.camera_true.fx_px;
+  truth.k1 = world.truth.camera_true.k1;
+  for (size_t d = 0; d < world.truth.dots_in_base.size(); ++d) {
+    truth.dots_in_base[static_cast<int>(d)] = world.truth.dots_in_base[d];
+  }
+  return bundle::BundleCramerRao(geometry, truth, sigma_px, options);
+}
+
+// Runs the bundle stage on one observation set and scores it against the truth; adds to the cell.
+void ScoreBundle(const sim::SimResult& world, const ObservationSet& obs, const PaperPipelineReport& paper,
+                 const StudyOptions& options, StudyCell* cell, StudyReport* study) {
+  const sim::SimTruth& truth = world.truth;
+  ++cell->bundle_runs;
+  const BundleStageReport stage = RunBundleStage(obs, paper, options.bundle);
+  const bundle::BundleReport& b = stage.bundle;
+  if (b.outcome != bundle::Outcome::kConverged) {
+    ++cell->bundle_runs_failed;
+    if (cell->bundle_failures.size() < 5) {
+      cell->bundle_failures.push_back(std::string(bundle::OutcomeName(b.outcome)) + ": " + b.message);
+    }
+    return;
+  }
+  if (study->bundle_free_parameters == 0) {
+    study->bundle_free_parameters = static_cast<int>(b.free_indices.size());
+    study->bundle_fixed_parameters = b.fixed_names;
+  }
+  cell->bundle_seconds.Add(b.seconds);
+  const RobotModel& robot = obs.robot;
+  const std::vector<int> id_poses = obs.PosesWithRole(PoseRole::kIdentification);
+  const int ref = id_poses.front();
+  const Rigid3 true_ref_from_base = truth.base_from_cam[ref].Inverse();
+  const Rigid3 model_ref_from_base = BaseFromCam(robot, b.rho, obs.poses[ref].joints_rad).Inverse();
+  auto relative_error = [&](int pose) {
+    const Rigid3 model = model_ref_from_base * BaseFromCam(robot, b.rho, obs.poses[pose].joints_rad);
+    return ComparePoses(true_ref_from_base * truth.base_from_cam[pose], model);
+  };
+  for (size_t k = 1; k < id_poses.size(); ++k) {
+    const PoseDifference d = relative_error(id_poses[k]);
+    cell->bundle_position_mm.Add(kMm * d.position_m);
+    cell->bundle_orientation_1e4rad.Add(k1e4 * d.rotation_rad);
+  }
+  cell->bundle_fx_px.Add(std::abs(b.fx_px - truth.camera_true.fx_px));
+  for (int v : obs.PosesWithRole(PoseRole::kVerification)) {
+    const PoseDifference d = relative_error(v);
+    cell->bundle_pose_position_mm.Add(kMm * d.position_m);
+    cell->bundle_pose_orientation_1e4rad.Add(k1e4 * d.rotation_rad);
+  }
+  for (const DistanceCheck& c : stage.verification.checks) {
+    if (c.ok) cell->bundle_error3d_mm.Add(kMm * c.error_m);
+  }
+  if (cell->noise_px <= 0) return;  // no noise: no sigma to cover with, no bound
+  // Coverage needs the truth in the bundle's gauge: every entry it held fixed equal to the truth's.
+  bool same_gauge = b.covariance_available;
+  for (int i = 0; i < b.rho.size() && same_gauge; ++i) {
+    const bool free = std::find(b.free_indices.begin(), b.free_indices.end(), i) != b.free_indices.end();
+    if (!free && b.rho[i] != truth.rho_true[i]) same_gauge = false;
+  }
+  if (same_gauge) {
+    for (int i : b.free_indices) {
+      ++cell->bundle_intervals;
+      cell->bundle_covered += std::abs(b.rho[i] - truth.rho_true[i]) <= 2 * b.stddev[i] ? 1 : 0;
+    }
+    if (options.bundle.bundle.estimate_fx) {
+      ++cell->bundle_intervals;
+      cell->bundle_covered += std::abs(b.fx_px - truth.camera_true.fx_px) <= 2 * b.fx_stddev ? 1 : 0;
+    }
+  }
+  if (!options.with_bound) return;
+  int copies = 0;
+  const bundle::CramerRaoReport bound = BundleBound(world, obs, cell->noise_px, options.bundle.bundle, &copies);
+  if (!bound.ok) return;
+  const size_t first_copy = bound.position_bound_m.size() - static_cast<size_t>(copies);
+  for (size_t k = 0; k < bound.position_bound_m.size(); ++k) {
+    if (k >= first_copy) {
+      cell->bundle_bound_position_mm.Add(kMm * bound.position_bound_m[k]);
+      cell->bundle_bound_orientation_1e4rad.Add(k1e4 * bound.orientation_bound_rad[k]);
+    } else {
+      cell->bundle_bound_pose_position_mm.Add(kMm * bound.position_bound_m[k]);
+      cell->bundle_bound_pose_orientation_1e4rad.Add(k1e4 * bound.orientation_bound_rad[k]);
+    }
+  }
+  if (std::isfinite(bound.fx_stddev)) cell->bundle_bound_fx_px.Add(bound.fx_stddev);
+}
+
 }  // namespace
 
 StudyReport RunStudy(const RobotModel& nominal, const std::vector<TrajectorySpec>& trajectories,
                      const StudyOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   StudyReport study;
+  study.flat_sheet = options.sim.flat_sheet;
   for (const TrajectorySpec& trajectory : trajectories) {
     std::vector<StudyCell> cells(options.noise_levels_px.size());
     for (size_t l = 0; l < cells.size(); ++l) {
@@ -166,21 +269,29 @@ StudyReport RunStudy(const RobotModel& nominal, const std::vector<TrajectorySpec
         if (!world.ok) {
           ++cell.runs_failed;
           if (cell.failures.size() < 5) cell.failures.push_back("simulation: " + world.message);
+          if (options.with_bundle) {
+            ++cell.bundle_runs;
+            ++cell.bundle_runs_failed;
+          }
           continue;
         }
         const ObservationSet obs =
             sim::Reobserve(world, cell.noise_px, options.seed * 7919 + 1000003ULL * static_cast<uint64_t>(run) + l);
         PaperPipelineReport report = RunPaperPipeline(obs, options.pipeline);
+        bool score_paper = true;
         if (report.outcome != Outcome::kSuccess) {
           ++cell.runs_failed;
           if (cell.failures.size() < 5) cell.failures.push_back(std::string(OutcomeName(report.outcome)) + ": " + report.message);
-          if (report.measurements.empty() || report.calibrated_rho.size() == 0) continue;
+          score_paper = !report.measurements.empty() && report.calibrated_rho.size() > 0;
         }
-        if (study.identifiable_parameters == 0) {
-          study.identifiable_parameters = report.identifiability.rank;
-          study.fixed_parameters = report.identifiability.fixed_names;
+        if (score_paper) {
+          if (study.identifiable_parameters == 0) {
+            study.identifiable_parameters = report.identifiability.rank;
+            study.fixed_parameters = report.identifiability.fixed_names;
+          }
+          ScoreRun(world, obs, report, options, &cell);
         }
-        ScoreRun(world, obs, report, options, &cell);
+        if (options.with_bundle) ScoreBundle(world, obs, report, options, &cell, &study);
       }
     }
     study.cells.insert(study.cells.end(), cells.begin(), cells.end());

@@ -1,13 +1,19 @@
 // Monte Carlo study reproducing the paper's Table 2 (pose measurement errors) and Fig. 6 (3-D errors after
 // calibration) over seeded simulated runs, beside OpenCV's essential-matrix pose (true f_x), the two-view
-// Cramer-Rao bound of the same setup, and the nominal model (does calibration help?).
+// Cramer-Rao bound of the same setup, and the nominal model (does calibration help?). Beyond the paper: the
+// kinematic bundle adjustment (pipeline/bundle_stage.h) on the same data, against the truth and its own
+// Cramer-Rao bound (bundle::BundleCramerRao), with the coverage of its reported sigmas. With
+// sim.flat_sheet the dots lie on one plane: the paper pipeline fails there (its rows count only the runs
+// it completed) while the bundle adjustment starts from the nominal model.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "pipeline/bundle_stage.h"
 #include "pipeline/paper_pipeline.h"
 #include "sim/sim_world.h"
 
@@ -22,10 +28,12 @@ struct StudyOptions {
   int runs = 200;
   std::vector<double> noise_levels_px = {0.0, 0.2, 0.5};  // 0: the bias of eq. (21); I and II of Table 1
   uint64_t seed = 1;           // run r uses world seed seed + r and noise seed seed + 1000003 r
-  sim::SimOptions sim;
+  sim::SimOptions sim;         // sim.flat_sheet: dots on one plane (`selfcal study --flat-sheet`)
   PaperPipelineOptions pipeline;
   bool with_opencv = true;
-  bool with_bound = true;
+  bool with_bound = true;      // the two-view bound and, with the bundle, the bundle's bound
+  bool with_bundle = true;     // the kinematic bundle adjustment rows
+  BundleStageOptions bundle;
 };
 
 // Running sample statistics.
@@ -64,12 +72,35 @@ struct StudyCell {
   Stat fx_final_error_px;       // |f_x used by the calibrated model - true|
   Stat yardstick_scale_error;   // |s * (true scale of the measurements) - 1|
   Stat seconds_per_calibration;
+
+  // Beyond the paper: the kinematic bundle adjustment on the same observations, started from the paper
+  // pipeline's result (the nominal model when it failed). Runs that did not converge count as failed.
+  int bundle_runs = 0, bundle_runs_failed = 0;
+  std::vector<std::string> bundle_failures;  // first few messages
+  // (a) Relative poses reference -> identification pose i predicted by the bundle's model vs the truth
+  // (comparable to the Table 2 rows, which measure the same poses), and |f_x - true|.
+  Stat bundle_position_mm, bundle_orientation_1e4rad, bundle_fx_px;
+  // (b) The bundle's Cramer-Rao bound at the truth for the same quantities: per pose sqrt(trace cov).
+  Stat bundle_bound_position_mm, bundle_bound_orientation_1e4rad, bundle_bound_fx_px;
+  // (c) Fig. 6 with the bundle's model: 3-D error of every check distance on the verification poses, and
+  // the verification relative poses (with their bound).
+  Stat bundle_error3d_mm, bundle_pose_position_mm, bundle_pose_orientation_1e4rad;
+  Stat bundle_bound_pose_position_mm, bundle_bound_pose_orientation_1e4rad;
+  // (d) Coverage, pooled over runs: free parameters and f_x whose truth lies within +-2 reported sigma of
+  // the estimate (runs with noise > 0 whose gauge is the truth's).
+  int bundle_intervals = 0, bundle_covered = 0;
+  double BundleCoverage() const { return bundle_intervals > 0 ? static_cast<double>(bundle_covered) / bundle_intervals : std::nan(""); }
+  // (e) Wall time of one bundle solve (the screen's refits included).
+  Stat bundle_seconds;
 };
 
 struct StudyReport {
   std::vector<StudyCell> cells;  // trajectory-major, noise-minor
   int identifiable_parameters = 0;
   std::vector<std::string> fixed_parameters;
+  int bundle_free_parameters = 0;  // kinematic, f_x not counted
+  std::vector<std::string> bundle_fixed_parameters;
+  bool flat_sheet = false;
   double seconds_total = 0;
 };
 

@@ -1,5 +1,6 @@
 #include "sim/sim_world.h"
 
+#include <Eigen/SVD>
 #include <gtest/gtest.h>
 
 #include "sim/trajectory_generator.h"
@@ -103,6 +104,42 @@ TEST(Sim, ReobserveChangesOnlyTheNoise) {
   }
   // 4000 coordinates: the sample std is within ~5 % of 0.5 px with overwhelming probability.
   EXPECT_NEAR(std::sqrt(sum2 / n), 0.5, 0.025);
+}
+
+// A flat dot sheet: one plane through the scene, the yardstick on it, every dot in every view.
+TEST(Sim, FlatSheetPutsEveryDotOnOnePlaneInViewOfEveryPose) {
+  const RobotModel puma = testing::Puma560();
+  SimOptions options;
+  options.pixel_noise_px = 0.0;
+  options.flat_sheet = true;
+  const SimResult world = Simulate(puma, ArcTrajectory(puma), options);
+  ASSERT_TRUE(world.ok) << world.message;
+  const std::vector<Eigen::Vector3d>& dots = world.truth.dots_in_base;
+  ASSERT_EQ(dots.size(), 80u);
+  EXPECT_NEAR((dots[0] - dots[1]).norm(), options.yardstick_length_m, 1e-12);
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : dots) mean += p;
+  mean /= static_cast<double>(dots.size());
+  Eigen::MatrixXd centred(3, dots.size());
+  for (size_t d = 0; d < dots.size(); ++d) centred.col(d) = dots[d] - mean;
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(centred, Eigen::ComputeFullU);
+  const Eigen::Vector3d normal = svd.matrixU().col(2);
+  EXPECT_GT(svd.singularValues()[1], 0.3);  // a sheet, not a line: spread over tenths of a metre
+  for (size_t d = 0; d < dots.size(); ++d) EXPECT_LT(std::abs(normal.dot(dots[d] - mean)), 1e-12) << "dot " << d;
+  const ObservationSet& obs = world.observations;
+  EXPECT_EQ(obs.Validate(), "");
+  for (size_t i = 0; i < obs.poses.size(); ++i) {
+    ASSERT_EQ(obs.poses[i].dots_px.size(), 80u) << "pose " << i;
+    const Rigid3 cam_from_base = world.truth.base_from_cam[i].Inverse();
+    for (const auto& [id, px] : obs.poses[i].dots_px) {
+      EXPECT_GE((cam_from_base * dots[id]).z(), options.min_depth_m) << "pose " << i << " dot " << id;
+      EXPECT_TRUE(InImage(obs.camera, px, options.image_margin_px)) << "pose " << i << " dot " << id;
+    }
+  }
+  // The sheet faces the cameras: the mean optical axis is its normal.
+  Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+  for (const Rigid3& c : world.truth.base_from_cam) axis += c.rotation.col(2);
+  EXPECT_GT(std::abs(normal.dot(axis.normalized())), 1 - 1e-9);
 }
 
 TEST(Sim, RefusesImpossibleSetups) {

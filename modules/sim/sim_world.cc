@@ -150,19 +150,44 @@ SimResult Simulate(const RobotModel& nominal, const std::vector<Eigen::VectorXd>
   };
   const int max_tries = 200000;
   int tries = 0;
-  // The yardstick: dots 0 and 1, yardstick_length_m apart along a random direction through the centre.
-  while (truth.dots_in_base.size() < 2 && tries < max_tries) {
-    ++tries;
-    const Eigen::Vector3d mid = centre + 0.3 * Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
-    const Eigen::Vector3d dir = Eigen::Vector3d(gauss(rng), gauss(rng), 0.3 * gauss(rng)).normalized();
-    const Eigen::Vector3d a = mid - 0.5 * options.yardstick_length_m * dir;
-    const Eigen::Vector3d b = mid + 0.5 * options.yardstick_length_m * dir;
-    if (visible_everywhere(a) && visible_everywhere(b)) truth.dots_in_base = {a, b};
-  }
-  while (static_cast<int>(truth.dots_in_base.size()) < options.num_dots && tries < max_tries) {
-    ++tries;
-    const Eigen::Vector3d p = centre + Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
-    if (visible_everywhere(p)) truth.dots_in_base.push_back(p);
+  if (options.flat_sheet) {
+    // The sheet's in-plane axes e1, e2 (orthonormal, perpendicular to the mean optical axis n).
+    Eigen::Vector3d n = Eigen::Vector3d::Zero();
+    for (const Rigid3& c : truth.base_from_cam) n += c.rotation.col(2);
+    n.normalize();
+    const Eigen::Vector3d helper = std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+    const Eigen::Vector3d e1 = n.cross(helper).normalized();
+    const Eigen::Vector3d e2 = n.cross(e1);
+    auto on_sheet = [&](double u, double v) { return Eigen::Vector3d(centre + u * e1 + v * e2); };
+    while (truth.dots_in_base.size() < 2 && tries < max_tries) {
+      ++tries;
+      const double mu = 0.3 * uniform(rng), mv = 0.3 * uniform(rng);
+      const Eigen::Vector2d dir = Eigen::Vector2d(gauss(rng), gauss(rng)).normalized();
+      const double h = 0.5 * options.yardstick_length_m;
+      const Eigen::Vector3d a = on_sheet(mu - h * dir.x(), mv - h * dir.y());
+      const Eigen::Vector3d b = on_sheet(mu + h * dir.x(), mv + h * dir.y());
+      if (visible_everywhere(a) && visible_everywhere(b)) truth.dots_in_base = {a, b};
+    }
+    while (static_cast<int>(truth.dots_in_base.size()) < options.num_dots && tries < max_tries) {
+      ++tries;
+      const Eigen::Vector3d p = on_sheet(uniform(rng), uniform(rng));
+      if (visible_everywhere(p)) truth.dots_in_base.push_back(p);
+    }
+  } else {
+    // The yardstick: dots 0 and 1, yardstick_length_m apart along a random direction through the centre.
+    while (truth.dots_in_base.size() < 2 && tries < max_tries) {
+      ++tries;
+      const Eigen::Vector3d mid = centre + 0.3 * Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
+      const Eigen::Vector3d dir = Eigen::Vector3d(gauss(rng), gauss(rng), 0.3 * gauss(rng)).normalized();
+      const Eigen::Vector3d a = mid - 0.5 * options.yardstick_length_m * dir;
+      const Eigen::Vector3d b = mid + 0.5 * options.yardstick_length_m * dir;
+      if (visible_everywhere(a) && visible_everywhere(b)) truth.dots_in_base = {a, b};
+    }
+    while (static_cast<int>(truth.dots_in_base.size()) < options.num_dots && tries < max_tries) {
+      ++tries;
+      const Eigen::Vector3d p = centre + Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
+      if (visible_everywhere(p)) truth.dots_in_base.push_back(p);
+    }
   }
   if (static_cast<int>(truth.dots_in_base.size()) < options.num_dots) {
     result.message = "could not place " + std::to_string(options.num_dots) +

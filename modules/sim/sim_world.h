@@ -1,6 +1,7 @@
 // The simulated world of DESIGN.md section 6: a true robot (nominal + hidden errors drawn from a seed),
-// a hidden flange-to-camera transform and focal length, a scene of non-coplanar dots in view of every
-// pose, a yardstick, and image points projected with Gaussian pixel noise. The solver only ever sees the
+// a hidden flange-to-camera transform and focal length, a scene of non-coplanar dots (or, with
+// flat_sheet, dots on one plane) in view of every pose, a yardstick, and image points projected with
+// Gaussian pixel noise. The solver only ever sees the
 // ObservationSet; the SimTruth is for scoring.
 #pragma once
 
@@ -37,6 +38,10 @@ struct SimOptions {
   double image_margin_px = 10.0;    // every dot at least this far inside every image
   double min_depth_m = 0.3;
   double yardstick_length_m = 0.2;  // dots 0 and 1 are placed this far apart
+  // A flat dot sheet: every dot (the yardstick's two included) on the plane through the point the cameras
+  // look at, facing the mean viewing direction (normal = mean optical axis), still in view of every
+  // pose. The paper's factor method is degenerate there; the kinematic bundle adjustment is not.
+  bool flat_sheet = false;
   double pixel_noise_px = 0.2;      // Gaussian, std per coordinate (the paper's Table 1, read as a std)
   int num_identification_poses = 15;  // the first ones; the rest are verification poses
   std::string Validate() const;

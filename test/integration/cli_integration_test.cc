@@ -1,5 +1,7 @@
 #include <sys/wait.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -54,7 +56,10 @@ TEST(Cli, SimulateEndToEndThenCalibrateTheSameFileIsDeterministic) {
     EXPECT_TRUE(fs::exists(dir / file)) << file << "\n" << output;
   }
   const nlohmann::json first = ReadJson(dir / "report.json");
-  EXPECT_EQ(first["outcome"], "success");
+  // The default method is the kinematic bundle adjustment, started from the paper pipeline.
+  EXPECT_EQ(first["method"], "bundle");
+  EXPECT_EQ(first["outcome"], "converged");
+  EXPECT_EQ(first["paper_pipeline"]["outcome"], "success");
   EXPECT_TRUE(first["accepted"].get<bool>());
   // The calibrated model is a robot config selfcal reads back.
   EXPECT_TRUE(io::LoadRobotModel((dir / "calibrated_model.yaml").string()).ok());
@@ -63,12 +68,82 @@ TEST(Cli, SimulateEndToEndThenCalibrateTheSameFileIsDeterministic) {
   ASSERT_EQ(RunSelfcal("calibrate " + (dir / "observations.yaml").string() + " --seed 3 --out " + again.string(), &output), 0)
       << output;
   nlohmann::json second = ReadJson(again / "report.json");
+  // Bit for bit, the bundle adjustment included: its parameter blocks sit in one buffer in a fixed
+  // layout, so Ceres' address-ordered elimination does not depend on this process's heap.
   nlohmann::json a = first, b = second;
   for (nlohmann::json* j : {&a, &b}) {
     j->erase("timing_s");
     j->erase("input");
   }
   EXPECT_EQ(a.dump(), b.dump());
+  fs::remove_all(dir);
+}
+
+// --method bundle: the report's bundle section, the model written from the bundle; --method paper: the
+// baseline alone. (The bundle's accuracy against the paper's is checked over several worlds in
+// pipeline's bundle_stage_test, where one draw cannot decide.)
+TEST(Cli, SimulateWithTheBundleMethodReportsTheBundleAndWritesItsModel) {
+  const fs::path dir = FreshDir("bundle");
+  std::string output;
+  ASSERT_EQ(RunSelfcal("simulate --method bundle --noise-px 0.2 --seed 5 --out " + dir.string(), &output), 0) << output;
+  const nlohmann::json report = ReadJson(dir / "report.json");
+  EXPECT_EQ(report["method"], "bundle");
+  EXPECT_EQ(report["exit_code"], 0);
+  const nlohmann::json& b = report["bundle"];
+  EXPECT_EQ(b["outcome"], "converged") << b.dump(2);
+  EXPECT_EQ(b["start"], "paper_pipeline");
+  EXPECT_FALSE(b["termination"].get<std::string>().empty());
+  EXPECT_GT(b["iterations"].get<int>(), 0);
+  EXPECT_LT(b["rms_reprojection_px"].get<double>(), 0.5);
+  EXPECT_TRUE(b["removed_observations"].is_array());
+  EXPECT_EQ(b["free"].size(), 24u);
+  EXPECT_EQ(b["free"].size() + b["fixed"].size(), b["parameters"].size());
+  for (const nlohmann::json& p : b["parameters"]) {
+    const bool length = p.contains("value_mm");
+    EXPECT_TRUE(length || p.contains("value_deg")) << p.dump();
+    const std::string sd = length ? "stddev_mm" : "stddev_deg";
+    ASSERT_TRUE(p.contains(sd)) << p.dump();
+    EXPECT_EQ(p["free"].get<bool>(), !p[sd].is_null()) << p.dump();
+  }
+  EXPECT_GT(b["fx_stddev_px"].get<double>(), 0);
+  EXPECT_EQ(b["verification"]["calibrated_model"]["num_ok"], 40);
+  EXPECT_NE(output.find("kinematic bundle adjustment vs truth"), std::string::npos) << output;
+  // Against the truth (this seed, deterministic): the verification relative poses, 10 mm off with the
+  // nominal model, come within ~1 mm.
+  const nlohmann::json comparison = ReadJson(dir / "comparison_with_truth.json");
+  ASSERT_TRUE(comparison.contains("bundle"));
+  const nlohmann::json& pose_mm = comparison["bundle"]["verification_pose_error_mean_mm"];
+  EXPECT_LT(pose_mm["bundle"].get<double>(), 0.3 * pose_mm["nominal"].get<double>()) << pose_mm.dump();
+  Result<io::CalibratedModel> model = io::LoadCalibratedModel((dir / "calibrated_model.yaml").string());
+  ASSERT_TRUE(model.ok()) << model.status().ToString();
+  EXPECT_NEAR(model->fx_px, b["fx_px"].get<double>(), 1e-6);
+  // The baseline alone on the same file: no bundle section, the paper's outcome.
+  const fs::path paper = dir / "paper";
+  ASSERT_EQ(RunSelfcal("calibrate " + (dir / "observations.yaml").string() + " --method paper --out " + paper.string(),
+                       &output), 0) << output;
+  const nlohmann::json baseline = ReadJson(paper / "report.json");
+  EXPECT_EQ(baseline["method"], "paper");
+  EXPECT_EQ(baseline["outcome"], "success");
+  EXPECT_FALSE(baseline.contains("bundle"));
+  EXPECT_EQ(RunSelfcal("calibrate " + (dir / "observations.yaml").string() + " --method nonsense --out " + paper.string(),
+                       &output), 2) << output;
+  fs::remove_all(dir);
+}
+
+// A flat dot sheet: the paper pipeline is degenerate (exit 3, no model), the bundle adjustment is not.
+TEST(Cli, FlatSheetIsDegenerateForThePaperMethodAndCalibratesWithTheBundle) {
+  const fs::path dir = FreshDir("flat");
+  std::string output;
+  ASSERT_EQ(RunSelfcal("simulate --flat-sheet --out " + dir.string(), &output), 0) << output;
+  const nlohmann::json report = ReadJson(dir / "report.json");
+  EXPECT_EQ(report["paper_pipeline"]["outcome"], "degenerate");
+  EXPECT_EQ(report["bundle"]["outcome"], "converged");
+  EXPECT_EQ(report["bundle"]["start"], "nominal");
+  EXPECT_TRUE(fs::exists(dir / "calibrated_model.yaml"));
+  const fs::path paper = dir / "paper";
+  EXPECT_EQ(RunSelfcal("calibrate " + (dir / "observations.yaml").string() + " --method paper --out " + paper.string(),
+                       &output), 3) << output;
+  EXPECT_FALSE(fs::exists(paper / "calibrated_model.yaml"));
   fs::remove_all(dir);
 }
 
@@ -132,6 +207,9 @@ TEST(Cli, Ur5eSimulationBeatsItsNominalModel) {
   const double nominal = report["verification"]["nominal_model"]["rms_error_mm"];
   const double calibrated = report["verification"]["calibrated_model"]["rms_error_mm"];
   EXPECT_LT(calibrated, 0.5 * nominal) << output;
+  // The bundle adjustment (the default method) on the same data, noise-free: exact.
+  EXPECT_EQ(report["bundle"]["outcome"], "converged") << output;
+  EXPECT_LT(report["bundle"]["verification"]["calibrated_model"]["max_error_mm"].get<double>(), 1e-6) << output;
   fs::remove_all(dir);
 }
 
