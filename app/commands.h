@@ -15,5 +15,6 @@ Command AddSimulateCommand(CLI::App& app);
 Command AddStudyCommand(CLI::App& app);
 Command AddIdentifiabilityCommand(CLI::App& app);
 Command AddMakeTrajectoryCommand(CLI::App& app);
+Command AddTrackerCommand(CLI::App& app);
 
 }  // namespace selfcal::app

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   const selfcal::app::Command study = selfcal::app::AddStudyCommand(app);
   const selfcal::app::Command identifiability = selfcal::app::AddIdentifiabilityCommand(app);
   const selfcal::app::Command make_trajectory = selfcal::app::AddMakeTrajectoryCommand(app);
+  const selfcal::app::Command identify_tracker = selfcal::app::AddTrackerCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -24,7 +25,7 @@ int main(int argc, char** argv) {
   try {
     for (const auto& [name, command] :
          {std::pair{"calibrate", calibrate}, {"simulate", simulate}, {"study", study},
-          {"identifiability", identifiability}, {"make-trajectory", make_trajectory}}) {
+          {"identifiability", identifiability}, {"make-trajectory", make_trajectory}, {"identify-tracker", identify_tracker}}) {
       if (app.got_subcommand(name)) return command();
     }
   } catch (const selfcal::InvalidArgument& e) {
