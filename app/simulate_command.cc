@@ -50,6 +50,35 @@ nlohmann::json TruthJson(const sim::SimResult& world) {
           {"dots_in_base_mm", dots}};
 }
 
+// Mean error of the relative poses reference -> each verification pose predicted by a model against the
+// truth (gauge-free). position in m, rotation in rad.
+PoseDifference MeanVerificationPoseError(const sim::SimResult& world, const ObservationSet& obs, int ref,
+                                         const RobotModel& model, const Eigen::VectorXd& rho) {
+  PoseDifference mean;
+  int n = 0;
+  for (int v : obs.PosesWithRole(PoseRole::kVerification)) {
+    const Rigid3 truth_rel = world.truth.base_from_cam[ref].Inverse() * world.truth.base_from_cam[v];
+    const Rigid3 model_rel =
+        BaseFromCam(model, rho, obs.poses[ref].joints_rad).Inverse() * BaseFromCam(model, rho, obs.poses[v].joints_rad);
+    const PoseDifference d = ComparePoses(truth_rel, model_rel);
+    mean.position_m += d.position_m;
+    mean.rotation_rad += d.rotation_rad;
+    ++n;
+  }
+  if (n > 0) {
+    mean.position_m /= n;
+    mean.rotation_rad /= n;
+  }
+  return mean;
+}
+
+void PrintVerificationPoseErrors(const PoseDifference& nominal, const PoseDifference& calibrated, const char* label,
+                                 std::ostream& out) {
+  out << "verification relative poses, mean error: nominal " << nominal.position_m * 1e3 << " mm / "
+      << RadToDeg(nominal.rotation_rad) << " deg; " << label << " " << calibrated.position_m * 1e3 << " mm / "
+      << RadToDeg(calibrated.rotation_rad) << " deg\n";
+}
+
 // Calibrated vs true, in the quantities that do not depend on the gauge.
 nlohmann::json CompareWithTruth(const sim::SimResult& world, const ObservationSet& obs,
                                 const pipeline::PaperPipelineReport& report, std::ostream& out) {
@@ -85,37 +114,20 @@ nlohmann::json CompareWithTruth(const sim::SimResult& world, const ObservationSe
       << RadToDeg(cam_error.rotation_rad) << " deg (includes what the fixed joint-6 offsets absorb)\n";
   out << "f_x: nominal " << obs.camera.fx_px << ", true " << world.truth.camera_true.fx_px << ", calibrated "
       << report.fx_px << " px\n";
-  // Relative poses reference -> verification pose: predicted vs true.
-  const int ref = report.reference_pose;
   const Eigen::VectorXd rho0 = KinematicParameters::Nominal(nominal);
-  double before = 0, after = 0, before_rot = 0, after_rot = 0;
-  int n = 0;
-  for (int v : obs.PosesWithRole(PoseRole::kVerification)) {
-    const Rigid3 truth_rel = world.truth.base_from_cam[ref].Inverse() * world.truth.base_from_cam[v];
-    const Rigid3 nominal_rel = BaseFromCam(nominal, rho0, obs.poses[ref].joints_rad).Inverse() *
-                               BaseFromCam(nominal, rho0, obs.poses[v].joints_rad);
-    const Rigid3 cal_rel = BaseFromCam(calibrated, report.calibrated_rho, obs.poses[ref].joints_rad).Inverse() *
-                           BaseFromCam(calibrated, report.calibrated_rho, obs.poses[v].joints_rad);
-    const PoseDifference b = ComparePoses(truth_rel, nominal_rel), a = ComparePoses(truth_rel, cal_rel);
-    before += b.position_m;
-    after += a.position_m;
-    before_rot += b.rotation_rad;
-    after_rot += a.rotation_rad;
-    ++n;
-  }
-  if (n > 0) {
-    out << "verification relative poses, mean error: nominal " << before / n * 1e3 << " mm / "
-        << RadToDeg(before_rot / n) << " deg; calibrated " << after / n * 1e3 << " mm / " << RadToDeg(after_rot / n)
-        << " deg\n";
-  }
+  const PoseDifference before = MeanVerificationPoseError(world, obs, report.reference_pose, nominal, rho0);
+  const PoseDifference after =
+      MeanVerificationPoseError(world, obs, report.reference_pose, calibrated, report.calibrated_rho);
+  PrintVerificationPoseErrors(before, after, "calibrated", out);
   out.unsetf(std::ios::floatfield);
   return {{"links", links},
           {"flange_from_cam_error_mm", cam_error.position_m * 1e3},
           {"flange_from_cam_error_deg", RadToDeg(cam_error.rotation_rad)},
           {"fx_true_px", world.truth.camera_true.fx_px},
           {"fx_calibrated_px", report.fx_px},
-          {"verification_pose_error_mean_mm", {{"nominal", n ? before / n * 1e3 : 0}, {"calibrated", n ? after / n * 1e3 : 0}}},
-          {"verification_pose_error_mean_deg", {{"nominal", n ? RadToDeg(before_rot / n) : 0}, {"calibrated", n ? RadToDeg(after_rot / n) : 0}}}};
+          {"verification_pose_error_mean_mm", {{"nominal", before.position_m * 1e3}, {"calibrated", after.position_m * 1e3}}},
+          {"verification_pose_error_mean_deg",
+           {{"nominal", RadToDeg(before.rotation_rad)}, {"calibrated", RadToDeg(after.rotation_rad)}}}};
 }
 
 // The bundle adjustment's result against the truth: every free parameter with its reported sigma (the
@@ -156,27 +168,10 @@ nlohmann::json CompareBundleWithTruth(const sim::SimResult& world, const Observa
   out << std::setprecision(4) << "f_x: nominal " << obs.camera.fx_px << ", true " << fx_true << ", bundle " << b.fx_px
       << " +- " << b.fx_stddev << " px (error " << b.fx_px - fx_true << " px)\n";
   out << within_2_sigma << " of " << count << " free parameters within 2 sigma of the truth\n";
-  // Relative poses reference -> verification pose: gauge-free.
   const int ref = obs.PosesWithRole(PoseRole::kIdentification).front();
-  double before = 0, after = 0, before_rot = 0, after_rot = 0;
-  int n = 0;
-  for (int v : obs.PosesWithRole(PoseRole::kVerification)) {
-    const Rigid3 truth_rel = world.truth.base_from_cam[ref].Inverse() * world.truth.base_from_cam[v];
-    const Rigid3 nominal_rel = BaseFromCam(nominal, rho0, obs.poses[ref].joints_rad).Inverse() *
-                               BaseFromCam(nominal, rho0, obs.poses[v].joints_rad);
-    const Rigid3 ba_rel = BaseFromCam(nominal, b.rho, obs.poses[ref].joints_rad).Inverse() *
-                          BaseFromCam(nominal, b.rho, obs.poses[v].joints_rad);
-    const PoseDifference d0 = ComparePoses(truth_rel, nominal_rel), d1 = ComparePoses(truth_rel, ba_rel);
-    before += d0.position_m;
-    after += d1.position_m;
-    before_rot += d0.rotation_rad;
-    after_rot += d1.rotation_rad;
-    ++n;
-  }
-  if (n > 0) {
-    out << "verification relative poses, mean error: nominal " << before / n * 1e3 << " mm / " << RadToDeg(before_rot / n)
-        << " deg; bundle " << after / n * 1e3 << " mm / " << RadToDeg(after_rot / n) << " deg\n";
-  }
+  const PoseDifference before = MeanVerificationPoseError(world, obs, ref, nominal, rho0);
+  const PoseDifference after = MeanVerificationPoseError(world, obs, ref, nominal, b.rho);
+  PrintVerificationPoseErrors(before, after, "bundle", out);
   out << "3-D error of the held-out distances, RMS: nominal " << stage.verification_nominal.rms_error_m * 1e3
       << " mm, bundle " << stage.verification.rms_error_m * 1e3 << " mm (max " << stage.verification.max_error_m * 1e3
       << " mm)\n";
@@ -188,8 +183,9 @@ nlohmann::json CompareBundleWithTruth(const sim::SimResult& world, const Observa
           {"fx_true_px", fx_true},
           {"fx_bundle_px", b.fx_px},
           {"fx_stddev_px", std::isfinite(b.fx_stddev) ? nlohmann::json(b.fx_stddev) : nlohmann::json()},
-          {"verification_pose_error_mean_mm", {{"nominal", n ? before / n * 1e3 : 0}, {"bundle", n ? after / n * 1e3 : 0}}},
-          {"verification_pose_error_mean_deg", {{"nominal", n ? RadToDeg(before_rot / n) : 0}, {"bundle", n ? RadToDeg(after_rot / n) : 0}}},
+          {"verification_pose_error_mean_mm", {{"nominal", before.position_m * 1e3}, {"bundle", after.position_m * 1e3}}},
+          {"verification_pose_error_mean_deg",
+           {{"nominal", RadToDeg(before.rotation_rad)}, {"bundle", RadToDeg(after.rotation_rad)}}},
           {"error3d_rms_mm", {{"nominal", stage.verification_nominal.rms_error_m * 1e3}, {"bundle", stage.verification.rms_error_m * 1e3}}}};
 }
 
