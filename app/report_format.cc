@@ -56,6 +56,17 @@ nlohmann::json BundleCellJson(const pipeline::StudyCell& c) {
                               {"orientation", Finite(Ratio(c.bundle_orientation_1e4rad.Rms(), c.bundle_bound_orientation_1e4rad.Rms()))},
                               {"fx", Finite(Ratio(c.bundle_fx_px.Rms(), c.bundle_bound_fx_px.Rms()))}}},
           {"fig6_3d_error_mm", StatJson(c.bundle_error3d_mm)},
+          {"predicted_3d_error_mm",
+           {{"description", "std of the 3-D error of each check distance predicted to first order (pipeline/"
+                            "predicted_error.h), pooled over runs; compare actual_rms with the rms entries"},
+            {"actual_rms", Finite(c.bundle_error3d_mm.Rms())},
+            {"predicted", StatJson(c.bundle_predicted3d_mm)},
+            {"predicted_parameters_part", StatJson(c.bundle_predicted3d_parameters_mm)},
+            {"predicted_pixels_part", StatJson(c.bundle_predicted3d_pixels_mm)},
+            {"bound", StatJson(c.bundle_bound3d_mm)},
+            {"bound_parameters_part", StatJson(c.bundle_bound3d_parameters_mm)},
+            {"actual_over_predicted", Finite(Ratio(c.bundle_error3d_mm.Rms(), c.bundle_predicted3d_mm.Rms()))},
+            {"actual_over_bound", Finite(Ratio(c.bundle_error3d_mm.Rms(), c.bundle_bound3d_mm.Rms()))}}},
           {"verification_pose_error", {{"position_mm", StatJson(c.bundle_pose_position_mm)},
                                        {"orientation_1e4rad", StatJson(c.bundle_pose_orientation_1e4rad)}}},
           {"coverage_2sigma", {{"intervals", c.bundle_intervals},
@@ -175,6 +186,29 @@ void PrintCalibrationSummary(const pipeline::PaperPipelineReport& r, std::ostrea
   out.unsetf(std::ios::floatfield);
 }
 
+namespace {
+
+nlohmann::json PredictedErrorJson(const pipeline::PredictedDistanceErrors& p) {
+  nlohmann::json distances = nlohmann::json::array();
+  for (const pipeline::PredictedDistanceError& e : p.distances) {
+    distances.push_back({{"dot_a", e.known.dot_a}, {"dot_b", e.known.dot_b}, {"ok", e.ok},
+                         {"std_mm", e.std_m * kMm}, {"parameters_std_mm", e.parameters_std_m * kMm},
+                         {"pixels_std_mm", e.pixels_std_m * kMm}});
+  }
+  return {{"description", "predicted std of the 3-D error of each check distance: the bundle's covariance of the free "
+                          "parameters and f_x (parameters part) and the stated pixel noise of the verification images "
+                          "(pixels part), propagated through the triangulation to first order"},
+          {"ok", p.ok},
+          {"message", p.message},
+          {"num_ok", p.num_ok},
+          {"rms_mm", p.rms_std_m * kMm},
+          {"rms_parameters_mm", p.rms_parameters_std_m * kMm},
+          {"rms_pixels_mm", p.rms_pixels_std_m * kMm},
+          {"distances", distances}};
+}
+
+}  // namespace
+
 nlohmann::json BundleReportJson(const ObservationSet& obs, const pipeline::BundleStageReport& stage) {
   const bundle::BundleReport& b = stage.bundle;
   nlohmann::json removed = nlohmann::json::array();
@@ -227,7 +261,8 @@ nlohmann::json BundleReportJson(const ObservationSet& obs, const pipeline::Bundl
           {"k1_stddev", Finite(b.k1_stddev)},
           {"verification", {{"poses", obs.PosesWithRole(PoseRole::kVerification).size()},
                             {"nominal_model", VerificationJson(stage.verification_nominal)},
-                            {"calibrated_model", VerificationJson(stage.verification)}}}};
+                            {"calibrated_model", VerificationJson(stage.verification)}}},
+          {"predicted_3d_error_mm", PredictedErrorJson(stage.predicted_error)}};
 }
 
 void PrintBundleSummary(const pipeline::BundleStageReport& stage, std::ostream& out) {
@@ -247,6 +282,12 @@ void PrintBundleSummary(const pipeline::BundleStageReport& stage, std::ostream& 
     out << "  3-D error on " << stage.verification.num_ok << " held-out distances: nominal model " << std::fixed
         << std::setprecision(3) << stage.verification_nominal.rms_error_m * kMm << " mm RMS, bundle "
         << stage.verification.rms_error_m * kMm << " mm RMS (max " << stage.verification.max_error_m * kMm << " mm)\n";
+  }
+  if (stage.predicted_error.ok) {
+    out << "  predicted 3-D error (first order): " << std::fixed << std::setprecision(3) << stage.predicted_error.rms_std_m * kMm
+        << " mm RMS (calibrated parameters " << stage.predicted_error.rms_parameters_std_m * kMm
+        << " mm, verification pixels " << stage.predicted_error.rms_pixels_std_m * kMm << " mm)\n";
+    out.unsetf(std::ios::floatfield);
   }
   out << "  time: " << std::fixed << std::setprecision(1) << b.seconds * 1e3 << " ms\n";
   out.unsetf(std::ios::floatfield);
@@ -405,6 +446,22 @@ void PrintStudyTables(const pipeline::StudyReport& study, std::ostream& out) {
                     c.bundle_error3d_mm.Percentile(90), c.pose_position_calibrated_mm.Mean(),
                     c.bundle_pose_position_mm.Mean(), c.bundle_bound_pose_position_mm.Rms(),
                     c.bundle_pose_orientation_1e4rad.Mean());
+      out << line;
+    }
+  }
+  if (any_bundle) {
+    out << "\nBA 3-D error of the check distances: actual RMS / predicted (each run's own covariance and pixel noise,\n"
+           "quadratic mean of the per-distance std; parts: parameters, verification pixels) / bound (Cramer-Rao\n"
+           "covariance at the truth, same propagation)\n";
+    std::snprintf(line, sizeof(line), "%-10s %-6s %12s %12s %12s %12s %12s %9s %9s\n", "trajectory", "noise",
+                  "3-D RMS mm", "predicted", "pred param", "pred pixel", "bound", "act/pred", "act/bound");
+    out << line;
+    for (const pipeline::StudyCell& c : study.cells) {
+      if (c.bundle_runs == 0 || c.bundle_predicted3d_mm.count() == 0) continue;
+      const double a = c.bundle_error3d_mm.Rms(), p = c.bundle_predicted3d_mm.Rms(), b = c.bundle_bound3d_mm.Rms();
+      std::snprintf(line, sizeof(line), "%-10s %-6.2f %12.4f %12.4f %12.4f %12.4f %12.4f %9.3f %9.3f\n",
+                    c.trajectory.c_str(), c.noise_px, a, p, c.bundle_predicted3d_parameters_mm.Rms(),
+                    c.bundle_predicted3d_pixels_mm.Rms(), b, Ratio(a, p), Ratio(a, b));
       out << line;
     }
   }

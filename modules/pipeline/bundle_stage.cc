@@ -82,6 +82,23 @@ BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineR
       } else {
         report.verification = VerifyDistances(obs, verification_poses, obs.robot, b.rho, b.fx_px, obs.check_distances);
       }
+      if (b.covariance_available) {
+        // Order free, f_x (when estimated), k1 (when estimated; not propagated). A held f_x: zero variance.
+        const int nf = static_cast<int>(b.free_indices.size());
+        Eigen::MatrixXd sigma = Eigen::MatrixXd::Zero(nf + 1, nf + 1);
+        sigma.topLeftCorner(nf, nf) = b.covariance_free.topLeftCorner(nf, nf);
+        if (options.bundle.estimate_fx) sigma = b.covariance_free.topLeftCorner(nf + 1, nf + 1);
+        ObservationSet with_k1;
+        if (options.bundle.estimate_k1) {
+          with_k1 = obs;
+          with_k1.camera.k1 = b.k1;
+        }
+        report.predicted_error = PredictDistanceErrors(options.bundle.estimate_k1 ? with_k1 : obs, verification_poses, obs.robot,
+                                                       b.rho, b.fx_px, b.free_indices, sigma, obs.pixel_noise_px,
+                                                       obs.check_distances);
+      } else {
+        report.predicted_error.message = "covariance unavailable: " + b.covariance_message;
+      }
     }
   }
   report.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();

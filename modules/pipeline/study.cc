@@ -213,6 +213,14 @@ void ScoreBundle(const sim::SimResult& world, const ObservationSet& obs, const P
     if (c.ok) cell->bundle_error3d_mm.Add(kMm * c.error_m);
   }
   if (cell->noise_px <= 0) return;  // no noise: no sigma to cover with, no bound
+  if (stage.predicted_error.ok) {
+    for (const PredictedDistanceError& e : stage.predicted_error.distances) {
+      if (!e.ok) continue;
+      cell->bundle_predicted3d_mm.Add(kMm * e.std_m);
+      cell->bundle_predicted3d_parameters_mm.Add(kMm * e.parameters_std_m);
+      cell->bundle_predicted3d_pixels_mm.Add(kMm * e.pixels_std_m);
+    }
+  }
   // Coverage needs the truth in the bundle's gauge: every entry it held fixed equal to the truth's.
   bool same_gauge = b.covariance_available;
   for (int i = 0; i < b.rho.size() && same_gauge; ++i) {
@@ -244,6 +252,22 @@ void ScoreBundle(const sim::SimResult& world, const ObservationSet& obs, const P
     }
   }
   if (std::isfinite(bound.fx_stddev)) cell->bundle_bound_fx_px.Add(bound.fx_stddev);
+  // The 3-D error bound: the Cramer-Rao covariance propagated with the truth's model and f_x (the free
+  // set is the solve's, chosen at the nominal model). A held f_x: zero variance.
+  const int nf = static_cast<int>(bound.free_indices.size());
+  if (bound.covariance_free.rows() >= nf) {
+    Eigen::MatrixXd sigma = Eigen::MatrixXd::Zero(nf + 1, nf + 1);
+    sigma.topLeftCorner(nf, nf) = bound.covariance_free.topLeftCorner(nf, nf);
+    if (options.bundle.bundle.estimate_fx) sigma = bound.covariance_free.topLeftCorner(nf + 1, nf + 1);
+    const PredictedDistanceErrors b3d =
+        PredictDistanceErrors(obs, obs.PosesWithRole(PoseRole::kVerification), obs.robot, truth.rho_true,
+                              truth.camera_true.fx_px, bound.free_indices, sigma, cell->noise_px, obs.check_distances);
+    for (const PredictedDistanceError& e : b3d.distances) {
+      if (!e.ok) continue;
+      cell->bundle_bound3d_mm.Add(kMm * e.std_m);
+      cell->bundle_bound3d_parameters_mm.Add(kMm * e.parameters_std_m);
+    }
+  }
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 
 #include "pipeline/bundle_stage.h"
 #include "pipeline/paper_pipeline.h"
+#include "pipeline/predicted_error.h"
 #include "sim/sim_world.h"
 
 namespace selfcal::pipeline {
@@ -86,6 +87,12 @@ struct StudyCell {
   // the verification relative poses (with their bound).
   Stat bundle_error3d_mm, bundle_pose_position_mm, bundle_pose_orientation_1e4rad;
   Stat bundle_bound_pose_position_mm, bundle_bound_pose_orientation_1e4rad;
+  // (c') The predicted std of that 3-D error (pipeline/predicted_error.h), per check distance pooled over
+  // runs: from each run's own covariance and pixel noise (total, part (a) parameters, part (b) pixels), and
+  // the bound: the same propagation of the bundle's Cramer-Rao covariance with the truth's model and f_x.
+  // Compare bundle_error3d_mm.Rms() with their Rms() (the quadratic mean: E[error^2] = mean variance).
+  Stat bundle_predicted3d_mm, bundle_predicted3d_parameters_mm, bundle_predicted3d_pixels_mm;
+  Stat bundle_bound3d_mm, bundle_bound3d_parameters_mm;
   // (d) Coverage, pooled over runs: free parameters and f_x whose truth lies within +-2 reported sigma of
   // the estimate (runs with noise > 0 whose gauge is the truth's).
   int bundle_intervals = 0, bundle_covered = 0;
