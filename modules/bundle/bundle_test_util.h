@@ -15,21 +15,13 @@
 #include "bundle/bundle_adjustment.h"
 #include "sim/sim_world.h"
 #include "sim/trajectory_generator.h"
+#include "support/sim_worlds.h"
 #include "support/test_robots.h"
 
 namespace selfcal::bundle::testing {
 
 inline sim::SimResult World(double noise_px, uint64_t world_seed = 1, uint64_t noise_seed = 1) {
-  const RobotModel puma = selfcal::testing::Puma560();
-  const sim::GeneratedTrajectory trajectory = sim::MakeArcTrajectory(puma, sim::ArcTrajectoryOptions());
-  EXPECT_TRUE(trajectory.ok) << trajectory.message;
-  sim::SimOptions options;
-  options.pixel_noise_px = noise_px;
-  options.world_seed = world_seed;
-  options.noise_seed = noise_seed;
-  sim::SimResult world = sim::Simulate(puma, trajectory.joints, options);
-  EXPECT_TRUE(world.ok) << world.message;
-  return world;
+  return selfcal::testing::PumaArcWorld(noise_px, world_seed, noise_seed);
 }
 
 inline BundleTruth Truth(const sim::SimResult& world) {

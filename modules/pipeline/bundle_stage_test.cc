@@ -9,6 +9,7 @@
 
 #include "sim/sim_world.h"
 #include "sim/trajectory_generator.h"
+#include "support/sim_worlds.h"
 #include "support/test_robots.h"
 
 namespace selfcal::pipeline {
@@ -17,17 +18,7 @@ namespace {
 constexpr double kExact = 1e-9;
 
 sim::SimResult World(double noise_px, uint64_t seed, bool flat_sheet = false) {
-  const RobotModel puma = testing::Puma560();
-  const sim::GeneratedTrajectory trajectory = sim::MakeArcTrajectory(puma, sim::ArcTrajectoryOptions());
-  EXPECT_TRUE(trajectory.ok) << trajectory.message;
-  sim::SimOptions options;
-  options.pixel_noise_px = noise_px;
-  options.world_seed = seed;
-  options.noise_seed = seed;
-  options.flat_sheet = flat_sheet;
-  sim::SimResult world = sim::Simulate(puma, trajectory.joints, options);
-  EXPECT_TRUE(world.ok) << world.message;
-  return world;
+  return testing::PumaArcWorld(noise_px, seed, seed, flat_sheet);
 }
 
 // Largest error of the predicted cam_ref_from_cam_v over the verification poses (gauge-free).

@@ -5,23 +5,13 @@
 #include "identification/identification.h"
 #include "sim/sim_world.h"
 #include "sim/trajectory_generator.h"
+#include "support/sim_worlds.h"
 #include "support/test_robots.h"
 
 namespace selfcal::pipeline {
 namespace {
 
-sim::SimResult World(double noise_px, uint64_t seed = 1) {
-  const RobotModel puma = testing::Puma560();
-  const sim::GeneratedTrajectory trajectory = sim::MakeArcTrajectory(puma, sim::ArcTrajectoryOptions());
-  EXPECT_TRUE(trajectory.ok) << trajectory.message;
-  sim::SimOptions options;
-  options.pixel_noise_px = noise_px;
-  options.world_seed = seed;
-  options.noise_seed = seed;
-  sim::SimResult world = sim::Simulate(puma, trajectory.joints, options);
-  EXPECT_TRUE(world.ok) << world.message;
-  return world;
-}
+sim::SimResult World(double noise_px, uint64_t seed = 1) { return testing::PumaArcWorld(noise_px, seed, seed); }
 
 // Noise-free: the factor method is exact, and the only error left in the measured relative poses is the
 // bias of eq. (21) (nominal position ratios standing in for the true ones), which we can predict exactly.

@@ -10,23 +10,13 @@
 #include "pipeline/paper_pipeline.h"
 #include "sim/sim_world.h"
 #include "sim/trajectory_generator.h"
+#include "support/sim_worlds.h"
 #include "support/test_robots.h"
 
 namespace selfcal::pipeline {
 namespace {
 
-sim::SimResult World(double noise_px, uint64_t seed) {
-  const RobotModel puma = testing::Puma560();
-  const sim::GeneratedTrajectory trajectory = sim::MakeArcTrajectory(puma, sim::ArcTrajectoryOptions());
-  EXPECT_TRUE(trajectory.ok) << trajectory.message;
-  sim::SimOptions options;
-  options.pixel_noise_px = noise_px;
-  options.world_seed = seed;
-  options.noise_seed = seed + 7;
-  sim::SimResult world = sim::Simulate(puma, trajectory.joints, options);
-  EXPECT_TRUE(world.ok) << world.message;
-  return world;
-}
+sim::SimResult World(double noise_px, uint64_t seed) { return testing::PumaArcWorld(noise_px, seed, seed + 7); }
 
 bundle::BundleReport Solve(const ObservationSet& obs) {
   return bundle::RunBundleAdjustment(obs, KinematicParameters::Nominal(obs.robot), obs.camera.fx_px, {});

@@ -1,0 +1,15 @@
+// The standard simulated world of the pipeline and bundle tests, built in one place: the PUMA 560 of
+// test_robots.h on the shipped initial arc (sim::MakeArcTrajectory defaults), default hidden errors.
+#pragma once
+
+#include <cstdint>
+
+#include "sim/sim_world.h"
+
+namespace selfcal::testing {
+
+// Fails the calling test (non-fatally) if the trajectory or the simulation cannot be built.
+sim::SimResult PumaArcWorld(double noise_px, uint64_t world_seed = 1, uint64_t noise_seed = 1,
+                            bool flat_sheet = false);
+
+}  // namespace selfcal::testing
