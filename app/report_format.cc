@@ -40,6 +40,41 @@ std::string Shortened(const std::string& message) {
 
 double Ratio(double a, double b) { return std::isfinite(a) && std::isfinite(b) && b > 0 ? a / b : NAN; }
 
+// Per free parameter: RMS error against the truth, RMS Cramer-Rao std, and their ratio (units in the key).
+nlohmann::json BundleParametersJson(const pipeline::StudyCell& c) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const auto& [name, error] : c.bundle_parameter_error) {
+    auto bound = c.bundle_parameter_bound.find(name);
+    const double b = bound == c.bundle_parameter_bound.end() ? NAN : bound->second.Rms();
+    rows.push_back({{"name", name}, {"n", error.count()}, {"rms_error", Finite(error.Rms())},
+                    {"rms_bound", Finite(b)}, {"ratio", Finite(Ratio(error.Rms(), b))}});
+  }
+  return rows;
+}
+
+// min, mean and max of the per-parameter RMS error / RMS bound, with the extreme parameters' names.
+struct RatioSummary {
+  int n = 0;
+  double min = NAN, mean = NAN, max = NAN;
+  std::string min_name, max_name;
+};
+RatioSummary SummarizeParameterRatios(const pipeline::StudyCell& c) {
+  RatioSummary r;
+  double sum = 0;
+  for (const auto& [name, error] : c.bundle_parameter_error) {
+    auto bound = c.bundle_parameter_bound.find(name);
+    if (bound == c.bundle_parameter_bound.end()) continue;
+    const double ratio = Ratio(error.Rms(), bound->second.Rms());
+    if (!std::isfinite(ratio)) continue;
+    if (r.n == 0 || ratio < r.min) r.min = ratio, r.min_name = name;
+    if (r.n == 0 || ratio > r.max) r.max = ratio, r.max_name = name;
+    sum += ratio;
+    ++r.n;
+  }
+  if (r.n > 0) r.mean = sum / r.n;
+  return r;
+}
+
 nlohmann::json BundleCellJson(const pipeline::StudyCell& c) {
   return {{"runs", c.bundle_runs},
           {"runs_failed", c.bundle_runs_failed},
@@ -72,6 +107,7 @@ nlohmann::json BundleCellJson(const pipeline::StudyCell& c) {
           {"coverage_2sigma", {{"intervals", c.bundle_intervals},
                                {"covered", c.bundle_covered},
                                {"fraction", Finite(c.BundleCoverage())}}},
+          {"parameters_rms_error_over_bound", BundleParametersJson(c)},
           {"seconds_per_solve", StatJson(c.bundle_seconds)}};
 }
 
@@ -433,6 +469,15 @@ void PrintStudyTables(const pipeline::StudyReport& study, std::ostream& out) {
       std::snprintf(line, sizeof(line), "%-10s %-6.2f %10.4f %10.4f %7.3f %10.4f %10.4f %7.3f %9.4f %9.4f %7.3f %8.1f%% %9.1f\n",
                     c.trajectory.c_str(), c.noise_px, p, pb, Ratio(p, pb), o, ob, Ratio(o, ob), f, fb, Ratio(f, fb),
                     100 * c.BundleCoverage(), 1e3 * c.bundle_seconds.Mean());
+      out << line;
+    }
+    for (const pipeline::StudyCell& c : study.cells) {
+      const RatioSummary r = SummarizeParameterRatios(c);
+      if (r.n == 0) continue;
+      std::snprintf(line, sizeof(line),
+                    "%-10s %-6.2f per-parameter RMS error / Cramer-Rao std, %d free parameters: mean %.3f, min %.3f "
+                    "(%s), max %.3f (%s)\n",
+                    c.trajectory.c_str(), c.noise_px, r.n, r.mean, r.min, r.min_name.c_str(), r.max, r.max_name.c_str());
       out << line;
     }
     out << "\nFig. 6 with the BA model: verification poses (paper pipeline's calibrated model beside it)\n";

@@ -227,8 +227,11 @@ void ScoreBundle(const sim::SimResult& world, const ObservationSet& obs, const P
     const bool free = std::find(b.free_indices.begin(), b.free_indices.end(), i) != b.free_indices.end();
     if (!free && b.rho[i] != truth.rho_true[i]) same_gauge = false;
   }
+  const KinematicParameters params(robot.num_joints());
+  auto in_report_units = [&](int i, double v) { return params.kind(i) == ParameterKind::kLength ? kMm * v : RadToDeg(v); };
   if (same_gauge) {
     for (int i : b.free_indices) {
+      cell->bundle_parameter_error[params.name(i)].Add(in_report_units(i, b.rho[i] - truth.rho_true[i]));
       ++cell->bundle_intervals;
       cell->bundle_covered += std::abs(b.rho[i] - truth.rho_true[i]) <= 2 * b.stddev[i] ? 1 : 0;
     }
@@ -252,6 +255,9 @@ void ScoreBundle(const sim::SimResult& world, const ObservationSet& obs, const P
     }
   }
   if (std::isfinite(bound.fx_stddev)) cell->bundle_bound_fx_px.Add(bound.fx_stddev);
+  for (int i : bound.free_indices) {
+    if (std::isfinite(bound.stddev[i])) cell->bundle_parameter_bound[params.name(i)].Add(in_report_units(i, bound.stddev[i]));
+  }
   // The 3-D error bound: the Cramer-Rao covariance propagated with the truth's model and f_x (the free
   // set is the solve's, chosen at the nominal model). A held f_x: zero variance.
   const int nf = static_cast<int>(bound.free_indices.size());

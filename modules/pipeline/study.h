@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cmath>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -97,6 +98,9 @@ struct StudyCell {
   // the estimate (runs with noise > 0 whose gauge is the truth's).
   int bundle_intervals = 0, bundle_covered = 0;
   double BundleCoverage() const { return bundle_intervals > 0 ? static_cast<double>(bundle_covered) / bundle_intervals : std::nan(""); }
+  // (f) Per free parameter (by name, mm or deg): the bundle's error against the truth (same-gauge runs) and
+  // the Cramer-Rao std at the truth; RMS error / RMS bound per parameter says whether it is efficient.
+  std::map<std::string, Stat> bundle_parameter_error, bundle_parameter_bound;
   // (e) Wall time of one bundle solve (the screen's refits included).
   Stat bundle_seconds;
 };
