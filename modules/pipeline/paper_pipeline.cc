@@ -118,21 +118,18 @@ PaperPipelineReport RunPaperPipeline(const ObservationSet& obs, const PaperPipel
   const Rigid3 nominal_ref_from_base = BaseFromCam(robot, rho_nominal, obs.poses[ref].joints_rad).Inverse();
 
   // K3: excitation is a property of the joint angles alone: check it before any image is used.
-  {
-    std::vector<Eigen::VectorXd> all_joints;
-    for (int i : id_poses) all_joints.push_back(obs.poses[i].joints_rad);
-    const identification::IdentifiabilityReport excitation =
-        identification::AnalyzeIdentifiability(robot, rho_nominal, all_joints, 0, options.identifiability);
-    if (!(excitation.condition_number <= options.max_condition_number)) {
-      report.identifiability = excitation;
-      report.outcome = Outcome::kDegenerate;
-      std::ostringstream msg;
-      msg << "insufficient excitation (K3): the identification poses give a condition number of "
-          << excitation.condition_number << " (limit " << options.max_condition_number
-          << "); move the joints further apart between poses";
-      report.message = msg.str();
-      return report;
-    }
+  std::vector<Eigen::VectorXd> all_joints;
+  for (int i : id_poses) all_joints.push_back(obs.poses[i].joints_rad);
+  report.identifiability =
+      identification::AnalyzeIdentifiability(robot, rho_nominal, all_joints, 0, options.identifiability);
+  if (!(report.identifiability.condition_number <= options.max_condition_number)) {
+    report.outcome = Outcome::kDegenerate;
+    std::ostringstream msg;
+    msg << "insufficient excitation (K3): the identification poses give a condition number of "
+        << report.identifiability.condition_number << " (limit " << options.max_condition_number
+        << "); move the joints further apart between poses";
+    report.message = msg.str();
+    return report;
   }
 
   // Step 2: the factor method on each pair (reference, i), eq. (21) for the scales.
@@ -211,8 +208,11 @@ PaperPipelineReport RunPaperPipeline(const ObservationSet& obs, const PaperPipel
     joints.push_back(obs.poses[m.pose_index].joints_rad);
     relative.push_back({static_cast<int>(joints.size()) - 1, m.measured_cam_ref_from_cam, true});
   }
-  report.identifiability =
-      identification::AnalyzeIdentifiability(robot, rho_nominal, joints, ref_in_joints, options.identifiability);
+  // The K3 analysis already covered these poses when every pair was usable (same poses, same order).
+  if (joints.size() != all_joints.size()) {
+    report.identifiability =
+        identification::AnalyzeIdentifiability(robot, rho_nominal, joints, ref_in_joints, options.identifiability);
+  }
   if (report.identifiability.free_indices.empty()) {
     report.outcome = Outcome::kDegenerate;
     report.message = "no kinematic parameter is identifiable from these poses";
