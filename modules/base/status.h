@@ -46,10 +46,27 @@ class Status {
   const std::string& message() const { return message_; }
   std::string ToString() const;
 
+  // An optional machine-readable detail finer than the ExitCode, for callers that must tell failures
+  // apart (e.g. capture::CaptureError: a camera that timed out is retried, a missing one is not).
+  // `domain` names the enum the value belongs to (a string literal, e.g. "capture"); an error without
+  // a detail has detail_domain() == "" and detail() == 0. Ignored on an OK status.
+  Status WithDetail(const char* domain, int detail) const {
+    Status copy = *this;
+    if (!copy.ok()) {
+      copy.detail_domain_ = domain != nullptr ? domain : "";
+      copy.detail_ = detail;
+    }
+    return copy;
+  }
+  const char* detail_domain() const { return detail_domain_; }
+  int detail() const { return detail_; }
+
  private:
   Status(ExitCode code, std::string message) : code_(code), message_(std::move(message)) {}
   ExitCode code_ = ExitCode::kOk;
   std::string message_;
+  const char* detail_domain_ = "";
+  int detail_ = 0;
 };
 
 // A value or the Status explaining why there is none.

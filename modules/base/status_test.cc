@@ -18,6 +18,20 @@ TEST(Status, ErrorCarriesCodeAndMessage) {
   EXPECT_EQ(s.ToString(), "usage_or_config: unknown key `max_velocty`");
 }
 
+TEST(Status, DetailTravelsWithTheErrorOnly) {
+  const Status plain = Status::Error(ExitCode::kHardware, "camera gone");
+  EXPECT_STREQ(plain.detail_domain(), "");
+  EXPECT_EQ(plain.detail(), 0);
+  const Status detailed = plain.WithDetail("capture", 7);
+  EXPECT_STREQ(detailed.detail_domain(), "capture");
+  EXPECT_EQ(detailed.detail(), 7);
+  EXPECT_EQ(detailed.code(), ExitCode::kHardware);
+  EXPECT_EQ(detailed.message(), "camera gone");
+  const Result<int> carried(detailed);
+  EXPECT_EQ(carried.status().detail(), 7);
+  EXPECT_EQ(Status::Ok().WithDetail("capture", 7).detail(), 0);
+}
+
 TEST(Result, ValueAndErrorAccess) {
   Result<int> good(42);
   ASSERT_TRUE(good.ok());

@@ -1,0 +1,158 @@
+#include "capture/file_util.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <vector>
+
+namespace selfcal::capture::internal {
+
+namespace {
+
+Status Failure(const std::string& what, const std::string& path, int error) {
+  return Status::Error(ExitCode::kUsage, "cannot write " + path + ": " + what + ": " + std::strerror(error));
+}
+
+std::string DirectoryOf(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  if (slash == std::string::npos) return ".";
+  if (slash == 0) return "/";
+  return path.substr(0, slash);
+}
+
+std::string BaseNameOf(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+bool WriteAll(int fd, const std::string& contents) {
+  size_t done = 0;
+  while (done < contents.size()) {
+    const ssize_t n = ::write(fd, contents.data() + done, contents.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    done += static_cast<size_t>(n);
+  }
+  return true;
+}
+
+int FsyncRetrying(int fd) {
+  int rc;
+  do {
+    rc = ::fsync(fd);
+  } while (rc != 0 && errno == EINTR);
+  return rc;
+}
+
+}  // namespace
+
+Status WriteFileAtomically(const std::string& path, const std::string& contents, Publish publish) {
+  const std::string base = BaseNameOf(path);
+  if (path.empty() || base.empty() || base == "." || base == "..") {
+    return Status::Error(ExitCode::kUsage, "cannot write `" + path + "`: not a file name");
+  }
+  const std::string directory = DirectoryOf(path);
+  std::string temp_name = directory + "/." + base + ".tmp.XXXXXX";
+  std::vector<char> temp(temp_name.begin(), temp_name.end());
+  temp.push_back('\0');
+  const int fd = ::mkostemp(temp.data(), O_CLOEXEC);
+  if (fd < 0) return Failure("cannot create a temporary file in " + directory, path, errno);
+  temp_name = temp.data();
+  auto abandon = [&](const std::string& what, int error, bool close_fd) {
+    if (close_fd) ::close(fd);
+    ::unlink(temp_name.c_str());
+    return Failure(what, path, error);
+  };
+  if (!WriteAll(fd, contents)) return abandon("write failed", errno, true);
+  if (::fchmod(fd, 0644) != 0) return abandon("chmod failed", errno, true);
+  if (FsyncRetrying(fd) != 0) return abandon("fsync failed", errno, true);
+  if (::close(fd) != 0) return abandon("close failed", errno, false);
+  if (publish == Publish::kReplace) {
+    if (::rename(temp_name.c_str(), path.c_str()) != 0) return abandon("rename failed", errno, false);
+  } else {
+    // link() refuses an existing target atomically, which rename() would silently replace.
+    if (::link(temp_name.c_str(), path.c_str()) != 0) {
+      const int error = errno;
+      return abandon(error == EEXIST ? "the file exists already (recorded data is never overwritten)" : "link failed",
+                     error, false);
+    }
+    ::unlink(temp_name.c_str());
+  }
+  const int dir_fd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir_fd < 0) return Failure("cannot open directory " + directory + " to fsync it", path, errno);
+  const int rc = FsyncRetrying(dir_fd);
+  const int error = errno;
+  ::close(dir_fd);
+  if (rc != 0) return Failure("fsync of directory " + directory + " failed", path, error);
+  return Status::Ok();
+}
+
+Result<std::string> ReadFileCapped(const std::string& path, std::size_t max_bytes, bool* missing) {
+  if (missing != nullptr) *missing = false;
+  // O_NONBLOCK: opening a FIFO must not wait for a writer; it is refused just below.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) {
+    const int error = errno;
+    if (missing != nullptr) *missing = error == ENOENT;
+    return Status::Error(ExitCode::kUsage, "cannot open " + path + ": " + std::strerror(error));
+  }
+  struct stat info {};
+  std::string text, error;
+  if (::fstat(fd, &info) != 0) {
+    error = "cannot stat " + path + ": " + std::strerror(errno);
+  } else if (!S_ISREG(info.st_mode)) {
+    error = path + " is not a regular file";
+  } else if (static_cast<unsigned long long>(info.st_size) > max_bytes) {
+    error =
+        path + " is " + std::to_string(info.st_size) + " bytes, more than the limit of " + std::to_string(max_bytes);
+  } else {
+    // One byte past the size from fstat, so that a file growing meanwhile is noticed.
+    text.resize(static_cast<size_t>(info.st_size) + 1);
+    size_t used = 0;
+    while (used < text.size()) {
+      const ssize_t n = ::read(fd, text.data() + used, text.size() - used);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) {
+        error = "cannot read " + path + ": " + std::strerror(errno);
+        break;
+      }
+      if (n == 0) break;
+      used += static_cast<size_t>(n);
+      if (used == text.size() && used <= max_bytes) text.resize(std::min(text.size() * 2, max_bytes + 1));
+    }
+    text.resize(used);
+    if (error.empty() && used > max_bytes) error = path + " is larger than " + std::to_string(max_bytes) + " bytes";
+  }
+  ::close(fd);
+  if (!error.empty()) return Status::Error(ExitCode::kUsage, error);
+  return text;
+}
+
+uint32_t Crc32(const std::string& bytes) {
+  static const std::array<uint32_t, 256> table = [] {
+    std::array<uint32_t, 256> t{};
+    for (uint32_t i = 0; i < 256; ++i) {
+      uint32_t c = i;
+      for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+      t[i] = c;
+    }
+    return t;
+  }();
+  uint32_t crc = 0xFFFFFFFFu;
+  for (const char ch : bytes) crc = table[(crc ^ static_cast<unsigned char>(ch)) & 0xFFu] ^ (crc >> 8);
+  return crc ^ 0xFFFFFFFFu;
+}
+
+std::string Crc32Hex(uint32_t crc) {
+  char hex[9];
+  std::snprintf(hex, sizeof(hex), "%08x", crc);
+  return hex;
+}
+
+}  // namespace selfcal::capture::internal

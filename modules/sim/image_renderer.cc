@@ -1,0 +1,281 @@
+#include "sim/image_renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include <Eigen/LU>
+
+#include "base/status.h"
+
+namespace selfcal::sim {
+
+namespace {
+
+constexpr int kRimPoints = 256;
+
+// Orthonormal in-plane axes of a disc with unit normal n.
+void PlaneAxes(const Eigen::Vector3d& n, Eigen::Vector3d* e1, Eigen::Vector3d* e2) {
+  const Eigen::Vector3d helper = std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  *e1 = n.cross(helper).normalized();
+  *e2 = n.cross(*e1);
+}
+
+// Pixel position of a camera-frame point and its derivative along the rim, through the full camera
+// model (pinhole + k1): the chain rule of camera/camera.h's ProjectPoint.
+void ProjectWithDerivative(const CameraIntrinsics& cam, const Eigen::Vector3d& p, const Eigen::Vector3d& dp,
+                           Eigen::Vector2d* uv, Eigen::Vector2d* duv) {
+  const double x = p.x() / p.z(), y = p.y() / p.z();
+  const double dx = (dp.x() * p.z() - p.x() * dp.z()) / (p.z() * p.z());
+  const double dy = (dp.y() * p.z() - p.y() * dp.z()) / (p.z() * p.z());
+  const double s = 1.0 + cam.k1 * (x * x + y * y);
+  const double ds = 2.0 * cam.k1 * (x * dx + y * dy);
+  *uv = Eigen::Vector2d(cam.fx_px * x * s + cam.cx_px, cam.fx_px * cam.mu * y * s + cam.cy_px);
+  *duv = Eigen::Vector2d(cam.fx_px * (dx * s + x * ds), cam.fx_px * cam.mu * (dy * s + y * ds));
+}
+
+// Separable Gaussian blur of a row-major float image, border replicated.
+void GaussianBlur(std::vector<double>* image, int width, int height, double sigma) {
+  const int radius = static_cast<int>(std::ceil(4.0 * sigma));
+  std::vector<double> kernel(2 * radius + 1);
+  double sum = 0;
+  for (int k = -radius; k <= radius; ++k) sum += kernel[k + radius] = std::exp(-0.5 * k * k / (sigma * sigma));
+  for (double& w : kernel) w /= sum;
+  std::vector<double> tmp(image->size());
+  const std::vector<double>& in = *image;
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      double acc = 0;
+      for (int k = -radius; k <= radius; ++k)
+        acc += kernel[k + radius] * in[v * width + std::clamp(u + k, 0, width - 1)];
+      tmp[v * width + u] = acc;
+    }
+  }
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      double acc = 0;
+      for (int k = -radius; k <= radius; ++k)
+        acc += kernel[k + radius] * tmp[std::clamp(v + k, 0, height - 1) * width + u];
+      (*image)[v * width + u] = acc;
+    }
+  }
+}
+
+}  // namespace
+
+std::string RenderOptions::Validate() const {
+  std::ostringstream out;
+  if (supersampling < 1 || supersampling > 8) out << "supersampling = " << supersampling << " must lie in [1, 8]\n";
+  auto grey = [&](double g, const char* name) {
+    if (!std::isfinite(g) || g < 0 || g > 255) out << name << " = " << g << " must lie in [0, 255]\n";
+  };
+  grey(background_grey, "background_grey");
+  grey(dot_grey, "dot_grey");
+  if (!std::isfinite(blur_sigma_px) || blur_sigma_px < 0 || blur_sigma_px > 20) {
+    out << "blur_sigma_px = " << blur_sigma_px << " must lie in [0, 20]\n";
+  }
+  if (!std::isfinite(noise_std_grey) || noise_std_grey < 0 || noise_std_grey > 100) {
+    out << "noise_std_grey = " << noise_std_grey << " must lie in [0, 100]\n";
+  }
+  if (!std::isfinite(merge_gap_px) || merge_gap_px < 0) out << "merge_gap_px = " << merge_gap_px << " must be >= 0\n";
+  return out.str();
+}
+
+DotScene MakeDotScene(const SimTruth& truth, double radius_m) {
+  SELFCAL_CHECK(std::isfinite(radius_m) && radius_m > 0, "dot radius " << radius_m << " m must be > 0");
+  SELFCAL_CHECK(!truth.base_from_cam.empty(), "the simulated world has no camera pose");
+  DotScene scene;
+  scene.radius_m = radius_m;
+  scene.centres_in_base = truth.dots_in_base;
+  for (const Eigen::Vector3d& p : truth.dots_in_base) {
+    Eigen::Vector3d towards = Eigen::Vector3d::Zero();
+    for (const Rigid3& c : truth.base_from_cam) towards += (c.translation - p).normalized();
+    scene.normals_in_base.push_back(towards.normalized());
+  }
+  return scene;
+}
+
+Eigen::Vector2d EllipseCentrePx(const CameraIntrinsics& camera, const Eigen::Vector3d& centre_in_cam,
+                                const Eigen::Vector3d& normal_in_cam, double radius_m) {
+  Eigen::Vector3d e1, e2;
+  PlaneAxes(normal_in_cam.normalized(), &e1, &e2);
+  Eigen::Matrix3d h;
+  h.col(0) = e1;
+  h.col(1) = e2;
+  h.col(2) = centre_in_cam;
+  Eigen::Matrix3d k = Eigen::Matrix3d::Identity();
+  k(0, 0) = camera.fx_px;
+  k(1, 1) = camera.fx_px * camera.mu;
+  k(0, 2) = camera.cx_px;
+  k(1, 2) = camera.cy_px;
+  const Eigen::Matrix3d q = Eigen::Vector3d(1, 1, -radius_m * radius_m).asDiagonal();
+  // Pixels -> plane coordinates: (K H)^-1; the conic transforms with its inverse on both sides.
+  const Eigen::Matrix3d to_plane = (k * h).inverse();
+  const Eigen::Matrix3d c = to_plane.transpose() * q * to_plane;
+  return -c.topLeftCorner<2, 2>().inverse() * c.topRightCorner<2, 1>();
+}
+
+RenderedImage RenderDots(const CameraIntrinsics& camera, const Rigid3& base_from_cam, const DotScene& scene,
+                         const RenderOptions& options, uint64_t noise_seed) {
+  {
+    const std::string problems = options.Validate() + camera.Validate();
+    SELFCAL_CHECK(problems.empty(), "invalid rendering options:\n" << problems);
+    SELFCAL_CHECK(scene.normals_in_base.size() == scene.centres_in_base.size(),
+                  scene.normals_in_base.size() << " normals for " << scene.centres_in_base.size() << " dots");
+    SELFCAL_CHECK(std::isfinite(scene.radius_m) && scene.radius_m > 0, "dot radius " << scene.radius_m);
+  }
+  const int width = camera.width_px, height = camera.height_px;
+  const int s = options.supersampling;
+  const double inv_s2 = 1.0 / (s * s);
+  const Rigid3 cam_from_base = base_from_cam.Inverse();
+  const double r = scene.radius_m;
+
+  RenderedImage out;
+  out.dots.resize(scene.centres_in_base.size());
+  std::vector<uint64_t> mask(static_cast<size_t>(width) * height, 0);  // dark samples, all dots
+  std::vector<int> owner(static_cast<size_t>(width) * height, -1);     // last dot that darkened a sample here
+  std::vector<std::vector<Eigen::Vector2d>> rims(out.dots.size());
+
+  for (size_t d = 0; d < out.dots.size(); ++d) {
+    RenderedDot& dot = out.dots[d];
+    dot.id = static_cast<int>(d);
+    const Eigen::Vector3d c = cam_from_base * scene.centres_in_base[d];
+    const Eigen::Vector3d n = (cam_from_base.rotation * scene.normals_in_base[d]).normalized();
+    Eigen::Vector3d e1, e2;
+    PlaneAxes(n, &e1, &e2);
+
+    // The rim: in front of the camera? Its projection gives the bounding box and, by Green's theorem,
+    // the exact area and centroid: A = 1/2 int(x y' - y x'), A cx = 1/2 int(x^2 y'), A cy = -1/2 int(y^2 x')
+    // (coordinates relative to the projected centre for conditioning).
+    bool in_front = c.z() > 0;
+    for (int k = 0; k < kRimPoints && in_front; ++k) {
+      const double t = 2 * kPi * k / kRimPoints;
+      in_front = (c + r * (std::cos(t) * e1 + std::sin(t) * e2)).z() > 1e-9;
+    }
+    if (!in_front) continue;
+    dot.in_front = true;
+    dot.projected_centre_px = *Project(camera, c);
+    const Eigen::Vector2d origin = dot.projected_centre_px;
+    double area2 = 0, mx = 0, my = 0;
+    double umin = 1e300, umax = -1e300, vmin = 1e300, vmax = -1e300;
+    std::vector<Eigen::Vector2d>& rim = rims[d];
+    rim.reserve(kRimPoints);
+    for (int k = 0; k < kRimPoints; ++k) {
+      const double t = 2 * kPi * k / kRimPoints;
+      const Eigen::Vector3d p = c + r * (std::cos(t) * e1 + std::sin(t) * e2);
+      const Eigen::Vector3d dp = r * (-std::sin(t) * e1 + std::cos(t) * e2);
+      Eigen::Vector2d uv, duv;
+      ProjectWithDerivative(camera, p, dp, &uv, &duv);
+      rim.push_back(uv);
+      umin = std::min(umin, uv.x()), umax = std::max(umax, uv.x());
+      vmin = std::min(vmin, uv.y()), vmax = std::max(vmax, uv.y());
+      const Eigen::Vector2d q = uv - origin;
+      area2 += q.x() * duv.y() - q.y() * duv.x();
+      mx += q.x() * q.x() * duv.y();
+      my -= q.y() * q.y() * duv.x();
+    }
+    const double dt = 2 * kPi / kRimPoints;
+    const double area = 0.5 * area2 * dt;
+    dot.area_px2 = std::abs(area);
+    dot.area_centroid_px = origin + Eigen::Vector2d(0.5 * mx * dt / area, 0.5 * my * dt / area);
+    dot.min_radius_px = 1e300;
+    for (const Eigen::Vector2d& uv : rim) {
+      const double distance = (uv - dot.area_centroid_px).norm();
+      dot.max_radius_px = std::max(dot.max_radius_px, distance);
+      dot.min_radius_px = std::min(dot.min_radius_px, distance);
+    }
+    dot.fully_inside = umin >= -0.5 && vmin >= -0.5 && umax <= width - 0.5 && vmax <= height - 0.5;
+
+    // Supersampling over the bounding box (one pixel of margin: the rim points are 1.4 degrees apart).
+    const int i0 = std::max(0, static_cast<int>(std::floor(umin + 0.5)) - 1);
+    const int i1 = std::min(width - 1, static_cast<int>(std::ceil(umax - 0.5)) + 1);
+    const int j0 = std::max(0, static_cast<int>(std::floor(vmin + 0.5)) - 1);
+    const int j1 = std::min(height - 1, static_cast<int>(std::ceil(vmax - 0.5)) + 1);
+    const double n_dot_c = n.dot(c);
+    long long dark = 0;
+    double su = 0, sv = 0;
+    for (int j = j0; j <= j1; ++j) {
+      for (int i = i0; i <= i1; ++i) {
+        uint64_t bits = 0;
+        for (int b = 0; b < s; ++b) {
+          const double v = j - 0.5 + (b + 0.5) / s;
+          for (int a = 0; a < s; ++a) {
+            const double u = i - 0.5 + (a + 0.5) / s;
+            const Eigen::Vector2d xy = PixelToNormalized(camera, camera.fx_px, Eigen::Vector2d(u, v));
+            const Eigen::Vector3d ray(xy.x(), xy.y(), 1.0);
+            const double denominator = n.dot(ray);
+            if (denominator == 0) continue;
+            const double t = n_dot_c / denominator;
+            if (t <= 0) continue;
+            if ((t * ray - c).squaredNorm() <= r * r) {
+              bits |= uint64_t{1} << (b * s + a);
+              ++dark;
+              su += u;
+              sv += v;
+            }
+          }
+        }
+        if (bits == 0) continue;
+        const size_t at = static_cast<size_t>(j) * width + i;
+        if ((mask[at] & bits) != 0 && owner[at] >= 0) {
+          RenderedDot& other = out.dots[owner[at]];
+          dot.overlapping = other.overlapping = true;
+          if (std::find(dot.neighbours.begin(), dot.neighbours.end(), other.id) == dot.neighbours.end()) {
+            dot.neighbours.push_back(other.id);
+            other.neighbours.push_back(dot.id);
+          }
+        }
+        mask[at] |= bits;
+        owner[at] = dot.id;
+      }
+    }
+    dot.visible = dark > 0;
+    dot.clipped = dot.visible && !dot.fully_inside;
+    dot.sample_area_px2 = dark * inv_s2;
+    if (dark > 0) dot.sample_centroid_px = Eigen::Vector2d(su / dark, sv / dark);
+  }
+
+  // Near neighbours: rims closer than merge_gap_px (cheap test on the bounding circles first).
+  for (size_t a = 0; a < out.dots.size(); ++a) {
+    RenderedDot& da = out.dots[a];
+    if (!da.visible) continue;
+    for (size_t b = a + 1; b < out.dots.size(); ++b) {
+      RenderedDot& db = out.dots[b];
+      if (!db.visible) continue;
+      const double centre_distance = (da.area_centroid_px - db.area_centroid_px).norm();
+      if (centre_distance > da.max_radius_px + db.max_radius_px + options.merge_gap_px) continue;
+      double closest = 1e300;
+      for (const Eigen::Vector2d& p : rims[a]) {
+        for (const Eigen::Vector2d& q : rims[b]) closest = std::min(closest, (p - q).squaredNorm());
+      }
+      if (da.overlapping && std::count(da.neighbours.begin(), da.neighbours.end(), db.id) > 0) closest = 0;
+      if (std::sqrt(closest) < options.merge_gap_px) {
+        da.near_other = db.near_other = true;
+        if (std::count(da.neighbours.begin(), da.neighbours.end(), db.id) == 0) {
+          da.neighbours.push_back(db.id);
+          db.neighbours.push_back(da.id);
+        }
+      }
+    }
+  }
+
+  // Image formation: coverage -> grey, blur, noise, quantisation.
+  std::vector<double> grey(mask.size(), options.background_grey);
+  const double contrast = options.background_grey - options.dot_grey;
+  for (size_t k = 0; k < mask.size(); ++k) {
+    if (mask[k] != 0) grey[k] -= contrast * __builtin_popcountll(mask[k]) * inv_s2;
+  }
+  if (options.blur_sigma_px > 0) GaussianBlur(&grey, width, height, options.blur_sigma_px);
+  out.image.resize(static_cast<unsigned>(height), static_cast<unsigned>(width));
+  std::mt19937_64 rng(noise_seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (size_t k = 0; k < grey.size(); ++k) {
+    double g = grey[k];
+    if (options.noise_std_grey > 0) g += options.noise_std_grey * noise(rng);
+    out.image.bitmap[k] = static_cast<unsigned char>(std::clamp(std::lround(g), 0L, 255L));
+  }
+  return out;
+}
+
+}  // namespace selfcal::sim
