@@ -1,0 +1,362 @@
+#include "tracking/blob_analysis.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <list>
+#include <optional>
+#include <sstream>
+#include <vector>
+
+#include <visp3/core/vpImagePoint.h>
+#include <visp3/core/vpRect.h>
+
+namespace selfcal::tracking::internal {
+namespace {
+
+constexpr int kEllipseSamples = 20;  // as vpDot2::isValid
+
+// Window-local classification of pixels around the blob.
+enum Cell : std::uint8_t { kFree = 0, kBlob = 1, kOther = 2 };
+
+struct Window {
+  int u0 = 0, v0 = 0, w = 0, h = 0;
+  std::vector<std::uint8_t> cells;
+  bool Contains(int u, int v) const { return u >= u0 && v >= v0 && u < u0 + w && v < v0 + h; }
+  std::uint8_t& At(int u, int v) { return cells[static_cast<size_t>((v - v0) * w + (u - u0))]; }
+  std::uint8_t At(int u, int v) const { return cells[static_cast<size_t>((v - v0) * w + (u - u0))]; }
+};
+
+double Median(std::vector<double>* values) {
+  if (values->empty()) return std::nan("");
+  const size_t mid = values->size() / 2;
+  std::nth_element(values->begin(), values->begin() + static_cast<std::ptrdiff_t>(mid), values->end());
+  double m = (*values)[mid];
+  if (values->size() % 2 == 0) {
+    m = 0.5 * (m + *std::max_element(values->begin(), values->begin() + static_cast<std::ptrdiff_t>(mid)));
+  }
+  return m;
+}
+
+// Blob pixels: the 8-connected dark pixels, inside the bbox, of the first seed whose component spans
+// exactly the bbox vpDot2 reported (other blobs may reach into that box). Every other dark pixel of the
+// window, dilated by one pixel (their anti-aliased rim), is "other" and stays out of the background ring
+// and of the weighted centroid. nullopt when no seed gives vpDot2's blob.
+std::optional<Window> ClassifyWindow(const vpImage<unsigned char>& image, int threshold, const PixelBox& bbox,
+                                     int margin, const std::vector<std::pair<int, int>>& seeds) {
+  Window win;
+  const int width = static_cast<int>(image.getWidth());
+  const int height = static_cast<int>(image.getHeight());
+  win.u0 = std::max(0, bbox.u_min - margin);
+  win.v0 = std::max(0, bbox.v_min - margin);
+  win.w = std::min(width - 1, bbox.u_max + margin) - win.u0 + 1;
+  win.h = std::min(height - 1, bbox.v_max + margin) - win.v0 + 1;
+  win.cells.assign(static_cast<size_t>(win.w * win.h), kFree);
+  auto dark = [&](int u, int v) { return static_cast<int>(image[v][u]) <= threshold; };
+
+  bool found = false;
+  std::vector<std::pair<int, int>> stack, filled;
+  for (const auto& [seed_u, seed_v] : seeds) {
+    if (seed_u < bbox.u_min || seed_u > bbox.u_max || seed_v < bbox.v_min || seed_v > bbox.v_max) continue;
+    if (win.At(seed_u, seed_v) != kFree || !dark(seed_u, seed_v)) continue;
+    PixelBox span{seed_u, seed_v, seed_u, seed_v};
+    filled.clear();
+    win.At(seed_u, seed_v) = kBlob;
+    stack.emplace_back(seed_u, seed_v);
+    while (!stack.empty()) {
+      const auto [u, v] = stack.back();
+      stack.pop_back();
+      filled.emplace_back(u, v);
+      span.u_min = std::min(span.u_min, u);
+      span.v_min = std::min(span.v_min, v);
+      span.u_max = std::max(span.u_max, u);
+      span.v_max = std::max(span.v_max, v);
+      for (int dv = -1; dv <= 1; ++dv) {
+        for (int du = -1; du <= 1; ++du) {
+          const int nu = u + du, nv = v + dv;
+          if (nu < bbox.u_min || nu > bbox.u_max || nv < bbox.v_min || nv > bbox.v_max) continue;
+          if (win.At(nu, nv) != kFree || !dark(nu, nv)) continue;
+          win.At(nu, nv) = kBlob;
+          stack.emplace_back(nu, nv);
+        }
+      }
+    }
+    if (span == bbox) {
+      found = true;
+      break;
+    }
+    for (const auto& [u, v] : filled) win.At(u, v) = kFree;  // another blob reaching into the box
+  }
+  if (!found) return std::nullopt;
+  std::vector<std::pair<int, int>> others;
+  for (int v = win.v0; v < win.v0 + win.h; ++v) {
+    for (int u = win.u0; u < win.u0 + win.w; ++u) {
+      if (win.At(u, v) == kFree && dark(u, v)) others.emplace_back(u, v);
+    }
+  }
+  for (const auto& [u, v] : others) {
+    for (int dv = -1; dv <= 1; ++dv) {
+      for (int du = -1; du <= 1; ++du) {
+        if (win.Contains(u + du, v + dv) && win.At(u + du, v + dv) == kFree) win.At(u + du, v + dv) = kOther;
+      }
+    }
+    win.At(u, v) = kOther;
+  }
+  return win;
+}
+
+BlobVerdict Reject(RejectReason reason, const std::string& detail) {
+  BlobVerdict verdict;
+  verdict.accepted = false;
+  verdict.reason = reason;
+  verdict.detail = detail;
+  return verdict;
+}
+
+std::string Describe(const char* what, double value, const char* limit_name, double limit) {
+  std::ostringstream s;
+  s << what << " " << value << " (" << limit_name << " " << limit << ")";
+  return s.str();
+}
+
+}  // namespace
+
+Levels DarkestAndMedian(const vpImage<unsigned char>& image, const PixelBox& box) {
+  return DarkestAndMedian(image, box, box);
+}
+
+Levels DarkestAndMedian(const vpImage<unsigned char>& image, const PixelBox& darkest_box, const PixelBox& median_box) {
+  const int w = static_cast<int>(image.getWidth()), h = static_cast<int>(image.getHeight());
+  Levels levels;
+  std::array<int, 256> hist{};
+  int n = 0;
+  for (int v = std::max(0, median_box.v_min); v <= std::min(h - 1, median_box.v_max); ++v) {
+    for (int u = std::max(0, median_box.u_min); u <= std::min(w - 1, median_box.u_max); ++u) {
+      ++hist[image[v][u]];
+      ++n;
+    }
+  }
+  for (int seen = 0; levels.median < 255; ++levels.median) {
+    seen += hist[static_cast<size_t>(levels.median)];
+    if (2 * seen >= n) break;
+  }
+  for (int v = std::max(0, darkest_box.v_min); v <= std::min(h - 1, darkest_box.v_max); ++v) {
+    for (int u = std::max(0, darkest_box.u_min); u <= std::min(w - 1, darkest_box.u_max); ++u) {
+      levels.darkest = std::min<int>(levels.darkest, image[v][u]);
+    }
+  }
+  return levels;
+}
+
+PixelBox BoxOf(const vpDot2& dot) {
+  const vpRect rect = dot.getBBox();
+  PixelBox box;
+  box.u_min = static_cast<int>(std::lround(rect.getLeft()));
+  box.v_min = static_cast<int>(std::lround(rect.getTop()));
+  box.u_max = static_cast<int>(std::lround(rect.getRight()));
+  box.v_max = static_cast<int>(std::lround(rect.getBottom()));
+  return box;
+}
+
+vpDot2 MakeDarkDot(int threshold) {
+  vpDot2 dot;
+  dot.setGraphics(false);
+  dot.setComputeMoments(true);
+  dot.setGrayLevelMin(0);
+  dot.setGrayLevelMax(static_cast<unsigned int>(std::clamp(threshold, 0, 255)));
+  dot.setSizePrecision(0.0);
+  dot.setEllipsoidShapePrecision(0.0);
+  dot.setEllipsoidBadPointsPercentage(1.0);
+  return dot;
+}
+
+BlobVerdict MeasureBlob(const vpImage<unsigned char>& image, int threshold, const vpDot2& dot,
+                        const DotAcceptanceOptions& options, DotDetection* out,
+                        const std::pair<int, int>* required_seed) {
+  DotDetection& d = *out;
+  d = DotDetection();
+  const int width = static_cast<int>(image.getWidth());
+  const int height = static_cast<int>(image.getHeight());
+
+  d.bbox = BoxOf(dot);
+  d.threshold = threshold;
+  d.cog_binary_px = Eigen::Vector2d(dot.getCog().get_u(), dot.getCog().get_v());
+  d.centroid_px = d.cog_binary_px;
+  d.polygon_area_px2 = dot.getArea();
+  if (d.bbox.u_min < 0 || d.bbox.v_min < 0 || d.bbox.u_max >= width || d.bbox.v_max >= height ||
+      d.bbox.width() <= 0 || d.bbox.height() <= 0) {
+    return Reject(RejectReason::kTrackerFailed, "vpDot2 returned a bounding box outside the image");
+  }
+  // Seeds for the blob's pixels: vpDot2's first border pixel (its border list is empty when track() fell
+  // back to a window search), then every dark pixel of the box's top row, which the blob touches.
+  std::vector<std::pair<int, int>> seeds;
+  if (required_seed != nullptr) {
+    seeds.push_back(*required_seed);
+  } else {
+    const std::list<vpImagePoint> edges = dot.getEdges();
+    if (!edges.empty()) {
+      seeds.emplace_back(static_cast<int>(std::lround(edges.front().get_u())),
+                         static_cast<int>(std::lround(edges.front().get_v())));
+    }
+    for (int u = d.bbox.u_min; u <= d.bbox.u_max; ++u) seeds.emplace_back(u, d.bbox.v_min);
+  }
+  const int margin = std::max(options.refine_margin_px, options.ring_gap_px + options.ring_width_px);
+  const std::optional<Window> classified = ClassifyWindow(image, threshold, d.bbox, margin, seeds);
+  if (!classified) {
+    return Reject(RejectReason::kTrackerFailed, required_seed != nullptr
+                                                    ? "vpDot2 traced a blob without the seed pixel"
+                                                    : "no 8-connected dark blob spans vpDot2's bounding box");
+  }
+  const Window& win = *classified;
+
+  // Area, dot level and second moments from the blob's own pixels (pixel centres, in double: vpDot2's
+  // moments are accumulated from float increments such as u^3 / 3 and lose most of their digits for
+  // small blobs far from the image origin; a 3 px disc at u = 512 came out with an axis ratio of 0.7).
+  std::vector<double> blob_values;
+  double su = 0, sv = 0, suu = 0, suv = 0, svv = 0;
+  for (int v = d.bbox.v_min; v <= d.bbox.v_max; ++v) {
+    for (int u = d.bbox.u_min; u <= d.bbox.u_max; ++u) {
+      if (win.At(u, v) != kBlob) continue;
+      blob_values.push_back(image[v][u]);
+      const double x = u - d.bbox.u_min, y = v - d.bbox.v_min;  // local, to keep the sums small
+      su += x;
+      sv += y;
+      suu += x * x;
+      suv += x * y;
+      svv += y * y;
+    }
+  }
+  d.area_px2 = static_cast<double>(blob_values.size());
+  if (d.area_px2 < options.min_area_px2) {
+    return Reject(RejectReason::kTooSmall, Describe("area", d.area_px2, "min", options.min_area_px2));
+  }
+  if (d.area_px2 > options.max_area_px2) {
+    return Reject(RejectReason::kTooLarge, Describe("area", d.area_px2, "max", options.max_area_px2));
+  }
+
+  // Background: median of the ring between the bbox dilated by gap and by gap + width.
+  std::vector<double> ring;
+  const int g = options.ring_gap_px, r = options.ring_gap_px + options.ring_width_px;
+  for (int v = d.bbox.v_min - r; v <= d.bbox.v_max + r; ++v) {
+    for (int u = d.bbox.u_min - r; u <= d.bbox.u_max + r; ++u) {
+      if (u >= d.bbox.u_min - g && u <= d.bbox.u_max + g && v >= d.bbox.v_min - g && v <= d.bbox.v_max + g) continue;
+      if (!win.Contains(u, v) || win.At(u, v) != kFree) continue;
+      ring.push_back(image[v][u]);
+    }
+  }
+  if (ring.size() < 8) {
+    return Reject(RejectReason::kLowContrast, "fewer than 8 background pixels around the blob");
+  }
+  d.background_level = Median(&ring);
+  d.dot_level = Median(&blob_values);
+  d.contrast = d.background_level - d.dot_level;
+
+  // D2: the blob's pixels within the border margin must be only partly covered by the dot; a (nearly)
+  // fully dark one there means the dot goes on past the edge and its centroid is biased.
+  const int m = options.border_margin_px;
+  if (d.bbox.u_min < m || d.bbox.v_min < m || d.bbox.u_max > width - 1 - m || d.bbox.v_max > height - 1 - m) {
+    double worst = 0;
+    for (int v = d.bbox.v_min; v <= d.bbox.v_max; ++v) {
+      for (int u = d.bbox.u_min; u <= d.bbox.u_max; ++u) {
+        if (win.At(u, v) != kBlob) continue;
+        if (u >= m && v >= m && u <= width - 1 - m && v <= height - 1 - m) continue;
+        const double coverage =
+            d.contrast > 0 ? (d.background_level - image[v][u]) / d.contrast : 1.0;
+        worst = std::max(worst, coverage);
+      }
+    }
+    if (worst >= options.max_edge_coverage) {
+      return Reject(RejectReason::kBorder, Describe("coverage of a pixel within the border margin", worst,
+                                                    "max", options.max_edge_coverage));
+    }
+  }
+  const double n = d.area_px2;
+  d.n20_px2 = suu / n - (su / n) * (su / n);
+  d.n11_px2 = suv / n - (su / n) * (sv / n);
+  d.n02_px2 = svv / n - (sv / n) * (sv / n);
+
+  // D7: vpDot2's centre of gravity and the moments must be finite.
+  if (!d.cog_binary_px.allFinite() || !std::isfinite(d.polygon_area_px2) || !std::isfinite(d.n20_px2) ||
+      !std::isfinite(d.n11_px2) || !std::isfinite(d.n02_px2)) {
+    return Reject(RejectReason::kNonFinite, "non-finite vpDot2 centre of gravity or moments");
+  }
+  const double half_sum = 0.5 * (d.n20_px2 + d.n02_px2);
+  const double root = std::sqrt(0.25 * (d.n20_px2 - d.n02_px2) * (d.n20_px2 - d.n02_px2) + d.n11_px2 * d.n11_px2);
+  d.semi_major_px = 2.0 * std::sqrt(std::max(0.0, half_sum + root));
+  d.semi_minor_px = 2.0 * std::sqrt(std::max(0.0, half_sum - root));
+  d.angle_rad = 0.5 * std::atan2(2.0 * d.n11_px2, d.n20_px2 - d.n02_px2);
+  d.fill_ratio = d.semi_minor_px > 0 ? d.area_px2 / (M_PI * d.semi_major_px * d.semi_minor_px) : 0.0;
+
+  if (!(d.contrast >= options.min_contrast)) {
+    return Reject(RejectReason::kLowContrast, Describe("contrast", d.contrast, "min", options.min_contrast));
+  }
+
+  // vpDot2's ellipsoid test, counted here instead of silently inside vpDot2.
+  if (options.ellipse_shape_precision > 0) {
+    const double p = options.ellipse_shape_precision;
+    const double c = std::cos(d.angle_rad), s = std::sin(d.angle_rad);
+    const int max_bad = static_cast<int>(kEllipseSamples * options.ellipse_bad_points_fraction);
+    int inner_bad = 0, outer_bad = 0;
+    for (int k = 0; k < kEllipseSamples; ++k) {
+      const double t = 2.0 * M_PI * k / kEllipseSamples;
+      const double ai = p * std::max(0.0, d.semi_major_px - 1.0) * std::cos(t);
+      const double bi = p * std::max(0.0, d.semi_minor_px - 1.0) * std::sin(t);
+      const int ui = static_cast<int>(std::lround(d.cog_binary_px.x() + c * ai - s * bi));
+      const int vi = static_cast<int>(std::lround(d.cog_binary_px.y() + s * ai + c * bi));
+      if (ui < 0 || vi < 0 || ui >= width || vi >= height || static_cast<int>(image[vi][ui]) > threshold) ++inner_bad;
+      const double ao = (2.0 - p) * (d.semi_major_px + 1.0) * std::cos(t);
+      const double bo = (2.0 - p) * (d.semi_minor_px + 1.0) * std::sin(t);
+      const int uo = static_cast<int>(std::lround(d.cog_binary_px.x() + c * ao - s * bo));
+      const int vo = static_cast<int>(std::lround(d.cog_binary_px.y() + s * ao + c * bo));
+      if (uo < 0 || vo < 0 || uo >= width || vo >= height) continue;
+      if (static_cast<int>(image[vo][uo]) <= threshold) ++outer_bad;
+    }
+    if (inner_bad > max_bad || outer_bad > max_bad) {
+      std::ostringstream s_detail;
+      s_detail << "ellipsoid test: " << inner_bad << " inner and " << outer_bad << " outer samples of "
+               << kEllipseSamples << " wrong (max " << max_bad << ")";
+      return Reject(RejectReason::kEllipseTest, s_detail.str());
+    }
+  }
+  const double axis_ratio = d.semi_major_px > 0 ? d.semi_minor_px / d.semi_major_px : 0.0;
+  if (axis_ratio < options.min_axis_ratio) {
+    return Reject(RejectReason::kElongated, Describe("axis ratio", axis_ratio, "min", options.min_axis_ratio));
+  }
+  if (d.fill_ratio < options.min_fill_ratio || d.fill_ratio > options.max_fill_ratio) {
+    std::ostringstream s_detail;
+    s_detail << "fill ratio " << d.fill_ratio << " outside [" << options.min_fill_ratio << ", "
+             << options.max_fill_ratio << "]";
+    return Reject(RejectReason::kFillRatio, s_detail.str());
+  }
+
+  // Intensity-weighted centroid: weights (background - I)+ over the bbox dilated by refine_margin_px,
+  // other blobs (and their rims) excluded.
+  if (options.refine_centroid) {
+    const int rm = options.refine_margin_px;
+    double sw = 0, su = 0, sv = 0;
+    for (int v = std::max(0, d.bbox.v_min - rm); v <= std::min(height - 1, d.bbox.v_max + rm); ++v) {
+      for (int u = std::max(0, d.bbox.u_min - rm); u <= std::min(width - 1, d.bbox.u_max + rm); ++u) {
+        if (win.At(u, v) == kOther) continue;
+        const double w = d.background_level - static_cast<double>(image[v][u]);
+        if (w <= 0) continue;
+        sw += w;
+        su += w * u;
+        sv += w * v;
+      }
+    }
+    if (sw > 0) {
+      const Eigen::Vector2d c_w(su / sw, sv / sw);
+      if (c_w.allFinite() && c_w.x() >= d.bbox.u_min && c_w.x() <= d.bbox.u_max && c_w.y() >= d.bbox.v_min &&
+          c_w.y() <= d.bbox.v_max) {
+        d.centroid_px = c_w;
+        d.refined = true;
+      }
+    }
+  }
+  BlobVerdict ok;
+  ok.accepted = true;
+  return ok;
+}
+
+}  // namespace selfcal::tracking::internal
