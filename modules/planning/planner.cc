@@ -273,13 +273,14 @@ void PlanEq39(const PlanningProblem& problem, const PlannerOptions& options, Pla
   // tolerance would take for convergence.
   solver_options.function_tolerance = 0;
   solver_options.gradient_tolerance = 1e-10;
-  solver_options.parameter_tolerance = 1e-12;
+  solver_options.parameter_tolerance = 0;
   solver_options.logging_type = ceres::SILENT;
   for (int round = 0; round < options.barrier_rounds; ++round) {
     objective->set_mu(mu);
     ceres::GradientProblemSolver::Summary summary;
     ceres::Solve(solver_options, gradient_problem, x.data(), &summary);
     result->iterations += static_cast<int>(summary.iterations.size());
+    result->solver_message = summary.message;
     mu /= options.barrier_decrease;
   }
   result->evaluations = objective->evaluations();

@@ -70,6 +70,7 @@ struct PlanResult {
   FisherValue fisher_start, fisher_final;
   PlanCheck check_start, check_final;
   int iterations = 0;    // L-BFGS iterations, or exchange sweeps
+  std::string solver_message;  // the last L-BFGS round's termination message
   int evaluations = 0;   // cost evaluations
   double seconds = 0;
 };
