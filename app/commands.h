@@ -16,5 +16,6 @@ Command AddStudyCommand(CLI::App& app);
 Command AddIdentifiabilityCommand(CLI::App& app);
 Command AddMakeTrajectoryCommand(CLI::App& app);
 Command AddTrackerCommand(CLI::App& app);
+Command AddPlanCommand(CLI::App& app);
 
 }  // namespace selfcal::app

@@ -221,25 +221,6 @@ void Subset(const BundleData& full, const BundleState& full_state, const std::ve
   }
 }
 
-// Free kinematic count of the relative-pose model at random joint angles: what generic poses identify.
-int GenericRank(const RobotModel& robot, const Eigen::VectorXd& rho, double rank_tolerance) {
-  std::mt19937_64 rng(20240607);
-  std::vector<Eigen::VectorXd> poses;
-  const int count = std::max(12, robot.num_parameters() / 2);
-  for (int p = 0; p < count; ++p) {
-    Eigen::VectorXd q(robot.num_joints());
-    for (int j = 0; j < robot.num_joints(); ++j) {
-      std::uniform_real_distribution<double> u(robot.limits[j].min_rad, robot.limits[j].max_rad);
-      q[j] = u(rng);
-    }
-    poses.push_back(q);
-  }
-  identification::IdentifiabilityOptions options;
-  options.rank_tolerance = rank_tolerance;
-  options.scale_known = true;  // the yardstick
-  return identification::AnalyzeIdentifiability(robot, rho, poses, 0, options).rank;
-}
-
 std::string Join(const std::vector<std::string>& names) {
   std::string out;
   for (const std::string& s : names) out += (out.empty() ? "" : ", ") + s;
@@ -349,7 +330,7 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
   report.fixed_names = gauge.fixed_names;
   report.null_combinations = gauge.null_combinations;
   report.condition_number = gauge.condition_number;
-  report.generic_rank = GenericRank(data.robot, KinematicParameters::Nominal(data.robot), options.rank_tolerance);
+  report.generic_rank = identification::GenericRank(data.robot, KinematicParameters::Nominal(data.robot), options.rank_tolerance);
   if (options.estimate_fx && !gauge.fx_identifiable) {
     return finish(Outcome::kDegenerate, "f_x is not identifiable from these poses (null directions: " +
                                             Join(gauge.null_combinations) + ")");

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 #include <numeric>
+#include <random>
 
 #include <Eigen/Dense>
 
@@ -113,6 +114,24 @@ IdentifiabilityReport AnalyzeIdentifiability(const RobotModel& model, const Eige
   for (int i : report.free_indices) report.free_names.push_back(params.name(i));
   for (int i : report.fixed_indices) report.fixed_names.push_back(params.name(i));
   return report;
+}
+
+int GenericRank(const RobotModel& model, const Eigen::VectorXd& rho, double rank_tolerance) {
+  std::mt19937_64 rng(20240607);
+  std::vector<Eigen::VectorXd> poses;
+  const int count = std::max(12, model.num_parameters() / 2);
+  for (int p = 0; p < count; ++p) {
+    Eigen::VectorXd q(model.num_joints());
+    for (int j = 0; j < model.num_joints(); ++j) {
+      std::uniform_real_distribution<double> u(model.limits[j].min_rad, model.limits[j].max_rad);
+      q[j] = u(rng);
+    }
+    poses.push_back(q);
+  }
+  IdentifiabilityOptions options;
+  options.rank_tolerance = rank_tolerance;
+  options.scale_known = true;  // the yardstick
+  return AnalyzeIdentifiability(model, rho, poses, 0, options).rank;
 }
 
 }  // namespace selfcal::identification

@@ -51,4 +51,9 @@ IdentifiabilityReport AnalyzeIdentifiability(const RobotModel& model, const Eige
                                              const std::vector<Eigen::VectorXd>& joint_poses, int reference_index,
                                              const IdentifiabilityOptions& options);
 
+// Number of identifiable parameters (metric relative poses, scale known) at 5n + 12 / 2 (at least 12)
+// random joint configurations within the limits (fixed seed): what generic poses of this robot identify.
+// A plan that identifies fewer does not excite some joint (K3, RELIABILITY.md C7).
+int GenericRank(const RobotModel& model, const Eigen::VectorXd& rho, double rank_tolerance);
+
 }  // namespace selfcal::identification

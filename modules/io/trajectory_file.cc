@@ -19,7 +19,7 @@ std::string Short(double v) {
   return buffer;
 }
 
-Result<std::vector<Eigen::VectorXd>> Load(const std::string& path, int num_joints, const RobotModel* robot) {
+Result<TrajectoryFile> Load(const std::string& path, int num_joints, const RobotModel* robot) {
   Result<YamlDocument> doc = LoadYamlFile(path);
   if (!doc.ok()) return doc.status();
   Problems problems(path);
@@ -28,9 +28,15 @@ Result<std::vector<Eigen::VectorXd>> Load(const std::string& path, int num_joint
     root.Abandon();
     return problems.ToStatus("trajectory");
   }
-  std::string robot_name, description;
+  TrajectoryFile file;
+  std::string& robot_name = file.robot;
   root.OptionalString("robot", &robot_name);
-  root.OptionalString("description", &description);
+  root.OptionalString("description", &file.description);
+  root.OptionalString("planner", &file.planner);
+  if (root.Optional("num_identification_poses")) {
+    long long count = 0;
+    if (root.Int("num_identification_poses", 3, 100000, &count)) file.num_identification_poses = static_cast<int>(count);
+  }
   if (robot && !robot_name.empty() && robot_name != robot->name) {
     problems.Add("`robot` = `" + robot_name + "` at " + problems.At(root.KeyLine("robot")) +
                  ", but the robot model is `" + robot->name + "`");
@@ -76,26 +82,55 @@ Result<std::vector<Eigen::VectorXd>> Load(const std::string& path, int num_joint
     }
   }
   root.Finish();
+  if (file.num_identification_poses > static_cast<int>(poses.size()) && problems.empty()) {
+    problems.Add("`num_identification_poses` = " + std::to_string(file.num_identification_poses) + " at " +
+                 problems.At(root.KeyLine("num_identification_poses")) + " exceeds the " + std::to_string(poses.size()) +
+                 " poses");
+  }
   if (!problems.empty()) return problems.ToStatus("trajectory");
-  return poses;
+  file.poses = std::move(poses);
+  return file;
 }
 
 }  // namespace
 
-Result<std::vector<Eigen::VectorXd>> LoadTrajectory(const std::string& path, int num_joints) {
+Result<TrajectoryFile> LoadTrajectoryFile(const std::string& path, int num_joints) {
   if (num_joints <= 0) return Status::Error(ExitCode::kUsage, "LoadTrajectory(" + path + "): num_joints must be > 0");
   return Load(path, num_joints, nullptr);
 }
 
-Result<std::vector<Eigen::VectorXd>> LoadTrajectory(const std::string& path, const RobotModel& robot) {
+Result<TrajectoryFile> LoadTrajectoryFile(const std::string& path, const RobotModel& robot) {
   if (robot.num_joints() <= 0 || robot.limits.size() != robot.links.size()) {
     return Status::Error(ExitCode::kUsage, "LoadTrajectory(" + path + "): the robot model has no joints or no limits");
   }
   return Load(path, robot.num_joints(), &robot);
 }
 
+Result<std::vector<Eigen::VectorXd>> LoadTrajectory(const std::string& path, int num_joints) {
+  Result<TrajectoryFile> file = LoadTrajectoryFile(path, num_joints);
+  if (!file.ok()) return file.status();
+  return file->poses;
+}
+
+Result<std::vector<Eigen::VectorXd>> LoadTrajectory(const std::string& path, const RobotModel& robot) {
+  Result<TrajectoryFile> file = LoadTrajectoryFile(path, robot);
+  if (!file.ok()) return file.status();
+  return file->poses;
+}
+
 Status SaveTrajectory(const std::vector<Eigen::VectorXd>& poses_rad, const std::string& path,
                       const std::string& robot_name, const std::string& description) {
+  TrajectoryFile file;
+  file.poses = poses_rad;
+  file.robot = robot_name;
+  file.description = description;
+  return SaveTrajectoryFile(file, path);
+}
+
+Status SaveTrajectoryFile(const TrajectoryFile& file, const std::string& path) {
+  const std::vector<Eigen::VectorXd>& poses_rad = file.poses;
+  const std::string& robot_name = file.robot;
+  const std::string& description = file.description;
   for (size_t i = 0; i < poses_rad.size(); ++i) {
     if (!poses_rad[i].allFinite() || poses_rad[i].size() != poses_rad.front().size() || poses_rad[i].size() == 0) {
       return Status::Error(ExitCode::kUsage, "refusing to write trajectory " + path + ": pose " + std::to_string(i) +
@@ -108,6 +143,8 @@ Status SaveTrajectory(const std::vector<Eigen::VectorXd>& poses_rad, const std::
       << "version: " << kTrajectoryVersion << "\n";
   if (!robot_name.empty()) out << "robot: " << YamlQuoted(robot_name) << "\n";
   if (!description.empty()) out << "description: " << YamlQuoted(description) << "\n";
+  if (!file.planner.empty()) out << "planner: " << YamlQuoted(file.planner) << "\n";
+  if (file.num_identification_poses > 0) out << "num_identification_poses: " << file.num_identification_poses << "\n";
   out << "poses_rad:" << (poses_rad.empty() ? " []\n" : "\n");
   for (size_t i = 0; i < poses_rad.size(); ++i) {
     out << "  - " << YamlNumberList(poses_rad[i]) << "  # " << i << ": [";

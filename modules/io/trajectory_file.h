@@ -4,6 +4,8 @@
 //   version: 1
 //   robot: puma560              # optional, informational
 //   description: "..."          # optional
+//   planner: "..."              # optional, provenance of a planned trajectory
+//   num_identification_poses: 15   # optional: the first 15 poses identify, the rest verify
 //   poses_deg:                  # one row of joint angles per pose (or poses_rad)
 //     - [0, -30, 120, 0, 45, 0]
 #pragma once
@@ -20,6 +22,22 @@ namespace selfcal::io {
 
 inline constexpr const char* kTrajectoryFormat = "selfcal-trajectory";
 inline constexpr int kTrajectoryVersion = 1;
+
+// A trajectory or measurement plan: a plan is a trajectory with num_identification_poses (the first poses
+// identify, the rest verify) and the planner's provenance (docs/trajectory-format.md).
+struct TrajectoryFile {
+  std::vector<Eigen::VectorXd> poses;  // rad
+  std::string robot, description;
+  int num_identification_poses = 0;    // 0: not given
+  std::string planner;                 // free text: criterion, options, figures
+};
+
+// The whole file, with the same checks as LoadTrajectory; num_identification_poses must not exceed the pose
+// count.
+Result<TrajectoryFile> LoadTrajectoryFile(const std::string& path, int num_joints);
+Result<TrajectoryFile> LoadTrajectoryFile(const std::string& path, const RobotModel& robot);
+// Writes atomically (the optional keys only when set).
+Status SaveTrajectoryFile(const TrajectoryFile& file, const std::string& path);
 
 // Joint angles in radians, one vector per pose. The whole file is refused (C5) if any pose has a joint
 // count other than `num_joints` (every such pose is named by index and line) or a non-finite value or

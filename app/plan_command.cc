@@ -1,0 +1,216 @@
+// selfcal plan: measurement configurations planned for the user (issue 4), or `--check PLAN` for a plan
+// written by hand. Prints the constraints' figures, every criterion before and after, the observability
+// indices and the predicted standard deviation of every identifiable parameter.
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include "app/cli_util.h"
+#include "app/commands.h"
+#include "io/robot_config.h"
+#include "io/trajectory_file.h"
+#include "planning/observability.h"
+#include "planning/planner.h"
+#include "sim/sim_world.h"
+
+namespace selfcal::app {
+
+namespace {
+
+struct PlanArgs {
+  std::string robot = "config/robots/puma560.yaml";
+  std::string start = "config/trajectories/initial_puma560.yaml";
+  std::string out = "out/plan.yaml";
+  std::string check;
+  std::string criterion = "eq39";
+  double lambda = 1e-7;
+  uint64_t seed = 1;
+  int pool = 200;
+  int identification_poses = 15;
+  std::vector<double> box_center_mm, box_size_mm;
+  int box_dots = 80;
+  uint64_t sim_world_seed = 1;
+  double fx_px = 1000, noise_px = 0.2;
+  int width = 640, height = 480;
+  double image_margin_px = 5, joint_margin_deg = 5, min_spread_mm = 20, min_axis_sine = 0.08, max_travel_deg = 90;
+  double min_depth_mm = 250, max_depth_mm = 2000;
+};
+
+std::string Fixed(double v, int digits) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.*f", digits, v);
+  return buffer;
+}
+
+void PrintCheck(const planning::PlanCheck& check, std::ostream& out) {
+  out << "  min camera spread " << Fixed(check.min_spread_m * 1e3, 1) << " mm, min axis sine "
+      << Fixed(check.min_axis_sine, 4) << ", min image margin " << Fixed(check.min_image_margin_px, 1)
+      << " px, max joint travel " << Fixed(RadToDeg(check.max_joint_travel_rad), 1) << " deg, identifiable "
+      << check.identifiable << "/" << check.generic_identifiable << "\n";
+  if (!check.ok) {
+    std::istringstream lines(check.Summary());
+    for (std::string line; std::getline(lines, line);) out << "  PROBLEM " << line << "\n";
+  }
+}
+
+void PrintObservability(const planning::ObservabilityReport& r, const RobotModel& robot, std::ostream& out) {
+  if (!r.ok) {
+    out << "observability: " << r.message << "\n";
+    return;
+  }
+  out << "observability of the identification poses (" << r.rows << " x " << r.columns
+      << " column-normalised Jacobian):\n  condition number " << Fixed(r.condition_number, 1)
+      << ", min singular value " << r.min_singular_value << ", log10 product of singular values "
+      << Fixed(r.log10_product_singular_values, 2) << ", observability index " << r.observability_index
+      << ", noise amplification index " << r.noise_amplification_index << "\n";
+  if (!r.prediction_ok) {
+    out << "  predicted accuracy: " << r.message << "\n";
+    return;
+  }
+  const KinematicParameters params(robot.num_joints());
+  out << "  predicted std at " << r.pixel_noise_px << " px (kinematic bundle adjustment, Cramer-Rao):\n";
+  for (size_t k = 0; k < r.free_indices.size(); ++k) {
+    const bool length = params.kind(r.free_indices[k]) == ParameterKind::kLength;
+    out << "    " << r.free_names[k] << " "
+        << (length ? Fixed(r.predicted_stddev[k] * 1e3, 4) + " mm" : Fixed(RadToDeg(r.predicted_stddev[k]), 5) + " deg")
+        << "\n";
+  }
+  out << "    f_x " << Fixed(r.predicted_fx_stddev_px, 3) << " px\n";
+}
+
+}  // namespace
+
+Command AddPlanCommand(CLI::App& app) {
+  auto args = std::make_shared<PlanArgs>();
+  CLI::App* cmd = app.add_subcommand("plan", "Plan measurement configurations (eq. 39, D- or A-optimal), or check a plan");
+  cmd->add_option("--robot", args->robot, "Nominal robot config");
+  cmd->add_option("--start", args->start, "Start trajectory (feasible; offending poses are repaired from a pool)");
+  cmd->add_option("--out", args->out, "Plan file to write");
+  cmd->add_option("--check", args->check, "Check this plan instead of planning (exit 3 when it has problems)");
+  cmd->add_option("--criterion", args->criterion, "eq39 (the paper's), d-optimal or a-optimal");
+  cmd->add_option("--lambda", args->lambda, "Weight of Cond(J) in eq. (39) (the paper's 1e-7)")->check(CLI::Range(0.0, 1e6));
+  cmd->add_option("--seed", args->seed, "Seed of the candidate pool");
+  cmd->add_option("--pool", args->pool, "Candidate pool size")->check(CLI::Range(1, 100000));
+  cmd->add_option("--identification-poses", args->identification_poses, "The first N poses identify")
+      ->check(CLI::Range(3, 10000));
+  cmd->add_option("--box-center-mm", args->box_center_mm, "Dot region: box centre in the base frame (mm)")
+      ->delimiter(',')->expected(3);
+  cmd->add_option("--box-size-mm", args->box_size_mm, "Dot region: box size (mm)")->delimiter(',')->expected(3);
+  cmd->add_option("--box-dots", args->box_dots, "Stand-in dots spread in the box")->check(CLI::Range(8, 100000));
+  cmd->add_option("--sim-world-seed", args->sim_world_seed,
+                  "Without a box: the simulator's scene of this world seed (dry runs)");
+  cmd->add_option("--fx-px", args->fx_px, "Nominal focal length (px)")->check(CLI::Range(1.0, 1e6));
+  cmd->add_option("--width", args->width, "Image width (px)")->check(CLI::Range(16, 100000));
+  cmd->add_option("--height", args->height, "Image height (px)")->check(CLI::Range(16, 100000));
+  cmd->add_option("--noise-px", args->noise_px, "Pixel noise for the predicted accuracy")->check(CLI::Range(1e-6, 100.0));
+  cmd->add_option("--image-margin-px", args->image_margin_px, "Scene points this far inside every image");
+  cmd->add_option("--joint-margin-deg", args->joint_margin_deg, "Inside the joint limits by this");
+  cmd->add_option("--min-spread-mm", args->min_spread_mm, "Camera centres at least this far apart");
+  cmd->add_option("--min-axis-sine", args->min_axis_sine, "Optical axes of (reference, i) apart (f_x observable)");
+  cmd->add_option("--max-travel-deg", args->max_travel_deg, "Largest joint change between consecutive poses");
+  cmd->add_option("--min-depth-mm", args->min_depth_mm, "Nearest scene depth");
+  cmd->add_option("--max-depth-mm", args->max_depth_mm, "Farthest scene depth");
+  return [args]() {
+    Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(args->robot));
+    if (!robot.ok()) return Fail(robot.status());
+    planning::Criterion criterion;
+    if (!planning::ParseCriterion(args->criterion, &criterion)) {
+      return Fail(Status::Error(ExitCode::kUsage, "--criterion `" + args->criterion + "`: expected eq39, d-optimal or a-optimal"));
+    }
+    const std::string plan_path = args->check.empty() ? args->start : args->check;
+    Result<io::TrajectoryFile> file = io::LoadTrajectoryFile(ResolveDataPath(plan_path), robot->num_joints());
+    if (!file.ok()) return Fail(file.status());
+
+    planning::PlanningProblem problem;
+    problem.robot = *robot;
+    problem.camera.width_px = args->width;
+    problem.camera.height_px = args->height;
+    problem.camera.cx_px = 0.5 * (args->width - 1);
+    problem.camera.cy_px = 0.5 * (args->height - 1);
+    problem.camera.fx_px = args->fx_px;
+    problem.num_identification_poses =
+        file->num_identification_poses > 0 && !args->check.empty() ? file->num_identification_poses : args->identification_poses;
+    planning::PlanConstraints& c = problem.constraints;
+    c.image_margin_px = args->image_margin_px;
+    c.joint_margin_rad = DegToRad(args->joint_margin_deg);
+    c.min_spread_m = args->min_spread_mm * 1e-3;
+    c.min_axis_sine = args->min_axis_sine;
+    c.max_joint_travel_rad = DegToRad(args->max_travel_deg);
+    c.min_depth_m = args->min_depth_mm * 1e-3;
+    c.max_depth_m = args->max_depth_mm * 1e-3;
+    if (args->box_center_mm.size() == 3 && args->box_size_mm.size() == 3) {
+      const Eigen::Vector3d centre(args->box_center_mm[0], args->box_center_mm[1], args->box_center_mm[2]);
+      const Eigen::Vector3d size(args->box_size_mm[0], args->box_size_mm[1], args->box_size_mm[2]);
+      problem.scene = planning::Scene::FromBox(centre * 1e-3, size * 1e-3, args->box_dots, args->seed);
+      std::cout << "scene: box centre " << centre.transpose() << " mm, size " << size.transpose() << " mm\n";
+    } else if (!args->box_center_mm.empty() || !args->box_size_mm.empty()) {
+      return Fail(Status::Error(ExitCode::kUsage, "--box-center-mm and --box-size-mm go together (3 values each)"));
+    } else {
+      sim::SimOptions sim_options;
+      sim_options.world_seed = args->sim_world_seed;
+      const sim::SimResult world = sim::Simulate(*robot, file->poses, sim_options);
+      if (!world.ok) {
+        return Fail(Status::Error(ExitCode::kDegenerateData, "no simulated scene for " + plan_path + ": " + world.message));
+      }
+      problem.scene = planning::Scene::FromDots(world.truth.dots_in_base);
+      std::cout << "scene: the simulator's " << world.truth.dots_in_base.size() << " dots (world seed "
+                << args->sim_world_seed << ")\n";
+    }
+    if (const std::string invalid = problem.Validate(); !invalid.empty()) {
+      return Fail(Status::Error(ExitCode::kUsage, "plan options: " + invalid));
+    }
+
+    if (!args->check.empty()) {
+      std::cout << "plan " << plan_path << ": " << file->poses.size() << " poses, " << problem.num_identification_poses
+                << " identify\n";
+      const planning::PlanCheck check = planning::CheckPlan(problem, file->poses);
+      PrintCheck(check, std::cout);
+      PrintObservability(planning::AnalyzeObservability(problem, file->poses, args->noise_px), *robot, std::cout);
+      std::cout << (check.ok ? "plan ok\n" : "plan refused: " + std::to_string(check.problems.size()) + " problems\n");
+      return check.ok ? 0 : static_cast<int>(ExitCode::kDegenerateData);
+    }
+
+    planning::PlannerOptions options;
+    options.criterion = criterion;
+    options.lambda = args->lambda;
+    options.seed = args->seed;
+    options.pool_size = args->pool;
+    options.fisher.pixel_noise_px = args->noise_px;
+    const planning::PlanResult r = planning::PlanMeasurements(problem, file->poses, options);
+    std::cout << "start " << plan_path << ":\n";
+    PrintCheck(r.check_start, std::cout);
+    if (r.repaired_poses > 0) std::cout << "  repaired: " << r.repaired_poses << " poses replaced from the pool\n";
+    if (!r.ok) return Fail(Status::Error(ExitCode::kDegenerateData, r.message));
+    std::cout << "planned (" << planning::CriterionName(criterion) << ", " << Fixed(r.seconds * 1e3, 1) << " ms, "
+              << r.iterations << " iterations, " << r.evaluations << " evaluations"
+              << (r.solver_message.empty() ? "" : "; " + r.solver_message) << "):\n";
+    PrintCheck(r.check_final, std::cout);
+    std::cout << "criteria, start -> planned:\n  eq. (39) " << r.eq39_start.total << " -> " << r.eq39_final.total
+              << " (ratio term " << r.eq39_start.ratio_term << " -> " << r.eq39_final.ratio_term << ", Cond(J) "
+              << r.eq39_start.condition_number << " -> " << r.eq39_final.condition_number << ", lambda " << args->lambda
+              << ")\n  D (log det information) " << r.fisher_start.log_det << " -> " << r.fisher_final.log_det
+              << "\n  A (sum of variance / prior variance) " << r.fisher_start.a_value << " -> " << r.fisher_final.a_value
+              << "\n";
+    PrintObservability(planning::AnalyzeObservability(problem, r.poses, args->noise_px), *robot, std::cout);
+    io::TrajectoryFile plan;
+    plan.poses = r.poses;
+    plan.robot = robot->name;
+    plan.num_identification_poses = problem.num_identification_poses;
+    plan.description = "planned from " + plan_path + " by selfcal plan";
+    std::ostringstream provenance;
+    provenance << "criterion " << planning::CriterionName(criterion) << ", lambda " << args->lambda << ", seed " << args->seed
+               << ", pool " << args->pool << "; eq39 " << r.eq39_start.total << " -> " << r.eq39_final.total
+               << ", D " << r.fisher_start.log_det << " -> " << r.fisher_final.log_det << ", A " << r.fisher_start.a_value
+               << " -> " << r.fisher_final.a_value;
+    plan.planner = provenance.str();
+    const size_t slash = args->out.find_last_of('/');
+    if (slash != std::string::npos && slash > 0) {
+      if (Status s = EnsureDirectory(args->out.substr(0, slash)); !s.ok()) return Fail(s);
+    }
+    if (Status s = io::SaveTrajectoryFile(plan, args->out); !s.ok()) return Fail(s);
+    std::cout << "wrote " << args->out << "\n";
+    return 0;
+  };
+}
+
+}  // namespace selfcal::app

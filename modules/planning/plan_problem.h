@@ -1,0 +1,67 @@
+// What the planner is given (issue 4): the robot's nominal model, the camera, where the dots roughly are,
+// and the constraints every measurement configuration must satisfy. Shared by the planner
+// (planning/planner.h), the plan check (planning/plan_check.h) and the observability report.
+//
+// Frames and units: dots and box in the robot base frame (m); joint angles in rad; pixels as in
+// camera/camera.h; the camera's f_x is the nominal one (the planner never knows the true f_x).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "camera/camera.h"
+#include "kinematics/robot_model.h"
+
+namespace selfcal::planning {
+
+// Where the dots are, roughly. Either a box (the planner spreads num_dots seeded points inside it to stand
+// for the dots, and requires the box's 8 corners in every image) or rough dot positions (every one of them
+// required in every image: the planner's barrier uses the ones on the convex hull, the check all of them).
+struct Scene {
+  std::vector<Eigen::Vector3d> dots_in_base;    // stand-ins for the dots (Fisher information, yardstick)
+  std::vector<Eigen::Vector3d> extent_in_base;  // points every image must contain with the margin
+
+  static Scene FromBox(const Eigen::Vector3d& center_m, const Eigen::Vector3d& size_m, int num_dots, uint64_t seed);
+  static Scene FromDots(const std::vector<Eigen::Vector3d>& dots_in_base);
+  // Empty when valid; otherwise every problem, one per line.
+  std::string Validate() const;
+};
+
+struct PlanConstraints {
+  double joint_margin_rad = DegToRad(5.0);  // inside the joint limits by at least this
+  double image_margin_px = 10.0;            // every scene point this far inside every image
+  double min_depth_m = 0.25;                // every scene point at a depth in [min, max] in every view
+  double max_depth_m = 2.0;
+  // Camera centres of any two poses at least this far apart (duplicates and near-duplicates, C7; the factor
+  // method also needs a baseline: pure rotation makes t unobservable, G3).
+  double min_spread_m = 0.02;
+  // For every identification pose i and the reference pose: the sine of the angle between one optical axis
+  // and the plane through the other axis and the second camera centre, at least this. Near zero the
+  // axes (nearly) intersect and f_x is unobservable from the pair (DESIGN.md section 4); the two-view
+  // estimator's own threshold is 0.05 (twoview::TwoViewOptions::focal_observability_min).
+  double min_axis_sine = 0.08;
+  // Largest change of any joint between consecutive poses (the order the robot visits them).
+  double max_joint_travel_rad = DegToRad(90.0);
+  // Fewer identification poses are refused (the paper's 6m > n; the rank check decides the rest).
+  int min_identification_poses = 6;
+  // Insufficient excitation (C7): refused when the identification poses identify fewer parameters than
+  // generic poses of the robot, or the column-normalised identification Jacobian's condition number
+  // exceeds this.
+  double max_condition_number = 1e4;
+  // Empty when valid; otherwise every problem, one per line.
+  std::string Validate() const;
+};
+
+struct PlanningProblem {
+  RobotModel robot;        // nominal (zero base and camera corrections are used)
+  CameraIntrinsics camera; // nominal intrinsics
+  Scene scene;
+  int num_identification_poses = 15;  // the first poses of a plan; the rest verify (the paper: 15 + 10)
+  PlanConstraints constraints;
+  std::string Validate() const;
+};
+
+}  // namespace selfcal::planning

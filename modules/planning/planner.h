@@ -1,0 +1,84 @@
+// Measurement-configuration planning (issue 4): from a feasible start plan, m poses (the first
+// num_identification_poses identify, the rest verify) that minimise a criterion under the constraints of
+// planning/plan_problem.h.
+//
+// Criteria:
+// - kEq39: the paper's eq. (39) (planning/eq39.h), minimised over the joint angles of the identification
+//   poses by L-BFGS (Ceres GradientProblemSolver) on eq. (39) plus a logarithmic barrier for every
+//   constraint (joint limits less the margin, every scene point in the image and in the depth range, camera
+//   centres apart, optical axes of (reference, i) not intersecting, joint travel between consecutive
+//   poses). The barrier keeps every iterate strictly feasible (an infeasible trial point is rejected and the
+//   line search shortens the step); its weight falls by barrier_decrease each round, so the result
+//   approaches the constrained minimum of eq. (39). Gradients: exact (Jets), see eq39.h. Deterministic.
+// - kDOptimal, kAOptimal: the Fisher information of the kinematic bundle adjustment
+//   (planning/fisher_design.h): identification poses exchanged with the poses of a seeded candidate pool
+//   (Fedorov exchange) to maximise log det of the information of (identifiable parameters, f_x) with the
+//   dots marginalised (D), or to minimise the sum of their variances relative to their prior spread (A).
+// The verification poses of the start are kept: every criterion is judged on the same held-out poses.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "planning/eq39.h"
+#include "planning/fisher_design.h"
+#include "planning/plan_check.h"
+#include "planning/plan_problem.h"
+
+namespace selfcal::planning {
+
+enum class Criterion { kEq39, kDOptimal, kAOptimal };
+const char* CriterionName(Criterion criterion);
+// "eq39", "d-optimal", "a-optimal"; false for anything else.
+bool ParseCriterion(const std::string& name, Criterion* criterion);
+
+struct PlannerOptions {
+  Criterion criterion = Criterion::kEq39;
+  double lambda = 1e-7;            // eq. (39)'s weight of Cond(J): the paper's value (section 4.2)
+  // Barrier continuation for eq. (39): the weight starts at barrier_start * E(start) / (number of
+  // constraints) and is divided by barrier_decrease after each of barrier_rounds L-BFGS solves.
+  int barrier_rounds = 3;
+  double barrier_start = 1e-3;
+  double barrier_decrease = 10.0;
+  int max_iterations_per_round = 200;
+  // Exchange designs (D, A): the pool and its seed.
+  int pool_size = 200;
+  uint64_t seed = 1;
+  int max_exchange_sweeps = 6;
+  FisherDesignOptions fisher;
+  std::string Validate() const;
+};
+
+struct PlanResult {
+  bool ok = false;
+  std::string message;
+  Criterion criterion = Criterion::kEq39;
+  std::vector<Eigen::VectorXd> poses;  // rad; the first num_identification_poses identify
+  int num_identification_poses = 0;
+  std::vector<int> free_columns;       // identifiable rho indices (J's columns)
+  std::vector<std::string> free_names;
+  // A start that breaks a constraint is repaired first: each offending pose after the reference is replaced by
+  // the nearest (joint space) feasible candidate of the seeded pool. The "start" figures are of the repaired
+  // start; check_start is of the start as given.
+  int repaired_poses = 0;
+  int pool_size = 0;                   // candidates generated for the exchange designs
+  // Every criterion at the start and at the result, whichever was optimised.
+  Eq39Value eq39_start, eq39_final;
+  FisherValue fisher_start, fisher_final;
+  PlanCheck check_start, check_final;
+  int iterations = 0;    // L-BFGS iterations, or exchange sweeps
+  std::string solver_message;  // the last L-BFGS round's termination message
+  int evaluations = 0;   // cost evaluations
+  double seconds = 0;
+};
+
+// Plans from `start` (its size is m). The start's reference pose (pose 0) must satisfy the single-pose
+// constraints and every pose must have the robot's joint count; other violations are repaired (above) or
+// the result says why not.
+PlanResult PlanMeasurements(const PlanningProblem& problem, const std::vector<Eigen::VectorXd>& start,
+                            const PlannerOptions& options);
+
+}  // namespace selfcal::planning
