@@ -30,6 +30,7 @@ struct PlanArgs {
   std::vector<double> box_center_mm, box_size_mm;
   int box_dots = 80;
   uint64_t sim_world_seed = 1;
+  std::string scene_from = "config/trajectories/initial_puma560.yaml";
   double fx_px = 1000, noise_px = 0.2;
   int width = 640, height = 480;
   double image_margin_px = 5, joint_margin_deg = 5, min_spread_mm = 20, min_axis_sine = 0.08, max_travel_deg = 90;
@@ -99,6 +100,8 @@ Command AddPlanCommand(CLI::App& app) {
   cmd->add_option("--box-dots", args->box_dots, "Stand-in dots spread in the box")->check(CLI::Range(8, 100000));
   cmd->add_option("--sim-world-seed", args->sim_world_seed,
                   "Without a box: the simulator's scene of this world seed (dry runs)");
+  cmd->add_option("--scene-from", args->scene_from,
+                  "Without a box: the trajectory the simulator's scene is placed for (the same for plan and --check)");
   cmd->add_option("--fx-px", args->fx_px, "Nominal focal length (px)")->check(CLI::Range(1.0, 1e6));
   cmd->add_option("--width", args->width, "Image width (px)")->check(CLI::Range(16, 100000));
   cmd->add_option("--height", args->height, "Image height (px)")->check(CLI::Range(16, 100000));
@@ -148,13 +151,16 @@ Command AddPlanCommand(CLI::App& app) {
     } else {
       sim::SimOptions sim_options;
       sim_options.world_seed = args->sim_world_seed;
-      const sim::SimResult world = sim::Simulate(*robot, file->poses, sim_options);
+      Result<std::vector<Eigen::VectorXd>> scene_poses =
+          io::LoadTrajectory(ResolveDataPath(args->scene_from), robot->num_joints());
+      if (!scene_poses.ok()) return Fail(scene_poses.status());
+      const sim::SimResult world = sim::Simulate(*robot, *scene_poses, sim_options);
       if (!world.ok) {
-        return Fail(Status::Error(ExitCode::kDegenerateData, "no simulated scene for " + plan_path + ": " + world.message));
+        return Fail(Status::Error(ExitCode::kDegenerateData, "no simulated scene for " + args->scene_from + ": " + world.message));
       }
       problem.scene = planning::Scene::FromDots(world.truth.dots_in_base);
       std::cout << "scene: the simulator's " << world.truth.dots_in_base.size() << " dots (world seed "
-                << args->sim_world_seed << ")\n";
+                << args->sim_world_seed << ", placed for " << args->scene_from << ")\n";
     }
     if (const std::string invalid = problem.Validate(); !invalid.empty()) {
       return Fail(Status::Error(ExitCode::kUsage, "plan options: " + invalid));

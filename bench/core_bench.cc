@@ -6,6 +6,7 @@
 #include "pipeline/bundle_stage.h"
 #include "pipeline/paper_pipeline.h"
 #include "pipeline/study.h"
+#include "planning/planner.h"
 #include "sim/sim_world.h"
 #include "sim/trajectory_generator.h"
 #include "support/test_robots.h"
@@ -76,6 +77,28 @@ void BM_Study200Runs(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(pipeline::RunStudy(puma, {trajectory}, options));
 }
 BENCHMARK(BM_Study200Runs)->Arg(0)->Arg(1)->ArgName("with_opencv_and_bound")->Iterations(1)->Unit(benchmark::kSecond);
+
+// Planning m = 25 poses (15 planned, 10 verification kept) on the PUMA 560 from the shipped initial arc, the
+// simulated scene's dots as the rough dot positions, the CLI's default constraints (image margin 5 px).
+// The paper's planner took about an hour (MATLAB, 150 MHz). Includes the repair of the arc's intersecting
+// axes from the candidate pool.
+void BM_Plan25Poses(benchmark::State& state) {
+  planning::PlanningProblem problem;
+  problem.robot = World().truth.nominal;
+  problem.camera = World().observations.camera;
+  problem.scene = planning::Scene::FromDots(World().truth.dots_in_base);
+  problem.constraints.image_margin_px = 5.0;
+  std::vector<Eigen::VectorXd> start;
+  for (const PoseObservation& p : World().observations.poses) start.push_back(p.joints_rad);
+  planning::PlannerOptions options;
+  options.criterion = static_cast<planning::Criterion>(state.range(0));
+  for (auto _ : state) {
+    const planning::PlanResult r = planning::PlanMeasurements(problem, start, options);
+    if (!r.ok) state.SkipWithError(r.message.c_str());
+  }
+  state.SetLabel(planning::CriterionName(options.criterion));
+}
+BENCHMARK(BM_Plan25Poses)->Arg(0)->Arg(1)->Arg(2)->ArgName("criterion")->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace selfcal

@@ -223,3 +223,33 @@ TEST(Cli, IdentifiabilityNamesTheFixedParameters) {
 
 }  // namespace
 }  // namespace selfcal
+
+namespace selfcal {
+namespace {
+
+// selfcal plan: the shipped arc is refused by --check (its optical axes nearly intersect the reference's),
+// the planned file passes it, and the same seed writes the same plan byte for byte.
+TEST(Cli, PlanCheckRefusesTheArcAndAcceptsThePlannedFile) {
+  const fs::path dir = FreshDir("plan");
+  auto read_file = [](const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  };
+  std::string output;
+  EXPECT_EQ(RunSelfcal("plan --check config/trajectories/initial_puma560.yaml", &output), 3) << output;
+  EXPECT_NE(output.find("axes_intersect: pose 0 (reference) and pose 12"), std::string::npos) << output;
+  const std::string a = (dir / "a.yaml").string(), b = (dir / "b.yaml").string();
+  ASSERT_EQ(RunSelfcal("plan --criterion d-optimal --seed 4 --out " + a, &output), 0) << output;
+  EXPECT_NE(output.find("repaired:"), std::string::npos) << output;
+  ASSERT_EQ(RunSelfcal("plan --criterion d-optimal --seed 4 --out " + b, &output), 0) << output;
+  EXPECT_EQ(read_file(a), read_file(b));
+  EXPECT_EQ(RunSelfcal("plan --image-margin-px 5 --check " + a, &output), 0) << output;
+  EXPECT_NE(output.find("plan ok"), std::string::npos) << output;
+  EXPECT_NE(output.find("predicted std at 0.2 px"), std::string::npos) << output;
+  EXPECT_EQ(RunSelfcal("plan --criterion best --out " + a, &output), 2) << output;
+}
+
+}  // namespace
+}  // namespace selfcal
