@@ -18,7 +18,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "capture/file_util.h"
+#include "base/atomic_file.h"
+#include "capture/crc32.h"
 #include "capture/strict_yaml.h"
 
 namespace selfcal::capture {
@@ -269,7 +270,7 @@ Status CheckPngHeader(const std::string& bytes, const std::string& path, const S
 Result<SequenceIndex> ReadSequenceIndex(const std::string& folder, const SequenceLimits& limits) {
   const std::string path = Join(folder, kSequenceIndexName);
   bool missing = false;
-  Result<std::string> text = internal::ReadFileCapped(path, limits.max_index_bytes, &missing);
+  Result<std::string> text = ReadFileCapped(path, limits.max_index_bytes, &missing);
   if (!text.ok()) {
     return Corrupt(missing ? path + " does not exist: " + folder + " is not a recorded sequence"
                            : text.status().message());
@@ -333,8 +334,8 @@ Result<RecordedSequenceWriter> RecordedSequenceWriter::Create(const std::string&
   SequenceIndex index;
   index.width_px = width_px;
   index.height_px = height_px;
-  if (Status s = internal::WriteFileAtomically(Join(folder, kSequenceIndexName), FormatSequenceIndex(index),
-                                               internal::Publish::kReplace);
+  if (Status s = WriteFileAtomically(Join(folder, kSequenceIndexName), FormatSequenceIndex(index),
+                                               Publish::kReplace);
       !s.ok()) {
     return s;
   }
@@ -379,7 +380,7 @@ Status RecordedSequenceWriter::Append(const Frame& frame, const std::string& pos
   char name[32];
   std::snprintf(name, sizeof(name), "frame_%06zu.png", index_.frames.size());
   const std::string bytes(png.begin(), png.end());
-  if (Status s = internal::WriteFileAtomically(Join(folder_, name), bytes, internal::Publish::kNoReplace); !s.ok())
+  if (Status s = WriteFileAtomically(Join(folder_, name), bytes, Publish::kNoReplace); !s.ok())
     return s;
   SequenceIndex next = index_;
   SequenceEntry e;
@@ -390,8 +391,8 @@ Status RecordedSequenceWriter::Append(const Frame& frame, const std::string& pos
   e.size_bytes = static_cast<int64_t>(bytes.size());
   e.crc32 = internal::Crc32(bytes);
   next.frames.push_back(e);
-  if (Status s = internal::WriteFileAtomically(Join(folder_, kSequenceIndexName), FormatSequenceIndex(next),
-                                               internal::Publish::kReplace);
+  if (Status s = WriteFileAtomically(Join(folder_, kSequenceIndexName), FormatSequenceIndex(next),
+                                               Publish::kReplace);
       !s.ok()) {
     return s;
   }
@@ -403,7 +404,7 @@ Status RecordedSequenceWriter::WriteAuxiliaryFile(const std::string& name, const
   if (!SafeFileName(name) || name == kSequenceIndexName) {
     return Status::Error(ExitCode::kUsage, "`" + name + "` is not a plain file name for " + folder_);
   }
-  return internal::WriteFileAtomically(Join(folder_, name), contents, internal::Publish::kNoReplace);
+  return WriteFileAtomically(Join(folder_, name), contents, Publish::kNoReplace);
 }
 
 // ---- Reader
@@ -457,7 +458,7 @@ Result<Frame> RecordedSequence::Load(const SequenceEntry& e) const {
   const std::string path = Join(folder_, e.image);
   const std::string at = " (entry at " + Join(folder_, kSequenceIndexName) + ":" + std::to_string(e.line) + ")";
   bool missing = false;
-  Result<std::string> bytes = internal::ReadFileCapped(path, options_.limits.max_image_bytes, &missing);
+  Result<std::string> bytes = ReadFileCapped(path, options_.limits.max_image_bytes, &missing);
   if (!bytes.ok()) return Corrupt((missing ? "missing image " + path : bytes.status().message()) + at);
   if (e.size_bytes >= 0 && static_cast<int64_t>(bytes->size()) != e.size_bytes) {
     return Corrupt(path + " is " + std::to_string(bytes->size()) + " bytes; the index says " +

@@ -1,23 +1,12 @@
-// File access for io: atomic replacement (P4) — a reader sees either the old file or the complete new
-// one, never a truncated mix, even after a crash or power loss — and size-capped reading (C8).
+// File access for io: the shared atomic writes and size-capped reads of base/atomic_file.h, under the
+// names io's callers use.
 #pragma once
 
-#include <cstddef>
-#include <string>
-
-#include "base/status.h"
+#include "base/atomic_file.h"
 
 namespace selfcal::io {
 
-// Writes `contents` to a temporary file in the directory of `path` (".<name>.tmp.XXXXXX"), fsyncs it,
-// renames it over `path` and fsyncs the directory. Permissions of a new file are 0644. On failure the
-// temporary file is removed, `path` is untouched, and the Status (ExitCode::kUsage: the output location
-// is part of the configuration, C10) names the path and the system error.
-Status WriteFileAtomically(const std::string& path, const std::string& contents);
-
-// Reads a whole regular file of at most `max_bytes`; the size is checked (fstat) before reading, and
-// reading stops one byte past the cap should the file grow meanwhile. FIFOs, devices and directories
-// are refused without blocking. ExitCode::kUsage, naming the path.
-Result<std::string> ReadFileCapped(const std::string& path, std::size_t max_bytes);
+using ::selfcal::ReadFileCapped;
+using ::selfcal::WriteFileAtomically;
 
 }  // namespace selfcal::io

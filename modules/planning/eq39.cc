@@ -57,6 +57,18 @@ PoseTerms Terms(const internal::CameraTwists<Jet>& pose, const internal::CameraT
   return out;
 }
 
+// Values of J: the blocks of poses 1 .. m-1 stacked.
+Eigen::MatrixXd StackJ(const std::vector<PoseTerms>& terms, int nf) {
+  const int m = static_cast<int>(terms.size());
+  Eigen::MatrixXd j(6 * (m - 1), nf);
+  for (int i = 1; i < m; ++i) {
+    for (int r = 0; r < 6; ++r) {
+      for (int c = 0; c < nf; ++c) j(6 * (i - 1) + r, c) = terms[i].m(r, c).a;
+    }
+  }
+  return j;
+}
+
 void CheckArguments(const RobotModel& model, const std::vector<Eigen::VectorXd>& poses,
                     const std::vector<int>& free_columns) {
   SELFCAL_CHECK(model.num_joints() <= kMaxJoints, "eq. (39) supports up to " << kMaxJoints << " joints, the robot has "
@@ -79,14 +91,9 @@ Eigen::MatrixXd TwistIdentificationJacobian(const RobotModel& model, const std::
   CheckArguments(model, poses, free_columns);
   const int m = static_cast<int>(poses.size());
   const internal::CameraTwists<Jet> ref = Twists(model, poses[0], 6);
-  Eigen::MatrixXd j(6 * (m - 1), free_columns.size());
-  for (int i = 1; i < m; ++i) {
-    const PoseTerms t = Terms(Twists(model, poses[i], 0), ref, free_columns);
-    for (int r = 0; r < 6; ++r) {
-      for (int c = 0; c < static_cast<int>(free_columns.size()); ++c) j(6 * (i - 1) + r, c) = t.m(r, c).a;
-    }
-  }
-  return j;
+  std::vector<PoseTerms> terms(m);
+  for (int i = 1; i < m; ++i) terms[i] = Terms(Twists(model, poses[i], 0), ref, free_columns);
+  return StackJ(terms, static_cast<int>(free_columns.size()));
 }
 
 Eq39Value EvaluateEq39(const RobotModel& model, const std::vector<Eigen::VectorXd>& poses,
@@ -114,12 +121,7 @@ Eq39Value EvaluateEq39(const RobotModel& model, const std::vector<Eigen::VectorX
   }
   value.ratio_term = std::sqrt(sum);
 
-  Eigen::MatrixXd j(6 * (m - 1), nf);
-  for (int i = 1; i < m; ++i) {
-    for (int r = 0; r < 6; ++r) {
-      for (int c = 0; c < nf; ++c) j(6 * (i - 1) + r, c) = terms[i].m(r, c).a;
-    }
-  }
+  const Eigen::MatrixXd j = StackJ(terms, nf);
   // Extreme singular values and vectors from the eigen-decomposition of J^T J (nf x nf, much cheaper than an
   // SVD of J; Cond(J) of a few thousand loses nothing in the squaring): sigma^2 = eigenvalue, u = J v / sigma.
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(j.transpose() * j);

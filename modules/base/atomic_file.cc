@@ -1,17 +1,16 @@
-#include "capture/file_util.h"
+#include "base/atomic_file.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <array>
 #include <cerrno>
-#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <vector>
 
-namespace selfcal::capture::internal {
+namespace selfcal {
 
 namespace {
 
@@ -134,25 +133,4 @@ Result<std::string> ReadFileCapped(const std::string& path, std::size_t max_byte
   return text;
 }
 
-uint32_t Crc32(const std::string& bytes) {
-  static const std::array<uint32_t, 256> table = [] {
-    std::array<uint32_t, 256> t{};
-    for (uint32_t i = 0; i < 256; ++i) {
-      uint32_t c = i;
-      for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-      t[i] = c;
-    }
-    return t;
-  }();
-  uint32_t crc = 0xFFFFFFFFu;
-  for (const char ch : bytes) crc = table[(crc ^ static_cast<unsigned char>(ch)) & 0xFFu] ^ (crc >> 8);
-  return crc ^ 0xFFFFFFFFu;
-}
-
-std::string Crc32Hex(uint32_t crc) {
-  char hex[9];
-  std::snprintf(hex, sizeof(hex), "%08x", crc);
-  return hex;
-}
-
-}  // namespace selfcal::capture::internal
+}  // namespace selfcal

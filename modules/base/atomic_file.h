@@ -1,0 +1,30 @@
+// File access shared by every module that writes or reads files (io for the calibration core, capture for
+// recorded sequences): atomic publication (P4) - a reader sees either the old file or the complete new one,
+// never a truncated mix, even after a crash or power loss - and size-capped reading (C8).
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include "base/status.h"
+
+namespace selfcal {
+
+enum class Publish {
+  kReplace,    // rename over `path` (a file rewritten in place: configs, results, a sequence index)
+  kNoReplace,  // link to `path`, refusing an existing file (recorded images are never overwritten)
+};
+
+// Writes `contents` to a temporary file in the directory of `path` (".<name>.tmp.XXXXXX"), fsyncs it,
+// publishes it as `path` and fsyncs the directory. Permissions of a new file are 0644. On failure the
+// temporary file is removed, `path` is untouched, and the Status (ExitCode::kUsage: the output location
+// is part of the configuration, C10) names the path and the system error.
+Status WriteFileAtomically(const std::string& path, const std::string& contents, Publish publish = Publish::kReplace);
+
+// Reads a whole regular file of at most `max_bytes`; the size is checked (fstat) before reading, and
+// reading stops one byte past the cap should the file grow meanwhile. FIFOs, devices and directories
+// are refused without blocking. ExitCode::kUsage, naming the path; `missing` (optional) is set when the
+// file does not exist.
+Result<std::string> ReadFileCapped(const std::string& path, std::size_t max_bytes, bool* missing = nullptr);
+
+}  // namespace selfcal
