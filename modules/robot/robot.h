@@ -1,0 +1,108 @@
+// The robot interface (DESIGN.md section 2, layer 2): what a calibration session needs from an arm, and
+// nothing else. Backends: the simulated robot (sim/simulated_robot.h), the network line protocol
+// (network_robot.h, docs/robot-protocol.md) and the manual backend (manual_robot.h).
+//
+// Motion is asynchronous: StartMove returns once the controller accepted (or refused) the target, and the
+// caller polls GetStatus while it tracks dots, runs its watchdog (RELIABILITY.md R6) and watches for a
+// stop request (R11). Backends never retry, resume or re-send a move by themselves (R9).
+//
+// Time: every timestamp is seconds on the session's Clock (clock.h). Live backends stamp readings with
+// the monotonic clock when they arrive (the clock V4L2 stamps frames with), the simulated robot with the
+// simulated clock it shares with the simulated camera.
+//
+// Errors: every failure is a Status with ExitCode kHardware whose detail (domain kRobotErrorDomain)
+// carries a RobotError; RobotErrorOf() reads it back. Messages name the backend and the pose or joint.
+#pragma once
+
+#include <string>
+
+#include <Eigen/Core>
+
+#include "base/status.h"
+
+namespace selfcal::robot {
+
+enum class RobotError {
+  kNone = 0,
+  kNotConnected,     // Connect() not called or failed
+  kRejected,         // the controller refused the move (out of reach, limits, not ready) [R5]
+  kTimeout,          // a reply or a motion did not come in time [R6]
+  kProtectiveStop,   // the controller stopped the arm (collision, limit) [R9]
+  kEmergencyStop,    // E-stop pressed [R9]
+  kDisconnected,     // the connection broke [R10]
+  kBadReading,       // joint reading stale, incomplete, non-finite [R8]
+  kProtocol,         // the backend answered something the protocol does not allow
+  kOperatorAbort,    // manual backend: the operator declined
+};
+
+inline constexpr const char* kRobotErrorDomain = "robot";
+
+// "rejected", "protective_stop", ...: stable names for journals and reports.
+const char* RobotErrorName(RobotError error);
+
+// A Status with ExitCode::kHardware carrying `error` (kNone is not allowed) and `message`.
+Status RobotFailure(RobotError error, const std::string& message);
+
+// The RobotError of a Status: kNone for OK and for errors without a robot detail.
+RobotError RobotErrorOf(const Status& status);
+
+struct RobotIdentity {
+  std::string backend;         // "simulated", "network", "manual"
+  std::string model;           // e.g. "puma560"
+  std::string serial;          // the controller's serial or "sim-<seed>"
+  std::string calibration_id;  // the controller's own calibration/version id (R13), "" if none
+  bool real_hardware = false;  // true when commands can move a physical arm (R12)
+};
+
+struct JointLimits {
+  Eigen::VectorXd lower_rad;
+  Eigen::VectorXd upper_rad;
+  Eigen::VectorXd max_velocity_rad_s;  // at velocity scaling 1
+};
+
+struct JointReading {
+  Eigen::VectorXd position_rad;
+  Eigen::VectorXd velocity_rad_s;  // same size as position; zeros when the backend cannot tell
+  double time_s = 0;               // when the joints had these values, on the session clock
+};
+
+enum class MotionState {
+  kIdle = 0,         // not moving; the last move (if any) finished
+  kMoving,
+  kProtectiveStop,   // stopped by the controller; needs a person [R9]
+  kEmergencyStop,    // E-stop; needs a person [R9]
+  kFault,            // any other controller fault
+};
+const char* MotionStateName(MotionState state);
+
+struct RobotStatus {
+  MotionState state = MotionState::kIdle;
+  std::string message;  // the controller's words, if any
+};
+
+// Not thread-safe: one caller drives a robot.
+class Robot {
+ public:
+  virtual ~Robot() = default;
+
+  virtual Status Connect() = 0;
+  virtual void Disconnect() = 0;
+
+  virtual Result<RobotIdentity> Identity() = 0;
+  virtual Result<JointLimits> Limits() = 0;
+
+  // The current joint state. A backend returns what it got; validating freshness, completeness and
+  // finiteness is the caller's job (R8), so that faults are counted in one place.
+  virtual Result<JointReading> ReadJoints() = 0;
+
+  // Starts a joint-space move to `target_rad` at `velocity_scaling` in (0, 1] of the joint velocity
+  // limits. Returns once the controller accepted it; kRejected when refused. Does not wait for arrival.
+  virtual Status StartMove(const Eigen::VectorXd& target_rad, double velocity_scaling) = 0;
+
+  virtual Result<RobotStatus> GetStatus() = 0;
+
+  // Stops any motion now. Safe to call in any state, repeatedly.
+  virtual Status Stop() = 0;
+};
+
+}  // namespace selfcal::robot
