@@ -15,11 +15,10 @@
 #include <set>
 #include <sstream>
 
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "base/atomic_file.h"
 #include "capture/crc32.h"
+#include "capture/png_codec.h"
 #include "capture/strict_yaml.h"
 
 namespace selfcal::capture {
@@ -368,18 +367,11 @@ Status RecordedSequenceWriter::Append(const Frame& frame, const std::string& pos
       return refuse("sequence number does not advance past " + std::to_string(last.sequence));
     }
   }
-  // The image's pixels without a copy (vpImage is row-major, contiguous).
-  const cv::Mat view(h, w, CV_8UC1, const_cast<unsigned char*>(frame.image.bitmap));
-  std::vector<unsigned char> png;
-  try {
-    if (!cv::imencode(".png", view, png, {cv::IMWRITE_PNG_COMPRESSION, png_compression_}))
-      return refuse("PNG encoding failed");
-  } catch (const cv::Exception& e) {
-    return refuse(std::string("PNG encoding failed: ") + e.what());
-  }
+  Result<std::string> png = EncodeGreyPng(frame.image, png_compression_);
+  if (!png.ok()) return refuse(png.status().message());
   char name[32];
   std::snprintf(name, sizeof(name), "frame_%06zu.png", index_.frames.size());
-  const std::string bytes(png.begin(), png.end());
+  const std::string& bytes = *png;
   if (Status s = WriteFileAtomically(Join(folder_, name), bytes, Publish::kNoReplace); !s.ok())
     return s;
   SequenceIndex next = index_;
@@ -472,23 +464,16 @@ Result<Frame> RecordedSequence::Load(const SequenceEntry& e) const {
     }
   }
   if (Status s = CheckPngHeader(*bytes, path, index_); !s.ok()) return Corrupt(s.message() + at);
-  cv::Mat decoded;
-  try {
-    const cv::Mat raw(1, static_cast<int>(bytes->size()), CV_8UC1, const_cast<char*>(bytes->data()));
-    decoded = cv::imdecode(raw, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& ex) {
-    return Corrupt("cannot decode " + path + ": " + ex.what() + at);
-  }
-  if (decoded.empty()) return Corrupt("cannot decode " + path + ": truncated or corrupted PNG data" + at);
-  if (decoded.type() != CV_8UC1 || decoded.cols != index_.width_px || decoded.rows != index_.height_px) {
-    return Corrupt(path + " decodes to " + std::to_string(decoded.cols) + "x" + std::to_string(decoded.rows) +
-                   " with " + std::to_string(decoded.channels()) + " channel(s); expected " +
-                   std::to_string(index_.width_px) + "x" + std::to_string(index_.height_px) + " grey" + at);
+  Result<vpImage<unsigned char>> decoded = DecodeGreyPng(*bytes, path);
+  if (!decoded.ok()) return Corrupt(decoded.status().message() + at);
+  if (static_cast<int>(decoded->getWidth()) != index_.width_px ||
+      static_cast<int>(decoded->getHeight()) != index_.height_px) {
+    return Corrupt(path + " decodes to " + std::to_string(decoded->getWidth()) + "x" +
+                   std::to_string(decoded->getHeight()) + "; expected " + std::to_string(index_.width_px) + "x" +
+                   std::to_string(index_.height_px) + " grey" + at);
   }
   Frame frame;
-  frame.image.resize(static_cast<unsigned>(decoded.rows), static_cast<unsigned>(decoded.cols));
-  for (int v = 0; v < decoded.rows; ++v)
-    std::memcpy(frame.image[v], decoded.ptr<unsigned char>(v), static_cast<size_t>(decoded.cols));
+  frame.image = std::move(decoded).value();
   frame.exposure_time_s = e.exposure_time_s;
   frame.sequence = e.sequence;
   frame.source = path;

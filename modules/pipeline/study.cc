@@ -284,10 +284,18 @@ StudyReport RunStudy(const RobotModel& nominal, const std::vector<TrajectorySpec
   StudyReport study;
   study.flat_sheet = options.sim.flat_sheet;
   for (const TrajectorySpec& trajectory : trajectories) {
-    std::vector<StudyCell> cells(options.noise_levels_px.size());
+    const size_t num_point_cells = options.noise_levels_px.size();
+    std::vector<StudyCell> cells(num_point_cells + options.rendered_levels.size());
     for (size_t l = 0; l < cells.size(); ++l) {
-      cells[l].trajectory = trajectory.name;
-      cells[l].noise_px = options.noise_levels_px[l];
+      if (l < num_point_cells) {
+        cells[l].trajectory = trajectory.name;
+        cells[l].noise_px = options.noise_levels_px[l];
+      } else {
+        const RenderedLevel& level = options.rendered_levels[l - num_point_cells];
+        cells[l].trajectory = trajectory.name + "/" + level.name;
+        cells[l].noise_px = level.assumed_noise_px;
+        cells[l].rendered = true;
+      }
     }
     for (int run = 0; run < options.runs; ++run) {
       sim::SimOptions sim_options = options.sim;
@@ -305,8 +313,18 @@ StudyReport RunStudy(const RobotModel& nominal, const std::vector<TrajectorySpec
           }
           continue;
         }
-        const ObservationSet obs =
-            sim::Reobserve(world, cell.noise_px, options.seed * 7919 + 1000003ULL * static_cast<uint64_t>(run) + l);
+        const uint64_t noise_seed = options.seed * 7919 + 1000003ULL * static_cast<uint64_t>(run) + l;
+        ObservationSet obs;
+        if (!cell.rendered) {
+          obs = sim::Reobserve(world, cell.noise_px, noise_seed);
+        } else {
+          const RenderedLevel& level = options.rendered_levels[l - num_point_cells];
+          RenderedObservationOptions rendered = options.rendered;
+          rendered.render.noise_std_grey = level.noise_std_grey;
+          rendered.render.blur_sigma_px = level.blur_sigma_px;
+          rendered.assumed_noise_px = level.assumed_noise_px;
+          obs = ObserveRendered(world, rendered, noise_seed, &cell.centroids);
+        }
         PaperPipelineReport report = RunPaperPipeline(obs, options.pipeline);
         bool score_paper = true;
         if (report.outcome != Outcome::kSuccess) {

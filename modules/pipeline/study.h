@@ -17,6 +17,7 @@
 #include "pipeline/bundle_stage.h"
 #include "pipeline/paper_pipeline.h"
 #include "pipeline/predicted_error.h"
+#include "pipeline/rendered_observations.h"
 #include "sim/sim_world.h"
 
 namespace selfcal::pipeline {
@@ -24,6 +25,16 @@ namespace selfcal::pipeline {
 struct TrajectorySpec {
   std::string name;
   std::vector<Eigen::VectorXd> joints;  // rad
+};
+
+// A row of observations measured on rendered images (pipeline/rendered_observations.h) instead of
+// projected points: grey-level noise and blur of the images; assumed_noise_px is the centroid noise the
+// solvers are told (and the bound is computed with).
+struct RenderedLevel {
+  std::string name;          // e.g. "img-I"; cells are labelled "<trajectory>/<name>"
+  double noise_std_grey = 0;
+  double blur_sigma_px = 0;
+  double assumed_noise_px = 0.05;
 };
 
 struct StudyOptions {
@@ -36,6 +47,10 @@ struct StudyOptions {
   bool with_bound = true;      // the two-view bound and, with the bundle, the bundle's bound
   bool with_bundle = true;     // the kinematic bundle adjustment rows
   BundleStageOptions bundle;
+  // Rows on rendered images, after the point rows of each trajectory (same worlds). Rendering needs
+  // dots that do not touch in any view: set sim.separation_dot_radius_m (the app does) for such rows.
+  std::vector<RenderedLevel> rendered_levels;
+  RenderedObservationOptions rendered;  // dot radius, detector, match radius (render noise/blur per level)
 };
 
 // Running sample statistics.
@@ -51,8 +66,10 @@ struct Stat {
 };
 
 struct StudyCell {
-  std::string trajectory;
-  double noise_px = 0;
+  std::string trajectory;  // "<trajectory>/<rendered level>" for rendered rows
+  double noise_px = 0;     // point rows: the pixel noise; rendered rows: the level's assumed_noise_px
+  bool rendered = false;
+  CentroidErrors centroids;  // rendered rows: the detector's centroids against the truth, pooled
   int runs = 0, runs_failed = 0;
   std::vector<std::string> failures;  // first few messages
 

@@ -24,6 +24,8 @@ std::string SimOptions::Validate() const {
   if (num_dots < 8) out << "num_dots = " << num_dots << " must be >= 8\n";
   if (!(yardstick_length_m > 0)) out << "yardstick_length_m must be > 0\n";
   if (num_identification_poses < 2) out << "num_identification_poses must be >= 2\n";
+  non_negative(separation_dot_radius_m, "separation_dot_radius_m");
+  non_negative(min_rim_gap_diameters, "min_rim_gap_diameters");
   return out.str();
 }
 
@@ -142,11 +144,51 @@ SimResult Simulate(const RobotModel& nominal, const std::vector<Eigen::VectorXd>
   const Eigen::Vector3d centre = ConvergencePoint(truth.base_from_cam);
   const double half_size = 0.3;
   std::uniform_real_distribution<double> uniform(-half_size, half_size);
+  // Per view, the projected centre and radius (px) of every dot placed so far (spacing rule only).
+  struct Disc {
+    Eigen::Vector2d uv;
+    double radius_px;
+  };
+  std::vector<std::vector<Disc>> placed(truth.base_from_cam.size());
+  const bool spaced = options.separation_dot_radius_m > 0;
+  std::vector<Rigid3> cam_from_base;
+  for (const Rigid3& c : truth.base_from_cam) cam_from_base.push_back(c.Inverse());
   auto visible_everywhere = [&](const Eigen::Vector3d& p) {
-    for (const Rigid3& c : truth.base_from_cam) {
-      if (!Visible(truth.camera_true, c, p, options.image_margin_px, options.min_depth_m)) return false;
+    for (size_t v = 0; v < truth.base_from_cam.size(); ++v) {
+      if (!Visible(truth.camera_true, truth.base_from_cam[v], p, options.image_margin_px, options.min_depth_m)) {
+        return false;
+      }
+      if (!spaced) continue;
+      const Eigen::Vector3d pc = cam_from_base[v] * p;
+      const Eigen::Vector2d uv = *Project(truth.camera_true, pc);
+      const double r = truth.camera_true.fx_px * options.separation_dot_radius_m / pc.z();
+      for (const Disc& d : placed[v]) {
+        const double gap = (uv - d.uv).norm() - r - d.radius_px;
+        if (gap < options.min_rim_gap_diameters * 2.0 * std::max(r, d.radius_px)) return false;
+      }
     }
     return true;
+  };
+  // Records p's discs for the spacing rule (call after accepting p).
+  auto place = [&](const Eigen::Vector3d& p) {
+    truth.dots_in_base.push_back(p);
+    if (!spaced) return;
+    for (size_t v = 0; v < truth.base_from_cam.size(); ++v) {
+      const Eigen::Vector3d pc = cam_from_base[v] * p;
+      placed[v].push_back({*Project(truth.camera_true, pc),
+                           truth.camera_true.fx_px * options.separation_dot_radius_m / pc.z()});
+    }
+  };
+  // The yardstick's two ends, checked against each other as well.
+  auto place_pair = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    if (!visible_everywhere(a)) return;
+    place(a);
+    if (visible_everywhere(b)) {
+      place(b);
+      return;
+    }
+    truth.dots_in_base.clear();
+    for (auto& view : placed) view.clear();
   };
   const int max_tries = 200000;
   int tries = 0;
@@ -166,12 +208,12 @@ SimResult Simulate(const RobotModel& nominal, const std::vector<Eigen::VectorXd>
       const double h = 0.5 * options.yardstick_length_m;
       const Eigen::Vector3d a = on_sheet(mu - h * dir.x(), mv - h * dir.y());
       const Eigen::Vector3d b = on_sheet(mu + h * dir.x(), mv + h * dir.y());
-      if (visible_everywhere(a) && visible_everywhere(b)) truth.dots_in_base = {a, b};
+      place_pair(a, b);
     }
     while (static_cast<int>(truth.dots_in_base.size()) < options.num_dots && tries < max_tries) {
       ++tries;
       const Eigen::Vector3d p = on_sheet(uniform(rng), uniform(rng));
-      if (visible_everywhere(p)) truth.dots_in_base.push_back(p);
+      if (visible_everywhere(p)) place(p);
     }
   } else {
     // The yardstick: dots 0 and 1, yardstick_length_m apart along a random direction through the centre.
@@ -181,12 +223,12 @@ SimResult Simulate(const RobotModel& nominal, const std::vector<Eigen::VectorXd>
       const Eigen::Vector3d dir = Eigen::Vector3d(gauss(rng), gauss(rng), 0.3 * gauss(rng)).normalized();
       const Eigen::Vector3d a = mid - 0.5 * options.yardstick_length_m * dir;
       const Eigen::Vector3d b = mid + 0.5 * options.yardstick_length_m * dir;
-      if (visible_everywhere(a) && visible_everywhere(b)) truth.dots_in_base = {a, b};
+      place_pair(a, b);
     }
     while (static_cast<int>(truth.dots_in_base.size()) < options.num_dots && tries < max_tries) {
       ++tries;
       const Eigen::Vector3d p = centre + Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
-      if (visible_everywhere(p)) truth.dots_in_base.push_back(p);
+      if (visible_everywhere(p)) place(p);
     }
   }
   if (static_cast<int>(truth.dots_in_base.size()) < options.num_dots) {

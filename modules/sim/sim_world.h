@@ -42,6 +42,12 @@ struct SimOptions {
   // look at, facing the mean viewing direction (normal = mean optical axis), still in view of every
   // pose. The paper's factor method is degenerate there; the kinematic bundle adjustment is not.
   bool flat_sheet = false;
+  // Rendered sessions: the dots are discs of this radius (m), and in every view the rims of any two
+  // projected discs (radius fx * r / depth) stay at least min_rim_gap_diameters of the larger projected
+  // diameter apart, so that a blob detector and a tracker can keep them apart (0 = no spacing rule,
+  // the point-projection default). Dots that break it are redrawn, so it changes the scene.
+  double separation_dot_radius_m = 0;
+  double min_rim_gap_diameters = 0.5;
   double pixel_noise_px = 0.2;      // Gaussian, std per coordinate (the paper's Table 1, read as a std)
   int num_identification_poses = 15;  // the first ones; the rest are verification poses
   std::string Validate() const;

@@ -40,6 +40,10 @@ void SimulatedCamera::SetPose(const Rigid3& base_from_cam, double time_s) {
   poses_.emplace_back(time_s, base_from_cam);
 }
 
+void SimulatedCamera::SetPoseFunction(std::function<Rigid3(double)> base_from_cam_at) {
+  pose_function_ = std::move(base_from_cam_at);
+}
+
 std::string SimulatedCamera::Describe() const {
   std::ostringstream out;
   out << "simulated camera: " << camera_.width_px << "x" << camera_.height_px << " GREY8, f_x " << camera_.fx_px
@@ -99,16 +103,21 @@ Result<capture::Frame> SimulatedCamera::Grab(double not_before_s, double timeout
   }
 
   // The pose in effect at the exposure.
-  const auto after = std::upper_bound(poses_.begin(), poses_.end(), exposure,
-                                      [](double t, const std::pair<double, Rigid3>& p) { return t < p.first; });
-  if (after == poses_.begin()) {
-    std::ostringstream why;
-    why.precision(6);
-    why << std::fixed << "simulated camera: no pose at exposure time " << exposure
-        << " s: SetPose must place the camera before frames are grabbed";
-    return Status::Error(ExitCode::kUsage, why.str());
+  Rigid3 base_from_cam;
+  if (pose_function_) {
+    base_from_cam = pose_function_(exposure);
+  } else {
+    const auto after = std::upper_bound(poses_.begin(), poses_.end(), exposure,
+                                        [](double t, const std::pair<double, Rigid3>& p) { return t < p.first; });
+    if (after == poses_.begin()) {
+      std::ostringstream why;
+      why.precision(6);
+      why << std::fixed << "simulated camera: no pose at exposure time " << exposure
+          << " s: SetPose must place the camera before frames are grabbed";
+      return Status::Error(ExitCode::kUsage, why.str());
+    }
+    base_from_cam = std::prev(after)->second;
   }
-  const Rigid3& base_from_cam = std::prev(after)->second;
   last_render_ =
       RenderDots(camera_, base_from_cam, scene_, options_.render, FrameNoiseSeed(options_.render.noise_seed, k));
   last_sequence_ = k;

@@ -19,6 +19,7 @@
 // After each successful Grab, last_render() holds the truth of that frame (per-dot centres, flags).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -52,6 +53,9 @@ class SimulatedCamera : public capture::FrameSource {
 
   // The camera is at `base_from_cam` from `time_s` on. Times must not decrease (SELFCAL_CHECK).
   void SetPose(const Rigid3& base_from_cam, double time_s);
+  // Instead of SetPose: the camera's pose as a function of the exposure time (a simulated robot's true
+  // motion through its true kinematics), so that frames grabbed during a move show the arm moving.
+  void SetPoseFunction(std::function<Rigid3(double time_s)> base_from_cam_at);
 
   std::string Describe() const override;
   Status Open() override;
@@ -69,7 +73,8 @@ class SimulatedCamera : public capture::FrameSource {
   CameraIntrinsics camera_;
   DotScene scene_;
   SimulatedCameraOptions options_;
-  std::vector<std::pair<double, Rigid3>> poses_;  // (from time, base_from_cam), time non-decreasing
+  std::vector<std::pair<double, Rigid3>> poses_;
+  std::function<Rigid3(double)> pose_function_;  // (from time, base_from_cam), time non-decreasing
   bool open_ = false;
   double grid_origin_s_ = 0;
   int64_t last_sequence_ = -1;

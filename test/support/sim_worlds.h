@@ -12,4 +12,7 @@ namespace selfcal::testing {
 sim::SimResult PumaArcWorld(double noise_px, uint64_t world_seed = 1, uint64_t noise_seed = 1,
                             bool flat_sheet = false);
 
+// The same world with any SimOptions (e.g. the spacing rule of rendered sessions).
+sim::SimResult PumaArcWorld(const sim::SimOptions& options);
+
 }  // namespace selfcal::testing
