@@ -3,6 +3,8 @@
 // started from its result; writes the chosen method's calibrated model (YAML) and a report (JSON).
 #include "app/calibrate_command.h"
 
+#include "app/session_command.h"
+
 #include <filesystem>
 #include <iostream>
 
@@ -98,12 +100,19 @@ int CalibrateAndWrite(const ObservationSet& obs, const std::string& source_path,
 Command AddCalibrateCommand(CLI::App& app) {
   auto args = std::make_shared<CalibrateArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "calibrate", "Calibrate from an observations file: the paper's pipeline, then the kinematic bundle adjustment");
-  cmd->add_option("observations", args->observations, "Observations file (docs/observations-format.md)")->required();
+      "calibrate",
+      "Calibrate from an observations file or a recorded session directory (offline: never touches a robot): the "
+      "paper's pipeline, then the kinematic bundle adjustment");
+  cmd->add_option("observations", args->observations,
+                  "Observations file (docs/observations-format.md) or session directory (docs/session-format.md)")
+      ->required();
   cmd->add_option("--out", args->out, "Output directory (created if missing)");
   cmd->add_option("--seed", args->seed, "Seed of the RANSAC sampling (results are deterministic per seed)");
   AddMethodOption(cmd, &args->method);
   return [args]() {
+    if (IsSessionDirectory(args->observations)) {
+      return CalibrateSession(args->observations, args->out, args->seed, ParseMethod(args->method), nullptr, nullptr);
+    }
     Result<ObservationSet> obs = io::LoadObservations(args->observations);
     if (!obs.ok()) return Fail(obs.status());
     if (Status s = EnsureDirectory(args->out); !s.ok()) return Fail(s);

@@ -17,5 +17,6 @@ Command AddIdentifiabilityCommand(CLI::App& app);
 Command AddMakeTrajectoryCommand(CLI::App& app);
 Command AddTrackerCommand(CLI::App& app);
 Command AddPlanCommand(CLI::App& app);
+Command AddRunCommand(CLI::App& app);
 
 }  // namespace selfcal::app

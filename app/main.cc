@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   const selfcal::app::Command make_trajectory = selfcal::app::AddMakeTrajectoryCommand(app);
   const selfcal::app::Command identify_tracker = selfcal::app::AddTrackerCommand(app);
   const selfcal::app::Command plan = selfcal::app::AddPlanCommand(app);
+  const selfcal::app::Command run = selfcal::app::AddRunCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -26,7 +27,8 @@ int main(int argc, char** argv) {
   try {
     for (const auto& [name, command] :
          {std::pair{"calibrate", calibrate}, {"simulate", simulate}, {"study", study},
-          {"identifiability", identifiability}, {"make-trajectory", make_trajectory}, {"identify-tracker", identify_tracker}, {"plan", plan}}) {
+          {"identifiability", identifiability}, {"make-trajectory", make_trajectory}, {"identify-tracker", identify_tracker}, {"plan", plan},
+          {"run", run}}) {
       if (app.got_subcommand(name)) return command();
     }
   } catch (const selfcal::InvalidArgument& e) {

@@ -1,12 +1,14 @@
 // selfcal simulate: a seeded simulated robot with hidden errors, its observations written to a file, the
 // calibration run from that file, and the result compared with the hidden truth.
 // selfcal make-trajectory: writes the smooth "initial" trajectory around the simulated scene.
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 
 #include "app/calibrate_command.h"
+#include "app/session_command.h"
 #include "app/cli_util.h"
 #include "app/commands.h"
 #include "app/report_format.h"
@@ -30,6 +32,10 @@ struct SimulateArgs {
   bool perturb_gauge = false;
   std::string method = "bundle";
   bool flat_sheet = false;
+  bool points = false;      // the fast point-projection mode (no images, no session)
+  double grey_noise = 2.0;  // image mode
+  double blur_px = 0.0;
+  int supersampling = 4;
 };
 
 nlohmann::json TruthJson(const sim::SimResult& world) {
@@ -191,6 +197,72 @@ nlohmann::json CompareBundleWithTruth(const sim::SimResult& world, const Observa
 
 }  // namespace
 
+namespace {
+
+// The first free "<out>/session", "<out>/session-2", ...: sessions are never overwritten (C10).
+std::string FreshSessionPath(const std::string& out) {
+  for (int k = 1;; ++k) {
+    const std::filesystem::path p = std::filesystem::path(out) / (k == 1 ? "session" : "session-" + std::to_string(k));
+    if (!std::filesystem::exists(p)) return p.string();
+  }
+}
+
+// selfcal simulate (default): the simulated arm and rendered camera through a real session directory, the
+// offline calibration of that session, and the comparison with the hidden truth.
+int SimulateSession(const SimulateArgs& args) {
+  Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(args.robot));
+  if (!robot.ok()) return Fail(robot.status());
+  Result<io::TrajectoryFile> plan = io::LoadTrajectoryFile(ResolveDataPath(args.trajectory), *robot);
+  if (!plan.ok()) return Fail(plan.status());
+  if (Status s = EnsureDirectory(args.out); !s.ok()) return Fail(s);
+  RunSettings run;
+  run.session = FreshSessionPath(args.out);
+  run.robot_config = args.robot;
+  run.plan = args.trajectory;
+  run.seed = args.seed;
+  run.grey_noise = args.grey_noise;
+  run.blur_px = args.blur_px;
+  run.supersampling = args.supersampling;
+  const auto start = std::chrono::steady_clock::now();
+  std::cout << "session " << run.session << ": simulated robot and rendered camera (grey noise " << args.grey_noise
+            << ", blur " << args.blur_px << " px)\n";
+  const int run_code = RunFromSettings(run);
+  const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (run_code != 0) return run_code;
+  CalibrationResult result;
+  ObservationSet obs;
+  const int code = CalibrateSession(run.session, args.out, args.seed, ParseMethod(args.method), &result, &obs);
+  const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // The hidden truth of the same seeds (the session never saw it).
+  Result<pipeline::SimCell> cell = pipeline::MakeSimCell(*robot, PlanPosesOf(*plan), SimCellOptionsForSettings(run),
+                                                         plan->poses.front(), 0.0);
+  if (!cell.ok()) return Fail(cell.status());
+  const sim::SimResult& world = *cell->world;
+  if (Status s = io::WriteJsonFile(TruthJson(world), (std::filesystem::path(args.out) / "truth.json").string()); !s.ok()) {
+    return Fail(s);
+  }
+  nlohmann::json comparison = nlohmann::json::object();
+  if (result.paper.calibrated_rho.size() > 0) {
+    std::cout << "\npaper pipeline vs truth:";
+    comparison = CompareWithTruth(world, obs, result.paper, std::cout);
+  }
+  if (result.bundle_run && result.bundle.bundle.rho.size() == obs.robot.num_parameters()) {
+    comparison["bundle"] = CompareBundleWithTruth(world, obs, result.bundle, false, std::cout);
+  }
+  comparison["seconds"] = {{"session", run_s}, {"session_and_calibration", total_s}};
+  if (Status s = io::WriteJsonFile(comparison, (std::filesystem::path(args.out) / "comparison_with_truth.json").string());
+      !s.ok()) {
+    return Fail(s);
+  }
+  std::cout << "\nsimulated session " << run_s << " s, with the calibration " << total_s << " s; results in " << args.out
+            << "/: " << std::filesystem::path(run.session).filename().string()
+            << "/ (the session), observations.yaml, report.json" << (code == 0 ? ", calibrated_model.yaml" : "")
+            << ", truth.json, comparison_with_truth.json\n";
+  return code;
+}
+
+}  // namespace
+
 Command AddSimulateCommand(CLI::App& app) {
   auto args = std::make_shared<SimulateArgs>();
   CLI::App* cmd = app.add_subcommand("simulate", "Simulated robot with hidden errors: observe, calibrate, compare");
@@ -202,8 +274,21 @@ Command AddSimulateCommand(CLI::App& app) {
   cmd->add_flag("--perturb-gauge", args->perturb_gauge, "Also perturb the parameters the measurements cannot see");
   cmd->add_flag("--flat-sheet", args->flat_sheet,
                 "Put every dot on one plane (the paper's factor method is degenerate there, the bundle is not)");
+  cmd->add_flag("--points", args->points,
+                "Fast mode: project the dots with Gaussian pixel noise (--noise-px), no images, no session");
+  cmd->add_option("--grey-noise", args->grey_noise, "Image mode: pixel noise std, grey levels")
+      ->check(CLI::Range(0.0, 50.0));
+  cmd->add_option("--blur-px", args->blur_px, "Image mode: Gaussian blur sigma, px")->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--supersampling", args->supersampling, "Image mode: samples per pixel side")
+      ->check(CLI::Range(1, 8));
   AddMethodOption(cmd, &args->method);
   return [args]() {
+    if (!args->points) {
+      if (args->flat_sheet || args->perturb_gauge) {
+        return Fail(Status::Error(ExitCode::kUsage, "--flat-sheet and --perturb-gauge need --points"));
+      }
+      return SimulateSession(*args);
+    }
     Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(args->robot));
     if (!robot.ok()) return Fail(robot.status());
     Result<std::vector<Eigen::VectorXd>> joints = io::LoadTrajectory(ResolveDataPath(args->trajectory), robot->num_joints());

@@ -15,7 +15,8 @@ namespace selfcal {
 namespace {
 
 Status Failure(const std::string& what, const std::string& path, int error) {
-  return Status::Error(ExitCode::kUsage, "cannot write " + path + ": " + what + ": " + std::strerror(error));
+  return Status::Error(ExitCode::kUsage, "cannot write " + path + ": " + what + ": " + std::strerror(error))
+      .WithDetail(kErrnoDomain, error);
 }
 
 std::string DirectoryOf(const std::string& path) {
@@ -30,26 +31,37 @@ std::string BaseNameOf(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
-bool WriteAll(int fd, const std::string& contents) {
+}  // namespace
+
+bool WriteAllToFd(int fd, const std::string& bytes) {
   size_t done = 0;
-  while (done < contents.size()) {
-    const ssize_t n = ::write(fd, contents.data() + done, contents.size() - done);
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
     if (n < 0 && errno == EINTR) continue;
+    if (n == 0) errno = EIO;  // no progress and no error: do not loop forever
     if (n <= 0) return false;
     done += static_cast<size_t>(n);
   }
   return true;
 }
 
-int FsyncRetrying(int fd) {
+bool FsyncRetrying(int fd) {
   int rc;
   do {
     rc = ::fsync(fd);
   } while (rc != 0 && errno == EINTR);
-  return rc;
+  return rc == 0;
 }
 
-}  // namespace
+bool FsyncDirectory(const std::string& directory) {
+  const int dir_fd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir_fd < 0) return false;
+  const bool synced = FsyncRetrying(dir_fd);
+  const int error = errno;
+  ::close(dir_fd);
+  errno = error;
+  return synced;
+}
 
 Status WriteFileAtomically(const std::string& path, const std::string& contents, Publish publish) {
   const std::string base = BaseNameOf(path);
@@ -68,9 +80,9 @@ Status WriteFileAtomically(const std::string& path, const std::string& contents,
     ::unlink(temp_name.c_str());
     return Failure(what, path, error);
   };
-  if (!WriteAll(fd, contents)) return abandon("write failed", errno, true);
+  if (!WriteAllToFd(fd, contents)) return abandon("write failed", errno, true);
   if (::fchmod(fd, 0644) != 0) return abandon("chmod failed", errno, true);
-  if (FsyncRetrying(fd) != 0) return abandon("fsync failed", errno, true);
+  if (!FsyncRetrying(fd)) return abandon("fsync failed", errno, true);
   if (::close(fd) != 0) return abandon("close failed", errno, false);
   if (publish == Publish::kReplace) {
     if (::rename(temp_name.c_str(), path.c_str()) != 0) return abandon("rename failed", errno, false);
@@ -83,12 +95,7 @@ Status WriteFileAtomically(const std::string& path, const std::string& contents,
     }
     ::unlink(temp_name.c_str());
   }
-  const int dir_fd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dir_fd < 0) return Failure("cannot open directory " + directory + " to fsync it", path, errno);
-  const int rc = FsyncRetrying(dir_fd);
-  const int error = errno;
-  ::close(dir_fd);
-  if (rc != 0) return Failure("fsync of directory " + directory + " failed", path, error);
+  if (!FsyncDirectory(directory)) return Failure("fsync of directory " + directory + " failed", path, errno);
   return Status::Ok();
 }
 
@@ -99,12 +106,15 @@ Result<std::string> ReadFileCapped(const std::string& path, std::size_t max_byte
   if (fd < 0) {
     const int error = errno;
     if (missing != nullptr) *missing = error == ENOENT;
-    return Status::Error(ExitCode::kUsage, "cannot open " + path + ": " + std::strerror(error));
+    return Status::Error(ExitCode::kUsage, "cannot open " + path + ": " + std::strerror(error))
+        .WithDetail(kErrnoDomain, error);
   }
   struct stat info {};
   std::string text, error;
+  int error_number = 0;
   if (::fstat(fd, &info) != 0) {
-    error = "cannot stat " + path + ": " + std::strerror(errno);
+    error_number = errno;
+    error = "cannot stat " + path + ": " + std::strerror(error_number);
   } else if (!S_ISREG(info.st_mode)) {
     error = path + " is not a regular file";
   } else if (static_cast<unsigned long long>(info.st_size) > max_bytes) {
@@ -118,7 +128,8 @@ Result<std::string> ReadFileCapped(const std::string& path, std::size_t max_byte
       const ssize_t n = ::read(fd, text.data() + used, text.size() - used);
       if (n < 0 && errno == EINTR) continue;
       if (n < 0) {
-        error = "cannot read " + path + ": " + std::strerror(errno);
+        error_number = errno;
+        error = "cannot read " + path + ": " + std::strerror(error_number);
         break;
       }
       if (n == 0) break;
@@ -129,6 +140,7 @@ Result<std::string> ReadFileCapped(const std::string& path, std::size_t max_byte
     if (error.empty() && used > max_bytes) error = path + " is larger than " + std::to_string(max_bytes) + " bytes";
   }
   ::close(fd);
+  if (error_number != 0) return Status::Error(ExitCode::kUsage, error).WithDetail(kErrnoDomain, error_number);
   if (!error.empty()) return Status::Error(ExitCode::kUsage, error);
   return text;
 }

@@ -1,6 +1,7 @@
 // The robot interface (DESIGN.md section 2, layer 2): what a calibration session needs from an arm, and
-// nothing else. Backends: the simulated robot (sim/simulated_robot.h), the network line protocol
-// (network_robot.h, docs/robot-protocol.md) and the manual backend (manual_robot.h).
+// nothing else. Backends: the simulated robot (simulated_robot.h), the network line protocol
+// (network_robot.h, docs/robot-protocol.md; robot_server.h serves any Robot with it) and the manual
+// backend (manual_robot.h).
 //
 // Motion is asynchronous: StartMove returns once the controller accepted (or refused) the target, and the
 // caller polls GetStatus while it tracks dots, runs its watchdog (RELIABILITY.md R6) and watches for a
@@ -74,6 +75,16 @@ enum class MotionState {
   kFault,            // any other controller fault
 };
 const char* MotionStateName(MotionState state);
+
+// Why `limits` cannot describe an arm ("" when they can): sizes differ or are zero, a value is not
+// finite, lower >= upper, or a velocity limit is not positive. Names the joint (1-based) and the value.
+std::string CheckJointLimits(const JointLimits& limits);
+
+// Why `target_rad` at `velocity_scaling` cannot be commanded to an arm with `limits` ("" when it can):
+// the size differs from the joint count, a value is not finite or outside its limits, or the scaling is
+// not in (0, 1]. Names the joint (1-based), the value and the limit, in rad. For the backends that check
+// targets themselves before anything moves (R3, C6).
+std::string CheckMoveTarget(const JointLimits& limits, const Eigen::VectorXd& target_rad, double velocity_scaling);
 
 struct RobotStatus {
   MotionState state = MotionState::kIdle;

@@ -50,7 +50,7 @@ nlohmann::json ReadJson(const fs::path& path) {
 TEST(Cli, SimulateEndToEndThenCalibrateTheSameFileIsDeterministic) {
   const fs::path dir = FreshDir("simulate");
   std::string output;
-  ASSERT_EQ(RunSelfcal("simulate --out " + dir.string() + " --seed 3", &output), 0) << output;
+  ASSERT_EQ(RunSelfcal("simulate --points --out " + dir.string() + " --seed 3", &output), 0) << output;
   for (const char* file : {"observations.yaml", "truth.json", "report.json", "calibrated_model.yaml",
                            "comparison_with_truth.json"}) {
     EXPECT_TRUE(fs::exists(dir / file)) << file << "\n" << output;
@@ -85,7 +85,7 @@ TEST(Cli, SimulateEndToEndThenCalibrateTheSameFileIsDeterministic) {
 TEST(Cli, SimulateWithTheBundleMethodReportsTheBundleAndWritesItsModel) {
   const fs::path dir = FreshDir("bundle");
   std::string output;
-  ASSERT_EQ(RunSelfcal("simulate --method bundle --noise-px 0.2 --seed 5 --out " + dir.string(), &output), 0) << output;
+  ASSERT_EQ(RunSelfcal("simulate --points --method bundle --noise-px 0.2 --seed 5 --out " + dir.string(), &output), 0) << output;
   const nlohmann::json report = ReadJson(dir / "report.json");
   EXPECT_EQ(report["method"], "bundle");
   EXPECT_EQ(report["exit_code"], 0);
@@ -134,7 +134,7 @@ TEST(Cli, SimulateWithTheBundleMethodReportsTheBundleAndWritesItsModel) {
 TEST(Cli, FlatSheetIsDegenerateForThePaperMethodAndCalibratesWithTheBundle) {
   const fs::path dir = FreshDir("flat");
   std::string output;
-  ASSERT_EQ(RunSelfcal("simulate --flat-sheet --out " + dir.string(), &output), 0) << output;
+  ASSERT_EQ(RunSelfcal("simulate --points --flat-sheet --out " + dir.string(), &output), 0) << output;
   const nlohmann::json report = ReadJson(dir / "report.json");
   EXPECT_EQ(report["paper_pipeline"]["outcome"], "degenerate");
   EXPECT_EQ(report["bundle"]["outcome"], "converged");
@@ -166,7 +166,7 @@ TEST(Cli, DegenerateDataExitsWithCode3AndWritesNoModel) {
   // Keep only four identification poses: three pose measurements are too few.
   const fs::path dir = FreshDir("degenerate");
   std::string output;
-  ASSERT_EQ(RunSelfcal("simulate --out " + dir.string(), &output), 0) << output;
+  ASSERT_EQ(RunSelfcal("simulate --points --out " + dir.string(), &output), 0) << output;
   Result<ObservationSet> obs = io::LoadObservations((dir / "observations.yaml").string());
   ASSERT_TRUE(obs.ok()) << obs.status().ToString();
   ObservationSet few = *obs;
@@ -200,7 +200,7 @@ TEST(Cli, ShippedInitialTrajectoryIsTheGeneratorsOutput) {
 TEST(Cli, Ur5eSimulationBeatsItsNominalModel) {
   const fs::path dir = FreshDir("ur5e");
   std::string output;
-  ASSERT_EQ(RunSelfcal("simulate --robot config/robots/ur5e.yaml --trajectory config/trajectories/initial_ur5e.yaml "
+  ASSERT_EQ(RunSelfcal("simulate --points --robot config/robots/ur5e.yaml --trajectory config/trajectories/initial_ur5e.yaml "
                        "--noise-px 0 --out " + dir.string(), &output), 0) << output;
   const nlohmann::json report = ReadJson(dir / "report.json");
   EXPECT_EQ(report["identifiability"]["identifiable"], 24);

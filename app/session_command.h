@@ -1,0 +1,61 @@
+// Sessions from the command line (issue 6): `selfcal run` (robot + camera -> a session directory),
+// `selfcal calibrate SESSION` (offline solve of a recorded session; never touches a robot) and the session
+// half of `selfcal simulate`.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "app/calibrate_command.h"
+#include "io/trajectory_file.h"
+#include "observations/observation_set.h"
+#include "pipeline/sim_session.h"
+
+namespace selfcal::app {
+
+// The settings of `selfcal run` (and of the session half of `selfcal simulate`).
+struct RunSettings {
+  std::string session;
+  bool resume = false;
+  bool force_changed_config = false;
+  bool dry_run = false;
+  std::string robot_config = "config/robots/puma560.yaml";
+  std::string plan = "config/trajectories/initial_puma560.yaml";
+  std::string setup;  // required unless --camera sim
+  std::string robot_backend = "sim";
+  std::string address = "127.0.0.1:5700";
+  std::string camera_backend = "sim";
+  std::string device = "/dev/video0";
+  double velocity_scaling = -1;  // default: 1.0 simulated, 0.1 otherwise (R1)
+  uint64_t seed = 1;
+  double grey_noise = 2.0;
+  double blur_px = 0.0;
+  int supersampling = 4;
+  std::vector<int> fault_reject_moves, fault_pstop_moves, fault_hang_moves, fault_disconnect_moves,
+      fault_jog_after_moves, fault_slow_settle_moves, fault_stale_reads, fault_nan_reads, fault_short_reads;
+};
+
+// `selfcal run` with these settings: creates or resumes the session, drives the robot, returns the exit code.
+int RunFromSettings(RunSettings settings);
+
+// The simulated cell `selfcal run --robot sim` builds for these settings (same seeds: the same world).
+pipeline::SimCellOptions SimCellOptionsForSettings(const RunSettings& settings);
+
+// The plan's poses with ids p00, p01, ... and roles (the first num_identification_poses identify).
+std::vector<pipeline::PlannedPose> PlanPosesOf(const io::TrajectoryFile& plan);
+
+// True when `path` is a session directory (it holds session.json).
+bool IsSessionDirectory(const std::string& path);
+
+// Builds the ObservationSet of a session: the setup input (camera, yardsticks, checks), the robot input,
+// and the accepted samples of the journal in plan order. Verifies every sample's image (P2). kUsage
+// naming the session and record on any inconsistency; kDegenerateData when too few samples were accepted.
+Result<ObservationSet> LoadSessionObservations(const std::string& session_path);
+
+// `selfcal calibrate SESSION`: LoadSessionObservations + CalibrateAndWrite into out_dir; writes
+// out_dir/observations.yaml (derived, for other tools) too.
+int CalibrateSession(const std::string& session_path, const std::string& out_dir, uint64_t seed, Method method,
+                     CalibrationResult* result, ObservationSet* observations);
+
+}  // namespace selfcal::app

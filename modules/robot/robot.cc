@@ -1,0 +1,110 @@
+#include "robot/robot.h"
+
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+namespace selfcal::robot {
+
+const char* RobotErrorName(RobotError error) {
+  switch (error) {
+    case RobotError::kNone:
+      return "none";
+    case RobotError::kNotConnected:
+      return "not_connected";
+    case RobotError::kRejected:
+      return "rejected";
+    case RobotError::kTimeout:
+      return "timeout";
+    case RobotError::kProtectiveStop:
+      return "protective_stop";
+    case RobotError::kEmergencyStop:
+      return "emergency_stop";
+    case RobotError::kDisconnected:
+      return "disconnected";
+    case RobotError::kBadReading:
+      return "bad_reading";
+    case RobotError::kProtocol:
+      return "protocol";
+    case RobotError::kOperatorAbort:
+      return "operator_abort";
+  }
+  return "unknown";
+}
+
+Status RobotFailure(RobotError error, const std::string& message) {
+  if (error == RobotError::kNone) throw InvalidArgument("RobotFailure needs an error, not kNone: " + message);
+  return Status::Error(ExitCode::kHardware, message).WithDetail(kRobotErrorDomain, static_cast<int>(error));
+}
+
+RobotError RobotErrorOf(const Status& status) {
+  if (status.ok() || std::strcmp(status.detail_domain(), kRobotErrorDomain) != 0) return RobotError::kNone;
+  return static_cast<RobotError>(status.detail());
+}
+
+const char* MotionStateName(MotionState state) {
+  switch (state) {
+    case MotionState::kIdle:
+      return "idle";
+    case MotionState::kMoving:
+      return "moving";
+    case MotionState::kProtectiveStop:
+      return "protective_stop";
+    case MotionState::kEmergencyStop:
+      return "emergency_stop";
+    case MotionState::kFault:
+      return "fault";
+  }
+  return "unknown";
+}
+
+std::string CheckJointLimits(const JointLimits& limits) {
+  const Eigen::Index n = limits.lower_rad.size();
+  std::ostringstream problem;
+  problem.precision(10);
+  if (n == 0 || limits.upper_rad.size() != n || limits.max_velocity_rad_s.size() != n) {
+    problem << "joint limits need one lower, upper and max velocity per joint, got " << limits.lower_rad.size()
+            << ", " << limits.upper_rad.size() << " and " << limits.max_velocity_rad_s.size();
+    return problem.str();
+  }
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double lower = limits.lower_rad[j], upper = limits.upper_rad[j], vmax = limits.max_velocity_rad_s[j];
+    if (!std::isfinite(lower) || !std::isfinite(upper) || !(lower < upper)) {
+      problem << "joint " << j + 1 << ": limits [" << lower << ", " << upper << "] rad are not a finite interval";
+      return problem.str();
+    }
+    if (!std::isfinite(vmax) || !(vmax > 0)) {
+      problem << "joint " << j + 1 << ": max velocity " << vmax << " rad/s is not positive and finite";
+      return problem.str();
+    }
+  }
+  return "";
+}
+
+std::string CheckMoveTarget(const JointLimits& limits, const Eigen::VectorXd& target_rad, double velocity_scaling) {
+  std::ostringstream problem;
+  problem.precision(10);
+  if (!(velocity_scaling > 0 && velocity_scaling <= 1)) {
+    problem << "velocity scaling " << velocity_scaling << " is not in (0, 1]";
+    return problem.str();
+  }
+  if (target_rad.size() != limits.lower_rad.size()) {
+    problem << "target has " << target_rad.size() << " joints, the robot has " << limits.lower_rad.size();
+    return problem.str();
+  }
+  for (Eigen::Index j = 0; j < target_rad.size(); ++j) {
+    const double q = target_rad[j];
+    if (!std::isfinite(q)) {
+      problem << "joint " << j + 1 << ": target " << q << " rad is not finite";
+      return problem.str();
+    }
+    if (q < limits.lower_rad[j] || q > limits.upper_rad[j]) {
+      problem << "joint " << j + 1 << ": target " << q << " rad is outside its limits [" << limits.lower_rad[j]
+              << ", " << limits.upper_rad[j] << "] rad";
+      return problem.str();
+    }
+  }
+  return "";
+}
+
+}  // namespace selfcal::robot

@@ -1,0 +1,368 @@
+#include "session/samples.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <stdexcept>
+
+#include "base/atomic_file.h"
+#include "capture/crc32.h"
+#include "session/file_util.h"
+
+namespace selfcal::session {
+
+namespace {
+
+constexpr int kMaxPoses = 100000;
+constexpr std::size_t kMaxJoints = 32;
+constexpr std::size_t kMaxDots = 100000;
+
+// A validation failure inside one record; ReadSessionLog turns it into a Status.
+class RecordError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Typed access to the fields of one record, each failure naming record, type and field.
+class Fields {
+ public:
+  Fields(const nlohmann::json& record, std::size_t index, std::string type)
+      : record_(record), index_(index), type_(std::move(type)) {}
+
+  [[noreturn]] void Fail(const std::string& field, const std::string& what) const {
+    throw RecordError(Where() + (field.empty() ? "" : ": field \"" + field + "\"") + ": " + what);
+  }
+  std::string Where() const { return "journal record " + std::to_string(index_ + 1) + " (" + type_ + ")"; }
+
+  const nlohmann::json& Get(const std::string& key) const {
+    const auto it = record_.find(key);
+    if (it == record_.end()) Fail(key, "missing");
+    return *it;
+  }
+  bool Has(const std::string& key) const { return record_.contains(key); }
+
+  std::int64_t Integer(const std::string& key, std::int64_t min, std::int64_t max) const {
+    return IntegerOf(Get(key), key, min, max);
+  }
+  std::int64_t IntegerOf(const nlohmann::json& value, const std::string& key, std::int64_t min,
+                         std::int64_t max) const {
+    if (!value.is_number_integer()) Fail(key, "expected an integer, found " + value.dump());
+    if (value.is_number_unsigned() && value.get<std::uint64_t>() > static_cast<std::uint64_t>(max)) {
+      Fail(key, value.dump() + " is larger than " + std::to_string(max));
+    }
+    const std::int64_t number = value.get<std::int64_t>();
+    if (number < min || number > max) {
+      Fail(key, std::to_string(number) + " is outside [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+    }
+    return number;
+  }
+  double Number(const std::string& key) const { return NumberOf(Get(key), key); }
+  double NumberOf(const nlohmann::json& value, const std::string& key) const {
+    if (!value.is_number()) Fail(key, "expected a finite number, found " + value.dump());
+    const double number = value.get<double>();
+    if (!std::isfinite(number)) Fail(key, "expected a finite number, found " + value.dump());
+    return number;
+  }
+  std::string String(const std::string& key) const {
+    const nlohmann::json& value = Get(key);
+    if (!value.is_string() || value.get_ref<const std::string&>().empty()) {
+      Fail(key, "expected a non-empty string, found " + value.dump());
+    }
+    return value.get<std::string>();
+  }
+  std::string OptionalString(const std::string& key) const {
+    if (!Has(key)) return "";
+    if (!Get(key).is_string()) Fail(key, "expected a string, found " + Get(key).dump());
+    return Get(key).get<std::string>();
+  }
+  // An array of finite numbers; `size` 0: 1 .. kMaxJoints entries.
+  std::vector<double> Joints(const std::string& key, std::size_t size) const {
+    const nlohmann::json& value = Get(key);
+    const bool size_ok = size == 0 ? value.size() >= 1 && value.size() <= kMaxJoints : value.size() == size;
+    if (!value.is_array() || !size_ok) {
+      Fail(key, "expected an array of " + (size == 0 ? "1-" + std::to_string(kMaxJoints) : std::to_string(size)) +
+                    " finite numbers, found " +
+                    (value.is_array() ? std::to_string(value.size()) + " values" : value.dump()));
+    }
+    std::vector<double> joints;
+    for (const nlohmann::json& item : value) joints.push_back(NumberOf(item, key));
+    return joints;
+  }
+  PoseRole Role() const {
+    const std::string role = String("role");
+    if (role == "identification") return PoseRole::kIdentification;
+    if (role == "verification") return PoseRole::kVerification;
+    Fail("role", "\"" + role + "\" is neither \"identification\" nor \"verification\"");
+  }
+  std::string Image() const {
+    const std::string image = String("image");
+    const std::string prefix = std::string(kImagesDirName) + "/";
+    if (image.compare(0, prefix.size(), prefix) != 0 || !internal::SafeFileName(image.substr(prefix.size()))) {
+      Fail("image", "\"" + image + "\" is not \"" + prefix + "<plain file name>\"");
+    }
+    return image;
+  }
+  std::uint32_t Crc32() const {
+    const std::string text = String("crc32");
+    const bool hex = text.size() == 8 && std::all_of(text.begin(), text.end(), [](char c) {
+                       return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f');
+                     });
+    if (!hex) Fail("crc32", "\"" + text + "\" is not 8 lower-case hex digits");
+    return static_cast<std::uint32_t>(std::stoul(text, nullptr, 16));
+  }
+
+ private:
+  const nlohmann::json& record_;
+  std::size_t index_;
+  std::string type_;
+};
+
+std::vector<SampleDot> ReadDots(const Fields& f) {
+  const nlohmann::json& value = f.Get("dots");
+  if (!value.is_array() || value.size() > kMaxDots) f.Fail("dots", "expected an array of at most 100000 dots");
+  std::vector<SampleDot> dots;
+  std::set<int> ids;
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    const nlohmann::json& dot = value[i];
+    const std::string key = "dots[" + std::to_string(i) + "]";
+    if (!dot.is_object()) f.Fail(key, "expected an object");
+    for (const char* field : {"id", "u", "v", "area", "w", "h"}) {
+      if (!dot.contains(field)) f.Fail(key, std::string("missing \"") + field + "\"");
+    }
+    SampleDot d;
+    d.id = static_cast<int>(f.IntegerOf(dot["id"], key + ".id", 0, 1 << 30));
+    d.u_px = f.NumberOf(dot["u"], key + ".u");
+    d.v_px = f.NumberOf(dot["v"], key + ".v");
+    d.area_px2 = f.NumberOf(dot["area"], key + ".area");
+    d.width_px = f.NumberOf(dot["w"], key + ".w");
+    d.height_px = f.NumberOf(dot["h"], key + ".h");
+    if (!ids.insert(d.id).second) f.Fail(key + ".id", "dot id " + std::to_string(d.id) + " repeats");
+    dots.push_back(d);
+  }
+  return dots;
+}
+
+bool SamePlan(const PlannedPose& a, const PlannedPose& b) {
+  return a.id == b.id && a.role == b.role && a.joints_rad == b.joints_rad;
+}
+
+// The log being built, one record at a time.
+class LogBuilder {
+ public:
+  void Add(const nlohmann::json& record, std::size_t index) {
+    const auto type_it = record.find("type");
+    if (type_it == record.end() || !type_it->is_string()) {
+      throw RecordError("journal record " + std::to_string(index + 1) + ": no \"type\" string");
+    }
+    const std::string type = type_it->get<std::string>();
+    const Fields f(record, index, type);
+    if (index == 0 && type != "session_started") f.Fail("type", "a session journal starts with session_started");
+    if (type == "session_started") {
+      if (index != 0) f.Fail("type", "session_started appears again (a continued session writes resumed)");
+      log_.started = true;
+      log_.start_time_s = f.Number("time_s");
+      log_.num_poses = static_cast<int>(f.Integer("num_poses", 0, kMaxPoses));
+      log_.mode = f.String("mode");
+    } else if (type == "resumed") {
+      f.Number("time_s");
+      ++log_.resumes;
+      log_.finished = false;
+    } else if (type == "pose_planned") {
+      AddPlanned(f);
+    } else if (type == "move_started") {
+      const int pose = Pose(f);
+      f.Number("time_s");
+      f.Joints("from_rad", log_.plan[pose].joints_rad.size());
+    } else if (type == "move_done" || type == "settled") {
+      Pose(f);
+      f.Number("time_s");
+    } else if (type == "frame_written") {
+      AddFrame(f, index);
+    } else if (type == "sample_accepted") {
+      AddAccepted(f, index);
+    } else if (type == "sample_skipped") {
+      const int pose = Pose(f);
+      SkippedSample skip{f.String("reason"), f.OptionalString("detail"), index};
+      ++log_.skips_by_reason[skip.reason];
+      log_.skips[pose].push_back(std::move(skip));
+    } else if (type == "fault") {
+      OptionalPose(f);
+      f.OptionalString("detail");
+      ++log_.faults_by_kind[f.String("kind")];
+    } else if (type == "halted") {
+      OptionalPose(f);
+      f.OptionalString("detail");
+      ++log_.halts_by_reason[f.String("reason")];
+    } else if (type == "finished") {
+      f.Number("time_s");
+      log_.finished = true;
+    } else {
+      ++log_.unknown_records;
+    }
+  }
+
+  SessionLog Take() { return std::move(log_); }
+
+ private:
+  // The pose a record names: in [0, num_poses) and planned.
+  int Pose(const Fields& f) const {
+    if (log_.num_poses == 0) f.Fail("pose", "the session has no poses");
+    const int pose = static_cast<int>(f.Integer("pose", 0, log_.num_poses - 1));
+    if (pose >= static_cast<int>(log_.plan.size())) {
+      f.Fail("pose", "pose " + std::to_string(pose) + " is not planned (no earlier pose_planned record)");
+    }
+    return pose;
+  }
+  void OptionalPose(const Fields& f) const {
+    if (f.Has("pose")) f.Integer("pose", 0, std::max(0, log_.num_poses - 1));
+  }
+
+  void AddPlanned(const Fields& f) {
+    PlannedPose planned;
+    if (log_.num_poses == 0) f.Fail("pose", "the session has no poses");
+    planned.pose = static_cast<int>(f.Integer("pose", 0, log_.num_poses - 1));
+    planned.id = f.String("id");
+    planned.role = f.Role();
+    planned.joints_rad = f.Joints("joints_rad", log_.plan.empty() ? 0 : log_.plan[0].joints_rad.size());
+    const std::size_t next = log_.plan.size();
+    if (static_cast<std::size_t>(planned.pose) < next) {
+      if (!SamePlan(planned, log_.plan[planned.pose])) f.Fail("pose", "planned again with other values");
+      return;
+    }
+    if (static_cast<std::size_t>(planned.pose) != next) {
+      f.Fail("pose", "pose " + std::to_string(planned.pose) + " planned before pose " + std::to_string(next));
+    }
+    for (const PlannedPose& other : log_.plan) {
+      if (other.id == planned.id)
+        f.Fail("id", "\"" + planned.id + "\" is the id of pose " + std::to_string(other.pose));
+    }
+    log_.plan.push_back(std::move(planned));
+    log_.accepted.emplace_back();
+    log_.skips.emplace_back();
+  }
+
+  void AddFrame(const Fields& f, std::size_t index) {
+    FrameWritten frame;
+    frame.pose = Pose(f);
+    frame.image = f.Image();
+    frame.crc32 = f.Crc32();
+    frame.bytes = static_cast<std::uint64_t>(f.Integer("bytes", 0, std::int64_t{1} << 40));
+    frame.exposure_time_s = f.Number("exposure_time_s");
+    frame.sequence = f.Integer("sequence", 0, std::int64_t{1} << 62);
+    frame.record = index;
+    const auto [it, inserted] = log_.frames.emplace(frame.image, frame);
+    if (!inserted &&
+        (it->second.pose != frame.pose || it->second.crc32 != frame.crc32 || it->second.bytes != frame.bytes)) {
+      f.Fail("image", frame.image + " was recorded by record " + std::to_string(it->second.record + 1) +
+                          " with another pose, size or CRC");
+    }
+  }
+
+  void AddAccepted(const Fields& f, std::size_t index) {
+    AcceptedSample sample;
+    sample.pose = Pose(f);
+    const PlannedPose& planned = log_.plan[sample.pose];
+    sample.id = f.String("id");
+    if (sample.id != planned.id)
+      f.Fail("id", "\"" + sample.id + "\" but pose " + std::to_string(sample.pose) + " was planned as \"" + planned.id +
+                       "\"");
+    sample.role = f.Role();
+    if (sample.role != planned.role) {
+      f.Fail("role",
+             std::string(PoseRoleName(sample.role)) + " but the pose was planned as " + PoseRoleName(planned.role));
+    }
+    sample.joints_rad = f.Joints("joints_rad", planned.joints_rad.size());
+    sample.joint_time_s = f.Number("joint_time_s");
+    sample.settle_time_s = f.Number("settle_time_s");
+    sample.exposure_time_s = f.Number("exposure_time_s");
+    sample.image = f.Image();
+    const auto frame = log_.frames.find(sample.image);
+    if (frame == log_.frames.end()) f.Fail("image", sample.image + " has no earlier frame_written record");
+    if (frame->second.pose != sample.pose) {
+      f.Fail("image", sample.image + " was written for pose " + std::to_string(frame->second.pose));
+    }
+    sample.dots = ReadDots(f);
+    if (f.Has("sim_clock_s")) sample.sim_clock_s = f.Number("sim_clock_s");
+    sample.record = index;
+    if (log_.accepted[sample.pose]) {
+      log_.duplicate_accepts.push_back(index);
+      return;
+    }
+    log_.last_accepted_pose = sample.pose;
+    log_.accepted[sample.pose] = std::move(sample);
+  }
+
+  SessionLog log_;
+};
+
+}  // namespace
+
+const char* PoseRoleName(PoseRole role) {
+  return role == PoseRole::kIdentification ? "identification" : "verification";
+}
+
+bool IsFinalSkipReason(const std::string& reason) {
+  static const std::set<std::string> kFinal = {"move_failed", "not_settled", "bad_reading",
+                                               "no_frame",    "bad_frame",   "too_few_dots"};
+  return kFinal.count(reason) > 0;
+}
+
+bool SessionLog::PoseDone(int pose) const {
+  if (pose < 0 || pose >= static_cast<int>(plan.size())) return false;
+  if (accepted[pose]) return true;
+  return std::any_of(skips[pose].begin(), skips[pose].end(),
+                     [](const SkippedSample& skip) { return IsFinalSkipReason(skip.reason); });
+}
+
+int SessionLog::FirstPoseWithoutAcceptedSample() const {
+  for (int pose = 0; pose < num_poses; ++pose) {
+    if (!PoseDone(pose)) return pose;
+  }
+  return num_poses;
+}
+
+int SessionLog::NumAccepted() const {
+  return static_cast<int>(std::count_if(accepted.begin(), accepted.end(), [](const auto& s) { return s.has_value(); }));
+}
+
+const AcceptedSample* SessionLog::LastAcceptedSample() const {
+  return last_accepted_pose ? &*accepted[*last_accepted_pose] : nullptr;
+}
+
+Result<SessionLog> ReadSessionLog(const std::vector<nlohmann::json>& records) {
+  LogBuilder builder;
+  try {
+    for (std::size_t i = 0; i < records.size(); ++i) builder.Add(records[i], i);
+  } catch (const RecordError& error) {
+    return Status::Error(ExitCode::kUsage, error.what());
+  } catch (const nlohmann::json::exception& error) {  // a value outside its type's range
+    return Status::Error(ExitCode::kUsage, std::string("journal: ") + error.what());
+  }
+  return builder.Take();
+}
+
+Status VerifySampleImages(const Session& session, const SessionLog& log) {
+  std::vector<std::string> problems;
+  for (const auto& sample : log.accepted) {
+    if (!sample) continue;
+    const FrameWritten& frame = log.frames.at(sample->image);
+    const std::string where = sample->image + " (pose " + std::to_string(sample->pose) + ")";
+    bool missing = false;
+    Result<std::string> bytes = ReadFileCapped(internal::Join(session.path(), sample->image), frame.bytes, &missing);
+    if (!bytes.ok()) {
+      problems.push_back(where + (missing ? ": missing" : ": " + bytes.status().message()));
+    } else if (bytes->size() != frame.bytes) {
+      problems.push_back(where + ": " + std::to_string(bytes->size()) + " bytes, the journal recorded " +
+                         std::to_string(frame.bytes));
+    } else if (capture::internal::Crc32(*bytes) != frame.crc32) {
+      problems.push_back(where + ": CRC-32 " + capture::internal::Crc32Hex(capture::internal::Crc32(*bytes)) +
+                         ", the journal recorded " + capture::internal::Crc32Hex(frame.crc32));
+    }
+  }
+  if (problems.empty()) return Status::Ok();
+  std::string message = "session " + session.path() + ": images of accepted samples do not match the journal: ";
+  for (std::size_t i = 0; i < problems.size(); ++i) message += (i ? "; " : "") + problems[i];
+  return Status::Error(ExitCode::kUsage, message);
+}
+
+}  // namespace selfcal::session

@@ -1,0 +1,366 @@
+#include "session/session_dir.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <functional>
+
+#include <gtest/gtest.h>
+
+#include "session/session_test_util.h"
+
+namespace selfcal::session {
+namespace {
+
+using testing::Contains;
+using testing::CreateTestSession;
+using testing::ReadFile;
+using testing::TempDir;
+using testing::TestCreateOptions;
+using testing::TestInputs;
+using testing::WriteFile;
+
+bool Exists(const std::string& path) { return std::filesystem::exists(path); }
+
+unsigned Permissions(const std::string& path) {
+  struct stat info {};
+  EXPECT_EQ(::stat(path.c_str(), &info), 0) << path;
+  return info.st_mode & 07777;
+}
+
+TEST(SessionDirTest, Sha256KnownVectors) {
+  EXPECT_EQ(Sha256Hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(Sha256Hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+}
+
+TEST(SessionDirTest, SessionIdIsDerivedFromTimeAndPath) {
+  const std::string id = DeriveSessionId("/data/sessions/a", "2025-03-01T12:00:00.250Z");
+  EXPECT_EQ(id, "20250301T120000250Z-" + Sha256Hex("/data/sessions/a").substr(0, 8));
+  EXPECT_EQ(DeriveSessionId("/data/sessions/./a/", "2025-03-01T12:00:00.250Z").substr(0, 20), id.substr(0, 20));
+  EXPECT_NE(DeriveSessionId("/data/sessions/b", "2025-03-01T12:00:00.250Z"), id);
+}
+
+TEST(SessionDirTest, CreateWritesTheDocumentedLayout) {
+  TempDir dir;
+  const std::string path = dir.File("session");
+  Result<Session> session = CreateTestSession(path);
+  ASSERT_TRUE(session.ok());
+  EXPECT_EQ(session->path(), path);
+  EXPECT_EQ(dir.List("session"), (std::vector<std::string>{"images", "inputs", "journal.log", "lock", "session.json"}));
+  EXPECT_EQ(dir.List("session/inputs"), (std::vector<std::string>{"config.yaml", "plan.yaml", "robot.yaml"}));
+  EXPECT_TRUE(dir.List("session/images").empty());
+  EXPECT_EQ(ReadFile(path + "/journal.log"), "");
+  EXPECT_EQ(ReadFile(path + "/inputs/robot.yaml"), "name: puma560\n");
+  EXPECT_EQ(Permissions(path + "/inputs/robot.yaml"), 0444u);
+  EXPECT_TRUE(Contains(ReadFile(path + "/lock"), std::to_string(::getpid()) + " "));
+
+  const nlohmann::json manifest = nlohmann::json::parse(ReadFile(path + "/session.json"));
+  EXPECT_EQ(manifest["format"], "selfcal-session");
+  EXPECT_EQ(manifest["version"], 1);
+  EXPECT_EQ(manifest["session_id"], DeriveSessionId(path, "2025-03-01T12:00:00Z"));
+  EXPECT_EQ(manifest["created_utc"], "2025-03-01T12:00:00Z");
+  EXPECT_EQ(manifest["software_version"], "selfcal 0.1.0-test");
+  ASSERT_EQ(manifest["inputs"].size(), 3u);
+  EXPECT_EQ(manifest["inputs"][1]["name"], "robot.yaml");
+  EXPECT_EQ(manifest["inputs"][1]["bytes"], 14);
+  EXPECT_EQ(manifest["inputs"][1]["sha256"], Sha256Hex("name: puma560\n"));
+
+  // The manifest reads back as written, and the stored inputs with it.
+  Result<SessionManifest> read = ReadManifest(path);
+  ASSERT_TRUE(read.ok()) << read.status().ToString();
+  EXPECT_EQ(read->session_id, session->manifest().session_id);
+  ASSERT_NE(read->FindInput("plan.yaml"), nullptr);
+  EXPECT_EQ(read->FindInput("plan.yaml")->sha256_hex, Sha256Hex("poses: []\n"));
+  EXPECT_EQ(session->ReadInput("config.yaml").value(), "mode: simulated\n");
+  EXPECT_FALSE(session->ReadInput("camera.yaml").ok());
+}
+
+TEST(SessionDirTest, GivenSessionIdIsUsed) {
+  TempDir dir;
+  CreateOptions options = TestCreateOptions();
+  options.session_id = "bench-7";
+  Result<Session> session = CreateSession(dir.File("s"), TestInputs(), "v", options);
+  ASSERT_TRUE(session.ok()) << session.status().ToString();
+  EXPECT_EQ(session->manifest().session_id, "bench-7");
+}
+
+TEST(SessionDirTest, CreateRefusesANonEmptyDirectory) {
+  TempDir dir;
+  const std::string path = dir.File("session");
+  ASSERT_TRUE(std::filesystem::create_directory(path));
+  WriteFile(path + "/notes.txt", "keep me");
+  Result<Session> session = CreateSession(path, TestInputs(), "v", TestCreateOptions());
+  ASSERT_FALSE(session.ok());
+  EXPECT_EQ(session.status().code(), ExitCode::kUsage);
+  EXPECT_TRUE(Contains(session.status().message(), path)) << session.status().message();
+  EXPECT_TRUE(Contains(session.status().message(), "never overwritten")) << session.status().message();
+  EXPECT_EQ(dir.List("session"), std::vector<std::string>{"notes.txt"});
+  EXPECT_EQ(ReadFile(path + "/notes.txt"), "keep me");
+
+  // An existing session is not empty either.
+  ASSERT_TRUE(CreateTestSession(dir.File("first")).ok());
+  EXPECT_FALSE(CreateSession(dir.File("first"), TestInputs(), "v", TestCreateOptions()).ok());
+}
+
+TEST(SessionDirTest, CreateUsesAnEmptyExistingDirectory) {
+  TempDir dir;
+  ASSERT_TRUE(std::filesystem::create_directory(dir.File("empty")));
+  EXPECT_TRUE(CreateTestSession(dir.File("empty") + "/").ok());
+  EXPECT_TRUE(Exists(dir.File("empty/session.json")));
+}
+
+TEST(SessionDirTest, CreateRefusesBadArgumentsBeforeWritingAnything) {
+  TempDir dir;
+  const std::string path = dir.File("s");
+  struct Case {
+    SessionInputs inputs;
+    std::string created_utc;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {{{"config.yaml", "a"}, {"config.yaml", "b"}}, "2025-03-01T12:00:00Z", "given twice"},
+      {{{"../config.yaml", "a"}}, "2025-03-01T12:00:00Z", "not a plain file name"},
+      {{{".hidden", "a"}}, "2025-03-01T12:00:00Z", "not a plain file name"},
+      {TestInputs(), "2025-03-01 12:00:00", "not UTC ISO 8601"},
+      {TestInputs(), "2025-13-01T12:00:00Z", "not UTC ISO 8601"},
+  };
+  for (const Case& c : cases) {
+    CreateOptions options = TestCreateOptions();
+    options.created_utc = c.created_utc;
+    Result<Session> session = CreateSession(path, c.inputs, "v", options);
+    ASSERT_FALSE(session.ok()) << c.expected;
+    EXPECT_EQ(session.status().code(), ExitCode::kUsage);
+    EXPECT_TRUE(Contains(session.status().message(), c.expected)) << session.status().message();
+    EXPECT_FALSE(Exists(path));
+  }
+  Result<Session> no_parent = CreateSession(dir.File("no/such/s"), TestInputs(), "v", TestCreateOptions());
+  ASSERT_FALSE(no_parent.ok());
+  EXPECT_TRUE(Contains(no_parent.status().message(), "does not exist")) << no_parent.status().message();
+}
+
+TEST(SessionDirTest, CreateChecksFreeSpace) {
+  TempDir dir;
+  CreateOptions options = TestCreateOptions();
+  options.min_free_bytes = std::uint64_t{1} << 62;  // 4 EiB
+  Result<Session> session = CreateSession(dir.File("s"), TestInputs(), "v", options);
+  ASSERT_FALSE(session.ok());
+  EXPECT_EQ(session.status().code(), ExitCode::kUsage);
+  EXPECT_TRUE(Contains(session.status().message(), "bytes are free")) << session.status().message();
+  EXPECT_FALSE(Exists(dir.File("s")));
+}
+
+TEST(SessionDirTest, CreateRefusesAReadOnlyDirectory) {
+  if (::geteuid() == 0) GTEST_SKIP() << "root writes into read-only directories";
+  TempDir dir;
+  const std::string parent = dir.File("ro");
+  ASSERT_TRUE(std::filesystem::create_directory(parent));
+  ASSERT_EQ(::chmod(parent.c_str(), 0555), 0);
+  Result<Session> session = CreateSession(parent + "/s", TestInputs(), "v", TestCreateOptions());
+  ::chmod(parent.c_str(), 0755);
+  ASSERT_FALSE(session.ok());
+  EXPECT_TRUE(Contains(session.status().message(), "not writable")) << session.status().message();
+}
+
+TEST(SessionDirTest, LockRefusesASecondSessionAndIsReleasedOnDestruction) {
+  TempDir dir;
+  const std::string path = dir.File("s");
+  {
+    Result<Session> first = CreateTestSession(path);
+    ASSERT_TRUE(first.ok());
+    Result<Session> second = OpenSession(path, TestInputs(), false);
+    ASSERT_FALSE(second.ok());
+    EXPECT_EQ(second.status().code(), ExitCode::kUsage);
+    EXPECT_TRUE(Contains(second.status().message(),
+                         "session " + path + " is in use by pid " + std::to_string(::getpid()) + " on host "))
+        << second.status().message();
+    // The refused attempt left the holder's line in place.
+    EXPECT_TRUE(Contains(ReadFile(path + "/lock"), std::to_string(::getpid())));
+    // A moved session keeps its lock.
+    Session moved = std::move(first).value();
+    EXPECT_FALSE(OpenSession(path, TestInputs(), false).ok());
+  }
+  EXPECT_EQ(ReadFile(path + "/lock"), "");  // released cleanly
+  Result<Session> again = OpenSession(path, TestInputs(), false);
+  ASSERT_TRUE(again.ok()) << again.status().ToString();
+  EXPECT_EQ(again->open_report().stale_lock_from, "");
+}
+
+TEST(SessionDirTest, AStaleLockIsTakenOverAndReported) {
+  TempDir dir;
+  const std::string path = dir.File("s");
+  ASSERT_TRUE(CreateTestSession(path).ok());
+  WriteFile(path + "/lock", "4242 deadhost 2025-03-01T11:00:00Z\n");  // left by a process that died
+  Result<Session> session = OpenSession(path, TestInputs(), false);
+  ASSERT_TRUE(session.ok()) << session.status().ToString();
+  EXPECT_EQ(session->open_report().stale_lock_from, "4242 deadhost 2025-03-01T11:00:00Z");
+  EXPECT_TRUE(Contains(ReadFile(path + "/lock"), std::to_string(::getpid()) + " "));
+}
+
+TEST(SessionDirTest, ResumeWithChangedInputsIsRefusedUnlessAllowed) {
+  TempDir dir;
+  const std::string path = dir.File("s");
+  ASSERT_TRUE(CreateTestSession(path).ok());
+  SessionInputs changed = TestInputs();
+  changed[0].contents = "mode: real\n";             // config.yaml differs
+  changed.push_back({"camera.yaml", "fx: 800\n"});  // not recorded
+  Result<Session> refused = OpenSession(path, changed, false);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), ExitCode::kUsage);
+  const std::string& message = refused.status().message();
+  EXPECT_TRUE(Contains(message, "config.yaml (recorded 16 bytes")) << message;
+  EXPECT_TRUE(Contains(message, "camera.yaml (not recorded")) << message;
+  EXPECT_FALSE(Contains(message, "robot.yaml")) << message;
+  EXPECT_FALSE(Contains(message, "plan.yaml")) << message;
+  EXPECT_EQ(ReadFile(path + "/lock"), "");  // refused before locking
+
+  Result<Session> allowed = OpenSession(path, changed, true);
+  ASSERT_TRUE(allowed.ok()) << allowed.status().ToString();
+  ASSERT_EQ(allowed->open_report().changed_inputs.size(), 2u);
+  EXPECT_TRUE(Contains(allowed->open_report().changed_inputs[0], "config.yaml"));
+  // The recorded inputs stay as they were.
+  EXPECT_EQ(allowed->ReadInput("config.yaml").value(), "mode: simulated\n");
+}
+
+TEST(SessionDirTest, AModifiedStoredInputIsDetected) {
+  TempDir dir;
+  const std::string path = dir.File("s");
+  ASSERT_TRUE(CreateTestSession(path).ok());
+  ASSERT_EQ(::chmod((path + "/inputs/plan.yaml").c_str(), 0644), 0);
+  WriteFile(path + "/inputs/plan.yaml", "poses: [[1]]\n");
+  Result<Session> session = OpenSession(path, {}, false);
+  ASSERT_TRUE(session.ok());
+  Result<std::string> plan = session->ReadInput("plan.yaml");
+  ASSERT_FALSE(plan.ok());
+  EXPECT_TRUE(Contains(plan.status().message(), "modified")) << plan.status().message();
+}
+
+TEST(SessionDirTest, TheManifestIsReadStrictly) {
+  TempDir dir;
+  const std::string path = dir.File("s");
+  ASSERT_TRUE(CreateTestSession(path).ok());
+  const nlohmann::json good = nlohmann::json::parse(ReadFile(path + "/session.json"));
+  struct Case {
+    std::function<void(nlohmann::json&)> edit;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {[](nlohmann::json& j) { j["version"] = 2; }, "unknown major version 2"},
+      {[](nlohmann::json& j) { j["format"] = "other"; }, "not a selfcal session"},
+      {[](nlohmann::json& j) { j["extra"] = 1; }, "unknown key \"extra\""},
+      {[](nlohmann::json& j) { j.erase("created_utc"); }, "missing key \"created_utc\""},
+      {[](nlohmann::json& j) { j["inputs"][0]["sha256"] = "ABC"; }, "inputs[0]: \"sha256\" must be 64"},
+      {[](nlohmann::json& j) { j["inputs"][1]["bytes"] = -1; }, "inputs[1]: \"bytes\""},
+      {[](nlohmann::json& j) { j["session_id"] = 7; }, "\"session_id\" must be a string"},
+  };
+  for (const Case& c : cases) {
+    nlohmann::json edited = good;
+    c.edit(edited);
+    WriteFile(path + "/session.json", edited.dump(2));
+    Result<Session> session = OpenSession(path, {}, false);
+    ASSERT_FALSE(session.ok()) << c.expected;
+    EXPECT_EQ(session.status().code(), ExitCode::kUsage);
+    EXPECT_TRUE(Contains(session.status().message(), c.expected)) << session.status().message();
+    EXPECT_TRUE(Contains(session.status().message(), "session.json")) << session.status().message();
+  }
+  WriteFile(path + "/session.json", good.dump(2));
+  std::filesystem::rename(path + "/journal.log", path + "/journal.log.moved");
+  Result<Session> no_journal = OpenSession(path, {}, false);
+  ASSERT_FALSE(no_journal.ok());
+  EXPECT_TRUE(Contains(no_journal.status().message(), "has no journal.log")) << no_journal.status().message();
+  EXPECT_FALSE(Exists(path + "/journal.log"));  // not started afresh
+  WriteFile(path + "/session.json", "not json");
+  EXPECT_FALSE(OpenSession(path, {}, false).ok());
+  std::filesystem::remove(path + "/session.json");
+  Result<Session> missing = OpenSession(path, {}, false);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_TRUE(Contains(missing.status().message(), "not a selfcal session")) << missing.status().message();
+}
+
+TEST(SessionDirTest, UnreferencedImagesAreMovedToOrphans) {
+  TempDir dir;
+  const std::string path = dir.File("s");
+  {
+    Result<Session> session = CreateTestSession(path);
+    ASSERT_TRUE(session.ok());
+    ASSERT_TRUE(session.value().WriteImage("p00.png", "image zero").ok());
+    ASSERT_TRUE(session.value().journal().Append({{"type", "frame_written"}, {"image", "images/p00.png"}}).ok());
+    ASSERT_TRUE(session.value().WriteImage("p01.png", "image one, never journaled").ok());
+  }
+  WriteFile(path + "/images/.p02.png.tmp.Ab12Cd", "half an image");  // a crash inside WriteImage
+  {
+    Result<Session> session = OpenSession(path, TestInputs(), false);
+    ASSERT_TRUE(session.ok()) << session.status().ToString();
+    EXPECT_EQ(session->open_report().orphans,
+              (std::vector<std::string>{"orphans/.p02.png.tmp.Ab12Cd", "orphans/p01.png"}));
+    EXPECT_EQ(dir.List("s/images"), std::vector<std::string>{"p00.png"});
+    EXPECT_EQ(ReadFile(path + "/orphans/p01.png"), "image one, never journaled");
+    EXPECT_EQ(ReadFile(path + "/orphans/.p02.png.tmp.Ab12Cd"), "half an image");
+    // The name is free again; an orphan of the same name later does not replace the first.
+    ASSERT_TRUE(session.value().WriteImage("p01.png", "second try").ok());
+  }
+  Result<Session> reopened = OpenSession(path, TestInputs(), false);
+  ASSERT_TRUE(reopened.ok());
+  EXPECT_EQ(reopened->open_report().orphans, std::vector<std::string>{"orphans/p01.png.1"});
+  EXPECT_EQ(ReadFile(path + "/orphans/p01.png"), "image one, never journaled");
+  EXPECT_EQ(ReadFile(path + "/orphans/p01.png.1"), "second try");
+}
+
+TEST(SessionDirTest, WriteImageIsAtomicAndNeverReplaces) {
+  TempDir dir;
+  const std::string path = dir.File("s");
+  Result<Session> session = CreateTestSession(path);
+  ASSERT_TRUE(session.ok());
+  ASSERT_TRUE(session.value().WriteImage("f.png", "AAAA").ok());
+  EXPECT_EQ(ReadFile(path + "/images/f.png"), "AAAA");
+  EXPECT_TRUE(session.value().WriteImage("f.png", "AAAA").ok());  // identical retry
+  const Status replaced = session.value().WriteImage("f.png", "BBBB");
+  EXPECT_EQ(replaced.code(), ExitCode::kUsage);
+  EXPECT_TRUE(Contains(replaced.message(), "never overwritten")) << replaced.message();
+  EXPECT_EQ(ReadFile(path + "/images/f.png"), "AAAA");
+  EXPECT_FALSE(session.value().WriteImage("f.png", "AAAAA").ok());  // a longer file is not identical
+  for (const char* bad : {"", ".hidden", "../escape.png", "a/b.png"}) {
+    EXPECT_EQ(session.value().WriteImage(bad, "x").code(), ExitCode::kUsage) << bad;
+  }
+  EXPECT_EQ(dir.List("s/images"), std::vector<std::string>{"f.png"});  // no temporary file left
+  EXPECT_FALSE(Exists(dir.File("escape.png")));
+  EXPECT_EQ(ImageRecordPath("f.png"), "images/f.png");
+}
+
+TEST(SessionDirTest, CheckFreeSpace) {
+  TempDir dir;
+  Result<Session> session = CreateTestSession(dir.File("s"));
+  ASSERT_TRUE(session.ok());
+  EXPECT_TRUE(session->CheckFreeSpace(0).ok());
+  const Status full = session->CheckFreeSpace(std::uint64_t{1} << 62);
+  EXPECT_EQ(full.code(), ExitCode::kHardware);
+  EXPECT_TRUE(Contains(full.message(), dir.File("s"))) << full.message();
+}
+
+TEST(SessionDirTest, OpenRecoversATornJournalAndRefusesADamagedOne) {
+  TempDir dir;
+  const std::string path = dir.File("s");
+  {
+    Result<Session> session = CreateTestSession(path);
+    ASSERT_TRUE(session.ok());
+    for (int i = 0; i < 3; ++i) ASSERT_TRUE(session.value().journal().Append({{"type", "t"}, {"i", i}}).ok());
+  }
+  const std::string journal = ReadFile(path + "/journal.log");
+  WriteFile(path + "/journal.log", journal + "J1 0000");
+  {
+    Result<Session> session = OpenSession(path, {}, false);
+    ASSERT_TRUE(session.ok()) << session.status().ToString();
+    EXPECT_EQ(session->open_report().journal.dropped_bytes, 7u);
+    EXPECT_EQ(session->journal().records().size(), 3u);
+  }
+  std::string damaged = journal;
+  damaged[journal.find("\"i\":1")] = 'X';
+  WriteFile(path + "/journal.log", damaged);
+  Result<Session> refused = OpenSession(path, {}, false);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_TRUE(Contains(refused.status().message(), "record 2 at byte offset")) << refused.status().message();
+  EXPECT_EQ(ReadFile(path + "/lock"), "");  // the refused open released the lock
+}
+
+}  // namespace
+}  // namespace selfcal::session
