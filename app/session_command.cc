@@ -376,7 +376,7 @@ Result<ObservationSet> LoadSessionObservations(const std::string& session_path) 
     if (!sample) continue;
     PoseObservation pose;
     pose.id = sample->id;
-    pose.role = sample->role == session::PoseRole::kVerification ? PoseRole::kVerification : PoseRole::kIdentification;
+    pose.role = sample->role;
     pose.joints_rad = Eigen::Map<const Eigen::VectorXd>(sample->joints_rad.data(),
                                                         static_cast<Eigen::Index>(sample->joints_rad.size()));
     for (const session::SampleDot& d : sample->dots) pose.dots_px[d.id] = {d.u_px, d.v_px};

@@ -64,6 +64,8 @@ class Runner {
   Step Grab(int pose, double not_before_s, bool during_move, capture::Frame* frame);
   // Names the dots of `frame`: tracked from tracked_, or identified when there is no state.
   Step Identify(int pose, const capture::Frame& frame);
+  // Marked dots (DotIdentifier::FindMarked) that tracking lost, found again in a settled frame.
+  void FindMarkedAgain(const capture::Frame& frame);
 
   const std::vector<PlannedPose>& plan_;
   const RunContext& c_;
@@ -193,6 +195,24 @@ Runner::Step Runner::Grab(int pose, double not_before_s, bool during_move, captu
   return Step::kSkip;
 }
 
+void Runner::FindMarkedAgain(const capture::Frame& frame) {
+  std::vector<int> missing;
+  for (int id : c_.identifier->MarkedIds()) {
+    bool tracked = false;
+    for (const tracking::PreviousDot& d : tracked_) tracked = tracked || d.id == id;
+    if (!tracked) missing.push_back(id);
+  }
+  if (missing.empty()) return;
+  const tracking::DetectionReport detections = tracking::DetectDots(frame.image, o_.detector);
+  for (const tracking::PreviousDot& found : c_.identifier->FindMarked(frame, detections, missing)) {
+    bool clash = false;  // never two ids on one blob
+    for (const tracking::PreviousDot& d : tracked_) clash = clash || (d.centroid_px - found.centroid_px).norm() < 3.0;
+    if (clash) continue;
+    tracked_.push_back(found);
+    ++report_.faults["dot_marked_found_again"];
+  }
+}
+
 Runner::Step Runner::Identify(int pose, const capture::Frame& frame) {
   if (tracked_.empty()) {
     const tracking::DetectionReport detections = tracking::DetectDots(frame.image, o_.detector);
@@ -316,8 +336,9 @@ RunReport Runner::Run() {
   }
   const int num_poses = static_cast<int>(plan_.size());
   if (log->started) {
-    bool same = log->num_poses == num_poses && log->plan_complete();
-    for (int i = 0; same && i < num_poses; ++i) {
+    // The recorded plan (a prefix of it if a crash came while it was being journaled) must be this one.
+    bool same = log->num_poses == num_poses && static_cast<int>(log->plan.size()) <= num_poses;
+    for (int i = 0; same && i < static_cast<int>(log->plan.size()); ++i) {
       same = log->plan[i].id == plan_[i].id && FromVector(log->plan[i].joints_rad) == plan_[i].joints_rad;
     }
     if (!same) {
@@ -420,14 +441,14 @@ RunReport Runner::Run() {
                  {"camera", c_.camera->Describe()}})) {
       return report_;
     }
-    for (int i = 0; i < num_poses; ++i) {
-      if (!Record({{"type", "pose_planned"}, {"pose", i}, {"id", plan_[i].id}, {"role", RoleName(plan_[i].role)},
-                   {"joints_rad", ToJson(plan_[i].joints_rad)}})) {
-        return report_;
-      }
-    }
   } else if (!Record({{"type", "resumed"}, {"time_s", Now()}, {"first_pose", first}})) {
     return report_;
+  }
+  for (int i = log->started ? static_cast<int>(log->plan.size()) : 0; i < num_poses; ++i) {
+    if (!Record({{"type", "pose_planned"}, {"pose", i}, {"id", plan_[i].id}, {"role", RoleName(plan_[i].role)},
+                 {"joints_rad", ToJson(plan_[i].joints_rad)}})) {
+      return report_;
+    }
   }
   for (const auto& [image, frame] : log->frames) ++frames_written_[frame.pose];
   if (Status s = c_.camera->Open(); !s.ok()) {
@@ -500,6 +521,7 @@ RunReport Runner::Run() {
     step = Identify(pose, frame);
     if (step == Step::kEnd) return report_;
     if (step == Step::kSkip) continue;
+    FindMarkedAgain(frame);
     if (tracked_.empty()) {
       Halt(RunOutcome::kHalted, ExitCode::kDegenerateData, "lost_track", "no dot is tracked any more", pose);
       return report_;

@@ -41,6 +41,15 @@ class DotIdentifier {
   // The named dots (ids >= 0, distinct) among `detections` of `frame`, or an error saying why not.
   virtual Result<std::vector<tracking::PreviousDot>> Identify(const capture::Frame& frame,
                                                               const tracking::DetectionReport& detections) = 0;
+  // Dots whose identity any single image shows (marked ones: the yardstick's ends carry a tag or a
+  // distinct size), found among `detections`. The loop asks at every settled pose for the marked dots it
+  // is no longer tracking, so that a yardstick end lost in a move comes back. Default: none are marked.
+  virtual std::vector<tracking::PreviousDot> FindMarked(const capture::Frame& /*frame*/,
+                                                        const tracking::DetectionReport& /*detections*/,
+                                                        const std::vector<int>& /*missing_ids*/) {
+    return {};
+  }
+  virtual std::vector<int> MarkedIds() const { return {}; }
 };
 
 // Ids 0, 1, ... in the detector's raster order: for scenes of unknown dots, where an id is only a label

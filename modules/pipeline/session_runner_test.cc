@@ -313,3 +313,101 @@ TEST(SessionRunner, BadFramesAreRetriedThenThePoseIsSkipped) {  // V6
 
 }  // namespace
 }  // namespace selfcal::pipeline
+
+namespace selfcal::pipeline {
+namespace {
+
+// A stand-in for a real robot backend (real_hardware = true) that records every command (R12, F8 (a)).
+class RecordingRealRobot : public robot::Robot {
+ public:
+  explicit RecordingRealRobot(Eigen::VectorXd joints) : joints_(std::move(joints)) {}
+  Status Connect() override { return Status::Ok(); }
+  void Disconnect() override {}
+  Result<robot::RobotIdentity> Identity() override { return robot::RobotIdentity{"network", "puma560", "SN-1", "", true}; }
+  Result<robot::JointLimits> Limits() override {
+    const int n = static_cast<int>(joints_.size());
+    return robot::JointLimits{Eigen::VectorXd::Constant(n, -3.1), Eigen::VectorXd::Constant(n, 3.1),
+                              Eigen::VectorXd::Constant(n, 1.0)};
+  }
+  Result<robot::JointReading> ReadJoints() override {
+    return robot::JointReading{joints_, Eigen::VectorXd::Zero(joints_.size()), 0.0};
+  }
+  Status StartMove(const Eigen::VectorXd&, double) override {
+    ++motion_commands;
+    return Status::Ok();
+  }
+  Result<robot::RobotStatus> GetStatus() override { return robot::RobotStatus{}; }
+  Status Stop() override {
+    ++motion_commands;
+    return Status::Ok();
+  }
+  int motion_commands = 0;
+
+ private:
+  Eigen::VectorXd joints_;
+};
+
+TEST(SessionRunner, DryRunOnARealBackendSendsItNoMotionCommand) {  // R12, F8 (a)
+  Harness h(5);
+  RecordingRealRobot real(h.plan.front().joints_rad);
+  RunContext c = h.Context();
+  c.robot = &real;
+  bool saw_real = false;
+  c.confirm = [&](const std::string& preview, const robot::RobotIdentity& identity) {
+    saw_real = identity.real_hardware && preview.find("REAL HARDWARE") != std::string::npos;
+    return false;  // --dry-run: preview only
+  };
+  const RunReport report = RunSession(h.plan, c, h.options);
+  EXPECT_TRUE(saw_real);
+  EXPECT_EQ(report.outcome, RunOutcome::kRefused);
+  EXPECT_EQ(real.motion_commands, 0);
+  EXPECT_EQ(h.cell.robot->counts().start_move, 0);  // nor to the simulated one
+}
+
+// A stopped session continued by a second RunSession (a person's --resume) on a cell rebuilt where the
+// last accepted sample left the arm gives the very samples an uninterrupted session gives (P3, F4).
+TEST(SessionRunner, ResumedSessionEqualsTheUninterruptedOne) {
+  Harness clean(8);
+  ASSERT_EQ(clean.Run().outcome, RunOutcome::kCompleted);
+  Harness h(8);
+  int lines = 0;
+  RunContext c = h.Context();
+  c.log = [&](const std::string&) {
+    if (++lines == 7) h.stop = true;
+  };
+  ASSERT_EQ(RunSession(h.plan, c, h.options).outcome, RunOutcome::kInterrupted);
+  const session::SessionLog stopped = h.Log();
+  const session::AcceptedSample* last = stopped.LastAcceptedSample();
+  ASSERT_NE(last, nullptr);
+  // The restart: a new cell at rest at the last sample's target, the clock at its journaled time.
+  SimCellOptions options;
+  options.camera.render.supersampling = 4;
+  options.camera.render.noise_std_grey = 2;
+  Result<SimCell> restarted =
+      MakeSimCell(testing::Puma560(), h.plan, options, h.plan[last->pose].joints_rad, last->sim_clock_s.value());
+  ASSERT_TRUE(restarted.ok());
+  h.stop = false;
+  RunContext c2 = h.Context();
+  c2.robot = restarted->robot.get();
+  c2.camera = restarted->camera.get();
+  c2.clock = restarted->clock.get();
+  c2.identifier = restarted->identifier.get();
+  const RunReport resumed = RunSession(h.plan, c2, h.options);
+  ASSERT_EQ(resumed.outcome, RunOutcome::kCompleted) << resumed.message;
+  EXPECT_EQ(resumed.first_pose, last->pose + 1);
+  const session::SessionLog a = clean.Log(), b = h.Log();
+  ASSERT_EQ(a.NumAccepted(), b.NumAccepted());
+  for (size_t p = 0; p < a.accepted.size(); ++p) {
+    ASSERT_TRUE(a.accepted[p] && b.accepted[p]);
+    ASSERT_EQ(a.accepted[p]->dots.size(), b.accepted[p]->dots.size()) << "pose " << p;
+    for (size_t k = 0; k < a.accepted[p]->dots.size(); ++k) {
+      EXPECT_EQ(a.accepted[p]->dots[k].id, b.accepted[p]->dots[k].id);
+      EXPECT_EQ(a.accepted[p]->dots[k].u_px, b.accepted[p]->dots[k].u_px);
+      EXPECT_EQ(a.accepted[p]->dots[k].v_px, b.accepted[p]->dots[k].v_px);
+    }
+    EXPECT_EQ(a.accepted[p]->joints_rad, b.accepted[p]->joints_rad);
+  }
+}
+
+}  // namespace
+}  // namespace selfcal::pipeline

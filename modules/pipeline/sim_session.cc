@@ -1,21 +1,21 @@
 #include "pipeline/sim_session.h"
 
+#include <algorithm>
 #include <limits>
 
 #include "sim/image_renderer.h"
 
 namespace selfcal::pipeline {
 
-Result<std::vector<tracking::PreviousDot>> TruthIdentifier::Identify(const capture::Frame& /*frame*/,
-                                                                     const tracking::DetectionReport& detections) {
+std::vector<std::pair<size_t, int>> TruthIdentifier::Match(const tracking::DetectionReport& detections,
+                                                           const std::vector<int>& ids) const {
   const sim::RenderedImage& render = camera_->last_render();
-  std::vector<tracking::PreviousDot> named;
   std::vector<int> claims(render.dots.size(), 0);
   std::vector<int> owner(detections.dots.size(), -1);
   for (size_t k = 0; k < detections.dots.size(); ++k) {
     double best = match_radius_px_;
     for (const sim::RenderedDot& dot : render.dots) {
-      if (!dot.visible) continue;
+      if (!dot.visible || (!ids.empty() && std::find(ids.begin(), ids.end(), dot.id) == ids.end())) continue;
       const double d = (detections.dots[k].centroid_px - dot.projected_centre_px).norm();
       if (d < best) {
         best = d;
@@ -24,11 +24,27 @@ Result<std::vector<tracking::PreviousDot>> TruthIdentifier::Identify(const captu
     }
     if (owner[k] >= 0) ++claims[owner[k]];
   }
+  std::vector<std::pair<size_t, int>> matches;
   for (size_t k = 0; k < detections.dots.size(); ++k) {
-    if (owner[k] >= 0 && claims[owner[k]] == 1) named.push_back(tracking::MakePreviousDot(owner[k], detections.dots[k]));
+    if (owner[k] >= 0 && claims[owner[k]] == 1) matches.push_back({k, owner[k]});
   }
+  return matches;
+}
+
+Result<std::vector<tracking::PreviousDot>> TruthIdentifier::Identify(const capture::Frame& /*frame*/,
+                                                                     const tracking::DetectionReport& detections) {
+  std::vector<tracking::PreviousDot> named;
+  for (const auto& [k, id] : Match(detections, {})) named.push_back(tracking::MakePreviousDot(id, detections.dots[k]));
   if (named.empty()) return Status::Error(ExitCode::kDegenerateData, "no detection matches a rendered dot");
   return named;
+}
+
+std::vector<tracking::PreviousDot> TruthIdentifier::FindMarked(const capture::Frame& /*frame*/,
+                                                               const tracking::DetectionReport& detections,
+                                                               const std::vector<int>& missing_ids) {
+  std::vector<tracking::PreviousDot> found;
+  for (const auto& [k, id] : Match(detections, missing_ids)) found.push_back(tracking::MakePreviousDot(id, detections.dots[k]));
+  return found;
 }
 
 Result<SimCell> MakeSimCell(const RobotModel& nominal, const std::vector<PlannedPose>& plan,
@@ -73,7 +89,12 @@ Result<SimCell> MakeSimCell(const RobotModel& nominal, const std::vector<Planned
   const robot::SimulatedRobot* arm = cell.robot.get();
   cell.camera->SetPoseFunction(
       [truth, arm](double t) { return BaseFromCam(truth->nominal, truth->rho_true, arm->JointsAt(t)); });
-  cell.identifier = std::make_unique<TruthIdentifier>(cell.camera.get());
+  std::vector<int> marked;
+  for (const KnownDistance& y : cell.world->observations.yardsticks) {
+    marked.push_back(y.dot_a);
+    marked.push_back(y.dot_b);
+  }
+  cell.identifier = std::make_unique<TruthIdentifier>(cell.camera.get(), marked);
   return cell;
 }
 

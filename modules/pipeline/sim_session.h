@@ -23,15 +23,25 @@
 namespace selfcal::pipeline {
 
 // Names detections by the nearest projected disc of the camera's last render (within match_radius_px).
+// `marked_ids` (the yardstick's ends) are the dots a real scene marks with a tag: FindMarked names them in
+// any frame; every other id after the first frame comes from tracking alone.
 class TruthIdentifier : public DotIdentifier {
  public:
-  explicit TruthIdentifier(const sim::SimulatedCamera* camera, double match_radius_px = 3.0)
-      : camera_(camera), match_radius_px_(match_radius_px) {}
+  TruthIdentifier(const sim::SimulatedCamera* camera, std::vector<int> marked_ids, double match_radius_px = 3.0)
+      : camera_(camera), marked_ids_(std::move(marked_ids)), match_radius_px_(match_radius_px) {}
   Result<std::vector<tracking::PreviousDot>> Identify(const capture::Frame& frame,
                                                       const tracking::DetectionReport& detections) override;
+  std::vector<tracking::PreviousDot> FindMarked(const capture::Frame& frame,
+                                                const tracking::DetectionReport& detections,
+                                                const std::vector<int>& missing_ids) override;
+  std::vector<int> MarkedIds() const override { return marked_ids_; }
 
  private:
+  // detection index -> rendered dot id among `ids` (all when empty), nearest within the radius, unique.
+  std::vector<std::pair<size_t, int>> Match(const tracking::DetectionReport& detections,
+                                            const std::vector<int>& ids) const;
   const sim::SimulatedCamera* camera_;
+  std::vector<int> marked_ids_;
   double match_radius_px_;
 };
 

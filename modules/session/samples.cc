@@ -297,9 +297,6 @@ class LogBuilder {
 
 }  // namespace
 
-const char* PoseRoleName(PoseRole role) {
-  return role == PoseRole::kIdentification ? "identification" : "verification";
-}
 
 bool IsFinalSkipReason(const std::string& reason) {
   static const std::set<std::string> kFinal = {"move_failed", "not_settled", "bad_reading",

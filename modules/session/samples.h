@@ -20,12 +20,14 @@
 #include <nlohmann/json.hpp>
 
 #include "base/status.h"
+#include "observations/observation_set.h"
 #include "session/session_dir.h"
 
 namespace selfcal::session {
 
-enum class PoseRole { kIdentification, kVerification };
-const char* PoseRoleName(PoseRole role);  // "identification", "verification"
+// The roles of observations/observation_set.h ("identification", "verification").
+using selfcal::PoseRole;
+using selfcal::PoseRoleName;
 
 // pose_planned.
 struct PlannedPose {

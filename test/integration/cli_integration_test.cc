@@ -253,3 +253,63 @@ TEST(Cli, PlanCheckRefusesTheArcAndAcceptsThePlannedFile) {
 
 }  // namespace
 }  // namespace selfcal
+
+namespace selfcal {
+namespace {
+
+// selfcal simulate (default): simulated arm + rendered camera through a session, calibrated offline from
+// it; the bundle's held-out 3-D error must beat the nominal model's, and the session must be complete.
+TEST(CliSession, SimulateRunsASessionEndToEndAndBeatsTheNominalModel) {
+  const fs::path dir = FreshDir("simulate_session");
+  std::string output;
+  ASSERT_EQ(RunSelfcal("simulate --out " + dir.string() + " --seed 2", &output), 0) << output;
+  EXPECT_TRUE(fs::exists(dir / "session" / "session.json"));
+  EXPECT_TRUE(fs::exists(dir / "calibrated_model.yaml"));
+  const nlohmann::json comparison = ReadJson(dir / "comparison_with_truth.json");
+  const double nominal = comparison["bundle"]["error3d_rms_mm"]["nominal"].get<double>();
+  const double bundle = comparison["bundle"]["error3d_rms_mm"]["bundle"].get<double>();
+  EXPECT_LT(bundle, 0.25 * nominal) << output;
+  // A second simulate into the same folder makes a new session, never overwriting the first (C10).
+  ASSERT_EQ(RunSelfcal("simulate --out " + dir.string() + " --seed 2", &output), 0) << output;
+  EXPECT_TRUE(fs::exists(dir / "session-2" / "session.json"));
+}
+
+TEST(CliSession, RunRefusesAnExistingSessionAndAChangedConfigOnResume) {  // C9, C10
+  const fs::path dir = FreshDir("run_refusals");
+  const std::string session = (dir / "s").string();
+  std::string output;
+  ASSERT_EQ(RunSelfcal("run --session " + session + " --seed 3", &output), 0) << output;
+  EXPECT_EQ(RunSelfcal("run --session " + session + " --seed 3", &output), 2) << output;
+  EXPECT_NE(output.find(session), std::string::npos) << output;
+  EXPECT_EQ(RunSelfcal("run --resume --session " + session + " --seed 4", &output), 2) << output;
+  EXPECT_NE(output.find("run.json"), std::string::npos) << output;
+  // Resuming a finished session with the same inputs has nothing left to do.
+  EXPECT_EQ(RunSelfcal("run --resume --session " + session + " --seed 3", &output), 0) << output;
+}
+
+TEST(CliSession, HardwareFaultExitsFourAndResumeFinishesTheSession) {  // R9, exit codes
+  const fs::path dir = FreshDir("run_fault");
+  const std::string session = (dir / "s").string();
+  std::string output;
+  EXPECT_EQ(RunSelfcal("run --session " + session + " --seed 3 --fault-protective-stop-move 3", &output), 4) << output;
+  EXPECT_NE(output.find("protective_stop"), std::string::npos) << output;
+  EXPECT_NE(output.find("HALTED"), std::string::npos) << output;
+  // Resuming needs the same inputs (the fault flags are inputs), so the operator resumes with them; the
+  // restarted simulated arm counts its moves afresh, so move #3 stops again: a halt is never silently
+  // skipped. Without the fault flag the inputs differ and resume is refused.
+  EXPECT_EQ(RunSelfcal("run --resume --session " + session + " --seed 3", &output), 2) << output;
+  ASSERT_EQ(RunSelfcal("calibrate " + session + " --out " + (dir / "cal").string(), &output), 3) << output;
+}
+
+TEST(CliSession, DryRunPrintsThePreviewAndRecordsNothing) {  // R1, F8
+  const fs::path dir = FreshDir("run_dry");
+  const std::string session = (dir / "s").string();
+  std::string output;
+  ASSERT_EQ(RunSelfcal("run --dry-run --session " + session + " --seed 3", &output), 0) << output;
+  EXPECT_NE(output.find("dry run: nothing moved"), std::string::npos) << output;
+  EXPECT_NE(output.find("25 moves"), std::string::npos) << output;
+  EXPECT_EQ(fs::file_size(fs::path(session) / "journal.log"), 0u);
+}
+
+}  // namespace
+}  // namespace selfcal
