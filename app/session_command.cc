@@ -23,11 +23,8 @@
 #include "io/trajectory_file.h"
 #include "pipeline/session_runner.h"
 #include "pipeline/sim_session.h"
-#if __has_include("robot/network_robot.h")
 #include "robot/manual_robot.h"
 #include "robot/network_robot.h"
-#define SELFCAL_HAVE_NETWORK_ROBOT 1
-#endif
 #include "session/samples.h"
 #include "session/session_dir.h"
 
@@ -280,7 +277,6 @@ int RunFromSettings(RunSettings a) {
   } else {
     owned_clock = std::make_unique<robot::MonotonicClock>();
     clock = owned_clock.get();
-#ifdef SELFCAL_HAVE_NETWORK_ROBOT
     if (a.robot_backend == "network") {
       const size_t colon = a.address.rfind(':');
       if (colon == std::string::npos) return Fail(Status::Error(ExitCode::kUsage, "--address must be HOST:PORT"));
@@ -301,9 +297,6 @@ int RunFromSettings(RunSettings a) {
     } else {
       return Fail(Status::Error(ExitCode::kUsage, "--robot must be sim, network or manual"));
     }
-#else
-    return Fail(Status::Error(ExitCode::kUsage, "--robot network/manual: not built"));
-#endif
     arm = owned_robot.get();
     capture::V4l2Options options;
     options.device = a.device;

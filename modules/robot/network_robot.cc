@@ -1,0 +1,225 @@
+#include "robot/network_robot.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <utility>
+
+namespace selfcal::robot {
+namespace {
+
+using protocol::RequestKind;
+
+constexpr double kByeTimeout_s = 0.2;  // Disconnect() does not wait longer for the BYE reply
+
+// "serial sim-1, now sim-2" for the fields that differ ("" when none does); empty `expected` fields
+// are not compared when `skip_empty`.
+std::string IdentityDifference(const RobotIdentity& expected, const RobotIdentity& seen, bool skip_empty) {
+  std::string difference;
+  const auto compare = [&](const char* field, const std::string& a, const std::string& b) {
+    if ((skip_empty && a.empty()) || a == b) return;
+    difference += std::string(difference.empty() ? "" : "; ") + field + " \"" + a + "\", now \"" + b + "\"";
+  };
+  compare("model", expected.model, seen.model);
+  compare("serial", expected.serial, seen.serial);
+  compare("calibration id", expected.calibration_id, seen.calibration_id);
+  return difference;
+}
+
+}  // namespace
+
+Status NetworkRobotOptions::Validate() const {
+  std::ostringstream problems;
+  if (!(std::isfinite(connect_timeout_s) && connect_timeout_s > 0)) {
+    problems << " connect_timeout_s = " << connect_timeout_s << " must be finite and > 0;";
+  }
+  if (!(std::isfinite(reply_timeout_s) && reply_timeout_s > 0)) {
+    problems << " reply_timeout_s = " << reply_timeout_s << " must be finite and > 0;";
+  }
+  if (max_line_bytes < 256) problems << " max_line_bytes = " << max_line_bytes << " must be at least 256;";
+  if (problems.str().empty()) return Status::Ok();
+  return Status::Error(ExitCode::kUsage, "network robot options:" + problems.str());
+}
+
+NetworkRobot::NetworkRobot(std::string host, int port, NetworkRobotOptions options)
+    : host_(std::move(host)),
+      port_(port),
+      options_(std::move(options)),
+      name_("network robot " + host_ + ":" + std::to_string(port_)),
+      last_controller_time_s_(std::numeric_limits<double>::quiet_NaN()) {
+  const Status valid = options_.Validate();
+  SELFCAL_CHECK(valid.ok(), valid.message());
+}
+
+NetworkRobot::~NetworkRobot() = default;
+
+Status NetworkRobot::LinkStatus(const char* call) const {
+  switch (link_) {
+    case Link::kUp:
+      return Status::Ok();
+    case Link::kBroken:
+      return RobotFailure(RobotError::kDisconnected,
+                          name_ + ": " + call + ": the connection was lost (" + broken_reason_ + "); Connect() again");
+    case Link::kNeverConnected:
+    case Link::kClosed:
+      break;
+  }
+  return RobotFailure(RobotError::kNotConnected, name_ + ": " + call + ": not connected");
+}
+
+void NetworkRobot::Break(const std::string& reason) {
+  socket_.Close();
+  if (link_ == Link::kUp) {
+    link_ = Link::kBroken;
+    broken_reason_ = reason;
+  }
+}
+
+Result<std::string> NetworkRobot::RoundTrip(RequestKind kind, const std::string& request) {
+  const std::string word = protocol::RequestWord(kind);
+  if (socket_.has_buffered_input()) {
+    Break("unrequested data from the controller");
+    return RobotFailure(RobotError::kProtocol, name_ + ": " + word + ": the controller sent a line nobody asked for");
+  }
+  LineIoResult io = socket_.WriteLine(request, options_.reply_timeout_s);
+  std::string reply;
+  if (io.ok()) io = socket_.ReadLine(&reply, options_.reply_timeout_s);
+  switch (io.outcome) {
+    case LineIo::kOk:
+      return reply;
+    case LineIo::kTimeout: {
+      std::ostringstream message;
+      message << "no reply to " << word << " within " << options_.reply_timeout_s << " s";
+      Break(message.str());
+      return RobotFailure(RobotError::kTimeout, name_ + ": " + message.str() + "; connection closed");
+    }
+    case LineIo::kTooLong:
+      Break("reply too long");
+      return RobotFailure(RobotError::kProtocol, name_ + ": " + word + ": reply too long (" + io.error +
+                                                     "); connection closed");
+    case LineIo::kClosed:
+    case LineIo::kFailed:
+      break;
+  }
+  const std::string reason = "closed during " + word + ": " + io.error;
+  Break(reason);
+  return RobotFailure(RobotError::kDisconnected, name_ + ": connection " + reason);
+}
+
+Status NetworkRobot::Handshake() {
+  const Result<std::string> hello_line = RoundTrip(RequestKind::kHello, protocol::HelloRequest());
+  if (!hello_line.ok()) return hello_line.status();
+  Result<protocol::HelloInfo> hello = protocol::ParseHelloReply(*hello_line, name_);
+  if (!hello.ok()) return hello.status();
+  if (first_hello_) {  // R10, R13: after a reconnect it must be the same arm
+    std::string difference = IdentityDifference(first_hello_->identity, hello->identity, false);
+    if (first_hello_->num_joints != hello->num_joints) {
+      difference += (difference.empty() ? "" : "; ") + std::string("joints ") +
+                    std::to_string(first_hello_->num_joints) + ", now " + std::to_string(hello->num_joints);
+    }
+    if (first_hello_->identity.real_hardware != hello->identity.real_hardware) {
+      difference += std::string(difference.empty() ? "" : "; ") + "real hardware flag changed";
+    }
+    if (!difference.empty()) {
+      return RobotFailure(RobotError::kProtocol, name_ + ": the controller is not the one first connected (" +
+                                                     difference + "); refusing it (R10, R13)");
+    }
+  }
+  if (options_.expected_identity) {  // R12, R13
+    const std::string difference = IdentityDifference(*options_.expected_identity, hello->identity, true);
+    if (!difference.empty()) {
+      return RobotFailure(RobotError::kProtocol, name_ + ": the controller is not the expected robot (expected " +
+                                                     difference + "); refusing it (R12, R13)");
+    }
+  }
+  const Result<std::string> limits_line = RoundTrip(RequestKind::kLimits, "LIMITS");
+  if (!limits_line.ok()) return limits_line.status();
+  Result<JointLimits> limits = protocol::ParseLimitsReply(*limits_line, hello->num_joints, name_);
+  if (!limits.ok()) return limits.status();
+  if (const std::string problem = CheckJointLimits(*limits); !problem.empty()) {
+    return RobotFailure(RobotError::kProtocol, name_ + ": LIMITS: " + problem);
+  }
+  hello_ = std::move(hello).value();
+  hello_.identity.backend = "network";
+  limits_ = std::move(limits).value();
+  if (!first_hello_) first_hello_ = hello_;
+  return Status::Ok();
+}
+
+Status NetworkRobot::Connect() {
+  if (link_ == Link::kUp && socket_.is_open()) return Status::Ok();
+  Result<LineSocket> socket =
+      LineSocket::Connect(host_, port_, options_.connect_timeout_s, options_.max_line_bytes);
+  if (!socket.ok()) return RobotFailure(RobotErrorOf(socket.status()), name_ + ": " + socket.status().message());
+  socket_ = std::move(socket).value();
+  const Status handshake = Handshake();
+  if (!handshake.ok()) {
+    socket_.Close();
+    return handshake;
+  }
+  link_ = Link::kUp;
+  broken_reason_.clear();
+  return Status::Ok();
+}
+
+void NetworkRobot::Disconnect() {
+  if (link_ == Link::kUp && socket_.is_open()) {
+    std::string ignored;
+    if (socket_.WriteLine("BYE", kByeTimeout_s).ok()) socket_.ReadLine(&ignored, kByeTimeout_s);
+  }
+  socket_.Close();
+  link_ = Link::kClosed;
+}
+
+Result<RobotIdentity> NetworkRobot::Identity() {
+  if (Status link = LinkStatus("Identity"); !link.ok()) return link;
+  return hello_.identity;
+}
+
+Result<JointLimits> NetworkRobot::Limits() {
+  if (Status link = LinkStatus("Limits"); !link.ok()) return link;
+  const Result<std::string> line = RoundTrip(RequestKind::kLimits, "LIMITS");
+  if (!line.ok()) return line.status();
+  Result<JointLimits> limits = protocol::ParseLimitsReply(*line, hello_.num_joints, name_);
+  if (limits.ok()) limits_ = *limits;
+  return limits;
+}
+
+Result<JointReading> NetworkRobot::ReadJoints() {
+  if (Status link = LinkStatus("ReadJoints"); !link.ok()) return link;
+  const Result<std::string> line = RoundTrip(RequestKind::kJoints, "JOINTS");
+  const double arrived_s = clock_.Now();  // the session's clock, not the controller's (see header)
+  if (!line.ok()) return line.status();
+  Result<JointReading> reading = protocol::ParseJointsReply(*line, name_);
+  if (!reading.ok()) return reading;
+  last_controller_time_s_ = reading->time_s;
+  reading.value().time_s = arrived_s;
+  return reading;
+}
+
+Status NetworkRobot::StartMove(const Eigen::VectorXd& target_rad, double velocity_scaling) {
+  if (Status link = LinkStatus("StartMove"); !link.ok()) return link;
+  if (const std::string problem = CheckMoveTarget(limits_, target_rad, velocity_scaling); !problem.empty()) {
+    return RobotFailure(RobotError::kRejected, name_ + ": move refused before sending: " + problem);
+  }
+  const Result<std::string> line = RoundTrip(RequestKind::kMove, protocol::MoveRequest(target_rad, velocity_scaling));
+  if (!line.ok()) return line.status();
+  return protocol::ParseOkReply(*line, RequestKind::kMove, RobotError::kRejected, name_);
+}
+
+Result<RobotStatus> NetworkRobot::GetStatus() {
+  if (Status link = LinkStatus("GetStatus"); !link.ok()) return link;
+  const Result<std::string> line = RoundTrip(RequestKind::kStatus, "STATUS");
+  if (!line.ok()) return line.status();
+  return protocol::ParseStatusReply(*line, name_);
+}
+
+Status NetworkRobot::Stop() {
+  if (Status link = LinkStatus("Stop"); !link.ok()) return link;
+  const Result<std::string> line = RoundTrip(RequestKind::kStop, "STOP");
+  if (!line.ok()) return line.status();
+  return protocol::ParseOkReply(*line, RequestKind::kStop, RobotError::kRejected, name_);
+}
+
+}  // namespace selfcal::robot
