@@ -417,6 +417,13 @@ RunReport Runner::Run() {
     route.push_back(plan_[i]);
     route_pose.push_back(i);
   }
+  // V1: the camera must work before anything moves (its Open grabs a test frame where it can).
+  if (Status s = c_.camera->Open(); !s.ok()) {
+    report_.outcome = RunOutcome::kHalted;
+    report_.exit_code = ExitCode::kHardware;
+    report_.message = "opening the camera " + c_.camera->Describe() + ": " + s.message();
+    return report_;
+  }
   const PreflightReport preflight = Preflight(route, limits_, now_joints->position_rad, o_.safety);
   report_.preview = "robot " + identity->backend + " " + identity->model + " serial " + identity->serial +
                     (identity->real_hardware ? " (REAL HARDWARE)" : " (no hardware)") + "\n" +
@@ -451,10 +458,6 @@ RunReport Runner::Run() {
     }
   }
   for (const auto& [image, frame] : log->frames) ++frames_written_[frame.pose];
-  if (Status s = c_.camera->Open(); !s.ok()) {
-    Halt(RunOutcome::kHalted, ExitCode::kHardware, "camera_open", s.message(), route_pose.front());
-    return report_;
-  }
 
   // R4: where the arm should be before each move: the previous move's target (the reading at the start).
   Eigen::VectorXd expected = now_joints->position_rad;
