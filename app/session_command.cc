@@ -19,6 +19,7 @@
 #include "base/atomic_file.h"
 #include "capture/v4l2_camera.h"
 #include "io/observations_file.h"
+#include "io/report_json.h"
 #include "io/robot_config.h"
 #include "io/trajectory_file.h"
 #include "pipeline/session_runner.h"
@@ -252,6 +253,10 @@ int RunFromSettings(RunSettings a) {
       }
     }
   } else {
+    const std::filesystem::path parent = std::filesystem::path(a.session).parent_path();
+    if (!parent.empty()) {
+      if (Status s = EnsureDirectory(parent.string()); !s.ok()) return Fail(s);
+    }
     session::CreateOptions create;
     create.created_utc = UtcNow();
     create.min_free_bytes = static_cast<std::uint64_t>(plan.size()) * 4 * 400 * 1024;
@@ -395,7 +400,33 @@ int CalibrateSession(const std::string& session_path, const std::string& out_dir
   if (Status s = io::SaveObservations(*obs, derived); !s.ok()) return Fail(s);
   std::cout << "session " << session_path << ": " << obs->poses.size() << " accepted samples\n";
   if (observations != nullptr) *observations = *obs;
-  return CalibrateAndWrite(*obs, session_path, out_dir, seed, method, result);
+  const int code = CalibrateAndWrite(*obs, session_path, out_dir, seed, method, result);
+  // The session's own figures beside the calibration: what was skipped, what went wrong, and why it halted.
+  Result<session::Session> s = session::OpenSession(session_path, {}, false);
+  if (!s.ok()) return Fail(s.status());
+  Result<session::SessionLog> log = session::ReadSessionLog(s->journal().records());
+  if (!log.ok()) return Fail(log.status());
+  const std::string report_path = (std::filesystem::path(out_dir) / "report.json").string();
+  Result<json> report = io::ReadJsonFile(report_path);
+  if (!report.ok()) return Fail(report.status());
+  json summary = {{"path", session_path},
+                  {"session_id", s->manifest().session_id},
+                  {"poses_planned", log->num_poses},
+                  {"samples_accepted", log->NumAccepted()},
+                  {"resumes", log->resumes},
+                  {"finished", log->finished},
+                  {"skips_by_reason", log->skips_by_reason},
+                  {"faults_by_kind", log->faults_by_kind},
+                  {"halts_by_reason", log->halts_by_reason}};
+  report.value()["session"] = summary;
+  if (Status w = io::WriteJsonFile(*report, report_path); !w.ok()) return Fail(w);
+  std::cout << "session: " << log->NumAccepted() << " of " << log->num_poses << " poses accepted, " << log->resumes
+            << " resumes";
+  for (const auto& [reason, n] : log->skips_by_reason) std::cout << ", skipped " << reason << " x" << n;
+  for (const auto& [kind, n] : log->faults_by_kind) std::cout << ", fault " << kind << " x" << n;
+  for (const auto& [reason, n] : log->halts_by_reason) std::cout << ", halted " << reason << " x" << n;
+  std::cout << "\n";
+  return code;
 }
 
 Command AddRunCommand(CLI::App& app) {
