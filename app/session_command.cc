@@ -186,7 +186,7 @@ bool ConfirmOnTerminal(const std::string& preview, const robot::RobotIdentity& i
 
 }  // namespace
 
-int RunFromSettings(RunSettings a) {
+int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
   const bool sim_robot = a.robot_backend == "sim";
   const bool sim_camera = a.camera_backend == "sim";
   if (sim_camera != sim_robot) {
@@ -248,8 +248,7 @@ int RunFromSettings(RunSettings a) {
       if (const session::AcceptedSample* last = log->LastAcceptedSample()) {
         start_joints = plan[last->pose].joints_rad;
         start_time_s = last->sim_clock_s.value_or(0);
-        cell = pipeline::MakeSimCell(*nominal, plan, SimCellOptionsFor(a), start_joints, start_time_s);
-        if (!cell.ok()) return Fail(cell.status());
+        pipeline::RestartSimCell(&cell.value(), SimCellOptionsFor(a), start_joints, start_time_s);
       }
     }
   } else {
@@ -343,24 +342,32 @@ int RunFromSettings(RunSettings a) {
                  "--session "
               << a.session << " (same options)\n";
   }
+  if (world != nullptr && sim_robot) *world = std::move(cell.value().world);
   return static_cast<int>(report.exit_code);
 }
-
-pipeline::SimCellOptions SimCellOptionsForSettings(const RunSettings& settings) { return SimCellOptionsFor(settings); }
-
-std::vector<pipeline::PlannedPose> PlanPosesOf(const io::TrajectoryFile& plan) { return PlanPoses(plan); }
 
 bool IsSessionDirectory(const std::string& path) {
   struct stat st {};
   return ::stat((std::filesystem::path(path) / session::kManifestFileName).c_str(), &st) == 0;
 }
 
-Result<ObservationSet> LoadSessionObservations(const std::string& session_path) {
+Result<ObservationSet> LoadSessionObservations(const std::string& session_path, nlohmann::json* summary) {
   Result<session::Session> opened = session::OpenSession(session_path, {}, false);
   if (!opened.ok()) return opened.status();
   const session::Session& s = *opened;
   Result<session::SessionLog> log = session::ReadSessionLog(s.journal().records());
   if (!log.ok()) return log.status();
+  if (summary != nullptr) {
+    *summary = {{"path", session_path},
+                {"session_id", s.manifest().session_id},
+                {"poses_planned", log->num_poses},
+                {"samples_accepted", log->NumAccepted()},
+                {"resumes", log->resumes},
+                {"finished", log->finished},
+                {"skips_by_reason", log->skips_by_reason},
+                {"faults_by_kind", log->faults_by_kind},
+                {"halts_by_reason", log->halts_by_reason}};
+  }
   if (Status v = session::VerifySampleImages(s, *log); !v.ok()) return v;
   Result<std::string> setup_text = s.ReadInput("setup.json");
   if (!setup_text.ok()) return setup_text.status();
@@ -393,7 +400,8 @@ Result<ObservationSet> LoadSessionObservations(const std::string& session_path) 
 
 int CalibrateSession(const std::string& session_path, const std::string& out_dir, uint64_t seed, Method method,
                      CalibrationResult* result, ObservationSet* observations) {
-  Result<ObservationSet> obs = LoadSessionObservations(session_path);
+  json summary;
+  Result<ObservationSet> obs = LoadSessionObservations(session_path, &summary);
   if (!obs.ok()) return Fail(obs.status());
   if (Status s = EnsureDirectory(out_dir); !s.ok()) return Fail(s);
   const std::string derived = (std::filesystem::path(out_dir) / "observations.yaml").string();
@@ -402,29 +410,17 @@ int CalibrateSession(const std::string& session_path, const std::string& out_dir
   if (observations != nullptr) *observations = *obs;
   const int code = CalibrateAndWrite(*obs, session_path, out_dir, seed, method, result);
   // The session's own figures beside the calibration: what was skipped, what went wrong, and why it halted.
-  Result<session::Session> s = session::OpenSession(session_path, {}, false);
-  if (!s.ok()) return Fail(s.status());
-  Result<session::SessionLog> log = session::ReadSessionLog(s->journal().records());
-  if (!log.ok()) return Fail(log.status());
   const std::string report_path = (std::filesystem::path(out_dir) / "report.json").string();
   Result<json> report = io::ReadJsonFile(report_path);
   if (!report.ok()) return Fail(report.status());
-  json summary = {{"path", session_path},
-                  {"session_id", s->manifest().session_id},
-                  {"poses_planned", log->num_poses},
-                  {"samples_accepted", log->NumAccepted()},
-                  {"resumes", log->resumes},
-                  {"finished", log->finished},
-                  {"skips_by_reason", log->skips_by_reason},
-                  {"faults_by_kind", log->faults_by_kind},
-                  {"halts_by_reason", log->halts_by_reason}};
   report.value()["session"] = summary;
   if (Status w = io::WriteJsonFile(*report, report_path); !w.ok()) return Fail(w);
-  std::cout << "session: " << log->NumAccepted() << " of " << log->num_poses << " poses accepted, " << log->resumes
-            << " resumes";
-  for (const auto& [reason, n] : log->skips_by_reason) std::cout << ", skipped " << reason << " x" << n;
-  for (const auto& [kind, n] : log->faults_by_kind) std::cout << ", fault " << kind << " x" << n;
-  for (const auto& [reason, n] : log->halts_by_reason) std::cout << ", halted " << reason << " x" << n;
+  std::cout << "session: " << summary["samples_accepted"] << " of " << summary["poses_planned"] << " poses accepted, "
+            << summary["resumes"] << " resumes";
+  for (const char* key : {"skips_by_reason", "faults_by_kind", "halts_by_reason"}) {
+    const char* word = key[0] == 's' ? "skipped" : key[0] == 'f' ? "fault" : "halted";
+    for (const auto& [name, n] : summary[key].items()) std::cout << ", " << word << " " << name << " x" << n;
+  }
   std::cout << "\n";
   return code;
 }

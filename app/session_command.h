@@ -4,13 +4,16 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "app/calibrate_command.h"
-#include "io/trajectory_file.h"
+#include "base/status.h"
 #include "observations/observation_set.h"
-#include "pipeline/sim_session.h"
+#include "sim/sim_world.h"
 
 namespace selfcal::app {
 
@@ -37,13 +40,8 @@ struct RunSettings {
 };
 
 // `selfcal run` with these settings: creates or resumes the session, drives the robot, returns the exit code.
-int RunFromSettings(RunSettings settings);
-
-// The simulated cell `selfcal run --robot sim` builds for these settings (same seeds: the same world).
-pipeline::SimCellOptions SimCellOptionsForSettings(const RunSettings& settings);
-
-// The plan's poses with ids p00, p01, ... and roles (the first num_identification_poses identify).
-std::vector<pipeline::PlannedPose> PlanPosesOf(const io::TrajectoryFile& plan);
+// With the simulated robot, *world (optional) receives the simulated world after the run (its hidden truth).
+int RunFromSettings(RunSettings settings, std::unique_ptr<sim::SimResult>* world = nullptr);
 
 // True when `path` is a session directory (it holds session.json).
 bool IsSessionDirectory(const std::string& path);
@@ -51,7 +49,8 @@ bool IsSessionDirectory(const std::string& path);
 // Builds the ObservationSet of a session: the setup input (camera, yardsticks, checks), the robot input,
 // and the accepted samples of the journal in plan order. Verifies every sample's image (P2). kUsage
 // naming the session and record on any inconsistency; kDegenerateData when too few samples were accepted.
-Result<ObservationSet> LoadSessionObservations(const std::string& session_path);
+// *summary (optional) receives the journal's counts: samples, resumes, skips, faults and halts by kind.
+Result<ObservationSet> LoadSessionObservations(const std::string& session_path, nlohmann::json* summary = nullptr);
 
 // `selfcal calibrate SESSION`: LoadSessionObservations + CalibrateAndWrite into out_dir; writes
 // out_dir/observations.yaml (derived, for other tools) too.

@@ -210,10 +210,6 @@ std::string FreshSessionPath(const std::string& out) {
 // selfcal simulate (default): the simulated arm and rendered camera through a real session directory, the
 // offline calibration of that session, and the comparison with the hidden truth.
 int SimulateSession(const SimulateArgs& args) {
-  Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(args.robot));
-  if (!robot.ok()) return Fail(robot.status());
-  Result<io::TrajectoryFile> plan = io::LoadTrajectoryFile(ResolveDataPath(args.trajectory), *robot);
-  if (!plan.ok()) return Fail(plan.status());
   if (Status s = EnsureDirectory(args.out); !s.ok()) return Fail(s);
   RunSettings run;
   run.session = FreshSessionPath(args.out);
@@ -226,18 +222,15 @@ int SimulateSession(const SimulateArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   std::cout << "session " << run.session << ": simulated robot and rendered camera (grey noise " << args.grey_noise
             << ", blur " << args.blur_px << " px)\n";
-  const int run_code = RunFromSettings(run);
+  std::unique_ptr<sim::SimResult> hidden;  // the session never saw it
+  const int run_code = RunFromSettings(run, &hidden);
   const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (run_code != 0) return run_code;
   CalibrationResult result;
   ObservationSet obs;
   const int code = CalibrateSession(run.session, args.out, args.seed, ParseMethod(args.method), &result, &obs);
   const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  // The hidden truth of the same seeds (the session never saw it).
-  Result<pipeline::SimCell> cell = pipeline::MakeSimCell(*robot, PlanPosesOf(*plan), SimCellOptionsForSettings(run),
-                                                         plan->poses.front(), 0.0);
-  if (!cell.ok()) return Fail(cell.status());
-  const sim::SimResult& world = *cell->world;
+  const sim::SimResult& world = *hidden;
   if (Status s = io::WriteJsonFile(TruthJson(world), (std::filesystem::path(args.out) / "truth.json").string()); !s.ok()) {
     return Fail(s);
   }

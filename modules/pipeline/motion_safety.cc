@@ -4,13 +4,9 @@
 #include <cstdio>
 #include <sstream>
 
-namespace selfcal::pipeline {
+#include "geometry/rigid3.h"
 
-namespace {
-constexpr double kPi = 3.14159265358979323846;
-double Deg(double rad) { return rad * 180.0 / kPi; }
-constexpr double kQuinticPeak = 1.875;  // max of d/dtau (10 tau^3 - 15 tau^4 + 6 tau^5)
-}  // namespace
+namespace selfcal::pipeline {
 
 std::string MotionSafetyOptions::Validate() const {
   std::ostringstream out;
@@ -18,26 +14,11 @@ std::string MotionSafetyOptions::Validate() const {
     out << "velocity_scaling = " << velocity_scaling << " must lie in (0, 1]\n";
   }
   if (!(max_joint_travel_rad > 0 && std::isfinite(max_joint_travel_rad))) {
-    out << "max_joint_travel = " << Deg(max_joint_travel_rad) << " deg must be > 0\n";
+    out << "max_joint_travel = " << RadToDeg(max_joint_travel_rad) << " deg must be > 0\n";
   }
   if (!(limit_margin_rad >= 0 && std::isfinite(limit_margin_rad))) out << "limit_margin must be >= 0\n";
   if (!(start_tolerance_rad > 0 && std::isfinite(start_tolerance_rad))) out << "start_tolerance must be > 0\n";
   return out.str();
-}
-
-double MoveDuration(const Eigen::VectorXd& from_rad, const Eigen::VectorXd& to_rad,
-                    const Eigen::VectorXd& max_velocity_rad_s, double velocity_scaling, int* limiting_joint) {
-  double duration = 0;
-  int limiting = -1;
-  for (int j = 0; j < from_rad.size(); ++j) {
-    const double t = kQuinticPeak * std::abs(to_rad[j] - from_rad[j]) / (max_velocity_rad_s[j] * velocity_scaling);
-    if (t > duration) {
-      duration = t;
-      limiting = j;
-    }
-  }
-  if (limiting_joint != nullptr) *limiting_joint = limiting;
-  return duration;
 }
 
 PreflightReport Preflight(const std::vector<PlannedPose>& plan, const robot::JointLimits& limits,
@@ -85,8 +66,8 @@ PreflightReport Preflight(const std::vector<PlannedPose>& plan, const robot::Joi
       } else if (q < limits.lower_rad[j] + options.limit_margin_rad || q > limits.upper_rad[j] - options.limit_margin_rad) {
         std::snprintf(text, sizeof(text),
                       "pose %s joint %d: %.3f deg is outside the limits [%.3f, %.3f] deg less a margin of %.3f deg (C6)",
-                      p.id.c_str(), j + 1, Deg(q), Deg(limits.lower_rad[j]), Deg(limits.upper_rad[j]),
-                      Deg(options.limit_margin_rad));
+                      p.id.c_str(), j + 1, RadToDeg(q), RadToDeg(limits.lower_rad[j]), RadToDeg(limits.upper_rad[j]),
+                      RadToDeg(options.limit_margin_rad));
         problem(text);
       }
     }
@@ -106,12 +87,12 @@ PreflightReport Preflight(const std::vector<PlannedPose>& plan, const robot::Joi
       std::snprintf(text, sizeof(text),
                     "move %s -> pose %s: joint %d travels %.2f deg, more than the bound of %.2f deg; add an "
                     "intermediate pose (R2)",
-                    from_name.c_str(), p.id.c_str(), worst + 1, Deg(move.max_travel_rad),
-                    Deg(options.max_joint_travel_rad));
+                    from_name.c_str(), p.id.c_str(), worst + 1, RadToDeg(move.max_travel_rad),
+                    RadToDeg(options.max_joint_travel_rad));
       problem(text);
     }
-    move.duration_s = MoveDuration(from, p.joints_rad, limits.max_velocity_rad_s, options.velocity_scaling,
-                                   &move.limiting_joint);
+    move.duration_s = robot::QuinticMoveDuration(from, p.joints_rad, limits.max_velocity_rad_s,
+                                                 options.velocity_scaling, &move.limiting_joint);
     report.total_motion_s += move.duration_s;
     report.moves.push_back(move);
     from = p.joints_rad;
@@ -129,7 +110,7 @@ std::string PreflightReport::Preview(const std::vector<PlannedPose>& plan, doubl
   for (size_t k = 0; k < moves.size(); ++k) {
     const MoveSummary& m = moves[k];
     std::snprintf(line, sizeof(line), "%-6zu %-14s %14.2f %14d %10.2f\n", k + 1, plan[m.pose].id.c_str(),
-                  Deg(m.max_travel_rad), m.limiting_joint + 1, m.duration_s);
+                  RadToDeg(m.max_travel_rad), m.limiting_joint + 1, m.duration_s);
     out << line;
   }
   std::snprintf(line, sizeof(line), "%zu moves, %.1f s of motion at velocity scaling %.0f %%\n", moves.size(),

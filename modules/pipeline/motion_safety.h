@@ -32,7 +32,7 @@ struct MoveSummary {
   int pose = -1;                  // the target pose (index in the plan)
   double max_travel_rad = 0;      // largest joint travel of the move
   int limiting_joint = -1;        // the joint that sets the duration
-  double duration_s = 0;          // at the scaling, quintic profile (peak 1.875 x mean speed)
+  double duration_s = 0;          // at the scaling: robot::QuinticMoveDuration
 };
 
 struct PreflightReport {
@@ -43,11 +43,6 @@ struct PreflightReport {
   // The dry-run preview: one line per move (pose id, max travel deg, limiting joint, seconds), totals.
   std::string Preview(const std::vector<PlannedPose>& plan, double velocity_scaling) const;
 };
-
-// Duration of a joint move at `velocity_scaling` with the quintic time scaling the simulated robot uses:
-// the limiting joint peaks at its velocity limit times the scaling.
-double MoveDuration(const Eigen::VectorXd& from_rad, const Eigen::VectorXd& to_rad,
-                    const Eigen::VectorXd& max_velocity_rad_s, double velocity_scaling, int* limiting_joint = nullptr);
 
 // Checks every pose of `plan` (joint count and finiteness [C5], limits less the margin [C6]) and every
 // move from `start_rad` through the plan in order (travel bound [R2]); refuses absent or non-positive

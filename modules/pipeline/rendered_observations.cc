@@ -41,26 +41,16 @@ ObservationSet ObserveRendered(const sim::SimResult& world, const RenderedObserv
     const tracking::DetectionReport report = tracking::DetectDots(image.image, options.detector);
     local.detected += static_cast<int>(report.dots.size());
     // Nearest true centre within the match radius; a dot claimed twice keeps neither claim.
-    std::vector<int> owner(image.dots.size(), -1);
-    std::vector<int> claim(report.dots.size(), -1);
-    for (size_t k = 0; k < report.dots.size(); ++k) {
-      double best = options.match_radius_px;
-      for (const sim::RenderedDot& dot : image.dots) {
-        if (!dot.visible) continue;
-        const double d = (report.dots[k].centroid_px - dot.projected_centre_px).norm();
-        if (d < best) {
-          best = d;
-          claim[k] = dot.id;
-        }
-      }
-      if (claim[k] < 0) {
+    std::vector<Eigen::Vector2d> centroids;
+    for (const tracking::DotDetection& d : report.dots) centroids.push_back(d.centroid_px);
+    const std::vector<int> names = sim::NameByNearestDisc(image, centroids, options.match_radius_px);
+    std::vector<int> owner(image.dots.size(), -1);  // dot id -> its detection
+    for (size_t k = 0; k < names.size(); ++k) {
+      if (names[k] >= 0) {
+        owner[names[k]] = static_cast<int>(k);
+      } else {
         ++local.spurious;
-        continue;
       }
-      owner[claim[k]] = owner[claim[k]] == -1 ? static_cast<int>(k) : -2;
-    }
-    for (size_t k = 0; k < report.dots.size(); ++k) {
-      if (claim[k] >= 0 && owner[claim[k]] == -2) ++local.spurious;
     }
     for (const sim::RenderedDot& dot : image.dots) {
       const int k = owner[dot.id];

@@ -57,8 +57,9 @@ class Runner {
 
   // A complete, finite, in-limits reading stamped at or after `after_s` (R8), retried; kSkip when none.
   Step ReadJoints(int pose, double after_s, robot::JointReading* reading);
-  // Moves to `target` and waits for arrival, tracking dots on the way (R5, R6, R9, R10, R11).
-  Step Move(int pose, const Eigen::VectorXd& target, double* arrival_s);
+  // Moves from `from` (read just before, R4) to `target` and waits for arrival, tracking dots on the way
+  // (R5, R6, R9, R10, R11).
+  Step Move(int pose, const robot::JointReading& from, const Eigen::VectorXd& target, double* arrival_s);
   Step Settle(int pose, double arrival_s, double* settle_s, robot::JointReading* reading);
   // A frame exposed after `not_before_s` (V3-V6), retried; kSkip when none.
   Step Grab(int pose, double not_before_s, bool during_move, capture::Frame* frame);
@@ -239,9 +240,8 @@ Runner::Step Runner::Identify(int pose, const capture::Frame& frame) {
   return Step::kOk;
 }
 
-Runner::Step Runner::Move(int pose, const Eigen::VectorXd& target, double* arrival_s) {
-  robot::JointReading from;
-  if (Step s = ReadJoints(pose, -std::numeric_limits<double>::infinity(), &from); s != Step::kOk) return s;
+Runner::Step Runner::Move(int pose, const robot::JointReading& from, const Eigen::VectorXd& target,
+                          double* arrival_s) {
   const double start = Now();
   if (!Record({{"type", "move_started"}, {"pose", pose}, {"time_s", start}, {"from_rad", ToJson(from.position_rad)}})) {
     return Step::kEnd;
@@ -254,7 +254,8 @@ Runner::Step Runner::Move(int pose, const Eigen::VectorXd& target, double* arriv
     }
     return HaltOnRobotError(s, pose, "starting the move");
   }
-  const double planned = MoveDuration(from.position_rad, target, limits_.max_velocity_rad_s, o_.safety.velocity_scaling);
+  const double planned =
+      robot::QuinticMoveDuration(from.position_rad, target, limits_.max_velocity_rad_s, o_.safety.velocity_scaling);
   const double deadline = start + o_.watchdog_factor * planned + o_.watchdog_slack_s;
   while (true) {
     if (StopRequested()) {
@@ -492,7 +493,7 @@ RunReport Runner::Run() {
     Log("pose " + target.id + ": moving");
     double arrival = 0, settle = 0;
     robot::JointReading settled;
-    step = Move(pose, target.joints_rad, &arrival);
+    step = Move(pose, before, target.joints_rad, &arrival);
     if (step == Step::kOk) {
       expected = target.joints_rad;  // R4: the next move must start from this move's target
       step = Settle(pose, arrival, &settle, &settled);

@@ -1,40 +1,26 @@
 #include "pipeline/sim_session.h"
 
-#include <algorithm>
 #include <limits>
 
 #include "sim/image_renderer.h"
 
 namespace selfcal::pipeline {
 
-std::vector<std::pair<size_t, int>> TruthIdentifier::Match(const tracking::DetectionReport& detections,
-                                                           const std::vector<int>& ids) const {
-  const sim::RenderedImage& render = camera_->last_render();
-  std::vector<int> claims(render.dots.size(), 0);
-  std::vector<int> owner(detections.dots.size(), -1);
-  for (size_t k = 0; k < detections.dots.size(); ++k) {
-    double best = match_radius_px_;
-    for (const sim::RenderedDot& dot : render.dots) {
-      if (!dot.visible || (!ids.empty() && std::find(ids.begin(), ids.end(), dot.id) == ids.end())) continue;
-      const double d = (detections.dots[k].centroid_px - dot.projected_centre_px).norm();
-      if (d < best) {
-        best = d;
-        owner[k] = dot.id;
-      }
-    }
-    if (owner[k] >= 0) ++claims[owner[k]];
+std::vector<tracking::PreviousDot> TruthIdentifier::Name(const tracking::DetectionReport& detections,
+                                                          const std::vector<int>& ids) const {
+  std::vector<Eigen::Vector2d> centroids;
+  for (const tracking::DotDetection& d : detections.dots) centroids.push_back(d.centroid_px);
+  const std::vector<int> names = sim::NameByNearestDisc(camera_->last_render(), centroids, match_radius_px_, ids);
+  std::vector<tracking::PreviousDot> named;
+  for (size_t k = 0; k < names.size(); ++k) {
+    if (names[k] >= 0) named.push_back(tracking::MakePreviousDot(names[k], detections.dots[k]));
   }
-  std::vector<std::pair<size_t, int>> matches;
-  for (size_t k = 0; k < detections.dots.size(); ++k) {
-    if (owner[k] >= 0 && claims[owner[k]] == 1) matches.push_back({k, owner[k]});
-  }
-  return matches;
+  return named;
 }
 
 Result<std::vector<tracking::PreviousDot>> TruthIdentifier::Identify(const capture::Frame& /*frame*/,
                                                                      const tracking::DetectionReport& detections) {
-  std::vector<tracking::PreviousDot> named;
-  for (const auto& [k, id] : Match(detections, {})) named.push_back(tracking::MakePreviousDot(id, detections.dots[k]));
+  std::vector<tracking::PreviousDot> named = Name(detections, {});
   if (named.empty()) return Status::Error(ExitCode::kDegenerateData, "no detection matches a rendered dot");
   return named;
 }
@@ -42,9 +28,7 @@ Result<std::vector<tracking::PreviousDot>> TruthIdentifier::Identify(const captu
 std::vector<tracking::PreviousDot> TruthIdentifier::FindMarked(const capture::Frame& /*frame*/,
                                                                const tracking::DetectionReport& detections,
                                                                const std::vector<int>& missing_ids) {
-  std::vector<tracking::PreviousDot> found;
-  for (const auto& [k, id] : Match(detections, missing_ids)) found.push_back(tracking::MakePreviousDot(id, detections.dots[k]));
-  return found;
+  return Name(detections, missing_ids);
 }
 
 Result<SimCell> MakeSimCell(const RobotModel& nominal, const std::vector<PlannedPose>& plan,
@@ -63,6 +47,16 @@ Result<SimCell> MakeSimCell(const RobotModel& nominal, const std::vector<Planned
   cell.world = std::make_unique<sim::SimResult>(sim::Simulate(nominal, joints, world_options));
   if (!cell.world->ok) return Status::Error(ExitCode::kDegenerateData, "simulation: " + cell.world->message);
 
+  RestartSimCell(&cell, options, start_joints_rad, start_time_s);
+  return cell;
+}
+
+void RestartSimCell(SimCell* cell, const SimCellOptions& options, const Eigen::VectorXd& start_joints_rad,
+                    double start_time_s) {
+  cell->identifier.reset();  // refers to the camera,
+  cell->camera.reset();      // whose pose function refers to the robot,
+  cell->robot.reset();       // which refers to the clock
+  const RobotModel& nominal = cell->world->truth.nominal;
   const int n = nominal.num_joints();
   robot::SimulatedRobotOptions robot_options;
   robot_options.identity = {"simulated", nominal.name.empty() ? "simulated-arm" : nominal.name,
@@ -78,24 +72,23 @@ Result<SimCell> MakeSimCell(const RobotModel& nominal, const std::vector<Planned
   robot_options.ring_cutoff_s = options.ring_cutoff_s;
   robot_options.faults = options.faults;
   robot_options.seed = options.world.world_seed;
-  cell.clock = std::make_unique<robot::SimulatedClock>(start_time_s);
-  cell.robot = std::make_unique<robot::SimulatedRobot>(robot_options, *cell.clock);
+  cell->clock = std::make_unique<robot::SimulatedClock>(start_time_s);
+  cell->robot = std::make_unique<robot::SimulatedRobot>(robot_options, *cell->clock);
 
   sim::SimulatedCameraOptions camera_options = options.camera;
   camera_options.render.noise_seed = options.world.noise_seed;
-  cell.camera = std::make_unique<sim::SimulatedCamera>(
-      cell.world->truth.camera_true, sim::MakeDotScene(cell.world->truth), camera_options);
-  const sim::SimTruth* truth = &cell.world->truth;
-  const robot::SimulatedRobot* arm = cell.robot.get();
-  cell.camera->SetPoseFunction(
+  cell->camera = std::make_unique<sim::SimulatedCamera>(
+      cell->world->truth.camera_true, sim::MakeDotScene(cell->world->truth), camera_options);
+  const sim::SimTruth* truth = &cell->world->truth;
+  const robot::SimulatedRobot* arm = cell->robot.get();
+  cell->camera->SetPoseFunction(
       [truth, arm](double t) { return BaseFromCam(truth->nominal, truth->rho_true, arm->JointsAt(t)); });
   std::vector<int> marked;
-  for (const KnownDistance& y : cell.world->observations.yardsticks) {
+  for (const KnownDistance& y : cell->world->observations.yardsticks) {
     marked.push_back(y.dot_a);
     marked.push_back(y.dot_b);
   }
-  cell.identifier = std::make_unique<TruthIdentifier>(cell.camera.get(), marked);
-  return cell;
+  cell->identifier = std::make_unique<TruthIdentifier>(cell->camera.get(), marked);
 }
 
 ObservationSet SimSetup(const SimCell& cell) {

@@ -37,9 +37,9 @@ class TruthIdentifier : public DotIdentifier {
   std::vector<int> MarkedIds() const override { return marked_ids_; }
 
  private:
-  // detection index -> rendered dot id among `ids` (all when empty), nearest within the radius, unique.
-  std::vector<std::pair<size_t, int>> Match(const tracking::DetectionReport& detections,
-                                            const std::vector<int>& ids) const;
+  // The detections that name a rendered dot among `ids` (all when empty): sim::NameByNearestDisc.
+  std::vector<tracking::PreviousDot> Name(const tracking::DetectionReport& detections,
+                                          const std::vector<int>& ids) const;
   const sim::SimulatedCamera* camera_;
   std::vector<int> marked_ids_;
   double match_radius_px_;
@@ -69,6 +69,11 @@ struct SimCell {
 Result<SimCell> MakeSimCell(const RobotModel& nominal, const std::vector<PlannedPose>& plan,
                             const SimCellOptions& options, const Eigen::VectorXd& start_joints_rad,
                             double start_time_s);
+
+// Rebuilds the clock, arm, camera and identifier of `cell` on its world (no new simulation): the arm at
+// rest at `start_joints_rad`, the clock at `start_time_s` (the restart model of the header comment).
+void RestartSimCell(SimCell* cell, const SimCellOptions& options, const Eigen::VectorXd& start_joints_rad,
+                    double start_time_s);
 
 // The setup of a simulated session: the world's observation header (camera with the nominal f_x,
 // yardstick, check distances), no poses.

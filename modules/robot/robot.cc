@@ -58,6 +58,21 @@ const char* MotionStateName(MotionState state) {
   return "unknown";
 }
 
+double QuinticMoveDuration(const Eigen::VectorXd& from_rad, const Eigen::VectorXd& to_rad,
+                           const Eigen::VectorXd& max_velocity_rad_s, double velocity_scaling, int* limiting_joint) {
+  double duration_s = 0;
+  int limiting = -1;
+  for (Eigen::Index j = 0; j < from_rad.size(); ++j) {
+    const double t = kQuinticPeakRate * std::abs(to_rad[j] - from_rad[j]) / (max_velocity_rad_s[j] * velocity_scaling);
+    if (t > duration_s) {
+      duration_s = t;
+      limiting = static_cast<int>(j);
+    }
+  }
+  if (limiting_joint != nullptr) *limiting_joint = limiting;
+  return duration_s;
+}
+
 std::string CheckJointLimits(const JointLimits& limits) {
   const Eigen::Index n = limits.lower_rad.size();
   std::ostringstream problem;

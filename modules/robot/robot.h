@@ -80,6 +80,17 @@ const char* MotionStateName(MotionState state);
 // finite, lower >= upper, or a velocity limit is not positive. Names the joint (1-based) and the value.
 std::string CheckJointLimits(const JointLimits& limits);
 
+// The joint-space profile every backend here assumes: the quintic time scaling
+// s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5, whose peak rate ds/dtau is 15/8.
+inline constexpr double kQuinticPeakRate = 1.875;
+
+// Duration of a quintic move from `from_rad` to `to_rad` when the limiting joint peaks at its velocity
+// limit times `velocity_scaling`; *limiting_joint (optional) receives that joint (-1 for a null move).
+// The simulated robot moves this way; the session's preflight and watchdog time moves with it.
+double QuinticMoveDuration(const Eigen::VectorXd& from_rad, const Eigen::VectorXd& to_rad,
+                           const Eigen::VectorXd& max_velocity_rad_s, double velocity_scaling,
+                           int* limiting_joint = nullptr);
+
 // Why `target_rad` at `velocity_scaling` cannot be commanded to an arm with `limits` ("" when it can):
 // the size differs from the joint count, a value is not finite or outside its limits, or the scaling is
 // not in (0, 1]. Names the joint (1-based), the value and the limit, in rad. For the backends that check

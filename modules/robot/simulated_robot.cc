@@ -10,7 +10,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 // Peak of ds/dtau of the quintic time scaling s = 10 tau^3 - 15 tau^4 + 6 tau^5 (at tau = 1/2).
-constexpr double kQuinticPeakRate = 1.875;
 constexpr double kSlowSettleFactor = 20;  // R7 fault: the ring-down's time constant times this
 constexpr double kStaleAge_s = 1;         // R8 fault: a stale reading is this much older than the last
 
@@ -198,12 +197,8 @@ Result<JointReading> SimulatedRobot::ReadJoints() {
 
 double SimulatedRobot::MoveDuration(const Eigen::VectorXd& from_rad, const Eigen::VectorXd& to_rad,
                                     double velocity_scaling) const {
-  double duration_s = options_.min_move_duration_s;
-  for (Eigen::Index j = 0; j < from_rad.size(); ++j) {
-    const double peak_rad_s = options_.limits.max_velocity_rad_s[j] * velocity_scaling;
-    duration_s = std::max(duration_s, kQuinticPeakRate * std::abs(to_rad[j] - from_rad[j]) / peak_rad_s);
-  }
-  return duration_s;
+  return std::max(options_.min_move_duration_s,
+                  QuinticMoveDuration(from_rad, to_rad, options_.limits.max_velocity_rad_s, velocity_scaling));
 }
 
 Status SimulatedRobot::StartMove(const Eigen::VectorXd& target_rad, double velocity_scaling) {

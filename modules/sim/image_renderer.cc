@@ -278,4 +278,26 @@ RenderedImage RenderDots(const CameraIntrinsics& camera, const Rigid3& base_from
   return out;
 }
 
+std::vector<int> NameByNearestDisc(const RenderedImage& image, const std::vector<Eigen::Vector2d>& points,
+                                   double radius_px, const std::vector<int>& ids) {
+  std::vector<int> names(points.size(), kNoDot);
+  std::vector<int> claims(image.dots.size(), 0);
+  for (size_t k = 0; k < points.size(); ++k) {
+    double best = radius_px;
+    for (const RenderedDot& dot : image.dots) {
+      if (!dot.visible || (!ids.empty() && std::find(ids.begin(), ids.end(), dot.id) == ids.end())) continue;
+      const double d = (points[k] - dot.projected_centre_px).norm();
+      if (d < best) {
+        best = d;
+        names[k] = dot.id;
+      }
+    }
+    if (names[k] >= 0) ++claims[names[k]];
+  }
+  for (int& name : names) {
+    if (name >= 0 && claims[name] > 1) name = kAmbiguousDot;
+  }
+  return names;
+}
+
 }  // namespace selfcal::sim

@@ -100,6 +100,15 @@ struct RenderedImage {
 RenderedImage RenderDots(const CameraIntrinsics& camera, const Rigid3& base_from_cam, const DotScene& scene,
                          const RenderOptions& options, uint64_t noise_seed);
 
+// Names points (e.g. detected centroids) by the rendered dots of `image`: for each point, the id of the
+// visible dot whose projected centre is nearest and closer than radius_px (among `ids` when not empty),
+// kNoDot when there is none, kAmbiguousDot when another point names the same dot (neither keeps it).
+// The simulator's stand-in for identities (pipeline/rendered_observations.h, pipeline/sim_session.h).
+inline constexpr int kNoDot = -1;
+inline constexpr int kAmbiguousDot = -2;
+std::vector<int> NameByNearestDisc(const RenderedImage& image, const std::vector<Eigen::Vector2d>& points,
+                                   double radius_px, const std::vector<int>& ids = {});
+
 // Centre of the ellipse a disc projects to through the pinhole part of `camera` (k1 ignored), px.
 // Closed form: with e1, e2 orthonormal in the disc's plane and H = [e1 e2 c] (c = centre_in_cam), the
 // rim a^2 + b^2 = r^2 in plane coordinates is the conic Q = diag(1, 1, -r^2); its image in pixels is

@@ -21,18 +21,13 @@
 
 #include "session/samples.h"
 #include "session/session_dir.h"
+#include "support/temp_files.h"
 
 namespace selfcal {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string ReadAll(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using testing::ReadFile;
 
 // Starts `selfcal args...` with output to `log`; returns its pid.
 pid_t Spawn(const std::vector<std::string>& args, const fs::path& log) {
@@ -113,10 +108,10 @@ TEST(KillResume, RandomKillsLoseNothingAndTheResultIsIdentical) {
 
   // The reference: one uninterrupted run, timed.
   const auto t0 = std::chrono::steady_clock::now();
-  ASSERT_EQ(RunToEnd(run_args(root / "clean", false), log), 0) << ReadAll(log);
+  ASSERT_EQ(RunToEnd(run_args(root / "clean", false), log), 0) << ReadFile(log);
   const double full_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ASSERT_EQ(RunToEnd({"calibrate", (root / "clean").string(), "--out", (root / "clean_cal").string()}, log), 0)
-      << ReadAll(log);
+      << ReadFile(log);
 
   // The killed one: delays uniform over [0, 2 full / kills + 0.3 s] so that kills land everywhere, from
   // start-up to the last write, and progress needs several lives.
@@ -147,7 +142,7 @@ TEST(KillResume, RandomKillsLoseNothingAndTheResultIsIdentical) {
       bool killed = false;
       const int code = Wait(pid, &killed);
       if (!killed && code == 0) ++completed_early;  // finished before the kill
-      if (!killed && code != 0) FAIL() << "run exited " << code << " without being killed:\n" << ReadAll(log);
+      if (!killed && code != 0) FAIL() << "run exited " << code << " without being killed:\n" << ReadFile(log);
       if (!fs::exists(dir / session::kManifestFileName)) {
         // Killed before the session existed (or while creating it): start afresh, as an operator would.
         fs::remove_all(dir);
@@ -164,14 +159,14 @@ TEST(KillResume, RandomKillsLoseNothingAndTheResultIsIdentical) {
       if (accepted == clean_samples) break;  // nothing left to interrupt in this session
     }
     if (!created) continue;
-    ASSERT_EQ(RunToEnd(run_args(dir, true), log), 0) << ReadAll(log);
+    ASSERT_EQ(RunToEnd(run_args(dir, true), log), 0) << ReadFile(log);
     EXPECT_EQ(AcceptedSamples(dir, &problem), clean_samples) << problem;
     const fs::path cal = root / ("cal_" + std::to_string(sessions));
-    ASSERT_EQ(RunToEnd({"calibrate", dir.string(), "--out", cal.string()}, log), 0) << ReadAll(log);
-    EXPECT_EQ(without_source(ReadAll(cal / "calibrated_model.yaml")),
-              without_source(ReadAll(root / "clean_cal" / "calibrated_model.yaml")))
+    ASSERT_EQ(RunToEnd({"calibrate", dir.string(), "--out", cal.string()}, log), 0) << ReadFile(log);
+    EXPECT_EQ(without_source(ReadFile(cal / "calibrated_model.yaml")),
+              without_source(ReadFile(root / "clean_cal" / "calibrated_model.yaml")))
         << "session " << dir;
-    EXPECT_EQ(ReadAll(cal / "observations.yaml"), ReadAll(root / "clean_cal" / "observations.yaml"));
+    EXPECT_EQ(ReadFile(cal / "observations.yaml"), ReadFile(root / "clean_cal" / "observations.yaml"));
   }
   std::printf("%d kills over %d sessions (%d after the run had journaled something, %d runs finished before "
               "their kill); recovered %d torn journal tails, moved %d orphan images; every resumed result "
