@@ -1,5 +1,6 @@
-// Shared by `calibrate` and `simulate`: run the calibration on a loaded observation set and write the
-// report (and, when accepted, the chosen method's calibrated model) into a directory.
+// The calibrate command's three steps, shared with `simulate`: load (an observations file or a session
+// directory), run the calibration facade (calibration/calibrate.h), write what it returns (report.json
+// always, calibrated_model.yaml only when accepted) and map its verdict to the exit code.
 #pragma once
 
 #include <cstdint>
@@ -7,27 +8,34 @@
 
 #include <CLI/CLI.hpp>
 
+#include "calibration/calibrate.h"
 #include "observations/observation_set.h"
-#include "pipeline/bundle_stage.h"
-#include "pipeline/paper_pipeline.h"
 
 namespace selfcal::app {
 
-enum class Method { kBundle, kPaper };
-inline Method ParseMethod(const std::string& name) { return name == "paper" ? Method::kPaper : Method::kBundle; }
+// "paper" -> kPaper, anything else the default kBundle (CLI11 has checked the name).
+inline calibration::Method MethodFromName(const std::string& name) {
+  return calibration::ParseMethod(name).value_or(calibration::Method::kBundle);
+}
 
 // Registers `--method bundle|paper` (default: whatever *method holds, "bundle").
 void AddMethodOption(CLI::App* cmd, std::string* method);
 
-struct CalibrationResult {
-  Method method = Method::kBundle;
-  pipeline::PaperPipelineReport paper;  // always run: the baseline and the bundle's start
-  bool bundle_run = false;
-  pipeline::BundleStageReport bundle;   // when method == kBundle
+struct CalibrateRequest {
+  std::string input;  // observations file or session directory
+  std::string out_dir;
+  uint64_t seed = 1;  // RANSAC sampling of the two-view step
+  calibration::Method method = calibration::Method::kBundle;
 };
 
-// Returns the process exit code of the chosen method's outcome; *result (optional) receives both reports.
-int CalibrateAndWrite(const ObservationSet& observations, const std::string& source_path, const std::string& out_dir,
-                      uint64_t seed, Method method, CalibrationResult* result);
+// What a calibration read and returned, for callers that compare it with a truth (`simulate`).
+struct CalibrationRun {
+  ObservationSet observations;
+  calibration::CalibrationReport report;
+};
+
+// Loads request.input (a session directory when it holds session.json), calibrates, writes into
+// request.out_dir; returns the process exit code. *run (optional) receives the observations and report.
+int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run = nullptr);
 
 }  // namespace selfcal::app

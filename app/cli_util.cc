@@ -19,28 +19,14 @@ int Fail(const Status& status) {
   return static_cast<int>(status.code());
 }
 
-ExitCode ExitCodeFor(pipeline::Outcome outcome) {
-  switch (outcome) {
-    case pipeline::Outcome::kSuccess: return ExitCode::kOk;
-    case pipeline::Outcome::kInvalidInput: return ExitCode::kUsage;
-    case pipeline::Outcome::kDegenerate:
-    case pipeline::Outcome::kScaleUnresolved: return ExitCode::kDegenerateData;
-    case pipeline::Outcome::kUnconverged:
-    case pipeline::Outcome::kSolverFailure:
-    case pipeline::Outcome::kNotRun: return ExitCode::kSolverFailure;
-  }
-  return ExitCode::kSolverFailure;
-}
-
-ExitCode ExitCodeFor(bundle::Outcome outcome) {
-  switch (outcome) {
-    case bundle::Outcome::kConverged: return ExitCode::kOk;
-    case bundle::Outcome::kInvalidInput: return ExitCode::kUsage;
-    case bundle::Outcome::kDegenerate:
-    case bundle::Outcome::kScaleUnresolved: return ExitCode::kDegenerateData;
-    case bundle::Outcome::kNoConvergence:
-    case bundle::Outcome::kFailure:
-    case bundle::Outcome::kNotRun: return ExitCode::kSolverFailure;
+ExitCode ExitCodeFor(calibration::Verdict verdict) {
+  switch (verdict) {
+    case calibration::Verdict::kAccepted: return ExitCode::kOk;
+    case calibration::Verdict::kInvalidInput: return ExitCode::kUsage;
+    case calibration::Verdict::kDegenerate:
+    case calibration::Verdict::kScaleUnresolved: return ExitCode::kDegenerateData;
+    case calibration::Verdict::kUnconverged:
+    case calibration::Verdict::kSolverFailure: return ExitCode::kSolverFailure;
   }
   return ExitCode::kSolverFailure;
 }

@@ -4,8 +4,7 @@
 #include <string>
 
 #include "base/status.h"
-#include "bundle/bundle_adjustment.h"
-#include "pipeline/paper_pipeline.h"
+#include "calibration/calibrate.h"
 
 namespace selfcal::app {
 
@@ -16,9 +15,9 @@ std::string ResolveDataPath(const std::string& path);
 // Prints "selfcal: <code name>: message" to stderr and returns the exit code.
 int Fail(const Status& status);
 
-ExitCode ExitCodeFor(pipeline::Outcome outcome);
-// kConverged 0; kScaleUnresolved, kDegenerate 3; kInvalidInput 2; anything else 5.
-ExitCode ExitCodeFor(bundle::Outcome outcome);
+// The exit code of a calibration verdict: accepted 0; invalid input 2; degenerate, no scale 3; unconverged,
+// solver failure 5.
+ExitCode ExitCodeFor(calibration::Verdict verdict);
 
 // 64-bit FNV-1a of a file's bytes as 16 hex digits ("" if unreadable): provenance in reports (P7).
 std::string FileHash(const std::string& path);

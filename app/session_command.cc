@@ -22,8 +22,8 @@
 #include "io/report_json.h"
 #include "io/robot_config.h"
 #include "io/trajectory_file.h"
-#include "pipeline/session_runner.h"
-#include "pipeline/sim_session.h"
+#include "acquisition/session_runner.h"
+#include "simulation/sim_session.h"
 #include "robot/manual_robot.h"
 #include "robot/network_robot.h"
 #include "session/samples.h"
@@ -111,8 +111,8 @@ Status ParseSetup(const std::string& text, const std::string& name, ObservationS
   return Status::Ok();
 }
 
-std::vector<pipeline::PlannedPose> PlanPoses(const io::TrajectoryFile& plan) {
-  std::vector<pipeline::PlannedPose> poses;
+std::vector<acquisition::PlannedPose> PlanPoses(const io::TrajectoryFile& plan) {
+  std::vector<acquisition::PlannedPose> poses;
   const int n = static_cast<int>(plan.poses.size());
   const int id_poses = plan.num_identification_poses > 0 ? plan.num_identification_poses : std::min(n, 15);
   for (int i = 0; i < n; ++i) {
@@ -145,8 +145,8 @@ json RunJson(const RunSettings& a) {
             {"short_reads", a.fault_short_reads}}}};
 }
 
-pipeline::SimCellOptions SimCellOptionsFor(const RunSettings& a) {
-  pipeline::SimCellOptions o;
+simulation::SimCellOptions SimCellOptionsFor(const RunSettings& a) {
+  simulation::SimCellOptions o;
   o.world.world_seed = a.seed;
   o.world.noise_seed = a.seed;
   o.world.pixel_noise_px = 0.02;  // the centroid noise the solvers are told (measured 0.01 px at grey noise 2)
@@ -207,7 +207,7 @@ int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
   if (!plan_text.ok()) return Fail(plan_text.status());
   Result<io::TrajectoryFile> plan_file = io::LoadTrajectoryFile(ResolveDataPath(a.plan), *nominal);
   if (!plan_file.ok()) return Fail(plan_file.status());
-  const std::vector<pipeline::PlannedPose> plan = PlanPoses(*plan_file);
+  const std::vector<acquisition::PlannedPose> plan = PlanPoses(*plan_file);
 
   // Resume: the simulated arm restarts where the last accepted sample left it (sim_session.h).
   Eigen::VectorXd start_joints = plan.front().joints_rad;
@@ -216,12 +216,12 @@ int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
   session::SessionInputs inputs = {{"robot.yaml", *robot_text}, {"plan.yaml", *plan_text},
                                    {"run.json", RunJson(a).dump(2) + "\n"}};
   // The simulated cell (built before the session so that its setup can be recorded).
-  Result<pipeline::SimCell> cell = Status::Error(ExitCode::kUsage, "no simulated cell");
+  Result<simulation::SimCell> cell = Status::Error(ExitCode::kUsage, "no simulated cell");
   std::string setup_text;
   if (sim_robot) {
-    cell = pipeline::MakeSimCell(*nominal, plan, SimCellOptionsFor(a), start_joints, start_time_s);
+    cell = simulation::MakeSimCell(*nominal, plan, SimCellOptionsFor(a), start_joints, start_time_s);
     if (!cell.ok()) return Fail(cell.status());
-    setup_text = SetupJson(pipeline::SimSetup(*cell)).dump(2) + "\n";
+    setup_text = SetupJson(simulation::SimSetup(*cell)).dump(2) + "\n";
   } else {
     Result<std::string> text = ReadWhole(a.setup);
     if (!text.ok()) return Fail(text.status());
@@ -248,7 +248,7 @@ int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
       if (const session::AcceptedSample* last = log->LastAcceptedSample()) {
         start_joints = plan[last->pose].joints_rad;
         start_time_s = last->sim_clock_s.value_or(0);
-        pipeline::RestartSimCell(&cell.value(), SimCellOptionsFor(a), start_joints, start_time_s);
+        simulation::RestartSimCell(&cell.value(), SimCellOptionsFor(a), start_joints, start_time_s);
       }
     }
   } else {
@@ -271,8 +271,8 @@ int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
   robot::Robot* arm = nullptr;
   capture::FrameSource* camera = nullptr;
   robot::Clock* clock = nullptr;
-  pipeline::DetectionOrderIdentifier order_identifier;
-  pipeline::DotIdentifier* identifier = &order_identifier;
+  acquisition::DetectionOrderIdentifier order_identifier;
+  acquisition::DotIdentifier* identifier = &order_identifier;
   if (sim_robot) {
     arm = cell->robot.get();
     camera = cell->camera.get();
@@ -309,12 +309,12 @@ int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
   }
 
   InstallStopHandlers();
-  pipeline::RunOptions options;
+  acquisition::RunOptions options;
   options.safety.velocity_scaling = a.velocity_scaling;
   options.journal_sim_clock = sim_robot;
   options.mode = sim_robot ? "simulated" : a.robot_backend;
   if (sim_robot) options.settle.min_dwell_s = 0.6;  // > the simulated ring-down cutoff (resume determinism)
-  pipeline::RunContext context;
+  acquisition::RunContext context;
   context.robot = arm;
   context.camera = camera;
   context.clock = clock;
@@ -326,18 +326,18 @@ int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
     return ConfirmOnTerminal(preview, identity, dry_run);
   };
   context.log = [](const std::string& line) { std::cout << line << "\n" << std::flush; };
-  const pipeline::RunReport report = pipeline::RunSession(plan, context, options);
-  if (a.dry_run && report.outcome == pipeline::RunOutcome::kRefused && report.preview.size() > 0 &&
+  const acquisition::RunReport report = acquisition::RunSession(plan, context, options);
+  if (a.dry_run && report.outcome == acquisition::RunOutcome::kRefused && report.preview.size() > 0 &&
       report.message.rfind("not confirmed", 0) == 0) {
     return 0;
   }
-  std::cout << "run: " << pipeline::RunOutcomeName(report.outcome) << ": " << report.message << "\n";
+  std::cout << "run: " << acquisition::RunOutcomeName(report.outcome) << ": " << report.message << "\n";
   std::cout << "this run: " << report.accepted << " samples accepted from pose " << report.first_pose << ", "
             << report.frames_grabbed << " frames grabbed, " << report.frames_tracked << " tracked";
   for (const auto& [reason, n] : report.skips) std::cout << ", skipped " << reason << " x" << n;
   for (const auto& [kind, n] : report.faults) std::cout << ", fault " << kind << " x" << n;
   std::cout << "\n";
-  if (report.outcome == pipeline::RunOutcome::kHalted || report.outcome == pipeline::RunOutcome::kInterrupted) {
+  if (report.outcome == acquisition::RunOutcome::kHalted || report.outcome == acquisition::RunOutcome::kInterrupted) {
     std::cout << "HALTED. The robot was told to stop. Check the cell, then continue with: selfcal run --resume "
                  "--session "
               << a.session << " (same options)\n";
@@ -396,33 +396,6 @@ Result<ObservationSet> LoadSessionObservations(const std::string& session_path, 
     return Status::Error(ExitCode::kDegenerateData, "session " + session_path + ": " + problems);
   }
   return set;
-}
-
-int CalibrateSession(const std::string& session_path, const std::string& out_dir, uint64_t seed, Method method,
-                     CalibrationResult* result, ObservationSet* observations) {
-  json summary;
-  Result<ObservationSet> obs = LoadSessionObservations(session_path, &summary);
-  if (!obs.ok()) return Fail(obs.status());
-  if (Status s = EnsureDirectory(out_dir); !s.ok()) return Fail(s);
-  const std::string derived = (std::filesystem::path(out_dir) / "observations.yaml").string();
-  if (Status s = io::SaveObservations(*obs, derived); !s.ok()) return Fail(s);
-  std::cout << "session " << session_path << ": " << obs->poses.size() << " accepted samples\n";
-  if (observations != nullptr) *observations = *obs;
-  const int code = CalibrateAndWrite(*obs, session_path, out_dir, seed, method, result);
-  // The session's own figures beside the calibration: what was skipped, what went wrong, and why it halted.
-  const std::string report_path = (std::filesystem::path(out_dir) / "report.json").string();
-  Result<json> report = io::ReadJsonFile(report_path);
-  if (!report.ok()) return Fail(report.status());
-  report.value()["session"] = summary;
-  if (Status w = io::WriteJsonFile(*report, report_path); !w.ok()) return Fail(w);
-  std::cout << "session: " << summary["samples_accepted"] << " of " << summary["poses_planned"] << " poses accepted, "
-            << summary["resumes"] << " resumes";
-  for (const char* key : {"skips_by_reason", "faults_by_kind", "halts_by_reason"}) {
-    const char* word = key[0] == 's' ? "skipped" : key[0] == 'f' ? "fault" : "halted";
-    for (const auto& [name, n] : summary[key].items()) std::cout << ", " << word << " " << name << " x" << n;
-  }
-  std::cout << "\n";
-  return code;
 }
 
 Command AddRunCommand(CLI::App& app) {

@@ -1,6 +1,5 @@
-// Sessions from the command line (issue 6): `selfcal run` (robot + camera -> a session directory),
-// `selfcal calibrate SESSION` (offline solve of a recorded session; never touches a robot) and the session
-// half of `selfcal simulate`.
+// Sessions from the command line: `selfcal run` (robot + camera -> a session directory), the session half
+// of `selfcal simulate`, and the reading of a recorded session for `selfcal calibrate SESSION`.
 #pragma once
 
 #include <cstdint>
@@ -10,7 +9,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/calibrate_command.h"
 #include "base/status.h"
 #include "observations/observation_set.h"
 #include "sim/sim_world.h"
@@ -51,10 +49,5 @@ bool IsSessionDirectory(const std::string& path);
 // naming the session and record on any inconsistency; kDegenerateData when too few samples were accepted.
 // *summary (optional) receives the journal's counts: samples, resumes, skips, faults and halts by kind.
 Result<ObservationSet> LoadSessionObservations(const std::string& session_path, nlohmann::json* summary = nullptr);
-
-// `selfcal calibrate SESSION`: LoadSessionObservations + CalibrateAndWrite into out_dir; writes
-// out_dir/observations.yaml (derived, for other tools) too.
-int CalibrateSession(const std::string& session_path, const std::string& out_dir, uint64_t seed, Method method,
-                     CalibrationResult* result, ObservationSet* observations);
 
 }  // namespace selfcal::app

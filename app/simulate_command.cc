@@ -11,7 +11,6 @@
 #include "app/session_command.h"
 #include "app/cli_util.h"
 #include "app/commands.h"
-#include "app/report_format.h"
 #include "io/report_json.h"
 #include "io/observations_file.h"
 #include "io/robot_config.h"
@@ -87,7 +86,7 @@ void PrintVerificationPoseErrors(const PoseDifference& nominal, const PoseDiffer
 
 // Calibrated vs true, in the quantities that do not depend on the gauge.
 nlohmann::json CompareWithTruth(const sim::SimResult& world, const ObservationSet& obs,
-                                const pipeline::PaperPipelineReport& report, std::ostream& out) {
+                                const calibration::PaperPipelineReport& report, std::ostream& out) {
   const RobotModel true_robot = ApplyParameters(world.truth.nominal, world.truth.rho_true);
   const RobotModel& nominal = world.truth.nominal;
   const RobotModel& calibrated = report.calibrated_robot;
@@ -140,7 +139,7 @@ nlohmann::json CompareWithTruth(const sim::SimResult& world, const ObservationSe
 // bundle's gauge is the nominal model's, as the simulator's truth is unless --perturb-gauge), f_x, the
 // verification relative poses and the held-out 3-D errors before and after.
 nlohmann::json CompareBundleWithTruth(const sim::SimResult& world, const ObservationSet& obs,
-                                      const pipeline::BundleStageReport& stage, bool gauge_perturbed, std::ostream& out) {
+                                      const calibration::BundleStageReport& stage, bool gauge_perturbed, std::ostream& out) {
   const bundle::BundleReport& b = stage.bundle;
   const RobotModel& nominal = world.truth.nominal;
   const KinematicParameters params(nominal.num_joints());
@@ -226,9 +225,10 @@ int SimulateSession(const SimulateArgs& args) {
   const int run_code = RunFromSettings(run, &hidden);
   const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (run_code != 0) return run_code;
-  CalibrationResult result;
-  ObservationSet obs;
-  const int code = CalibrateSession(run.session, args.out, args.seed, ParseMethod(args.method), &result, &obs);
+  CalibrationRun calibrated;
+  const int code = CalibrateAndWrite({run.session, args.out, args.seed, MethodFromName(args.method)}, &calibrated);
+  const ObservationSet& obs = calibrated.observations;
+  const calibration::CalibrationReport& result = calibrated.report;
   const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const sim::SimResult& world = *hidden;
   if (Status s = io::WriteJsonFile(TruthJson(world), (std::filesystem::path(args.out) / "truth.json").string()); !s.ok()) {
@@ -239,8 +239,8 @@ int SimulateSession(const SimulateArgs& args) {
     std::cout << "\npaper pipeline vs truth:";
     comparison = CompareWithTruth(world, obs, result.paper, std::cout);
   }
-  if (result.bundle_run && result.bundle.bundle.rho.size() == obs.robot.num_parameters()) {
-    comparison["bundle"] = CompareBundleWithTruth(world, obs, result.bundle, false, std::cout);
+  if (result.bundle && result.bundle->bundle.rho.size() == obs.robot.num_parameters()) {
+    comparison["bundle"] = CompareBundleWithTruth(world, obs, *result.bundle, false, std::cout);
   }
   comparison["seconds"] = {{"session", run_s}, {"session_and_calibration", total_s}};
   if (Status s = io::WriteJsonFile(comparison, (std::filesystem::path(args.out) / "comparison_with_truth.json").string());
@@ -305,17 +305,17 @@ Command AddSimulateCommand(CLI::App& app) {
     if (Status s = io::SaveObservations(world.observations, obs_path); !s.ok()) return Fail(s);
     if (Status s = io::WriteJsonFile(TruthJson(world), (out / "truth.json").string()); !s.ok()) return Fail(s);
     // Calibrate from the file, as any user's data would be.
-    Result<ObservationSet> obs = io::LoadObservations(obs_path);
-    if (!obs.ok()) return Fail(obs.status());
-    CalibrationResult result;
-    const int code = CalibrateAndWrite(*obs, obs_path, args->out, args->seed, ParseMethod(args->method), &result);
+    CalibrationRun calibrated;
+    const int code = CalibrateAndWrite({obs_path, args->out, args->seed, MethodFromName(args->method)}, &calibrated);
+    const calibration::CalibrationReport& result = calibrated.report;
+    const ObservationSet* obs = &calibrated.observations;
     nlohmann::json comparison = nlohmann::json::object();
     if (result.paper.calibrated_rho.size() > 0) {
       std::cout << "\npaper pipeline vs truth:";
       comparison = CompareWithTruth(world, *obs, result.paper, std::cout);
     }
-    if (result.bundle_run && result.bundle.bundle.rho.size() == obs->robot.num_parameters()) {
-      comparison["bundle"] = CompareBundleWithTruth(world, *obs, result.bundle, args->perturb_gauge, std::cout);
+    if (result.bundle && result.bundle->bundle.rho.size() == obs->robot.num_parameters()) {
+      comparison["bundle"] = CompareBundleWithTruth(world, *obs, *result.bundle, args->perturb_gauge, std::cout);
     }
     if (!comparison.empty()) {
       if (Status s = io::WriteJsonFile(comparison, (out / "comparison_with_truth.json").string()); !s.ok()) return Fail(s);

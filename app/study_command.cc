@@ -4,7 +4,7 @@
 
 #include "app/cli_util.h"
 #include "app/commands.h"
-#include "app/report_format.h"
+#include "report/study_report.h"
 #include "io/report_json.h"
 #include "io/robot_config.h"
 #include "io/trajectory_file.h"
@@ -50,7 +50,7 @@ Command AddStudyCommand(CLI::App& app) {
   return [args]() {
     Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(args->robot));
     if (!robot.ok()) return Fail(robot.status());
-    std::vector<pipeline::TrajectorySpec> trajectories;
+    std::vector<simulation::TrajectorySpec> trajectories;
     for (const std::string& spec : args->trajectories) {
       const size_t eq = spec.find('=');
       if (eq == std::string::npos || eq == 0) {
@@ -64,7 +64,7 @@ Command AddStudyCommand(CLI::App& app) {
     for (double n : args->noise) {
       if (!(n >= 0 && n < 10)) return Fail(Status::Error(ExitCode::kUsage, "--noise-px: " + std::to_string(n) + " is not in [0, 10)"));
     }
-    pipeline::StudyOptions options;
+    simulation::StudyOptions options;
     options.runs = args->runs;
     options.noise_levels_px = args->noise;
     options.seed = args->seed;
@@ -79,16 +79,16 @@ Command AddStudyCommand(CLI::App& app) {
       options.rendered_levels = {{"img-0", 0, 0, 0.01}, {"img-I", 2, 0, 0.01}, {"img-II", 5, 0, 0.02},
                                  {"img-II-blur", 5, 1.0, 0.02}};
     }
-    const pipeline::StudyReport study = pipeline::RunStudy(*robot, trajectories, options);
-    PrintStudyTables(study, std::cout);
-    nlohmann::json json = StudyJson(study, options);
+    const simulation::StudyReport study = simulation::RunStudy(*robot, trajectories, options);
+    report::PrintStudyTables(study, std::cout);
+    nlohmann::json json = report::StudyJson(study, options);
     if (args->bound_sweep) {
       for (double noise : args->noise) {
         if (noise <= 0) continue;
-        const std::vector<pipeline::BoundPoint> sweep =
-            pipeline::SweepTwoViewBound(pipeline::DefaultBoundGrid(noise), args->seed);
-        PrintBoundSweep(sweep, std::cout);
-        json["bound_sweep"].push_back(BoundSweepJson(sweep));
+        const std::vector<simulation::BoundPoint> sweep =
+            simulation::SweepTwoViewBound(simulation::DefaultBoundGrid(noise), args->seed);
+        report::PrintBoundSweep(sweep, std::cout);
+        json["bound_sweep"].push_back(report::BoundSweepJson(sweep));
       }
     }
     if (Status s = io::WriteJsonFile(json, args->out); !s.ok()) return Fail(s);

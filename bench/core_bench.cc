@@ -3,9 +3,9 @@
 #include <benchmark/benchmark.h>
 
 #include "bundle/bundle_adjustment.h"
-#include "pipeline/bundle_stage.h"
-#include "pipeline/paper_pipeline.h"
-#include "pipeline/study.h"
+#include "calibration/bundle_stage.h"
+#include "calibration/paper_pipeline.h"
+#include "simulation/study.h"
 #include "planning/planner.h"
 #include "sim/sim_world.h"
 #include "sim/trajectory_generator.h"
@@ -36,23 +36,23 @@ BENCHMARK(BM_TwoViewPair80Dots)->Unit(benchmark::kMillisecond);
 void BM_PaperPipeline25Poses80Dots(benchmark::State& state) {
   const ObservationSet& obs = World().observations;
   for (auto _ : state) {
-    const pipeline::PaperPipelineReport report = pipeline::RunPaperPipeline(obs, pipeline::PaperPipelineOptions());
-    if (report.outcome != pipeline::Outcome::kSuccess) state.SkipWithError(report.message.c_str());
+    const calibration::PaperPipelineReport report = calibration::RunPaperPipeline(obs, calibration::PaperPipelineOptions());
+    if (report.outcome != calibration::Outcome::kSuccess) state.SkipWithError(report.message.c_str());
   }
 }
 BENCHMARK(BM_PaperPipeline25Poses80Dots)->Unit(benchmark::kMillisecond);
 
 // The bundle solve alone (screen refits and covariance included), started from the paper pipeline's result
-// as pipeline::RunBundleStage starts it; the paper pipeline runs once, outside the timed loop.
+// as calibration::RunBundleStage starts it; the paper pipeline runs once, outside the timed loop.
 void BM_BundleAdjustment25Poses80Dots(benchmark::State& state) {
   const ObservationSet& obs = World().observations;
-  const pipeline::PaperPipelineReport paper = pipeline::RunPaperPipeline(obs, pipeline::PaperPipelineOptions());
-  if (paper.outcome != pipeline::Outcome::kSuccess) {
+  const calibration::PaperPipelineReport paper = calibration::RunPaperPipeline(obs, calibration::PaperPipelineOptions());
+  if (paper.outcome != calibration::Outcome::kSuccess) {
     state.SkipWithError(paper.message.c_str());
     return;
   }
   double fx_start = 0;
-  const Eigen::VectorXd rho_start = pipeline::BundleStartFromPaper(obs, paper, &fx_start);
+  const Eigen::VectorXd rho_start = calibration::BundleStartFromPaper(obs, paper, &fx_start);
   int iterations = 0;
   for (auto _ : state) {
     const bundle::BundleReport r = bundle::RunBundleAdjustment(obs, rho_start, fx_start, bundle::BundleOptions());
@@ -67,14 +67,14 @@ BENCHMARK(BM_BundleAdjustment25Poses80Dots)->Unit(benchmark::kMillisecond);
 // with_opencv_and_bound = 1 also the OpenCV comparison and both Cramer-Rao bounds.
 void BM_Study200Runs(benchmark::State& state) {
   const RobotModel puma = testing::Puma560();
-  const pipeline::TrajectorySpec trajectory{"initial", sim::MakeArcTrajectory(puma, sim::ArcTrajectoryOptions()).joints};
-  pipeline::StudyOptions options;
+  const simulation::TrajectorySpec trajectory{"initial", sim::MakeArcTrajectory(puma, sim::ArcTrajectoryOptions()).joints};
+  simulation::StudyOptions options;
   options.runs = 200;
   options.noise_levels_px = {0.2};
   options.with_opencv = state.range(0) != 0;
   options.with_bound = state.range(0) != 0;
   options.with_bundle = true;
-  for (auto _ : state) benchmark::DoNotOptimize(pipeline::RunStudy(puma, {trajectory}, options));
+  for (auto _ : state) benchmark::DoNotOptimize(simulation::RunStudy(puma, {trajectory}, options));
 }
 BENCHMARK(BM_Study200Runs)->Arg(0)->Arg(1)->ArgName("with_opencv_and_bound")->Iterations(1)->Unit(benchmark::kSecond);
 

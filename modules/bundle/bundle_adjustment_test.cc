@@ -11,7 +11,7 @@
 #include "bundle/bundle_test_util.h"
 #include "identification/identifiability.h"
 #include "kinematics/autodiff_jacobian.h"
-#include "pipeline/paper_pipeline.h"
+#include "calibration/paper_pipeline.h"
 
 namespace selfcal::bundle {
 namespace {
@@ -97,8 +97,8 @@ TEST(BundleAdjustment, NoiseFreeFromAPerturbedStartWithTheGaugeOfTheNominalModel
 TEST(BundleAdjustment, NoiseFreeFromThePaperPipelineStart) {
   const sim::SimResult world = World(0.0);
   const ObservationSet& obs = world.observations;
-  const pipeline::PaperPipelineReport paper = pipeline::RunPaperPipeline(obs, pipeline::PaperPipelineOptions());
-  ASSERT_EQ(paper.outcome, pipeline::Outcome::kSuccess) << paper.message;
+  const calibration::PaperPipelineReport paper = calibration::RunPaperPipeline(obs, calibration::PaperPipelineOptions());
+  ASSERT_EQ(paper.outcome, calibration::Outcome::kSuccess) << paper.message;
   const Eigen::VectorXd start = ExpressOnModel(obs.robot, paper.calibrated_robot, paper.calibrated_rho);
   const BundleReport r = RunBundleAdjustment(obs, start, paper.fx_px, {});
   ASSERT_EQ(r.outcome, Outcome::kConverged) << r.message;
@@ -307,13 +307,13 @@ TEST(BundleAdjustment, FlatDotSheetConvergesFromTheNominalStart) {
       EXPECT_LT(std::abs(r.fx_px - world.truth.camera_true.fx_px), 4 * r.fx_stddev);
     }
     const testing::PoseErrors pose = VerificationPoseErrors(world, obs, obs.robot, r.rho);
-    const pipeline::PaperPipelineReport paper = pipeline::RunPaperPipeline(obs, pipeline::PaperPipelineOptions());
+    const calibration::PaperPipelineReport paper = calibration::RunPaperPipeline(obs, calibration::PaperPipelineOptions());
     std::cout << "[ figure ] flat sheet, noise " << noise << " px: BA " << OutcomeName(r.outcome) << ", "
               << r.num_observations << " observations, max parameter error " << max_err;
     if (noise > 0) std::cout << " (worst " << KinematicParameters(6).name(worst) << " at " << max_z << " sigma)";
     std::cout << ", f_x error " << std::abs(r.fx_px - world.truth.camera_true.fx_px) << " px, max verification pose error "
               << pose.MaxPosition() * 1e3 << " mm, " << r.seconds * 1e3 << " ms; paper pipeline: "
-              << pipeline::OutcomeName(paper.outcome);
+              << calibration::OutcomeName(paper.outcome);
     if (paper.calibrated_rho.size() == obs.robot.num_parameters()) {
       std::cout << ", verification pose error "
                 << VerificationPoseErrors(world, obs, paper.calibrated_robot, paper.calibrated_rho).MaxPosition() * 1e3

@@ -9,7 +9,7 @@
 
 #include "bundle/bundle_adjustment.h"
 #include "bundle/bundle_test_util.h"
-#include "pipeline/paper_pipeline.h"
+#include "calibration/paper_pipeline.h"
 
 namespace selfcal::bundle {
 namespace {
@@ -62,13 +62,13 @@ void AddRun(const sim::SimResult& world, const ObservationSet& obs, bool with_pa
   t->pose_position_sq += run_pose_sq;
   t->pose_count += static_cast<int>(pose.position_m.size());
   const std::vector<int> verification = obs.PosesWithRole(PoseRole::kVerification);
-  const pipeline::VerificationSummary distances =
-      pipeline::VerifyDistances(obs, verification, obs.robot, r.rho, r.fx_px, obs.check_distances);
+  const calibration::VerificationSummary distances =
+      calibration::VerifyDistances(obs, verification, obs.robot, r.rho, r.fx_px, obs.check_distances);
   t->distance_sq += distances.rms_error_m * distances.rms_error_m * distances.num_ok;
   t->distance_count += distances.num_ok;
   if (!with_paper) return;
-  const pipeline::PaperPipelineReport paper = pipeline::RunPaperPipeline(obs, pipeline::PaperPipelineOptions());
-  ASSERT_EQ(paper.outcome, pipeline::Outcome::kSuccess) << paper.message;
+  const calibration::PaperPipelineReport paper = calibration::RunPaperPipeline(obs, calibration::PaperPipelineOptions());
+  ASSERT_EQ(paper.outcome, calibration::Outcome::kSuccess) << paper.message;
   const testing::PoseErrors paper_pose = VerificationPoseErrors(world, obs, paper.calibrated_robot, paper.calibrated_rho);
   for (size_t k = 0; k < paper_pose.position_m.size(); ++k) {
     t->paper_pose_position_sq += paper_pose.position_m[k] * paper_pose.position_m[k];
@@ -79,7 +79,7 @@ void AddRun(const sim::SimResult& world, const ObservationSet& obs, bool with_pa
   for (double e : paper_pose.position_m) paper_run_sq += e * e;
   t->pose_ratio_per_run.push_back(std::sqrt(run_pose_sq / paper_run_sq));
   t->bundle_pose_position_sq_same_runs += run_pose_sq;
-  const pipeline::VerificationSummary& pd = paper.verification_calibrated;
+  const calibration::VerificationSummary& pd = paper.verification_calibrated;
   t->paper_distance_sq += pd.rms_error_m * pd.rms_error_m * pd.num_ok;
   t->paper_distance_count += pd.num_ok;
   t->bundle_distance_sq_same_runs += distances.rms_error_m * distances.rms_error_m * distances.num_ok;

@@ -58,8 +58,10 @@ TEST(Cli, SimulateEndToEndThenCalibrateTheSameFileIsDeterministic) {
   const nlohmann::json first = ReadJson(dir / "report.json");
   // The default method is the kinematic bundle adjustment, started from the paper pipeline.
   EXPECT_EQ(first["method"], "bundle");
-  EXPECT_EQ(first["outcome"], "converged");
-  EXPECT_EQ(first["paper_pipeline"]["outcome"], "success");
+  EXPECT_EQ(first["verdict"], "accepted");
+  EXPECT_EQ(first["methods"]["bundle"]["outcome"], "converged");
+  EXPECT_EQ(first["methods"]["paper"]["outcome"], "success");
+  EXPECT_EQ(first["version"], 2);
   EXPECT_TRUE(first["accepted"].get<bool>());
   // The calibrated model is a robot config selfcal reads back.
   EXPECT_TRUE(io::LoadRobotModel((dir / "calibrated_model.yaml").string()).ok());
@@ -72,7 +74,7 @@ TEST(Cli, SimulateEndToEndThenCalibrateTheSameFileIsDeterministic) {
   // layout, so Ceres' address-ordered elimination does not depend on this process's heap.
   nlohmann::json a = first, b = second;
   for (nlohmann::json* j : {&a, &b}) {
-    j->erase("timing_s");
+    j->erase("timing");
     j->erase("input");
   }
   EXPECT_EQ(a.dump(), b.dump());
@@ -89,24 +91,27 @@ TEST(Cli, SimulateWithTheBundleMethodReportsTheBundleAndWritesItsModel) {
   const nlohmann::json report = ReadJson(dir / "report.json");
   EXPECT_EQ(report["method"], "bundle");
   EXPECT_EQ(report["exit_code"], 0);
-  const nlohmann::json& b = report["bundle"];
+  const nlohmann::json& b = report["methods"]["bundle"];
   EXPECT_EQ(b["outcome"], "converged") << b.dump(2);
   EXPECT_EQ(b["start"], "paper_pipeline");
-  EXPECT_FALSE(b["termination"].get<std::string>().empty());
-  EXPECT_GT(b["iterations"].get<int>(), 0);
+  EXPECT_FALSE(b["solver"]["termination"].get<std::string>().empty());
+  EXPECT_GT(b["solver"]["iterations"].get<int>(), 0);
   EXPECT_LT(b["rms_reprojection_px"].get<double>(), 0.5);
   EXPECT_TRUE(b["removed_observations"].is_array());
   EXPECT_EQ(b["free"].size(), 24u);
   EXPECT_EQ(b["free"].size() + b["fixed"].size(), b["parameters"].size());
   for (const nlohmann::json& p : b["parameters"]) {
-    const bool length = p.contains("value_mm");
-    EXPECT_TRUE(length || p.contains("value_deg")) << p.dump();
-    const std::string sd = length ? "stddev_mm" : "stddev_deg";
+    const bool length = p.contains("value_m");
+    EXPECT_TRUE(length || p.contains("value_rad")) << p.dump();
+    const std::string sd = length ? "stddev_m" : "stddev_rad";
     ASSERT_TRUE(p.contains(sd)) << p.dump();
     EXPECT_EQ(p["free"].get<bool>(), !p[sd].is_null()) << p.dump();
   }
   EXPECT_GT(b["fx_stddev_px"].get<double>(), 0);
   EXPECT_EQ(b["verification"]["calibrated_model"]["num_ok"], 40);
+  // The top level is the chosen method's answer.
+  EXPECT_EQ(report["verification"], b["verification"]);
+  EXPECT_EQ(report["fx_px"], b["fx_px"]);
   EXPECT_NE(output.find("kinematic bundle adjustment vs truth"), std::string::npos) << output;
   // Against the truth (this seed, deterministic): the verification relative poses, 10 mm off with the
   // nominal model, come within ~1 mm.
@@ -123,8 +128,10 @@ TEST(Cli, SimulateWithTheBundleMethodReportsTheBundleAndWritesItsModel) {
                        &output), 0) << output;
   const nlohmann::json baseline = ReadJson(paper / "report.json");
   EXPECT_EQ(baseline["method"], "paper");
-  EXPECT_EQ(baseline["outcome"], "success");
-  EXPECT_FALSE(baseline.contains("bundle"));
+  EXPECT_EQ(baseline["verdict"], "accepted");
+  EXPECT_EQ(baseline["methods"]["paper"]["outcome"], "success");
+  EXPECT_FALSE(baseline["methods"].contains("bundle"));
+  EXPECT_EQ(baseline["verification"], baseline["methods"]["paper"]["verification"]);
   EXPECT_EQ(RunSelfcal("calibrate " + (dir / "observations.yaml").string() + " --method nonsense --out " + paper.string(),
                        &output), 2) << output;
   fs::remove_all(dir);
@@ -136,9 +143,10 @@ TEST(Cli, FlatSheetIsDegenerateForThePaperMethodAndCalibratesWithTheBundle) {
   std::string output;
   ASSERT_EQ(RunSelfcal("simulate --points --flat-sheet --out " + dir.string(), &output), 0) << output;
   const nlohmann::json report = ReadJson(dir / "report.json");
-  EXPECT_EQ(report["paper_pipeline"]["outcome"], "degenerate");
-  EXPECT_EQ(report["bundle"]["outcome"], "converged");
-  EXPECT_EQ(report["bundle"]["start"], "nominal");
+  EXPECT_EQ(report["methods"]["paper"]["outcome"], "degenerate");
+  EXPECT_EQ(report["methods"]["bundle"]["outcome"], "converged");
+  EXPECT_EQ(report["methods"]["bundle"]["start"], "nominal");
+  EXPECT_EQ(report["verdict"], "accepted");
   EXPECT_TRUE(fs::exists(dir / "calibrated_model.yaml"));
   const fs::path paper = dir / "paper";
   EXPECT_EQ(RunSelfcal("calibrate " + (dir / "observations.yaml").string() + " --method paper --out " + paper.string(),
@@ -203,13 +211,14 @@ TEST(Cli, Ur5eSimulationBeatsItsNominalModel) {
   ASSERT_EQ(RunSelfcal("simulate --points --robot config/robots/ur5e.yaml --trajectory config/trajectories/initial_ur5e.yaml "
                        "--noise-px 0 --out " + dir.string(), &output), 0) << output;
   const nlohmann::json report = ReadJson(dir / "report.json");
-  EXPECT_EQ(report["identifiability"]["identifiable"], 24);
-  const double nominal = report["verification"]["nominal_model"]["rms_error_mm"];
-  const double calibrated = report["verification"]["calibrated_model"]["rms_error_mm"];
+  const nlohmann::json& paper = report["methods"]["paper"];
+  EXPECT_EQ(paper["identifiability"]["identifiable"], 24);
+  const double nominal = paper["verification"]["nominal_model"]["rms_error_m"];
+  const double calibrated = paper["verification"]["calibrated_model"]["rms_error_m"];
   EXPECT_LT(calibrated, 0.5 * nominal) << output;
   // The bundle adjustment (the default method) on the same data, noise-free: exact.
-  EXPECT_EQ(report["bundle"]["outcome"], "converged") << output;
-  EXPECT_LT(report["bundle"]["verification"]["calibrated_model"]["max_error_mm"].get<double>(), 1e-6) << output;
+  EXPECT_EQ(report["methods"]["bundle"]["outcome"], "converged") << output;
+  EXPECT_LT(report["verification"]["calibrated_model"]["max_error_m"].get<double>(), 1e-9) << output;
   fs::remove_all(dir);
 }
 

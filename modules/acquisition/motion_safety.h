@@ -1,0 +1,53 @@
+// Motion safety before the first move (RELIABILITY.md C5, C6, R1-R3, design rule 3): the whole plan is
+// checked against the robot's limits and the per-move joint travel bound, the moves are timed within the
+// velocity limits times the scaling, and the operator gets a preview to confirm. Pure functions: no
+// robot is touched here.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "observations/observation_set.h"
+#include "robot/robot.h"
+
+namespace selfcal::acquisition {
+
+struct PlannedPose {
+  std::string id;                 // e.g. "p00"
+  PoseRole role = PoseRole::kIdentification;
+  Eigen::VectorXd joints_rad;
+};
+
+struct MotionSafetyOptions {
+  double velocity_scaling = 0.1;                 // R1: real robots start slow; (0, 1]
+  double max_joint_travel_rad = 1.5707963267948966;  // R2: per joint per move (easy_handeye's 90 deg)
+  double limit_margin_rad = 0.0;                 // kept clear of each joint limit
+  double start_tolerance_rad = 0.01;             // R4: actual vs expected joints before a move
+  std::string Validate() const;                  // empty when valid
+};
+
+struct MoveSummary {
+  int pose = -1;                  // the target pose (index in the plan)
+  double max_travel_rad = 0;      // largest joint travel of the move
+  int limiting_joint = -1;        // the joint that sets the duration
+  double duration_s = 0;          // at the scaling: robot::QuinticMoveDuration
+};
+
+struct PreflightReport {
+  std::vector<std::string> problems;  // each names the pose, joint, value and bound; empty = go
+  std::vector<MoveSummary> moves;     // start -> pose 0 -> pose 1 ...
+  double total_motion_s = 0;
+  bool ok() const { return problems.empty(); }
+  // The dry-run preview: one line per move (pose id, max travel deg, limiting joint, seconds), totals.
+  std::string Preview(const std::vector<PlannedPose>& plan, double velocity_scaling) const;
+};
+
+// Checks every pose of `plan` (joint count and finiteness [C5], limits less the margin [C6]) and every
+// move from `start_rad` through the plan in order (travel bound [R2]); refuses absent or non-positive
+// velocity limits [R3]. `first_pose` skips the poses before it (a resumed session starts there).
+PreflightReport Preflight(const std::vector<PlannedPose>& plan, const robot::JointLimits& limits,
+                          const Eigen::VectorXd& start_rad, const MotionSafetyOptions& options, int first_pose = 0);
+
+}  // namespace selfcal::acquisition

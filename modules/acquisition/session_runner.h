@@ -1,0 +1,137 @@
+// The operator's session loop (issue 6; DESIGN.md "move / grab / track / record"; RELIABILITY.md design
+// rule 3): drives a robot::Robot through a plan, grabs frames from a capture::FrameSource, tracks the dots
+// through every move (identities never jump: vpDot2 follows them frame to frame), and records every event
+// in a session directory's journal before it counts. It never solves anything: `selfcal calibrate SESSION`
+// reads what it wrote.
+//
+// States: preflight (the whole plan against the robot's limits, travel bound and velocity limits, before
+// any command: motion_safety.h) -> armed (the caller's confirm callback said yes) -> per pose: moving
+// (watchdog; frames tracked) -> settling (velocities below a threshold for N readings and a dwell) ->
+// capturing (a frame exposed after the settle time, a fresh complete joint reading) -> recorded. Any stop,
+// fault, lost device or stop request ends in `halted`: the robot is told to stop, the journal says why,
+// and RunSession returns. Nothing here resumes by itself: continuing is a new RunSession on the same
+// session (`selfcal run --resume`), started by a person, which re-reads the robot and re-checks the plan.
+//
+// Resume: the journal decides. RunSession continues at the first pose with neither an accepted sample
+// nor a final skip (session/samples.h), with the dots of the last accepted sample as the tracker's state;
+// if the robot is no longer where that sample was taken (beyond the start tolerance) it first returns
+// there (a move of its own in the preview) and re-finds the dots in a frame at that pose.
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "capture/frame_source.h"
+#include "acquisition/motion_safety.h"
+#include "robot/clock.h"
+#include "robot/robot.h"
+#include "session/session_dir.h"
+#include "tracking/dot_detector.h"
+#include "tracking/dot_tracker.h"
+
+namespace selfcal::acquisition {
+
+// Names the dots of a frame when there is no previous frame to track from (the first pose of a session).
+class DotIdentifier {
+ public:
+  virtual ~DotIdentifier() = default;
+  // The named dots (ids >= 0, distinct) among `detections` of `frame`, or an error saying why not.
+  virtual Result<std::vector<tracking::PreviousDot>> Identify(const capture::Frame& frame,
+                                                              const tracking::DetectionReport& detections) = 0;
+  // Dots whose identity any single image shows (marked ones: the yardstick's ends carry a tag or a
+  // distinct size), found among `detections`. The loop asks at every settled pose for the marked dots it
+  // is no longer tracking, so that a yardstick end lost in a move comes back. Default: none are marked.
+  virtual std::vector<tracking::PreviousDot> FindMarked(const capture::Frame& /*frame*/,
+                                                        const tracking::DetectionReport& /*detections*/,
+                                                        const std::vector<int>& /*missing_ids*/) {
+    return {};
+  }
+  virtual std::vector<int> MarkedIds() const { return {}; }
+};
+
+// Ids 0, 1, ... in the detector's raster order: for scenes of unknown dots, where an id is only a label
+// that tracking keeps. The yardstick's ends must then be named by the operator from the first image.
+class DetectionOrderIdentifier : public DotIdentifier {
+ public:
+  Result<std::vector<tracking::PreviousDot>> Identify(const capture::Frame& frame,
+                                                      const tracking::DetectionReport& detections) override;
+};
+
+// The tracker as a session uses it: the identity check (a robust planar fit between consecutive frames)
+// tolerates the parallax of a deep 3-D scene over one frame of motion (4 px); a swap moves a dot by about
+// one dot spacing, which the spacing of a usable scene keeps above 3 dot radii.
+tracking::DotTrackerOptions DefaultSessionTracker();
+
+struct SettleOptions {
+  double velocity_threshold_rad_s = 1e-3;  // R7: every joint below this...
+  int consecutive_readings = 3;            // ...for this many readings in a row...
+  double min_dwell_s = 0.2;                // ...and at least this long after the controller said done
+  double timeout_s = 5.0;                  // not settled by then: the pose is skipped (not_settled)
+  double reading_period_s = 0.02;
+};
+
+struct RunOptions {
+  MotionSafetyOptions safety;
+  SettleOptions settle;
+  double watchdog_factor = 1.1;     // R6: a move may take factor x its planned duration + slack
+  double watchdog_slack_s = 0.5;
+  int reading_retries = 3;          // R8: invalid joint readings retried, then the pose is skipped
+  double frame_timeout_s = 1.0;     // V3: per grab
+  int frame_retries = 3;            // V3, V6: timeouts / bad frames retried at the same pose, then skip
+  double tracking_interval_s = 0.0; // frames grabbed during a move at least this far apart (0: every one)
+  tracking::DotDetectorOptions detector;
+  tracking::DotTrackerOptions tracker = DefaultSessionTracker();
+  int min_dots = 8;                 // D1: fewer named dots in a sample -> skipped (too_few_dots)
+  int png_compression = 1;
+  std::uint64_t frame_bytes_estimate = 400 * 1024;  // P5: free space needed per frame
+  bool journal_sim_clock = false;   // simulated sessions: journal the clock with each sample (resume)
+  std::string mode = "simulated";   // session_started.mode
+  std::string Validate() const;     // empty when valid
+};
+
+enum class RunOutcome {
+  kCompleted = 0,  // every pose has an accepted sample or a final skip
+  kRefused,        // preflight or the operator said no: nothing moved
+  kHalted,         // a stop, fault or lost device: the robot was told to stop
+  kInterrupted,    // the stop request (Ctrl-C, SIGTERM) was honoured
+  kSessionError,   // the session directory could not be written or read
+};
+const char* RunOutcomeName(RunOutcome outcome);
+
+struct RunReport {
+  RunOutcome outcome = RunOutcome::kRefused;
+  ExitCode exit_code = ExitCode::kUsage;
+  std::string message;
+  std::string preview;          // the dry-run preview shown to confirm
+  int first_pose = 0;           // where this invocation started (resume point)
+  int accepted = 0;             // samples accepted by this invocation
+  std::map<std::string, int> skips;   // by reason, this invocation
+  std::map<std::string, int> faults;  // by kind, this invocation (each retried or tolerated fault)
+  std::string halt_reason;      // when halted / interrupted
+  int frames_grabbed = 0, frames_tracked = 0;
+  int identity_flags = 0;       // D4: merged + inconsistent dots dropped by the tracker
+};
+
+struct RunContext {
+  robot::Robot* robot = nullptr;
+  capture::FrameSource* camera = nullptr;
+  robot::Clock* clock = nullptr;
+  session::Session* session = nullptr;
+  DotIdentifier* identifier = nullptr;
+  // Polled between every step; set by a signal handler (the handler only sets it, R11).
+  const std::atomic<bool>* stop_requested = nullptr;
+  // Shown the preview after a successful preflight; returns true to arm (typed confirmation for real
+  // robots, automatic for the simulated one, false for a dry run). Required.
+  std::function<bool(const std::string& preview, const robot::RobotIdentity& robot)> confirm;
+  // Progress lines for the operator (optional).
+  std::function<void(const std::string& line)> log;
+};
+
+// Runs (or continues) the session of `plan` (see the header comment). The plan must be the one the
+// session's journal recorded, if it recorded one (else kRefused).
+RunReport RunSession(const std::vector<PlannedPose>& plan, const RunContext& context, const RunOptions& options);
+
+}  // namespace selfcal::acquisition

@@ -1,0 +1,108 @@
+#include "calibration/bundle_stage.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace selfcal::calibration {
+
+const char* BundleStartName(BundleStart start) {
+  switch (start) {
+    case BundleStart::kNotRun: return "not_run";
+    case BundleStart::kPaperPipeline: return "paper_pipeline";
+    case BundleStart::kNominal: return "nominal";
+  }
+  return "unknown";
+}
+
+Eigen::VectorXd BundleStartFromPaper(const ObservationSet& obs, const PaperPipelineReport& paper, double* fx_px,
+                                     BundleStart* start, std::string* note) {
+  const Eigen::VectorXd nominal = KinematicParameters::Nominal(obs.robot);
+  const bool usable = paper.outcome == Outcome::kSuccess && paper.calibrated_rho.size() == obs.robot.num_parameters() &&
+                      paper.calibrated_robot.num_joints() == obs.robot.num_joints() &&
+                      paper.calibrated_rho.allFinite() && std::isfinite(paper.fx_px) && paper.fx_px > 0;
+  if (!usable) {
+    // The paper's f_x comes from the same factor method that failed (on a flat sheet its pairs are
+    // planar): the user's prior is the safer start.
+    *fx_px = obs.camera.fx_px;
+    if (start != nullptr) *start = BundleStart::kNominal;
+    if (note != nullptr) {
+      *note = std::string("nominal model and prior f_x (the paper pipeline ended ") + OutcomeName(paper.outcome) + ")";
+    }
+    return nominal;
+  }
+  Eigen::VectorXd rho = bundle::ExpressOnModel(obs.robot, paper.calibrated_robot, paper.calibrated_rho);
+  // The paper's gauge (what it held fixed) went through its yardstick scaling; the bundle keeps its fixed
+  // entries at their start, so put them back to nominal (unobservable: no image changes, exactly).
+  const std::vector<int>& free = paper.identifiability.free_indices;
+  for (int i = 0; i < rho.size(); ++i) {
+    if (std::find(free.begin(), free.end(), i) == free.end()) rho[i] = nominal[i];
+  }
+  *fx_px = paper.fx_px;
+  if (start != nullptr) *start = BundleStart::kPaperPipeline;
+  if (note != nullptr) *note = "paper pipeline's calibrated model and f_x (its fixed entries at nominal)";
+  return rho;
+}
+
+BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineReport& paper,
+                                 const BundleStageOptions& options) {
+  const auto clock_start = std::chrono::steady_clock::now();
+  BundleStageReport report;
+  const Eigen::VectorXd rho_start =
+      BundleStartFromPaper(obs, paper, &report.fx_start_px, &report.start, &report.start_note);
+  report.bundle = bundle::RunBundleAdjustment(obs, rho_start, report.fx_start_px, options.bundle);
+  const bool retry = options.retry_from_nominal && report.start == BundleStart::kPaperPipeline &&
+                     (report.bundle.outcome == bundle::Outcome::kNoConvergence ||
+                      report.bundle.outcome == bundle::Outcome::kFailure);
+  if (retry) {
+    const std::string first = bundle::OutcomeName(report.bundle.outcome);
+    bundle::BundleReport again =
+        bundle::RunBundleAdjustment(obs, KinematicParameters::Nominal(obs.robot), obs.camera.fx_px, options.bundle);
+    again.seconds += report.bundle.seconds;
+    report.bundle = std::move(again);
+    report.start = BundleStart::kNominal;
+    report.fx_start_px = obs.camera.fx_px;
+    report.start_note = "nominal model and prior f_x (the start from the paper pipeline's result ended " + first + ")";
+  }
+  const bundle::BundleReport& b = report.bundle;
+  const std::vector<int> verification_poses = obs.PosesWithRole(PoseRole::kVerification);
+  const bool verify = !verification_poses.empty() && !obs.check_distances.empty() && obs.Validate().empty();
+  if (verify) {
+    report.verification_nominal = VerifyDistances(obs, verification_poses, obs.robot, KinematicParameters::Nominal(obs.robot),
+                                                  obs.camera.fx_px, obs.check_distances);
+  }
+  if (b.rho.size() == obs.robot.num_parameters() && b.rho.allFinite() && std::isfinite(b.fx_px) && b.fx_px > 0) {
+    report.calibrated_robot = ApplyParameters(obs.robot, b.rho);
+    report.calibrated_rho = KinematicParameters::Nominal(report.calibrated_robot);
+    if (verify) {
+      if (options.bundle.estimate_k1) {
+        ObservationSet with_k1 = obs;
+        with_k1.camera.k1 = b.k1;
+        report.verification = VerifyDistances(with_k1, verification_poses, obs.robot, b.rho, b.fx_px, obs.check_distances);
+      } else {
+        report.verification = VerifyDistances(obs, verification_poses, obs.robot, b.rho, b.fx_px, obs.check_distances);
+      }
+      if (b.covariance_available) {
+        // Order free, f_x (when estimated), k1 (when estimated; not propagated). A held f_x: zero variance.
+        const int nf = static_cast<int>(b.free_indices.size());
+        Eigen::MatrixXd sigma = Eigen::MatrixXd::Zero(nf + 1, nf + 1);
+        sigma.topLeftCorner(nf, nf) = b.covariance_free.topLeftCorner(nf, nf);
+        if (options.bundle.estimate_fx) sigma = b.covariance_free.topLeftCorner(nf + 1, nf + 1);
+        ObservationSet with_k1;
+        if (options.bundle.estimate_k1) {
+          with_k1 = obs;
+          with_k1.camera.k1 = b.k1;
+        }
+        report.predicted_error = PredictDistanceErrors(options.bundle.estimate_k1 ? with_k1 : obs, verification_poses, obs.robot,
+                                                       b.rho, b.fx_px, b.free_indices, sigma, obs.pixel_noise_px,
+                                                       obs.check_distances);
+      } else {
+        report.predicted_error.message = "covariance unavailable: " + b.covariance_message;
+      }
+    }
+  }
+  report.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
+  return report;
+}
+
+}  // namespace selfcal::calibration

@@ -1,0 +1,66 @@
+// The product's calibration stage beyond the paper (DESIGN.md section 5): the kinematic bundle adjustment
+// (bundle/bundle_adjustment.h) started from the paper pipeline's result, then the same held-out 3-D check
+// as the paper's step 5 with the bundle's model and f_x.
+//
+// Start. When the paper pipeline succeeded: its metric calibrated model re-expressed on the nominal model
+// (bundle::ExpressOnModel), with the entries the paper held fixed (its gauge: base, joint 1, redundant
+// offsets, which its yardstick step had scaled) put back to their nominal values, and its f_x. The
+// bundle then fixes its own gauge at the nominal values, as "identify corrections from the nominal model"
+// asks, and the result is comparable entry by entry with a simulator's truth. When the paper pipeline
+// failed (e.g. kDegenerate on a flat dot sheet, where the factor method has no unique solution): the
+// nominal model with the prior f_x. A start from the paper's result that does not converge is retried
+// once from the nominal model (the report says so).
+//
+// Works on an ObservationSet only: no files, no hardware, no truth.
+#pragma once
+
+#include <string>
+
+#include <Eigen/Core>
+
+#include "bundle/bundle_adjustment.h"
+#include "observations/observation_set.h"
+#include "calibration/paper_pipeline.h"
+#include "calibration/predicted_error.h"
+
+namespace selfcal::calibration {
+
+struct BundleStageOptions {
+  bundle::BundleOptions bundle;
+  bool retry_from_nominal = true;  // when the start from the paper's result does not converge
+};
+
+enum class BundleStart { kNotRun, kPaperPipeline, kNominal };
+const char* BundleStartName(BundleStart start);
+
+struct BundleStageReport {
+  bundle::BundleReport bundle;          // outcome, free/fixed names, rho (on observations.robot), covariance
+  BundleStart start = BundleStart::kNotRun;
+  std::string start_note;               // why this start, in words
+  double fx_start_px = 0;
+  // The calibrated model ready for writing: ApplyParameters(observations.robot, bundle.rho), and its
+  // rho (= Nominal(calibrated_robot), zero corrections). Empty unless the bundle produced a full rho.
+  RobotModel calibrated_robot;
+  Eigen::VectorXd calibrated_rho;
+  // Section 4.1 step 5 with the bundle's model and f_x (k1 as estimated when it was): 3-D error of the
+  // check distances triangulated from the verification poses.
+  VerificationSummary verification;
+  VerificationSummary verification_nominal;  // the same with the nominal model and the prior f_x (before)
+  // The predicted std of that 3-D error (pipeline/predicted_error.h): the bundle's covariance of the free
+  // parameters and f_x, and the stated pixel noise (observations.pixel_noise_px) of the verification
+  // images. ok = false when the covariance was unavailable.
+  PredictedDistanceErrors predicted_error;
+  double seconds_total = 0;
+};
+
+// Runs the bundle adjustment on `observations` started as described above from `paper` (the report of
+// RunPaperPipeline on the same observations; any outcome). kInvalidInput from the bundle's own checks when
+// the observations or options are invalid.
+BundleStageReport RunBundleStage(const ObservationSet& observations, const PaperPipelineReport& paper,
+                                 const BundleStageOptions& options);
+
+// The start described above, for callers that time the solve alone (benchmarks). *fx_px receives f_x.
+Eigen::VectorXd BundleStartFromPaper(const ObservationSet& observations, const PaperPipelineReport& paper,
+                                     double* fx_px, BundleStart* start = nullptr, std::string* note = nullptr);
+
+}  // namespace selfcal::calibration

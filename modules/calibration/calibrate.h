@@ -1,0 +1,81 @@
+// The calibration facade: one entry point from an observation set to a report that carries the verdict
+// and, when the verdict is "accepted", the model to write.
+//
+//   Calibrate(observations, options)
+//     -> RunPaperPipeline                 (always: the baseline, and the bundle adjustment's start)
+//     -> RunBundleStage                   (Method::kBundle, the default: the product's answer)
+//     -> verdict of the chosen method     (one vocabulary for every method: Verdict)
+//     -> the chosen method's model        (only when accepted)
+//
+// Commands call this and nothing below it: they parse, load, call Calibrate, and write what it returns
+// (report/ turns the report into JSON and text). Works on an ObservationSet only: no files, no hardware,
+// no truth, no exit codes (the application maps the verdict to those).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include <Eigen/Core>
+
+#include "calibration/bundle_stage.h"
+#include "calibration/paper_pipeline.h"
+#include "kinematics/robot_model.h"
+#include "observations/observation_set.h"
+
+namespace selfcal::calibration {
+
+enum class Method {
+  kBundle,  // the paper's pipeline, then the kinematic bundle adjustment started from it (the product)
+  kPaper,   // the paper's pipeline alone (Meng & Zhuang 2001, section 4.1; the baseline)
+};
+const char* MethodName(Method method);  // "bundle", "paper"
+std::optional<Method> ParseMethod(std::string_view name);
+
+// The verdict on a calibration, whatever method produced it.
+enum class Verdict {
+  kAccepted,         // converged, metric: the model may be applied
+  kInvalidInput,     // the observations or options fail validation (the message names pose and dot)
+  kDegenerate,       // too few usable poses, insufficient excitation, nothing identifiable
+  kScaleUnresolved,  // no usable yardstick: no metric scale
+  kUnconverged,      // the solver stopped without converging: the result is not to be applied
+  kSolverFailure,    // the solver failed (non-finite start, internal failure)
+};
+const char* VerdictName(Verdict verdict);  // "accepted", "invalid_input", ...
+
+struct CalibrateOptions {
+  Method method = Method::kBundle;
+  PaperPipelineOptions paper;  // paper.two_view.seed seeds the RANSAC sampling
+  BundleStageOptions bundle;
+};
+
+// The chosen method's calibrated model, ready for writing.
+struct CalibratedModel {
+  RobotModel robot;            // nominal values replaced by the calibrated ones, metric
+  double fx_px = 0;
+  // The calibrated parameter vector on the observations' nominal model (corrections for base and
+  // camera), when the method estimates one (the bundle adjustment); empty otherwise.
+  Eigen::VectorXd parameters;
+  std::string method_description;  // e.g. "kinematic bundle adjustment"
+};
+
+struct CalibrationReport {
+  Method method = Method::kBundle;
+  Verdict verdict = Verdict::kSolverFailure;
+  std::string message;  // why, when not accepted (the chosen method's own message)
+  PaperPipelineReport paper;               // always run
+  std::optional<BundleStageReport> bundle;  // when method == kBundle
+  std::optional<CalibratedModel> model;    // the chosen method's model, only when accepted
+
+  bool accepted() const { return verdict == Verdict::kAccepted; }
+  // The chosen method's held-out verification (3-D error of the check distances), before and after.
+  const VerificationSummary& verification_calibrated() const;
+  const VerificationSummary& verification_nominal() const;
+};
+
+CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateOptions& options);
+
+Verdict VerdictFor(Outcome paper_outcome);
+Verdict VerdictFor(bundle::Outcome bundle_outcome);
+
+}  // namespace selfcal::calibration

@@ -1,0 +1,190 @@
+#include "calibration/predicted_error.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "identification/triangulation.h"
+
+namespace selfcal::calibration {
+
+namespace {
+
+// Steps: large enough that the triangulation's convergence (it compares costs, so it stops within ~1e-10 m
+// of the minimum) stays far below the difference, small enough that the curvature does not matter
+// (relative truncation error ~h^2, below 1e-6 here).
+constexpr double kRhoStep = 1e-4;    // m or rad
+constexpr double kFxStep = 0.1;      // px
+constexpr double kPixelStep = 0.05;  // px
+
+// One end of a distance: the verification views that see the dot (index into pose_indices) and the pixel.
+struct EndViews {
+  std::vector<int> views;
+  std::vector<Eigen::Vector2d> pixels;
+};
+
+EndViews Views(const ObservationSet& obs, const std::vector<int>& pose_indices, int dot) {
+  EndViews end;
+  for (size_t k = 0; k < pose_indices.size(); ++k) {
+    const auto& dots = obs.poses[pose_indices[k]].dots_px;
+    auto it = dots.find(dot);
+    if (it == dots.end()) continue;
+    end.views.push_back(static_cast<int>(k));
+    end.pixels.push_back(it->second);
+  }
+  return end;
+}
+
+// Triangulates one end exactly as VerifyDistances does (sigma only scales the unused covariance).
+bool Triangulate(const ObservationSet& obs, double fx_px, const std::vector<Rigid3>& cams, const EndViews& end,
+                 const std::vector<Eigen::Vector2d>& pixels, Eigen::Vector3d* point) {
+  identification::PointTrack track;
+  for (size_t k = 0; k < end.views.size(); ++k) {
+    track.base_from_cam.push_back(cams[end.views[k]]);
+    track.pixels.push_back(pixels[k]);
+  }
+  const identification::TriangulationResult r = identification::TriangulatePoint(obs.camera, fx_px, track, 1.0);
+  if (!r.ok) return false;
+  *point = r.point;
+  return true;
+}
+
+}  // namespace
+
+PredictedDistanceErrors PredictDistanceErrors(const ObservationSet& obs, const std::vector<int>& pose_indices,
+                                              const RobotModel& robot, const Eigen::VectorXd& rho, double fx_px,
+                                              const std::vector<int>& free_indices, const Eigen::MatrixXd& covariance,
+                                              double sigma_px, const std::vector<KnownDistance>& distances,
+                                              double step_scale) {
+  PredictedDistanceErrors out;
+  const int nf = static_cast<int>(free_indices.size());
+  const int nt = nf + 1;
+  std::ostringstream problems;
+  if (rho.size() != robot.num_parameters() || !rho.allFinite()) problems << "rho must be finite with " << robot.num_parameters() << " entries\n";
+  for (int i : free_indices) {
+    if (i < 0 || i >= rho.size()) problems << "free index " << i << " out of range\n";
+  }
+  if (!(std::isfinite(fx_px) && fx_px > 0)) problems << "f_x must be finite and > 0\n";
+  if (covariance.rows() < nt || covariance.cols() != covariance.rows() || !covariance.allFinite()) {
+    problems << "covariance must be square, finite, with at least free + 1 (f_x) = " << nt << " rows\n";
+  }
+  if (!(std::isfinite(sigma_px) && sigma_px >= 0)) problems << "sigma_px must be finite and >= 0\n";
+  if (!(std::isfinite(step_scale) && step_scale > 0)) problems << "step_scale must be > 0\n";
+  for (int p : pose_indices) {
+    if (p < 0 || p >= static_cast<int>(obs.poses.size())) problems << "pose index " << p << " out of range\n";
+  }
+  if (!problems.str().empty()) {
+    out.message = problems.str();
+    return out;
+  }
+  const Eigen::MatrixXd sigma = covariance.topLeftCorner(nt, nt);
+
+  auto cameras = [&](const Eigen::VectorXd& r) {
+    std::vector<Rigid3> cams;
+    for (int p : pose_indices) cams.push_back(BaseFromCam(robot, r, obs.poses[p].joints_rad));
+    return cams;
+  };
+  const std::vector<Rigid3> cams0 = cameras(rho);
+  const size_t nd = distances.size();
+  std::vector<EndViews> ends_a(nd), ends_b(nd);
+  out.distances.resize(nd);
+  std::vector<bool> ok(nd, true);
+  for (size_t d = 0; d < nd; ++d) {
+    PredictedDistanceError& e = out.distances[d];
+    e.known = distances[d];
+    ends_a[d] = Views(obs, pose_indices, distances[d].dot_a);
+    ends_b[d] = Views(obs, pose_indices, distances[d].dot_b);
+    e.gradient_theta = Eigen::VectorXd::Zero(nt);
+    e.gradient_px = Eigen::VectorXd::Zero(2 * (ends_a[d].views.size() + ends_b[d].views.size()));
+    Eigen::Vector3d a, b;
+    ok[d] = Triangulate(obs, fx_px, cams0, ends_a[d], ends_a[d].pixels, &a) &&
+            Triangulate(obs, fx_px, cams0, ends_b[d], ends_b[d].pixels, &b);
+    if (ok[d]) e.measured_m = (a - b).norm();
+  }
+  // Distance of every check at a model; false entries where a triangulation failed.
+  auto all_distances = [&](const std::vector<Rigid3>& cams, double fx, std::vector<double>* values) {
+    values->assign(nd, 0.0);
+    for (size_t d = 0; d < nd; ++d) {
+      if (!ok[d]) continue;
+      Eigen::Vector3d a, b;
+      if (Triangulate(obs, fx, cams, ends_a[d], ends_a[d].pixels, &a) &&
+          Triangulate(obs, fx, cams, ends_b[d], ends_b[d].pixels, &b)) {
+        (*values)[d] = (a - b).norm();
+      } else {
+        ok[d] = false;
+      }
+    }
+  };
+  // g_theta: one pair of model evaluations per parameter, shared by every distance.
+  std::vector<double> plus, minus;
+  for (int t = 0; t < nt; ++t) {
+    const bool is_fx = t == nf;
+    const double h = step_scale * (is_fx ? kFxStep : kRhoStep);
+    Eigen::VectorXd r = rho;
+    if (is_fx) {
+      all_distances(cams0, fx_px + h, &plus);
+      all_distances(cams0, fx_px - h, &minus);
+    } else {
+      r[free_indices[t]] = rho[free_indices[t]] + h;
+      all_distances(cameras(r), fx_px, &plus);
+      r[free_indices[t]] = rho[free_indices[t]] - h;
+      all_distances(cameras(r), fx_px, &minus);
+    }
+    for (size_t d = 0; d < nd; ++d) out.distances[d].gradient_theta[t] = (plus[d] - minus[d]) / (2 * h);
+  }
+  // g_px: only the perturbed end moves.
+  const double hp = step_scale * kPixelStep;
+  for (size_t d = 0; d < nd; ++d) {
+    if (!ok[d]) continue;
+    PredictedDistanceError& e = out.distances[d];
+    Eigen::Vector3d a0, b0;
+    Triangulate(obs, fx_px, cams0, ends_a[d], ends_a[d].pixels, &a0);
+    Triangulate(obs, fx_px, cams0, ends_b[d], ends_b[d].pixels, &b0);
+    int row = 0;
+    for (int end = 0; end < 2 && ok[d]; ++end) {
+      const EndViews& v = end == 0 ? ends_a[d] : ends_b[d];
+      const Eigen::Vector3d& other = end == 0 ? b0 : a0;
+      for (size_t k = 0; k < v.views.size() && ok[d]; ++k) {
+        for (int c = 0; c < 2 && ok[d]; ++c, ++row) {
+          std::vector<Eigen::Vector2d> pixels = v.pixels;
+          Eigen::Vector3d p_plus, p_minus;
+          pixels[k][c] = v.pixels[k][c] + hp;
+          const bool ok_plus = Triangulate(obs, fx_px, cams0, v, pixels, &p_plus);
+          pixels[k][c] = v.pixels[k][c] - hp;
+          const bool ok_minus = Triangulate(obs, fx_px, cams0, v, pixels, &p_minus);
+          if (!ok_plus || !ok_minus) {
+            ok[d] = false;
+            break;
+          }
+          e.gradient_px[row] = ((p_plus - other).norm() - (p_minus - other).norm()) / (2 * hp);
+        }
+      }
+    }
+  }
+  double sum2 = 0, sum2_a = 0, sum2_b = 0;
+  for (size_t d = 0; d < nd; ++d) {
+    PredictedDistanceError& e = out.distances[d];
+    e.ok = ok[d];
+    if (!e.ok) continue;
+    const double var_a = std::max(0.0, e.gradient_theta.dot(sigma * e.gradient_theta));
+    const double var_b = sigma_px * sigma_px * e.gradient_px.squaredNorm();
+    e.parameters_std_m = std::sqrt(var_a);
+    e.pixels_std_m = std::sqrt(var_b);
+    e.std_m = std::sqrt(var_a + var_b);
+    ++out.num_ok;
+    sum2 += var_a + var_b;
+    sum2_a += var_a;
+    sum2_b += var_b;
+  }
+  if (out.num_ok > 0) {
+    out.rms_std_m = std::sqrt(sum2 / out.num_ok);
+    out.rms_parameters_std_m = std::sqrt(sum2_a / out.num_ok);
+    out.rms_pixels_std_m = std::sqrt(sum2_b / out.num_ok);
+    out.ok = true;
+    out.message = "ok";
+  } else {
+    out.message = "no check distance triangulated from the given poses";
+  }
+  return out;
+}
+
+}  // namespace selfcal::calibration

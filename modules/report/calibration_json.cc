@@ -1,0 +1,222 @@
+#include <algorithm>
+#include <cmath>
+
+#include "report/calibration_report.h"
+#include "report/json_util.h"
+
+namespace selfcal::report {
+
+namespace {
+
+using nlohmann::json;
+
+bool Contains(const std::vector<int>& v, int i) { return std::find(v.begin(), v.end(), i) != v.end(); }
+
+// A figure over no checks is absent (null), never 0.
+json VerificationSummaryJson(const calibration::VerificationSummary& v) {
+  json checks = json::array();
+  for (const calibration::DistanceCheck& c : v.checks) {
+    checks.push_back({{"dot_a", c.known.dot_a}, {"dot_b", c.known.dot_b}, {"known_m", c.known.length_m},
+                      {"ok", c.ok}, {"measured_m", c.ok ? json(c.measured_m) : json()},
+                      {"error_m", c.ok ? json(c.error_m) : json()}});
+  }
+  const bool any = v.num_ok > 0;
+  return {{"num_checks", v.checks.size()},
+          {"num_ok", v.num_ok},
+          {"mean_error_m", any ? Finite(v.mean_error_m) : json()},
+          {"rms_error_m", any ? Finite(v.rms_error_m) : json()},
+          {"max_error_m", any ? Finite(v.max_error_m) : json()},
+          {"checks", checks}};
+}
+
+json VerificationJson(const ObservationSet& obs, const calibration::VerificationSummary& nominal,
+                      const calibration::VerificationSummary& calibrated) {
+  return {{"poses", obs.PosesWithRole(PoseRole::kVerification).size()},
+          {"nominal_model", VerificationSummaryJson(nominal)},
+          {"calibrated_model", VerificationSummaryJson(calibrated)}};
+}
+
+json PredictedErrorJson(const calibration::PredictedDistanceErrors& p) {
+  json distances = json::array();
+  for (const calibration::PredictedDistanceError& e : p.distances) {
+    distances.push_back({{"dot_a", e.known.dot_a}, {"dot_b", e.known.dot_b}, {"ok", e.ok},
+                         {"std_m", Finite(e.std_m)}, {"parameters_std_m", Finite(e.parameters_std_m)},
+                         {"pixels_std_m", Finite(e.pixels_std_m)}});
+  }
+  const bool any = p.ok && p.num_ok > 0;
+  return {{"description", "predicted std of the 3-D error of each check distance: the bundle's covariance of the free "
+                          "parameters and f_x (parameters part) and the stated pixel noise of the verification images "
+                          "(pixels part), propagated through the triangulation to first order"},
+          {"ok", p.ok},
+          {"message", p.message},
+          {"num_ok", p.num_ok},
+          {"rms_std_m", any ? Finite(p.rms_std_m) : json()},
+          {"rms_parameters_std_m", any ? Finite(p.rms_parameters_std_m) : json()},
+          {"rms_pixels_std_m", any ? Finite(p.rms_pixels_std_m) : json()},
+          {"distances", distances}};
+}
+
+json PoseMeasurementsJson(const calibration::PaperPipelineReport& r) {
+  json measurements = json::array();
+  for (const calibration::PoseMeasurement& m : r.measurements) {
+    measurements.push_back({{"pose", m.pose_id},
+                            {"outcome", twoview::OutcomeName(m.two_view.outcome)},
+                            {"message", m.two_view.message},
+                            {"used", m.used},
+                            {"fx_px", m.two_view.fx_px},
+                            {"fx_observable", m.two_view.fx_observable},
+                            {"fx_from_other_pairs", m.fx_from_other_pairs},
+                            {"planar", m.two_view.planar},
+                            {"inliers", m.two_view.num_inliers},
+                            {"rms_epipolar_px", m.two_view.rms_epipolar_px},
+                            {"eq21_scale_m", m.scale},
+                            {"far_point_fraction", m.two_view.far_point_fraction},
+                            {"warnings", m.two_view.warnings},
+                            {"refinement", m.two_view.refinement_termination}});
+  }
+  return measurements;
+}
+
+json PaperParametersJson(const ObservationSet& obs, const identification::IdentificationReport& ident) {
+  json parameters = json::array();
+  if (ident.rho.size() != obs.robot.num_parameters()) return parameters;
+  const KinematicParameters params(obs.robot.num_joints());
+  const Eigen::VectorXd nominal = KinematicParameters::Nominal(obs.robot);
+  for (int i = 0; i < params.size(); ++i) {
+    const std::string unit = SiSuffix(params, i);
+    parameters.push_back({{"name", params.name(i)},
+                          {"free", Contains(ident.free_indices, i)},
+                          {"nominal" + unit, nominal[i]},
+                          {"identified_before_yardstick" + unit, ident.rho[i]},
+                          {"stddev" + unit, Finite(ident.stddev.size() > i ? ident.stddev[i] : NAN)}});
+  }
+  return parameters;
+}
+
+json PaperSectionJson(const ObservationSet& obs, const calibration::PaperPipelineReport& r) {
+  const identification::IdentifiabilityReport& id = r.identifiability;
+  const identification::IdentificationReport& ident = r.identification;
+  json lengths = json::array();
+  for (double l : r.yardstick.measured_lengths_m) lengths.push_back(l);
+  return {
+      {"description", "paper pipeline (Meng & Zhuang 2001): factor method, eq. (21) scale, LM identification, yardstick"},
+      {"verdict", calibration::VerdictName(calibration::VerdictFor(r.outcome))},
+      {"outcome", calibration::OutcomeName(r.outcome)},
+      {"message", r.message},
+      {"fx_px", r.fx_px},
+      {"fx_pairs", r.fx_pairs},
+      {"reference_pose", r.reference_pose >= 0 ? obs.poses[r.reference_pose].id : ""},
+      {"pose_measurements", PoseMeasurementsJson(r)},
+      {"identifiability", {{"num_parameters", id.num_parameters}, {"identifiable", id.rank},
+                           {"free", id.free_names}, {"fixed", id.fixed_names},
+                           {"null_combinations", id.null_combinations},
+                           {"condition_number", Finite(id.condition_number)}}},
+      {"identification", {{"outcome", identification::OutcomeName(ident.outcome)},
+                          {"message", ident.message},
+                          {"termination", ident.termination},
+                          {"iterations", ident.iterations},
+                          {"initial_cost", ident.initial_cost},
+                          {"final_cost", ident.final_cost},
+                          {"rms_position_m", ident.rms_position_m},
+                          {"rms_rotation_rad", ident.rms_rotation_rad},
+                          {"covariance_available", ident.covariance_available},
+                          {"covariance_message", ident.covariance_message}}},
+      {"parameters", PaperParametersJson(obs, ident)},
+      {"yardstick", {{"ok", r.yardstick.ok},
+                     {"message", r.yardstick.message},
+                     {"scale", r.yardstick.scale},
+                     {"scale_sigma", r.yardstick.scale_sigma},
+                     {"measured_lengths_before_scale_m", lengths}}},
+      {"verification", VerificationJson(obs, r.verification_nominal, r.verification_calibrated)},
+      {"predicted_3d_error", nullptr}};
+}
+
+json BundleParametersJson(const ObservationSet& obs, const bundle::BundleReport& b) {
+  json parameters = json::array();
+  if (b.rho.size() != obs.robot.num_parameters()) return parameters;
+  const KinematicParameters params(obs.robot.num_joints());
+  const Eigen::VectorXd nominal = KinematicParameters::Nominal(obs.robot);
+  for (int i = 0; i < params.size(); ++i) {
+    const std::string unit = SiSuffix(params, i);
+    parameters.push_back({{"name", params.name(i)},
+                          {"free", Contains(b.free_indices, i)},
+                          {"nominal" + unit, nominal[i]},
+                          {"value" + unit, b.rho[i]},
+                          {"correction" + unit, b.rho[i] - nominal[i]},
+                          {"stddev" + unit, Finite(b.stddev.size() > i ? b.stddev[i] : NAN)}});
+  }
+  return parameters;
+}
+
+json BundleSectionJson(const ObservationSet& obs, const calibration::BundleStageReport& stage) {
+  const bundle::BundleReport& b = stage.bundle;
+  json removed = json::array();
+  for (const bundle::RemovedObservation& o : b.removed) {
+    removed.push_back({{"pose", o.pose_id}, {"dot", o.dot_id}, {"residual_px", o.residual_px}});
+  }
+  return {{"description", "kinematic bundle adjustment (DESIGN.md section 5): reprojection of every dot in every "
+                          "identification image over the free kinematic parameters, hand-eye, f_x and the dots; "
+                          "yardstick as a length constraint"},
+          {"verdict", calibration::VerdictName(calibration::VerdictFor(b.outcome))},
+          {"outcome", bundle::OutcomeName(b.outcome)},
+          {"message", b.message},
+          {"fx_px", b.fx_px},
+          {"fx_stddev_px", Finite(b.fx_stddev)},
+          {"k1", b.k1},
+          {"k1_stddev", Finite(b.k1_stddev)},
+          {"start", calibration::BundleStartName(stage.start)},
+          {"start_note", stage.start_note},
+          {"fx_start_px", stage.fx_start_px},
+          {"solver", {{"termination", b.termination}, {"iterations", b.iterations},
+                      {"initial_cost", b.initial_cost}, {"final_cost", b.final_cost}}},
+          {"num_observations", b.num_observations},
+          {"rms_reprojection_px", b.rms_reprojection_px},
+          {"removed_observations", removed},
+          {"dropped_dots", b.dropped_dots},
+          {"free", b.free_names},
+          {"fixed", b.fixed_names},
+          {"null_combinations", b.null_combinations},
+          {"generic_rank", b.generic_rank},
+          {"condition_number", Finite(b.condition_number)},
+          {"covariance_available", b.covariance_available},
+          {"covariance_message", b.covariance_message},
+          {"parameters", BundleParametersJson(obs, b)},
+          {"verification", VerificationJson(obs, stage.verification_nominal, stage.verification)},
+          {"predicted_3d_error", PredictedErrorJson(stage.predicted_error)}};
+}
+
+}  // namespace
+
+json CalibrationReportJson(const ObservationSet& obs, const calibration::CalibrationReport& report,
+                           const ReportContext& context) {
+  json methods = {{"paper", PaperSectionJson(obs, report.paper)}};
+  if (report.bundle) methods["bundle"] = BundleSectionJson(obs, *report.bundle);
+  const json& chosen = methods[calibration::MethodName(report.method)];
+  json j;
+  j["format"] = kCalibrationReportFormat;
+  j["version"] = kCalibrationReportVersion;
+  j["software_version"] = SELFCAL_VERSION;
+  j["input"] = {{"kind", context.input.kind}, {"path", context.input.path}, {"sha256", context.input.sha256}};
+  j["method"] = calibration::MethodName(report.method);
+  j["verdict"] = calibration::VerdictName(report.verdict);
+  j["accepted"] = report.accepted();
+  j["message"] = report.message;
+  j["exit_code"] = context.exit_code;
+  j["pixel_noise_px"] = obs.pixel_noise_px;
+  j["pixel_noise_note"] = "standard deviation per coordinate (the paper's N(0, s) read as a std)";
+  // The chosen method's figures, so that a script reading the top level reads the product's answer.
+  j["fx_px"] = chosen["fx_px"];
+  j["verification"] = chosen["verification"];
+  j["predicted_3d_error"] = chosen["predicted_3d_error"];
+  j["methods"] = methods;
+  j["session"] = context.session;
+  // Timing in one place, so that two reports of the same input compare equal without it.
+  const calibration::PaperPipelineReport& p = report.paper;
+  j["timing"] = {{"paper_two_view_s", p.seconds_two_view},
+                 {"paper_identification_s", p.seconds_identification},
+                 {"paper_total_s", p.seconds_total},
+                 {"bundle_s", report.bundle ? json(report.bundle->bundle.seconds) : json()}};
+  return j;
+}
+
+}  // namespace selfcal::report

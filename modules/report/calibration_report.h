@@ -1,0 +1,41 @@
+// report.json of a calibration (schema: docs/report-format.md, "selfcal-calibration-report" version 2)
+// and its on-screen summary. Every value in the JSON is SI with the unit in the key (_m, _rad, _px, _s);
+// the text prints mm and degrees. The top level carries the chosen method's verdict and figures; the
+// sections under "methods" have the same shape for every method that ran.
+#pragma once
+
+#include <ostream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "calibration/calibrate.h"
+#include "observations/observation_set.h"
+
+namespace selfcal::report {
+
+inline constexpr const char* kCalibrationReportFormat = "selfcal-calibration-report";
+inline constexpr int kCalibrationReportVersion = 2;
+
+// What was read: the observations file, or a session directory (whose provenance is its manifest).
+struct ReportInput {
+  std::string kind;    // "observations" or "session"
+  std::string path;
+  std::string sha256;  // of the observations file, or of the session's session.json
+};
+
+// The application's side of the report: the process exit code it maps the verdict to, and (for a
+// session) the journal's counts as the session module reports them.
+struct ReportContext {
+  ReportInput input;
+  int exit_code = 0;
+  nlohmann::json session;  // null when the input was not a session
+};
+
+nlohmann::json CalibrationReportJson(const ObservationSet& observations, const calibration::CalibrationReport& report,
+                                     const ReportContext& context);
+
+// The text summary: the paper pipeline, then the bundle adjustment when it ran.
+void PrintCalibrationSummary(const calibration::CalibrationReport& report, std::ostream& out);
+
+}  // namespace selfcal::report

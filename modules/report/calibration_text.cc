@@ -1,0 +1,80 @@
+#include <iomanip>
+
+#include "report/calibration_report.h"
+
+namespace selfcal::report {
+
+namespace {
+
+constexpr double kMm = 1e3;  // the text prints mm
+
+void PrintPaperSummary(const calibration::PaperPipelineReport& r, std::ostream& out) {
+  out << "outcome: " << calibration::OutcomeName(r.outcome);
+  if (!r.message.empty()) out << " (" << r.message << ")";
+  out << "\n";
+  int used = 0;
+  for (const auto& m : r.measurements) used += m.used ? 1 : 0;
+  out << "pose measurements: " << used << " of " << r.measurements.size() << " pairs used; f_x = " << std::fixed
+      << std::setprecision(3) << r.fx_px << " px from " << r.fx_pairs << " pairs\n";
+  out << "identifiable parameters: " << r.identifiability.rank << " of " << r.identifiability.num_parameters
+      << " (condition number " << std::setprecision(1) << r.identifiability.condition_number << ")\n";
+  out << "identification: " << identification::OutcomeName(r.identification.outcome) << ", "
+      << r.identification.iterations << " iterations, residual RMS " << std::setprecision(3)
+      << r.identification.rms_position_m * kMm << " mm / " << RadToDeg(r.identification.rms_rotation_rad) << " deg\n";
+  if (r.yardstick.ok) {
+    out << "yardstick scale: " << std::setprecision(6) << r.yardstick.scale << " +- " << r.yardstick.scale_sigma << "\n";
+  } else {
+    out << "yardstick: " << r.yardstick.message << "\n";
+  }
+  if (r.verification_calibrated.num_ok > 0) {
+    out << "3-D error on " << r.verification_calibrated.num_ok << " held-out distances: nominal model "
+        << std::setprecision(3) << r.verification_nominal.rms_error_m * kMm << " mm RMS, calibrated "
+        << r.verification_calibrated.rms_error_m * kMm << " mm RMS (max " << r.verification_calibrated.max_error_m * kMm
+        << " mm)\n";
+  }
+  out << "time: " << std::setprecision(1) << r.seconds_total * 1e3 << " ms\n";
+  out.unsetf(std::ios::floatfield);
+}
+
+
+void PrintBundleSummary(const calibration::BundleStageReport& stage, std::ostream& out) {
+  const bundle::BundleReport& b = stage.bundle;
+  out << "kinematic bundle adjustment: " << bundle::OutcomeName(b.outcome);
+  if (!b.message.empty()) out << " (" << b.message << ")";
+  out << "\n  start: " << stage.start_note << "\n";
+  if (b.rho.size() == 0) return;
+  out << "  " << b.free_names.size() << " free kinematic parameters + f_x, " << b.fixed_names.size()
+      << " fixed; " << b.num_observations << " observations, " << b.removed.size() << " removed by the screen, "
+      << b.dropped_dots.size() << " dots dropped\n";
+  out << "  " << b.iterations << " iterations (" << b.termination << "), reprojection RMS " << std::setprecision(4)
+      << b.rms_reprojection_px << " px; f_x = " << std::fixed << std::setprecision(3) << b.fx_px << " +- "
+      << b.fx_stddev << " px\n";
+  out.unsetf(std::ios::floatfield);
+  if (stage.verification.num_ok > 0) {
+    out << "  3-D error on " << stage.verification.num_ok << " held-out distances: nominal model " << std::fixed
+        << std::setprecision(3) << stage.verification_nominal.rms_error_m * kMm << " mm RMS, bundle "
+        << stage.verification.rms_error_m * kMm << " mm RMS (max " << stage.verification.max_error_m * kMm << " mm)\n";
+  }
+  if (stage.predicted_error.ok) {
+    out << "  predicted 3-D error (first order): " << std::fixed << std::setprecision(3) << stage.predicted_error.rms_std_m * kMm
+        << " mm RMS (calibrated parameters " << stage.predicted_error.rms_parameters_std_m * kMm
+        << " mm, verification pixels " << stage.predicted_error.rms_pixels_std_m * kMm << " mm)\n";
+    out.unsetf(std::ios::floatfield);
+  }
+  out << "  time: " << std::fixed << std::setprecision(1) << b.seconds * 1e3 << " ms\n";
+  out.unsetf(std::ios::floatfield);
+}
+
+
+}  // namespace
+
+void PrintCalibrationSummary(const calibration::CalibrationReport& report, std::ostream& out) {
+  out << "paper pipeline (Meng & Zhuang):\n";
+  PrintPaperSummary(report.paper, out);
+  if (report.bundle) {
+    out << "\n";
+    PrintBundleSummary(*report.bundle, out);
+  }
+}
+
+}  // namespace selfcal::report

@@ -1,0 +1,113 @@
+#include "report/calibration_report.h"
+
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "report/literature.h"
+#include "report/study_report.h"
+#include "support/sim_worlds.h"
+
+namespace selfcal::report {
+namespace {
+
+// Every key of the document, with its path, for the key-style checks.
+void CollectKeys(const nlohmann::json& j, const std::string& path, std::vector<std::string>* keys) {
+  if (j.is_object()) {
+    for (const auto& [key, value] : j.items()) {
+      keys->push_back(path + "/" + key);
+      CollectKeys(value, path + "/" + key, keys);
+    }
+  } else if (j.is_array()) {
+    for (std::size_t i = 0; i < j.size(); ++i) CollectKeys(j[i], path + "/" + std::to_string(i), keys);
+  }
+}
+
+bool EndsWith(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+class CalibrationReportTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    world_ = new sim::SimResult(testing::PumaArcWorld(0.2, 2, 2));
+    report_ = new calibration::CalibrationReport(calibration::Calibrate(world_->observations, {}));
+  }
+  static void TearDownTestSuite() {
+    delete report_;
+    delete world_;
+  }
+  static sim::SimResult* world_;
+  static calibration::CalibrationReport* report_;
+};
+sim::SimResult* CalibrationReportTest::world_ = nullptr;
+calibration::CalibrationReport* CalibrationReportTest::report_ = nullptr;
+
+TEST_F(CalibrationReportTest, TopLevelCarriesTheChosenMethodsFigures) {
+  ASSERT_TRUE(report_->accepted()) << report_->message;
+  const nlohmann::json j = CalibrationReportJson(world_->observations, *report_, {{"observations", "o.yaml", "ab"}, 0, {}});
+  EXPECT_EQ(j["format"], kCalibrationReportFormat);
+  EXPECT_EQ(j["version"], 2);
+  EXPECT_EQ(j["method"], "bundle");
+  EXPECT_EQ(j["verdict"], "accepted");
+  EXPECT_EQ(j["accepted"], true);
+  EXPECT_EQ(j["fx_px"], j["methods"]["bundle"]["fx_px"]);
+  EXPECT_EQ(j["verification"], j["methods"]["bundle"]["verification"]);
+  EXPECT_DOUBLE_EQ(j["verification"]["calibrated_model"]["rms_error_m"].get<double>(),
+                   report_->bundle->verification.rms_error_m);
+  EXPECT_NE(j["verification"], j["methods"]["paper"]["verification"]);
+  EXPECT_EQ(j["input"]["sha256"], "ab");
+  EXPECT_TRUE(j["session"].is_null());
+}
+
+// One key style: SI values with the unit in the key; no mm or degree keys anywhere in report.json.
+TEST_F(CalibrationReportTest, EveryKeyIsSi) {
+  const nlohmann::json j = CalibrationReportJson(world_->observations, *report_, {});
+  std::vector<std::string> keys;
+  CollectKeys(j, "", &keys);
+  ASSERT_GT(keys.size(), 100u);
+  for (const std::string& k : keys) {
+    EXPECT_FALSE(EndsWith(k, "_mm") || EndsWith(k, "_deg") || k.find("_mm/") != std::string::npos) << k;
+  }
+}
+
+// Both method sections have the same shape at their top.
+TEST_F(CalibrationReportTest, MethodSectionsAreSymmetric) {
+  const nlohmann::json j = CalibrationReportJson(world_->observations, *report_, {});
+  for (const char* method : {"paper", "bundle"}) {
+    for (const char* key : {"description", "verdict", "outcome", "message", "fx_px", "parameters", "verification",
+                            "predicted_3d_error"}) {
+      EXPECT_TRUE(j["methods"][method].contains(key)) << method << "." << key;
+    }
+  }
+}
+
+// A scene without known distances has no distance figures: they are absent (null), not 0.
+TEST(CalibrationReport, AbsentFiguresAreNullNotZero) {
+  sim::SimResult world = testing::PumaArcWorld(0.2, 1, 1);
+  world.observations.check_distances.clear();
+  const calibration::CalibrationReport report = calibration::Calibrate(world.observations, {});
+  const nlohmann::json j = CalibrationReportJson(world.observations, report, {});
+  EXPECT_EQ(j["verification"]["calibrated_model"]["num_ok"], 0);
+  EXPECT_TRUE(j["verification"]["calibrated_model"]["rms_error_m"].is_null());
+  EXPECT_TRUE(j["verification"]["calibrated_model"]["max_error_m"].is_null());
+}
+
+// The paper's Table 2 comes from the literature table, as printed there.
+TEST(Literature, Table2RowsAsPrinted) {
+  ASSERT_EQ(MengZhuang2001Table2().size(), 4u);
+  const PaperTable2Row* row = NearestTable2Row("optimal", 0.45);
+  ASSERT_NE(row, nullptr);
+  EXPECT_EQ(row->noise_px, 0.5);
+  EXPECT_EQ(row->position_mm.mean, 0.3035);
+  EXPECT_EQ(NearestTable2Row("initial", 0.0)->noise_px, 0.2);
+  EXPECT_EQ(NearestTable2Row("spiral", 0.2), nullptr);
+  std::ostringstream text;
+  simulation::BoundPoint point;
+  point.setup.sigma_px = 0.5;
+  PrintBoundSweep({point}, text);
+  EXPECT_NE(text.str().find("optimal at noise II: 2.40e-4 rad, 0.30 mm, 0.35 px"), std::string::npos) << text.str();
+}
+
+}  // namespace
+}  // namespace selfcal::report

@@ -1,0 +1,82 @@
+// A simulated cell for sessions: the simulated world (hidden robot errors, hand-eye, f_x, spaced dots),
+// a SimulatedRobot moving the true arm on a simulated clock, and the rendered SimulatedCamera looking
+// through the true kinematics at the arm's true joints at every exposure, so that RunSession runs on it
+// exactly as on hardware (issue 6; `selfcal simulate` and `selfcal run --robot sim --camera sim`).
+//
+// The first frame's dots are named by TruthIdentifier (the renderer knows which disc is which), standing
+// in for a pattern or AprilTags; every later identity comes from tracking alone.
+//
+// Restart model (resume after a kill): a simulated arm that was killed mid-session is rebuilt at rest at
+// the target of the last accepted sample, with the clock at that sample's journaled time, which is what
+// an uninterrupted run has at that moment once the ring-down has ended (ring_cutoff_s < settle dwell).
+#pragma once
+
+#include <memory>
+#include <optional>
+
+#include "acquisition/motion_safety.h"
+#include "acquisition/session_runner.h"
+#include "robot/simulated_robot.h"
+#include "sim/simulated_camera.h"
+#include "sim/sim_world.h"
+
+namespace selfcal::simulation {
+
+// Names detections by the nearest projected disc of the camera's last render (within match_radius_px).
+// `marked_ids` (the yardstick's ends) are the dots a real scene marks with a tag: FindMarked names them in
+// any frame; every other id after the first frame comes from tracking alone.
+class TruthIdentifier : public acquisition::DotIdentifier {
+ public:
+  TruthIdentifier(const sim::SimulatedCamera* camera, std::vector<int> marked_ids, double match_radius_px = 3.0)
+      : camera_(camera), marked_ids_(std::move(marked_ids)), match_radius_px_(match_radius_px) {}
+  Result<std::vector<tracking::PreviousDot>> Identify(const capture::Frame& frame,
+                                                      const tracking::DetectionReport& detections) override;
+  std::vector<tracking::PreviousDot> FindMarked(const capture::Frame& frame,
+                                                const tracking::DetectionReport& detections,
+                                                const std::vector<int>& missing_ids) override;
+  std::vector<int> MarkedIds() const override { return marked_ids_; }
+
+ private:
+  // The detections that name a rendered dot among `ids` (all when empty): sim::NameByNearestDisc.
+  std::vector<tracking::PreviousDot> Name(const tracking::DetectionReport& detections,
+                                          const std::vector<int>& ids) const;
+  const sim::SimulatedCamera* camera_;
+  std::vector<int> marked_ids_;
+  double match_radius_px_;
+};
+
+struct SimCellOptions {
+  sim::SimOptions world;                 // seeds, hidden errors, camera; spacing is switched on here
+  sim::SimulatedCameraOptions camera;    // rendering, frame period
+  double max_velocity_rad_s = 1.0471975511965976;  // 60 deg/s on every joint
+  robot::SimulatedRobotFaults faults;
+  double ring_cutoff_s = 0.5;            // the ring-down ends exactly this long after arrival
+};
+
+// Everything a simulated session needs, owned together (the robot refers to the clock, the camera's
+// pose function to the robot).
+struct SimCell {
+  std::unique_ptr<sim::SimResult> world;  // heap: the camera's pose function points into it
+  std::unique_ptr<robot::SimulatedClock> clock;
+  std::unique_ptr<robot::SimulatedRobot> robot;
+  std::unique_ptr<sim::SimulatedCamera> camera;
+  std::unique_ptr<TruthIdentifier> identifier;
+};
+
+// Builds the cell for `plan` on the nominal robot. `start_joints_rad` / `start_time_s`: where the arm
+// rests and the clock starts (a fresh session: the plan's first pose at t = 0; a resumed one: see the
+// header comment). Fails (kDegenerateData) when the world cannot be simulated.
+Result<SimCell> MakeSimCell(const RobotModel& nominal, const std::vector<acquisition::PlannedPose>& plan,
+                            const SimCellOptions& options, const Eigen::VectorXd& start_joints_rad,
+                            double start_time_s);
+
+// Rebuilds the clock, arm, camera and identifier of `cell` on its world (no new simulation): the arm at
+// rest at `start_joints_rad`, the clock at `start_time_s` (the restart model of the header comment).
+void RestartSimCell(SimCell* cell, const SimCellOptions& options, const Eigen::VectorXd& start_joints_rad,
+                    double start_time_s);
+
+// The setup of a simulated session: the world's observation header (camera with the nominal f_x,
+// yardstick, check distances), no poses.
+ObservationSet SimSetup(const SimCell& cell);
+
+}  // namespace selfcal::simulation

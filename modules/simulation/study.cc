@@ -1,0 +1,351 @@
+#include "simulation/study.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+namespace selfcal::simulation {
+
+double Stat::Mean() const {
+  if (values.empty()) return std::nan("");
+  return std::accumulate(values.begin(), values.end(), 0.0) / values.size();
+}
+double Stat::Sd() const {
+  if (values.size() < 2) return std::nan("");
+  const double m = Mean();
+  double s = 0;
+  for (double v : values) s += (v - m) * (v - m);
+  return std::sqrt(s / (values.size() - 1));
+}
+double Stat::Rms() const {
+  if (values.empty()) return std::nan("");
+  double s = 0;
+  for (double v : values) s += v * v;
+  return std::sqrt(s / values.size());
+}
+double Stat::Max() const {
+  if (values.empty()) return std::nan("");
+  return *std::max_element(values.begin(), values.end());
+}
+double Stat::Percentile(double p) const {
+  if (values.empty()) return std::nan("");
+  std::vector<double> sorted = values;
+  std::sort(sorted.begin(), sorted.end());
+  const double pos = p / 100.0 * (sorted.size() - 1);
+  const size_t lo = static_cast<size_t>(std::floor(pos));
+  const size_t hi = std::min(lo + 1, sorted.size() - 1);
+  return sorted[lo] + (pos - lo) * (sorted[hi] - sorted[lo]);
+}
+
+namespace {
+
+constexpr double kMm = 1e3;
+constexpr double k1e4 = 1e4;
+
+// Scores one pipeline run against the simulator's truth and adds to the cell.
+void ScoreRun(const sim::SimResult& world, const ObservationSet& obs, const calibration::PaperPipelineReport& report,
+              const StudyOptions& options, StudyCell* cell) {
+  const sim::SimTruth& truth = world.truth;
+  const int ref = report.reference_pose;
+  const Rigid3 true_ref_from_base = truth.base_from_cam[ref].Inverse();
+  // k_1 from the true first motion: the pipeline used ||tbar_1||, rescale by ||t_1|| / ||tbar_1||.
+  double k_correction = 1.0;
+  for (const calibration::PoseMeasurement& m : report.measurements) {
+    if (!m.used) continue;
+    const Rigid3 true_rel = true_ref_from_base * truth.base_from_cam[m.pose_index];
+    k_correction = true_rel.translation.norm() / m.nominal_translation.norm();
+    break;
+  }
+  double ratio_first_true = 0, ratio_first_nominal = 0;
+  bool first = true;
+  std::vector<Eigen::Vector3d> dots_in_ref;
+  for (const Eigen::Vector3d& p : truth.dots_in_base) dots_in_ref.push_back(true_ref_from_base * p);
+  for (const calibration::PoseMeasurement& m : report.measurements) {
+    const Rigid3 true_rel = true_ref_from_base * truth.base_from_cam[m.pose_index];  // cam_ref_from_cam_i
+    if (m.used) {
+      const Eigen::Vector3d t_meas = k_correction * m.measured_cam_ref_from_cam.translation;
+      cell->position_mm.Add(kMm * (t_meas - true_rel.translation).norm());
+      const Eigen::Vector3d t_true_scale = true_rel.translation.norm() * m.measured_cam_ref_from_cam.translation.normalized();
+      cell->position_true_scale_mm.Add(kMm * (t_true_scale - true_rel.translation).norm());
+      cell->orientation_1e4rad.Add(k1e4 * RotationAngle(m.measured_cam_ref_from_cam.rotation.transpose() * true_rel.rotation));
+      if (m.two_view.fx_observable) cell->fx_px.Add(std::abs(m.two_view.fx_px - truth.camera_true.fx_px));
+      if (first) {
+        ratio_first_true = true_rel.translation.norm();
+        ratio_first_nominal = m.nominal_translation.norm();
+        first = false;
+      } else {
+        const double nominal_ratio = m.nominal_translation.norm() / ratio_first_nominal;
+        const double true_ratio = true_rel.translation.norm() / ratio_first_true;
+        cell->scale_ratio_error.Add(std::abs(nominal_ratio / true_ratio - 1.0));
+      }
+    }
+    if (options.with_opencv && obs.poses.size() > 0) {
+      CameraIntrinsics camera = obs.camera;
+      camera.fx_px = truth.camera_true.fx_px;
+      const Matches matches = MatchById(obs.poses[ref], obs.poses[m.pose_index]);
+      twoview::TwoViewOptions cv_options = options.pipeline.two_view;
+      const twoview::TwoViewReport cv = twoview::EstimateTwoViewOpenCv(cv_options, camera, matches.pixels_a, matches.pixels_b);
+      if (cv.outcome == twoview::Outcome::kSuccess) {
+        const Eigen::Matrix3d r = cv.rotation.transpose();
+        const Eigen::Vector3d dir = -(r * cv.translation_direction).normalized();
+        const Eigen::Vector3d t_meas = k_correction * m.nominal_translation.norm() * dir;
+        cell->opencv_position_mm.Add(kMm * (t_meas - true_rel.translation).norm());
+        cell->opencv_position_true_scale_mm.Add(kMm * (true_rel.translation.norm() * dir - true_rel.translation).norm());
+        cell->opencv_orientation_1e4rad.Add(k1e4 * RotationAngle(r.transpose() * true_rel.rotation));
+      }
+    }
+    if (options.with_bound && obs.pixel_noise_px > 0 && cell->noise_px > 0) {
+      const Rigid3 cam_i_from_ref = true_rel.Inverse();
+      for (bool fx_unknown : {true, false}) {
+        const twoview::TwoViewBound bound =
+            twoview::TwoViewCramerRao(truth.camera_true, cam_i_from_ref, dots_in_ref, cell->noise_px, fx_unknown);
+        if (!bound.ok) continue;
+        // Position error of the measurement cam_ref_from_cam_i = -R^T t: with ||t|| exact, its direction
+        // error has the same angle as t's (rotation error enters too; the t term dominates).
+        const double position = kMm * true_rel.translation.norm() * bound.translation_dir_rms_rad();
+        const double orientation = k1e4 * bound.rotation_rms_rad();
+        if (fx_unknown) {
+          cell->bound_position_mm_fx_unknown.Add(position);
+          cell->bound_orientation_1e4rad_fx_unknown.Add(orientation);
+          cell->bound_fx_px.Add(std::sqrt(bound.fx_variance));
+        } else {
+          cell->bound_position_mm_fx_known.Add(position);
+          cell->bound_orientation_1e4rad_fx_known.Add(orientation);
+        }
+      }
+    }
+  }
+  for (const calibration::DistanceCheck& c : report.verification_nominal.checks) {
+    if (c.ok) cell->error3d_nominal_mm.Add(kMm * c.error_m);
+  }
+  for (const calibration::DistanceCheck& c : report.verification_calibrated.checks) {
+    if (c.ok) cell->error3d_calibrated_mm.Add(kMm * c.error_m);
+  }
+  const Eigen::VectorXd rho_nominal = KinematicParameters::Nominal(obs.robot);
+  const Rigid3 nominal_ref_from_base = BaseFromCam(obs.robot, rho_nominal, obs.poses[ref].joints_rad).Inverse();
+  const Rigid3 calibrated_ref_from_base =
+      BaseFromCam(report.calibrated_robot, report.calibrated_rho, obs.poses[ref].joints_rad).Inverse();
+  for (int v : obs.PosesWithRole(PoseRole::kVerification)) {
+    const Rigid3 true_rel = true_ref_from_base * truth.base_from_cam[v];
+    const Rigid3 nominal_rel = nominal_ref_from_base * BaseFromCam(obs.robot, rho_nominal, obs.poses[v].joints_rad);
+    const Rigid3 calibrated_rel = calibrated_ref_from_base *
+                                  BaseFromCam(report.calibrated_robot, report.calibrated_rho, obs.poses[v].joints_rad);
+    const PoseDifference before = ComparePoses(true_rel, nominal_rel);
+    const PoseDifference after = ComparePoses(true_rel, calibrated_rel);
+    cell->pose_position_nominal_mm.Add(kMm * before.position_m);
+    cell->pose_position_calibrated_mm.Add(kMm * after.position_m);
+    cell->pose_orientation_nominal_1e4rad.Add(k1e4 * before.rotation_rad);
+    cell->pose_orientation_calibrated_1e4rad.Add(k1e4 * after.rotation_rad);
+  }
+  cell->fx_final_error_px.Add(std::abs(report.fx_px - truth.camera_true.fx_px));
+  // The measurements carried lengths 1/k_correction times the truth; a right yardstick scale undoes that.
+  if (report.yardstick.ok) cell->yardstick_scale_error.Add(std::abs(report.yardstick.scale / k_correction - 1.0));
+  cell->seconds_per_calibration.Add(report.seconds_total);
+}
+
+// The bundle's Cramer-Rao bound at the truth. Its propagation covers the held-out poses of the geometry;
+// copies of the identification poses (ref excluded) appended as held-out poses give the bound of the
+// relative poses the Table 2 rows measure (the bound reads only their joint angles).
+bundle::CramerRaoReport BundleBound(const sim::SimResult& world, const ObservationSet& obs, double sigma_px,
+                                    const bundle::BundleOptions& options, int* num_identification_copies) {
+  ObservationSet geometry = obs;
+  const std::vector<int> id_poses = obs.PosesWithRole(PoseRole::kIdentification);
+  *num_identification_copies = 0;
+  for (size_t k = 1; k < id_poses.size(); ++k) {
+    PoseObservation copy;
+    copy.id = "identification:" + obs.poses[id_poses[k]].id;
+    copy.role = PoseRole::kVerification;
+    copy.joints_rad = obs.poses[id_poses[k]].joints_rad;
+    geometry.poses.push_back(std::move(copy));
+    ++*num_identification_copies;
+  }
+  bundle::BundleTruth truth;
+  truth.rho = world.truth.rho_true;
+  truth.fx_px = world.truth.camera_true.fx_px;
+  truth.k1 = world.truth.camera_true.k1;
+  for (size_t d = 0; d < world.truth.dots_in_base.size(); ++d) {
+    truth.dots_in_base[static_cast<int>(d)] = world.truth.dots_in_base[d];
+  }
+  return bundle::BundleCramerRao(geometry, truth, sigma_px, options);
+}
+
+// Runs the bundle stage on one observation set and scores it against the truth; adds to the cell.
+void ScoreBundle(const sim::SimResult& world, const ObservationSet& obs, const calibration::PaperPipelineReport& paper,
+                 const StudyOptions& options, StudyCell* cell, StudyReport* study) {
+  const sim::SimTruth& truth = world.truth;
+  ++cell->bundle_runs;
+  const calibration::BundleStageReport stage = calibration::RunBundleStage(obs, paper, options.bundle);
+  const bundle::BundleReport& b = stage.bundle;
+  if (b.outcome != bundle::Outcome::kConverged) {
+    ++cell->bundle_runs_failed;
+    if (cell->bundle_failures.size() < 5) {
+      cell->bundle_failures.push_back(std::string(bundle::OutcomeName(b.outcome)) + ": " + b.message);
+    }
+    return;
+  }
+  if (study->bundle_free_parameters == 0) {
+    study->bundle_free_parameters = static_cast<int>(b.free_indices.size());
+    study->bundle_fixed_parameters = b.fixed_names;
+  }
+  cell->bundle_seconds.Add(b.seconds);
+  const RobotModel& robot = obs.robot;
+  const std::vector<int> id_poses = obs.PosesWithRole(PoseRole::kIdentification);
+  const int ref = id_poses.front();
+  const Rigid3 true_ref_from_base = truth.base_from_cam[ref].Inverse();
+  const Rigid3 model_ref_from_base = BaseFromCam(robot, b.rho, obs.poses[ref].joints_rad).Inverse();
+  auto relative_error = [&](int pose) {
+    const Rigid3 model = model_ref_from_base * BaseFromCam(robot, b.rho, obs.poses[pose].joints_rad);
+    return ComparePoses(true_ref_from_base * truth.base_from_cam[pose], model);
+  };
+  for (size_t k = 1; k < id_poses.size(); ++k) {
+    const PoseDifference d = relative_error(id_poses[k]);
+    cell->bundle_position_mm.Add(kMm * d.position_m);
+    cell->bundle_orientation_1e4rad.Add(k1e4 * d.rotation_rad);
+  }
+  cell->bundle_fx_px.Add(std::abs(b.fx_px - truth.camera_true.fx_px));
+  for (int v : obs.PosesWithRole(PoseRole::kVerification)) {
+    const PoseDifference d = relative_error(v);
+    cell->bundle_pose_position_mm.Add(kMm * d.position_m);
+    cell->bundle_pose_orientation_1e4rad.Add(k1e4 * d.rotation_rad);
+  }
+  for (const calibration::DistanceCheck& c : stage.verification.checks) {
+    if (c.ok) cell->bundle_error3d_mm.Add(kMm * c.error_m);
+  }
+  if (cell->noise_px <= 0) return;  // no noise: no sigma to cover with, no bound
+  if (stage.predicted_error.ok) {
+    for (const calibration::PredictedDistanceError& e : stage.predicted_error.distances) {
+      if (!e.ok) continue;
+      cell->bundle_predicted3d_mm.Add(kMm * e.std_m);
+      cell->bundle_predicted3d_parameters_mm.Add(kMm * e.parameters_std_m);
+      cell->bundle_predicted3d_pixels_mm.Add(kMm * e.pixels_std_m);
+    }
+  }
+  // Coverage needs the truth in the bundle's gauge: every entry it held fixed equal to the truth's.
+  bool same_gauge = b.covariance_available;
+  for (int i = 0; i < b.rho.size() && same_gauge; ++i) {
+    const bool free = std::find(b.free_indices.begin(), b.free_indices.end(), i) != b.free_indices.end();
+    if (!free && b.rho[i] != truth.rho_true[i]) same_gauge = false;
+  }
+  const KinematicParameters params(robot.num_joints());
+  auto in_report_units = [&](int i, double v) { return params.kind(i) == ParameterKind::kLength ? kMm * v : RadToDeg(v); };
+  if (same_gauge) {
+    for (int i : b.free_indices) {
+      cell->bundle_parameter_error[params.name(i)].Add(in_report_units(i, b.rho[i] - truth.rho_true[i]));
+      ++cell->bundle_intervals;
+      cell->bundle_covered += std::abs(b.rho[i] - truth.rho_true[i]) <= 2 * b.stddev[i] ? 1 : 0;
+    }
+    if (options.bundle.bundle.estimate_fx) {
+      ++cell->bundle_intervals;
+      cell->bundle_covered += std::abs(b.fx_px - truth.camera_true.fx_px) <= 2 * b.fx_stddev ? 1 : 0;
+    }
+  }
+  if (!options.with_bound) return;
+  int copies = 0;
+  const bundle::CramerRaoReport bound = BundleBound(world, obs, cell->noise_px, options.bundle.bundle, &copies);
+  if (!bound.ok) return;
+  const size_t first_copy = bound.position_bound_m.size() - static_cast<size_t>(copies);
+  for (size_t k = 0; k < bound.position_bound_m.size(); ++k) {
+    if (k >= first_copy) {
+      cell->bundle_bound_position_mm.Add(kMm * bound.position_bound_m[k]);
+      cell->bundle_bound_orientation_1e4rad.Add(k1e4 * bound.orientation_bound_rad[k]);
+    } else {
+      cell->bundle_bound_pose_position_mm.Add(kMm * bound.position_bound_m[k]);
+      cell->bundle_bound_pose_orientation_1e4rad.Add(k1e4 * bound.orientation_bound_rad[k]);
+    }
+  }
+  if (std::isfinite(bound.fx_stddev)) cell->bundle_bound_fx_px.Add(bound.fx_stddev);
+  for (int i : bound.free_indices) {
+    if (std::isfinite(bound.stddev[i])) cell->bundle_parameter_bound[params.name(i)].Add(in_report_units(i, bound.stddev[i]));
+  }
+  // The 3-D error bound: the Cramer-Rao covariance propagated with the truth's model and f_x (the free
+  // set is the solve's, chosen at the nominal model). A held f_x: zero variance.
+  const int nf = static_cast<int>(bound.free_indices.size());
+  if (bound.covariance_free.rows() >= nf) {
+    Eigen::MatrixXd sigma = Eigen::MatrixXd::Zero(nf + 1, nf + 1);
+    sigma.topLeftCorner(nf, nf) = bound.covariance_free.topLeftCorner(nf, nf);
+    if (options.bundle.bundle.estimate_fx) sigma = bound.covariance_free.topLeftCorner(nf + 1, nf + 1);
+    const calibration::PredictedDistanceErrors b3d =
+        calibration::PredictDistanceErrors(obs, obs.PosesWithRole(PoseRole::kVerification), obs.robot, truth.rho_true,
+                              truth.camera_true.fx_px, bound.free_indices, sigma, cell->noise_px, obs.check_distances);
+    for (const calibration::PredictedDistanceError& e : b3d.distances) {
+      if (!e.ok) continue;
+      cell->bundle_bound3d_mm.Add(kMm * e.std_m);
+      cell->bundle_bound3d_parameters_mm.Add(kMm * e.parameters_std_m);
+    }
+  }
+}
+
+}  // namespace
+
+StudyReport RunStudy(const RobotModel& nominal, const std::vector<TrajectorySpec>& trajectories,
+                     const StudyOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  StudyReport study;
+  study.flat_sheet = options.sim.flat_sheet;
+  for (const TrajectorySpec& trajectory : trajectories) {
+    const size_t num_point_cells = options.noise_levels_px.size();
+    std::vector<StudyCell> cells(num_point_cells + options.rendered_levels.size());
+    for (size_t l = 0; l < cells.size(); ++l) {
+      if (l < num_point_cells) {
+        cells[l].trajectory = trajectory.name;
+        cells[l].noise_px = options.noise_levels_px[l];
+      } else {
+        const RenderedLevel& level = options.rendered_levels[l - num_point_cells];
+        cells[l].trajectory = trajectory.name + "/" + level.name;
+        cells[l].noise_px = level.assumed_noise_px;
+        cells[l].rendered = true;
+      }
+    }
+    for (int run = 0; run < options.runs; ++run) {
+      sim::SimOptions sim_options = options.sim;
+      sim_options.world_seed = options.seed + static_cast<uint64_t>(run);
+      const sim::SimResult world = sim::Simulate(nominal, trajectory.joints, sim_options);
+      for (size_t l = 0; l < cells.size(); ++l) {
+        StudyCell& cell = cells[l];
+        ++cell.runs;
+        if (!world.ok) {
+          ++cell.runs_failed;
+          if (cell.failures.size() < 5) cell.failures.push_back("simulation: " + world.message);
+          if (options.with_bundle) {
+            ++cell.bundle_runs;
+            ++cell.bundle_runs_failed;
+          }
+          continue;
+        }
+        const uint64_t noise_seed = options.seed * 7919 + 1000003ULL * static_cast<uint64_t>(run) + l;
+        ObservationSet obs;
+        if (!cell.rendered) {
+          obs = sim::Reobserve(world, cell.noise_px, noise_seed);
+        } else {
+          const RenderedLevel& level = options.rendered_levels[l - num_point_cells];
+          RenderedObservationOptions rendered = options.rendered;
+          rendered.render.noise_std_grey = level.noise_std_grey;
+          rendered.render.blur_sigma_px = level.blur_sigma_px;
+          rendered.assumed_noise_px = level.assumed_noise_px;
+          obs = ObserveRendered(world, rendered, noise_seed, &cell.centroids);
+        }
+        calibration::PaperPipelineReport report = calibration::RunPaperPipeline(obs, options.pipeline);
+        bool score_paper = true;
+        if (report.outcome != calibration::Outcome::kSuccess) {
+          ++cell.runs_failed;
+          if (cell.failures.size() < 5) cell.failures.push_back(std::string(calibration::OutcomeName(report.outcome)) + ": " + report.message);
+          score_paper = !report.measurements.empty() && report.calibrated_rho.size() > 0;
+        }
+        if (score_paper) {
+          if (study.identifiable_parameters == 0) {
+            study.identifiable_parameters = report.identifiability.rank;
+            study.fixed_parameters = report.identifiability.fixed_names;
+          }
+          ScoreRun(world, obs, report, options, &cell);
+        }
+        if (options.with_bundle) ScoreBundle(world, obs, report, options, &cell, &study);
+      }
+    }
+    study.cells.insert(study.cells.end(), cells.begin(), cells.end());
+  }
+  study.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return study;
+}
+
+}  // namespace selfcal::simulation

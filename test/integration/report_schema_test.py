@@ -1,0 +1,99 @@
+#!/usr/bin/python3
+"""report.json against its documented schema (docs/report.schema.json, docs/report-format.md).
+
+Runs the selfcal binary as a user would: `simulate --points` (bundle, accepted), `calibrate --method paper`
+on its observations (paper, accepted), and `calibrate` on a file with too few poses (exit 3, not
+accepted, no model), then validates every report.json with python3-jsonschema and checks the rules the
+schema cannot state: the top level repeats the chosen method's figures, and no key carries mm or degrees.
+
+  report_schema_test.py SELFCAL_BINARY SOURCE_DIR
+"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+import jsonschema
+import yaml
+
+
+def run(binary, args, cwd):
+    p = subprocess.run([binary] + args, cwd=cwd, capture_output=True, text=True)
+    return p.returncode, p.stdout + p.stderr
+
+
+def keys(node, path=""):
+    if isinstance(node, dict):
+        for k, v in node.items():
+            yield path + "/" + k
+            yield from keys(v, path + "/" + k)
+    elif isinstance(node, list):
+        for i, v in enumerate(node):
+            yield from keys(v, f"{path}/{i}")
+
+
+def check(report_path, schema, expect_method, expect_accepted, failures):
+    with open(report_path) as f:
+        report = json.load(f)
+    validator = jsonschema.Draft202012Validator(schema)
+    for error in sorted(validator.iter_errors(report), key=lambda e: list(e.path)):
+        failures.append(f"{report_path}: /{'/'.join(map(str, error.path))}: {error.message}")
+    if report.get("method") != expect_method:
+        failures.append(f"{report_path}: method {report.get('method')!r}, expected {expect_method!r}")
+    if report.get("accepted") != expect_accepted:
+        failures.append(f"{report_path}: accepted {report.get('accepted')!r}, expected {expect_accepted!r}")
+    chosen = report.get("methods", {}).get(expect_method, {})
+    for key in ("fx_px", "verification", "predicted_3d_error"):
+        if report.get(key) != chosen.get(key):
+            failures.append(f"{report_path}: top-level {key} is not methods.{expect_method}.{key}")
+    for k in keys(report):
+        if k.endswith(("_mm", "_deg")):
+            failures.append(f"{report_path}: key {k} is not SI")
+    return report
+
+
+def main():
+    binary, source = sys.argv[1], sys.argv[2]
+    with open(os.path.join(source, "docs", "report.schema.json")) as f:
+        schema = json.load(f)
+    jsonschema.Draft202012Validator.check_schema(schema)
+    failures = []
+    with tempfile.TemporaryDirectory(prefix="selfcal-schema-") as tmp:
+        sim = os.path.join(tmp, "sim")
+        code, out = run(binary, ["simulate", "--points", "--seed", "2", "--out", sim], source)
+        if code != 0:
+            print(out)
+            failures.append(f"simulate exited {code}")
+        else:
+            check(os.path.join(sim, "report.json"), schema, "bundle", True, failures)
+            paper = os.path.join(tmp, "paper")
+            code, out = run(binary, ["calibrate", os.path.join(sim, "observations.yaml"), "--method", "paper",
+                                     "--out", paper], source)
+            if code != 0:
+                failures.append(f"calibrate --method paper exited {code}: {out[-2000:]}")
+            check(os.path.join(paper, "report.json"), schema, "paper", True, failures)
+            # Too few poses: exit 3, a report that says why, no model.
+            with open(os.path.join(sim, "observations.yaml")) as f:
+                observations = yaml.safe_load(f)
+            observations["poses"] = observations["poses"][:3]
+            few = os.path.join(tmp, "few.yaml")
+            with open(few, "w") as f:
+                yaml.safe_dump(observations, f)
+            out_few = os.path.join(tmp, "few")
+            code, out = run(binary, ["calibrate", few, "--out", out_few], source)
+            if code != 3:
+                failures.append(f"calibrate on 3 poses exited {code}, expected 3: {out[-2000:]}")
+            report = check(os.path.join(out_few, "report.json"), schema, "bundle", False, failures)
+            if report.get("exit_code") != 3:
+                failures.append(f"few.yaml report exit_code {report.get('exit_code')}, expected 3")
+            if os.path.exists(os.path.join(out_few, "calibrated_model.yaml")):
+                failures.append("a model was written for a result that was not accepted")
+    for f in failures:
+        print("FAIL:", f)
+    print(f"report schema: {len(failures)} problem(s) in 3 reports" if failures else "report schema: 3 reports valid")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
