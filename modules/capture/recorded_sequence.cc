@@ -17,7 +17,7 @@
 
 
 #include "base/atomic_file.h"
-#include "capture/crc32.h"
+#include "base/crc32.h"
 #include "capture/png_codec.h"
 #include "yaml/yaml_reader.h"
 
@@ -307,7 +307,7 @@ std::string FormatSequenceIndex(const SequenceIndex& index) {
     out << "    exposure_time_s: " << time << "\n";
     out << "    sequence: " << e.sequence << "\n";
     if (e.size_bytes >= 0) out << "    size_bytes: " << e.size_bytes << "\n";
-    if (e.crc32) out << "    crc32: \"" << internal::Crc32Hex(*e.crc32) << "\"\n";
+    if (e.crc32) out << "    crc32: \"" << Crc32Hex(*e.crc32) << "\"\n";
   }
   return out.str();
 }
@@ -391,7 +391,7 @@ Status RecordedSequenceWriter::Append(const Frame& frame, const std::string& pos
   e.exposure_time_s = frame.exposure_time_s;
   e.sequence = frame.sequence;
   e.size_bytes = static_cast<int64_t>(bytes.size());
-  e.crc32 = internal::Crc32(bytes);
+  e.crc32 = Crc32(bytes);
   next.frames.push_back(e);
   if (Status s = WriteFileAtomically(Join(folder_, kSequenceIndexName), FormatSequenceIndex(next),
                                                Publish::kReplace);
@@ -467,10 +467,10 @@ Result<Frame> RecordedSequence::Load(const SequenceEntry& e) const {
                    std::to_string(e.size_bytes) + " (truncated or replaced?)" + at);
   }
   if (e.crc32) {
-    const uint32_t crc = internal::Crc32(*bytes);
+    const uint32_t crc = Crc32(*bytes);
     if (crc != *e.crc32) {
-      return Corrupt(path + " has CRC-32 " + internal::Crc32Hex(crc) + "; the index says " +
-                     internal::Crc32Hex(*e.crc32) + " (checksum mismatch)" + at);
+      return Corrupt(path + " has CRC-32 " + Crc32Hex(crc) + "; the index says " +
+                     Crc32Hex(*e.crc32) + " (checksum mismatch)" + at);
     }
   }
   if (Status s = CheckPngHeader(*bytes, path, index_); !s.ok()) return Corrupt(s.message() + at);
