@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "base/status.h"
 
 namespace selfcal::external {
 namespace {
