@@ -1,5 +1,5 @@
 // selfcal study: Monte Carlo reproduction of the paper's Table 2 and Fig. 6, and the kinematic bundle
-// adjustment beyond it (pipeline/study.h).
+// adjustment beyond it (simulation/study.h).
 #include <iostream>
 
 #include "app/cli_util.h"

@@ -13,15 +13,27 @@ function(selfcal_add_module)
 endfunction()
 
 # selfcal_add_module_test(NAME <m> SRCS ... [DEPS ...] [LABELS ...])
-#   One gtest binary per module, registered test by test with gtest_discover_tests.
+#   One gtest binary per module, registered test by test with gtest_discover_tests. It links the module
+#   selfcal::<m> (and so what the module links), selfcal::test_support and GTest; DEPS adds test support
+#   (selfcal::test_worlds) or third-party libraries, never another selfcal module: a module's tests use
+#   only what the module itself may use (tests that check one module against another live in
+#   test/cross_module).
 function(selfcal_add_module_test)
   cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS;LABELS" ${ARGN})
   if(NOT SELFCAL_BUILD_TESTS)
     return()
   endif()
+  foreach(dep ${ARG_DEPS})
+    string(REGEX REPLACE "^selfcal::" "" name "${dep}")
+    if(NOT name STREQUAL dep AND name IN_LIST SELFCAL_MODULE_ORDER)  # modules/CMakeLists.txt
+      message(FATAL_ERROR "${ARG_NAME}_test: DEPS ${dep}: a module's test links only its module (selfcal::${ARG_NAME}) "
+        "and what that links; add ${dep} to the module's DEPS if its sources use it, or test the pair in test/cross_module")
+    endif()
+  endforeach()
   set(target ${ARG_NAME}_test)
   add_executable(${target} ${ARG_SRCS})
-  target_link_libraries(${target} PRIVATE ${ARG_DEPS} selfcal::test_support GTest::gtest GTest::gtest_main)
+  target_link_libraries(${target} PRIVATE selfcal::${ARG_NAME} ${ARG_DEPS} selfcal::test_support GTest::gtest
+    GTest::gtest_main)
   target_compile_definitions(${target} PRIVATE
     SELFCAL_SOURCE_DIR="${SELFCAL_SOURCE_DIR}"
     SELFCAL_SHARED_DATA_DIR="${SELFCAL_SHARED_DATA_DIR}")

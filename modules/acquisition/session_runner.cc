@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "capture/crc32.h"
+#include "base/crc32.h"
 #include "capture/png_codec.h"
 #include "session/samples.h"
 
@@ -549,7 +549,7 @@ RunReport Runner::Run() {
     }
     const std::string image = std::string(session::kImagesDirName) + "/" + name;
     if (!Record({{"type", "frame_written"}, {"pose", pose}, {"image", image},
-                 {"crc32", capture::internal::Crc32Hex(capture::internal::Crc32(*png))}, {"bytes", png->size()},
+                 {"crc32", Crc32Hex(Crc32(*png))}, {"bytes", png->size()},
                  {"exposure_time_s", frame.exposure_time_s}, {"sequence", frame.sequence}})) {
       return report_;
     }

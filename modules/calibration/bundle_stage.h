@@ -46,7 +46,7 @@ struct BundleStageReport {
   // check distances triangulated from the verification poses.
   VerificationSummary verification;
   VerificationSummary verification_nominal;  // the same with the nominal model and the prior f_x (before)
-  // The predicted std of that 3-D error (pipeline/predicted_error.h): the bundle's covariance of the free
+  // The predicted std of that 3-D error (calibration/predicted_error.h): the bundle's covariance of the free
   // parameters and f_x, and the stated pixel noise (observations.pixel_noise_px) of the verification
   // images. ok = false when the covariance was unavailable.
   PredictedDistanceErrors predicted_error;

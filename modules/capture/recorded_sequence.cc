@@ -17,15 +17,20 @@
 
 
 #include "base/atomic_file.h"
-#include "capture/crc32.h"
+#include "base/crc32.h"
 #include "capture/png_codec.h"
-#include "capture/strict_yaml.h"
+#include "yaml/yaml_reader.h"
 
 namespace selfcal::capture {
 
 namespace {
 
-using internal::YamlTree;
+using yaml::YamlNode;
+
+// The index's YAML rules: selfcal writes it with two levels of nesting (frames, entries) and one node per
+// key and value, so a deeper or larger tree is damage.
+constexpr int kMaxIndexDepth = 8;
+constexpr std::size_t kMaxIndexNodes = 2000000;
 
 std::string Join(const std::string& folder, const std::string& name) {
   if (folder.empty()) return name;
@@ -59,13 +64,13 @@ class IndexReader {
  public:
   explicit IndexReader(std::string name) : name_(std::move(name)) {}
 
-  Status Problem(const YamlTree& node, const std::string& key, const std::string& what) const {
+  Status Problem(const YamlNode& node, const std::string& key, const std::string& what) const {
     return Corrupt(name_ + ":" + std::to_string(node.line) + ": " + key + ": " + what);
   }
 
-  Status Keys(const YamlTree& map, const std::string& where, const std::vector<std::string>& required,
+  Status Keys(const YamlNode& map, const std::string& where, const std::vector<std::string>& required,
               const std::vector<std::string>& optional) const {
-    if (map.kind != YamlTree::Kind::kMap)
+    if (map.kind != YamlNode::Kind::kMap)
       return Problem(map, where, std::string("expected a map, found ") + map.KindName());
     std::string missing;
     for (const std::string& k : required) {
@@ -80,11 +85,11 @@ class IndexReader {
     return Status::Ok();
   }
 
-  Status Integer(const YamlTree& map, const std::string& key, const std::string& where, int64_t min, int64_t max,
+  Status Integer(const YamlNode& map, const std::string& key, const std::string& where, int64_t min, int64_t max,
                  int64_t* out) const {
-    const YamlTree& node = *map.Find(key);
+    const YamlNode& node = *map.Find(key);
     const std::string full = where.empty() ? key : where + "." + key;
-    if (node.kind != YamlTree::Kind::kScalar || !node.plain) {
+    if (node.kind != YamlNode::Kind::kScalar || !node.plain) {
       return Problem(node, full, std::string("expected an integer, found ") + node.KindName());
     }
     errno = 0;
@@ -101,10 +106,10 @@ class IndexReader {
     return Status::Ok();
   }
 
-  Status Real(const YamlTree& map, const std::string& key, const std::string& where, double* out) const {
-    const YamlTree& node = *map.Find(key);
+  Status Real(const YamlNode& map, const std::string& key, const std::string& where, double* out) const {
+    const YamlNode& node = *map.Find(key);
     const std::string full = where + "." + key;
-    if (node.kind != YamlTree::Kind::kScalar || !node.plain) {
+    if (node.kind != YamlNode::Kind::kScalar || !node.plain) {
       return Problem(node, full, std::string("expected a number, found ") + node.KindName());
     }
     errno = 0;
@@ -117,10 +122,10 @@ class IndexReader {
     return Status::Ok();
   }
 
-  Status String(const YamlTree& map, const std::string& key, const std::string& where, std::string* out) const {
-    const YamlTree& node = *map.Find(key);
+  Status String(const YamlNode& map, const std::string& key, const std::string& where, std::string* out) const {
+    const YamlNode& node = *map.Find(key);
     const std::string full = where.empty() ? key : where + "." + key;
-    if (node.kind != YamlTree::Kind::kScalar || node.scalar.empty()) {
+    if (node.kind != YamlNode::Kind::kScalar || node.scalar.empty()) {
       return Problem(node, full, std::string("expected a non-empty string, found ") + node.KindName());
     }
     *out = node.scalar;
@@ -131,7 +136,7 @@ class IndexReader {
   std::string name_;
 };
 
-Status ParseIndex(const YamlTree& root, const std::string& name, const SequenceLimits& limits, SequenceIndex* index) {
+Status ParseIndex(const YamlNode& root, const std::string& name, const SequenceLimits& limits, SequenceIndex* index) {
   const IndexReader r(name);
   if (Status s = r.Keys(root, "index", {"format", "format_version", "camera", "frame_count", "frames"}, {}); !s.ok())
     return s;
@@ -147,7 +152,7 @@ Status ParseIndex(const YamlTree& root, const std::string& name, const SequenceL
                      "version " + std::to_string(version) + " is not the one this selfcal reads (" +
                          std::to_string(kSequenceFormatVersion) + ")");
   }
-  const YamlTree& camera = *root.Find("camera");
+  const YamlNode& camera = *root.Find("camera");
   if (Status s = r.Keys(camera, "camera", {"width_px", "height_px"}, {}); !s.ok()) return s;
   if (Status s = r.Integer(camera, "width_px", "camera", 1, limits.max_width_px, &width); !s.ok()) return s;
   if (Status s = r.Integer(camera, "height_px", "camera", 1, limits.max_height_px, &height); !s.ok()) return s;
@@ -156,10 +161,10 @@ Status ParseIndex(const YamlTree& root, const std::string& name, const SequenceL
   index->width_px = static_cast<int>(width);
   index->height_px = static_cast<int>(height);
 
-  const YamlTree& frames = *root.Find("frames");
-  if (frames.kind == YamlTree::Kind::kNull) {
+  const YamlNode& frames = *root.Find("frames");
+  if (frames.kind == YamlNode::Kind::kNull) {
     // An empty block value: no frames yet.
-  } else if (frames.kind != YamlTree::Kind::kSequence) {
+  } else if (frames.kind != YamlNode::Kind::kSequence) {
     return r.Problem(frames, "frames", std::string("expected a sequence, found ") + frames.KindName());
   }
   if (static_cast<int64_t>(frames.items.size()) != count) {
@@ -169,7 +174,7 @@ Status ParseIndex(const YamlTree& root, const std::string& name, const SequenceL
   }
   std::set<std::string> names;
   for (size_t i = 0; i < frames.items.size(); ++i) {
-    const YamlTree& f = frames.items[i];
+    const YamlNode& f = frames.items[i];
     const std::string where = "frames[" + std::to_string(i) + "]";
     if (Status s = r.Keys(f, where, {"pose_id", "image", "exposure_time_s", "sequence"}, {"size_bytes", "crc32"});
         !s.ok()) {
@@ -193,7 +198,7 @@ Status ParseIndex(const YamlTree& root, const std::string& name, const SequenceL
         return s;
       }
     }
-    if (const YamlTree* crc = f.Find("crc32"); crc != nullptr) {
+    if (const YamlNode* crc = f.Find("crc32"); crc != nullptr) {
       std::string hex;
       if (Status s = r.String(f, "crc32", where, &hex); !s.ok()) return s;
       const bool valid = hex.size() == 8 && std::all_of(hex.begin(), hex.end(), [](char c) {
@@ -274,10 +279,15 @@ Result<SequenceIndex> ReadSequenceIndex(const std::string& folder, const Sequenc
     return Corrupt(missing ? path + " does not exist: " + folder + " is not a recorded sequence"
                            : text.status().message());
   }
-  Result<YamlTree> tree = internal::ParseStrictYaml(*text, path);
-  if (!tree.ok()) return Corrupt(tree.status().message());
+  yaml::YamlRules rules;
+  rules.max_bytes = limits.max_index_bytes;
+  rules.max_depth = kMaxIndexDepth;
+  rules.max_nodes = kMaxIndexNodes;
+  rules.wording = yaml::YamlWording::kSequenceIndex;
+  Result<yaml::YamlDocument> doc = yaml::ParseYamlText(*text, path, rules);
+  if (!doc.ok()) return Corrupt(doc.status().message());
   SequenceIndex index;
-  if (Status s = ParseIndex(*tree, path, limits, &index); !s.ok()) return s;
+  if (Status s = ParseIndex(doc->root, path, limits, &index); !s.ok()) return s;
   return index;
 }
 
@@ -297,7 +307,7 @@ std::string FormatSequenceIndex(const SequenceIndex& index) {
     out << "    exposure_time_s: " << time << "\n";
     out << "    sequence: " << e.sequence << "\n";
     if (e.size_bytes >= 0) out << "    size_bytes: " << e.size_bytes << "\n";
-    if (e.crc32) out << "    crc32: \"" << internal::Crc32Hex(*e.crc32) << "\"\n";
+    if (e.crc32) out << "    crc32: \"" << Crc32Hex(*e.crc32) << "\"\n";
   }
   return out.str();
 }
@@ -381,7 +391,7 @@ Status RecordedSequenceWriter::Append(const Frame& frame, const std::string& pos
   e.exposure_time_s = frame.exposure_time_s;
   e.sequence = frame.sequence;
   e.size_bytes = static_cast<int64_t>(bytes.size());
-  e.crc32 = internal::Crc32(bytes);
+  e.crc32 = Crc32(bytes);
   next.frames.push_back(e);
   if (Status s = WriteFileAtomically(Join(folder_, kSequenceIndexName), FormatSequenceIndex(next),
                                                Publish::kReplace);
@@ -457,10 +467,10 @@ Result<Frame> RecordedSequence::Load(const SequenceEntry& e) const {
                    std::to_string(e.size_bytes) + " (truncated or replaced?)" + at);
   }
   if (e.crc32) {
-    const uint32_t crc = internal::Crc32(*bytes);
+    const uint32_t crc = Crc32(*bytes);
     if (crc != *e.crc32) {
-      return Corrupt(path + " has CRC-32 " + internal::Crc32Hex(crc) + "; the index says " +
-                     internal::Crc32Hex(*e.crc32) + " (checksum mismatch)" + at);
+      return Corrupt(path + " has CRC-32 " + Crc32Hex(crc) + "; the index says " +
+                     Crc32Hex(*e.crc32) + " (checksum mismatch)" + at);
     }
   }
   if (Status s = CheckPngHeader(*bytes, path, index_); !s.ok()) return Corrupt(s.message() + at);

@@ -2,14 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <iostream>
-#include <fstream>
 #include <random>
 
 #include <gtest/gtest.h>
 
-#include "io/fanuc_tracker_csv.h"
+#include "base/status.h"
 
 namespace selfcal::external {
 namespace {
@@ -145,53 +142,6 @@ TEST(TrackerIdentification, SyntheticRecoversFromPerturbedStart) {
   const ErrorStats after = RelativePoseErrors(r.nominal, id.rho, q, tracker_from_nest, r.reference_row, r.holdout_rows);
   EXPECT_LT(after.max_m, 1e-9);
   EXPECT_LT(after.rms_rotation_rad, 1e-9);
-}
-
-// The Fanuc laser-tracker session (README in the folder). Not copied into the repository.
-std::string FanucFolder() { return std::string(SELFCAL_SHARED_DATA_DIR) + "/fanuc-lasertracker-kinident"; }
-
-TEST(TrackerIdentification, FanucTrackerData) {
-  const std::string file = FanucFolder() + "/N1N2N3Jval.csv";
-  if (!std::filesystem::exists(file)) GTEST_SKIP() << "Fanuc laser-tracker data not found at " << FanucFolder();
-  const Result<std::vector<io::FanucTrackerRow>> rows = io::LoadFanucTrackerCsv(file);
-  ASSERT_TRUE(rows.ok()) << rows.status().ToString();
-  ASSERT_EQ(rows->size(), 36u);
-  std::vector<SmrTriple> points;
-  std::vector<Eigen::VectorXd> joints;
-  for (const auto& row : *rows) {
-    points.push_back(row.smr_in_tracker_m);
-    joints.push_back(row.joints_rad);
-  }
-  const TrackerIdentificationReport r = RunTrackerIdentification(points, joints, {});
-  ASSERT_EQ(r.outcome, Outcome::kSuccess) << r.message;
-  // Rigid nest: README 0.030-0.038 mm standard deviation.
-  EXPECT_LT(r.distances.max_stddev_m, 1e-4);
-  // The J2 sweep is a pure rotation of angle |dJ2| only with q3 = J3 + J2 (coupling right).
-  EXPECT_NEAR(r.axes[1].angle_ratio, 1.0, 0.01);
-  for (const AxisFit& a : r.axes) {
-    std::cout << "joint " << a.joint << ": radial RMS " << a.rms_radial_m * 1e3 << " mm, out-of-plane RMS "
-              << a.rms_out_of_plane_m * 1e3 << " mm, angle ratio " << a.angle_ratio << "\n";
-    EXPECT_LT(a.rms_radial_m, 5e-4);
-  }
-  std::cout << "held-out RMS before " << r.holdout_before.rms_m * 1e3 << " mm, after " << r.holdout_after.rms_m * 1e3
-            << " mm; in-sample after " << r.insample_after.rms_m * 1e3 << " mm\n";
-  // Tracker ~0.05 mm, Fanuc repeatability ~0.03 mm, joint-dependent errors the geometric model cannot
-  // hold (gear and compliance): a few tenths of a mm; 1 mm is the bound.
-  EXPECT_LT(r.holdout_after.rms_m, r.holdout_before.rms_m);
-  EXPECT_LT(r.holdout_after.rms_m, 1e-3);
-}
-
-TEST(FanucTrackerCsv, RefusesMalformedRowsWithFileAndLine) {
-  const std::string path = (std::filesystem::temp_directory_path() / "selfcal_fanuc_bad.csv").string();
-  {
-    std::ofstream out(path);
-    for (int i = 0; i < 21; ++i) out << "1.0 ";
-    out << "\n1 2 3\n";
-  }
-  const auto rows = io::LoadFanucTrackerCsv(path);
-  ASSERT_FALSE(rows.ok());
-  EXPECT_NE(rows.status().message().find(path + ":2:"), std::string::npos) << rows.status().message();
-  std::filesystem::remove(path);
 }
 
 }  // namespace

@@ -9,7 +9,7 @@
 
 #include "io/io_test_util.h"
 #include "io/robot_config.h"
-#include "io/yaml_reader.h"
+#include "yaml/yaml_reader.h"
 #include "io/yaml_schema.h"
 #include "io/yaml_writer.h"
 
@@ -53,7 +53,7 @@ TEST(YamlSchema, C1UnknownKeyNamesLineAndSuggestsTheClosestKey) {
   TempDir dir;
   const std::string path = dir.File("motion.yaml");
   WriteFile(path, "speed_scale: 0.1\n# the typo is on line 3\nmax_velocty: 0.5\n");
-  Result<YamlDocument> doc = LoadYamlFile(path);
+  Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(path);
   ASSERT_TRUE(doc.ok()) << doc.status().ToString();
   Problems problems(path);
   {
@@ -141,7 +141,7 @@ TEST(YamlSchema, NumbersRoundTripExactly) {
     if (i % 3 == 0) value *= 1e-9;
     if (i % 5 == 0) value *= 1e12;
     if (i == 0) value = -0.0;
-    Result<YamlDocument> doc = ParseYamlText("v: " + YamlNumber(value) + "\n", "number.yaml");
+    Result<yaml::YamlDocument> doc = yaml::ParseYamlText("v: " + YamlNumber(value) + "\n", "number.yaml");
     ASSERT_TRUE(doc.ok());
     Problems problems("number.yaml");
     MapReader map(doc->root, "", &problems);
@@ -224,7 +224,7 @@ TEST(MalformedFiles, C8FileOverTheSizeCapIsRefusedBeforeParsing) {
   while (text.size() < 11u * 1000u * 1000u) text += "  - [0, 0, 0, 0, 0, 0]\n";
   WriteFile(path, text);
   EXPECT_TRUE(CleanRefusal(LoadRobotModel(path).status(), path, "more than the limit of 10485760"));
-  EXPECT_TRUE(CleanRefusal(ParseYamlText(text, "memory.yaml").status(), "memory.yaml", "larger than"));
+  EXPECT_TRUE(CleanRefusal(yaml::ParseYamlText(text, "memory.yaml").status(), "memory.yaml", "larger than"));
 }
 
 TEST(MalformedFiles, C8DeepNestingIsRefusedWithoutRecursion) {

@@ -45,7 +45,7 @@ std::string PixelProblem(const CameraIntrinsics& camera, const Eigen::Vector2d& 
 }
 
 bool ReadCamera(MapReader* root, Problems* problems, CameraIntrinsics* camera) {
-  const YamlNode* node = root->Required("camera");
+  const yaml::YamlNode* node = root->Required("camera");
   if (!node) return false;
   MapReader map(*node, "camera", problems);
   if (!map.ok()) return false;
@@ -71,7 +71,7 @@ bool ReadCamera(MapReader* root, Problems* problems, CameraIntrinsics* camera) {
 
 bool ReadDistances(MapReader* root, const std::string& key, bool required, Problems* problems,
                    std::vector<KnownDistance>* out) {
-  const YamlNode* node = required ? root->Required(key) : root->Optional(key);
+  const yaml::YamlNode* node = required ? root->Required(key) : root->Optional(key);
   if (!node) return !required;
   if (!node->IsSequence()) {
     problems->Add("`" + key + "` at " + problems->At(node->line) + " must be a sequence of {dot_a, dot_b, length_mm} " +
@@ -97,7 +97,7 @@ bool ReadDistances(MapReader* root, const std::string& key, bool required, Probl
   return ok;
 }
 
-bool ReadDots(const YamlNode& node, const std::string& name, const CameraIntrinsics* camera, Problems* problems,
+bool ReadDots(const yaml::YamlNode& node, const std::string& name, const CameraIntrinsics* camera, Problems* problems,
               std::map<int, Eigen::Vector2d>* dots) {
   if (!node.IsSequence()) {
     problems->Add("`" + name + "` at " + problems->At(node.line) + " must be a sequence of [dot id, u_px, v_px] " +
@@ -106,7 +106,7 @@ bool ReadDots(const YamlNode& node, const std::string& name, const CameraIntrins
   }
   bool ok = true;
   for (size_t i = 0; i < node.items.size(); ++i) {
-    const YamlNode& item = node.items[i];
+    const yaml::YamlNode& item = node.items[i];
     const std::string item_name = name + "[" + std::to_string(i) + "]";
     if (!item.IsSequence() || item.items.size() != 3) {
       problems->Add("`" + item_name + "` at " + problems->At(item.line) + " must be [dot id, u_px, v_px]");
@@ -137,7 +137,7 @@ bool ReadDots(const YamlNode& node, const std::string& name, const CameraIntrins
   return ok;
 }
 
-bool ReadPose(const YamlNode& node, const std::string& name, const RobotModel* robot, const CameraIntrinsics* camera,
+bool ReadPose(const yaml::YamlNode& node, const std::string& name, const RobotModel* robot, const CameraIntrinsics* camera,
               Problems* problems, PoseObservation* pose) {
   MapReader map(node, name, problems);
   if (!map.ok()) return false;
@@ -173,7 +173,7 @@ bool ReadPose(const YamlNode& node, const std::string& name, const RobotModel* r
   } else {
     ok = false;
   }
-  if (const YamlNode* dots = map.Required("dots")) {
+  if (const yaml::YamlNode* dots = map.Required("dots")) {
     ok &= ReadDots(*dots, map.Path("dots"), camera, problems, &pose->dots_px);
   } else {
     ok = false;
@@ -183,7 +183,7 @@ bool ReadPose(const YamlNode& node, const std::string& name, const RobotModel* r
 
 }  // namespace
 
-Result<ObservationSet> ParseObservations(const YamlDocument& doc) {
+Result<ObservationSet> ParseObservations(const yaml::YamlDocument& doc) {
   Problems problems(doc.path);
   MapReader root(doc.root, "", &problems);
   if (!CheckFormatAndVersion(&root, kObservationsFormat, kObservationsVersion)) {
@@ -192,8 +192,8 @@ Result<ObservationSet> ParseObservations(const YamlDocument& doc) {
   }
   ObservationSet set;
   bool robot_ok = false;
-  const YamlNode* robot = root.Optional("robot");
-  const YamlNode* robot_file = root.Optional("robot_file");
+  const yaml::YamlNode* robot = root.Optional("robot");
+  const yaml::YamlNode* robot_file = root.Optional("robot_file");
   if (robot && robot_file) {
     problems.Add("both `robot` and `robot_file` given at " + problems.At(root.KeyLine("robot_file")) + "; keep one");
   } else if (robot) {
@@ -219,7 +219,7 @@ Result<ObservationSet> ParseObservations(const YamlDocument& doc) {
   root.Double("pixel_noise_px", Range::Positive(100.0), &set.pixel_noise_px);
   ReadDistances(&root, "yardsticks", /*required=*/true, &problems, &set.yardsticks);
   ReadDistances(&root, "check_distances", /*required=*/false, &problems, &set.check_distances);
-  if (const YamlNode* poses = root.Required("poses")) {
+  if (const yaml::YamlNode* poses = root.Required("poses")) {
     if (!poses->IsSequence()) {
       problems.Add("`poses` at " + problems.At(poses->line) + " must be a sequence of poses (found " +
                    poses->KindName() + ")");
@@ -241,7 +241,7 @@ Result<ObservationSet> ParseObservations(const YamlDocument& doc) {
 }
 
 Result<ObservationSet> LoadObservations(const std::string& path) {
-  Result<YamlDocument> doc = LoadYamlFile(path);
+  Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(path);
   if (!doc.ok()) return doc.status();
   return ParseObservations(*doc);
 }

@@ -20,7 +20,7 @@
 #include <string>
 
 #include "base/status.h"
-#include "io/yaml_reader.h"
+#include "yaml/yaml_reader.h"
 #include "observations/observation_set.h"
 
 namespace selfcal::io {
@@ -34,7 +34,7 @@ inline constexpr int kObservationsVersion = 1;
 Result<ObservationSet> LoadObservations(const std::string& path);
 
 // The same for a document already parsed; robot_file is resolved relative to doc.path's directory.
-Result<ObservationSet> ParseObservations(const YamlDocument& doc);
+Result<ObservationSet> ParseObservations(const yaml::YamlDocument& doc);
 
 // Writes the set atomically (P4) in SI units (joints_rad, length_m, robot in exact form) with
 // shortest round-trip numbers, so that LoadObservations returns a bit-identical set. Refuses a set

@@ -128,7 +128,7 @@ TEST(ObservationsFile, TheDocumentedExampleLoads) {
   const size_t body = start + 8;
   const std::string example = doc.substr(body, doc.find("```", body) - body);
   // Named as the doc so that robot_file resolves relative to docs/.
-  Result<YamlDocument> parsed = ParseYamlText(example, doc_path);
+  Result<yaml::YamlDocument> parsed = yaml::ParseYamlText(example, doc_path);
   ASSERT_TRUE(parsed.ok()) << parsed.status().ToString();
   Result<ObservationSet> set = ParseObservations(*parsed);
   ASSERT_TRUE(set.ok()) << set.status().ToString();

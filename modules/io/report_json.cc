@@ -3,7 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.h"
-#include "io/yaml_reader.h"
+#include "yaml/yaml_reader.h"
 
 namespace selfcal::io {
 
@@ -49,11 +49,11 @@ Status WriteJsonFile(const nlohmann::json& document, const std::string& path) {
 }
 
 Result<nlohmann::json> ReadJsonFile(const std::string& path) {
-  Result<std::string> text = ReadFileCapped(path, kMaxYamlBytes);
+  Result<std::string> text = ReadFileCapped(path, yaml::kMaxYamlBytes);
   if (!text.ok()) return text.status();
   size_t offset = 0;
-  if (JsonDepth(*text, &offset) > kMaxYamlDepth) {
-    return Status::Error(ExitCode::kUsage, path + ": JSON nested deeper than " + std::to_string(kMaxYamlDepth) +
+  if (JsonDepth(*text, &offset) > yaml::kMaxYamlDepth) {
+    return Status::Error(ExitCode::kUsage, path + ": JSON nested deeper than " + std::to_string(yaml::kMaxYamlDepth) +
                                                " levels at byte " + std::to_string(offset));
   }
   try {

@@ -14,7 +14,7 @@ namespace selfcal::io {
 // become null (JSON has no NaN); invalid UTF-8 in a string is refused. ExitCode::kUsage on failure.
 Status WriteJsonFile(const nlohmann::json& document, const std::string& path);
 
-// Reads a JSON file with the same guards as YAML files: size cap (io/yaml_reader.h kMaxYamlBytes),
+// Reads a JSON file with the same guards as YAML files: size cap (yaml/yaml_reader.h kMaxYamlBytes),
 // nesting depth cap (kMaxYamlDepth), every parse error a Status naming the file and byte offset.
 Result<nlohmann::json> ReadJsonFile(const std::string& path);
 

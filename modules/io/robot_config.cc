@@ -4,7 +4,7 @@
 #include <sstream>
 
 #include "io/atomic_file.h"
-#include "io/yaml_reader.h"
+#include "yaml/yaml_reader.h"
 #include "io/yaml_writer.h"
 
 namespace selfcal::io {
@@ -25,7 +25,7 @@ Convention ReadConvention(MapReader* map) {
   if (text == "standard") return Convention::kStandard;
   if (text == "modified") return Convention::kModified;
   if (text == "modified_hayati") return Convention::kModifiedHayati;
-  const YamlNode* node = map->Optional("dh_convention");
+  const yaml::YamlNode* node = map->Optional("dh_convention");
   map->problems()->Add("`" + map->Path("dh_convention") + "` = `" + text + "` at " +
                        map->problems()->At(node->line) + " must be one of standard, modified, modified_hayati");
   return Convention::kInvalid;
@@ -36,7 +36,7 @@ struct JointRow {
   JointLimits limits;
 };
 
-bool ReadJoint(const YamlNode& node, const std::string& name, Convention convention, Problems* problems,
+bool ReadJoint(const yaml::YamlNode& node, const std::string& name, Convention convention, Problems* problems,
                JointRow* row) {
   MapReader map(node, name, problems);
   if (!map.ok()) return false;
@@ -65,7 +65,7 @@ bool ReadJoint(const YamlNode& node, const std::string& name, Convention convent
 }
 
 void ReadParameters(MapReader* root, int num_joints, Eigen::VectorXd* out) {
-  const YamlNode* node = root->Optional("parameters");
+  const yaml::YamlNode* node = root->Optional("parameters");
   if (!node || num_joints <= 0) return;
   MapReader map(*node, root->Path("parameters"), root->problems());
   if (!map.ok()) return;
@@ -81,7 +81,7 @@ void ReadParameters(MapReader* root, int num_joints, Eigen::VectorXd* out) {
 }
 
 void ReadProvenance(MapReader* root, std::vector<std::pair<std::string, std::string>>* out) {
-  const YamlNode* node = root->Optional("provenance");
+  const yaml::YamlNode* node = root->Optional("provenance");
   if (!node) return;
   MapReader map(*node, root->Path("provenance"), root->problems());
   if (!map.ok()) return;
@@ -94,12 +94,12 @@ void ReadProvenance(MapReader* root, std::vector<std::pair<std::string, std::str
   }
 }
 
-CalibratedModel Parse(const YamlNode& node, const std::string& name, Problems* problems, std::string* format) {
+CalibratedModel Parse(const yaml::YamlNode& node, const std::string& name, Problems* problems, std::string* format) {
   CalibratedModel out;
   const size_t problems_before = problems->size();
   MapReader map(node, name, problems);
   if (!map.ok()) return out;
-  if (const YamlNode* f = map.Optional("format")) {
+  if (const yaml::YamlNode* f = map.Optional("format")) {
     if (!ReadString(*f, map.Path("format"), problems, format)) return out;
     if (*format != kRobotFormat && *format != kCalibratedModelFormat) {
       problems->Add("`" + map.Path("format") + "` = `" + *format + "` at " + problems->At(f->line) + ": expected `" +
@@ -127,7 +127,7 @@ CalibratedModel Parse(const YamlNode& node, const std::string& name, Problems* p
   ok &= convention != Convention::kInvalid;
 
   std::vector<JointRow> rows;
-  if (const YamlNode* joints = map.Required("joints")) {
+  if (const yaml::YamlNode* joints = map.Required("joints")) {
     const std::string path = map.Path("joints");
     if (!joints->IsSequence() || joints->items.empty() || static_cast<int>(joints->items.size()) > kMaxJoints) {
       problems->Add("`" + path + "` at " + problems->At(joints->line) + " must be a sequence of 1 to " +
@@ -188,13 +188,13 @@ std::string Indent(int n) { return std::string(static_cast<size_t>(n), ' '); }
 
 }  // namespace
 
-CalibratedModel ParseRobotModel(const YamlNode& node, const std::string& name, Problems* problems) {
+CalibratedModel ParseRobotModel(const yaml::YamlNode& node, const std::string& name, Problems* problems) {
   std::string format;
   return Parse(node, name, problems, &format);
 }
 
 Result<RobotModel> LoadRobotModel(const std::string& path) {
-  Result<YamlDocument> doc = LoadYamlFile(path);
+  Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(path);
   if (!doc.ok()) return doc.status();
   Problems problems(path);
   std::string format;
@@ -204,7 +204,7 @@ Result<RobotModel> LoadRobotModel(const std::string& path) {
 }
 
 Result<CalibratedModel> LoadCalibratedModel(const std::string& path) {
-  Result<YamlDocument> doc = LoadYamlFile(path);
+  Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(path);
   if (!doc.ok()) return doc.status();
   Problems problems(path);
   std::string format;

@@ -63,7 +63,7 @@ Status SaveCalibratedModel(const CalibratedModel& calibrated, const std::string&
 // file), recording problems under the key path `name`. The returned model is meaningful only when no
 // problem was added. Calibrated-model keys are accepted when the map has
 // `format: selfcal-calibrated-model`.
-CalibratedModel ParseRobotModel(const YamlNode& node, const std::string& name, Problems* problems);
+CalibratedModel ParseRobotModel(const yaml::YamlNode& node, const std::string& name, Problems* problems);
 
 // The robot as a YAML block of `indent` spaces (keys name, dh_convention: modified_hayati, joints,
 // base_from_link0, link_n_from_flange, flange_from_cam). kExact writes SI values and rotation matrices

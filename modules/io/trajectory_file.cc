@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "io/atomic_file.h"
-#include "io/yaml_reader.h"
+#include "yaml/yaml_reader.h"
 #include "io/yaml_schema.h"
 #include "io/yaml_writer.h"
 
@@ -20,7 +20,7 @@ std::string Short(double v) {
 }
 
 Result<TrajectoryFile> Load(const std::string& path, int num_joints, const RobotModel* robot) {
-  Result<YamlDocument> doc = LoadYamlFile(path);
+  Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(path);
   if (!doc.ok()) return doc.status();
   Problems problems(path);
   MapReader root(doc->root, "", &problems);
@@ -43,21 +43,21 @@ Result<TrajectoryFile> Load(const std::string& path, int num_joints, const Robot
   }
   std::vector<Eigen::VectorXd> poses;
   root.Disallow("poses", "the unit goes in the key: `poses_deg` or `poses_rad`");
-  const YamlNode* deg = root.Optional("poses_deg");
-  const YamlNode* rad = root.Optional("poses_rad");
+  const yaml::YamlNode* deg = root.Optional("poses_deg");
+  const yaml::YamlNode* rad = root.Optional("poses_rad");
   if (deg && rad) {
     problems.Add("both `poses_deg` and `poses_rad` given at " + problems.At(root.KeyLine("poses_rad")) + "; keep one");
   } else if (!deg && !rad) {
     if (!root.Optional("poses")) root.AddMissing("`poses_deg` (or `poses_rad`)");
   } else {
-    const YamlNode& list = deg ? *deg : *rad;
+    const yaml::YamlNode& list = deg ? *deg : *rad;
     const std::string key = deg ? "poses_deg" : "poses_rad";
     if (!list.IsSequence()) {
       problems.Add("`" + key + "` at " + problems.At(list.line) + " must be a sequence of joint-angle rows (found " +
                    list.KindName() + ")");
     }
     for (size_t i = 0; list.IsSequence() && i < list.items.size(); ++i) {
-      const YamlNode& row = list.items[i];
+      const yaml::YamlNode& row = list.items[i];
       const std::string name = key + "[" + std::to_string(i) + "]";
       if (row.IsSequence() && static_cast<int>(row.items.size()) != num_joints) {
         problems.Add("pose " + std::to_string(i) + " (`" + name + "` at " + problems.At(row.line) + ") has " +

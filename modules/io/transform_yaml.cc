@@ -14,7 +14,7 @@ namespace {
 constexpr double kMaxTranslationM = 10.0;
 constexpr double kRotationTolerance = 1e-9;
 
-bool ReadRotationMatrix(const YamlNode& node, const std::string& name, Problems* problems, Eigen::Matrix3d* out) {
+bool ReadRotationMatrix(const yaml::YamlNode& node, const std::string& name, Problems* problems, Eigen::Matrix3d* out) {
   if (!node.IsSequence() || node.items.size() != 3) {
     problems->Add("`" + name + "` at " + problems->At(node.line) + " must be 3 rows of 3 numbers: [[r00, r01, r02], " +
                   "[r10, r11, r12], [r20, r21, r22]]");
@@ -62,7 +62,7 @@ Eigen::Vector3d RpyFromRotation(const Eigen::Matrix3d& r) {
 }
 
 bool ReadTransform(MapReader* parent, const std::string& key, bool required, Rigid3* out) {
-  const YamlNode* node = required ? parent->Required(key) : parent->Optional(key);
+  const yaml::YamlNode* node = required ? parent->Required(key) : parent->Optional(key);
   if (!node) return !required;
   MapReader map(*node, parent->Path(key), parent->problems());
   if (!map.ok()) return false;
@@ -72,7 +72,7 @@ bool ReadTransform(MapReader* parent, const std::string& key, bool required, Rig
   std::string rpy_key;
   const bool rpy_ok = map.QuantityList("rpy", Unit::kAngle, 3, Range::Closed(DegToRad(-360), DegToRad(360)), &rpy,
                                        /*required=*/false, &rpy_key);
-  const YamlNode* matrix_node = map.Optional("rotation");
+  const yaml::YamlNode* matrix_node = map.Optional("rotation");
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   if (matrix_node && !rpy_key.empty()) {
     problems->Add("`" + map.Path("rotation") + "` and `" + map.Path(rpy_key) + "` at " +

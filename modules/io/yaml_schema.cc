@@ -20,18 +20,18 @@ std::string FormatBound(double v) {
 }
 
 // The value as written, shortened for messages.
-std::string Shown(const YamlNode& node) {
+std::string Shown(const yaml::YamlNode& node) {
   if (!node.IsScalar()) return node.KindName();
   std::string text = node.scalar.size() > 40 ? node.scalar.substr(0, 37) + "..." : node.scalar;
   return "`" + text + "`";
 }
 
-std::string Where(const std::string& name, const YamlNode& node, const Problems& problems) {
+std::string Where(const std::string& name, const yaml::YamlNode& node, const Problems& problems) {
   return "`" + name + "` = " + Shown(node) + " at " + problems.At(node.line);
 }
 
 // `key:` with nothing after it.
-bool ReportIfEmpty(const YamlNode& node, const std::string& name, Problems* problems) {
+bool ReportIfEmpty(const yaml::YamlNode& node, const std::string& name, Problems* problems) {
   if (!node.IsNull()) return false;
   problems->Add("`" + name + "` at " + problems->At(node.line) + " has no value");
   return true;
@@ -109,7 +109,7 @@ double ToSi(double value, KeyUnit unit) {
   return value;
 }
 
-bool ReadDouble(const YamlNode& node, const std::string& name, const Range& range_si, Problems* problems,
+bool ReadDouble(const yaml::YamlNode& node, const std::string& name, const Range& range_si, Problems* problems,
                 double* out, KeyUnit unit) {
   if (ReportIfEmpty(node, name, problems)) return false;
   if (!node.IsScalar() || !node.plain) {
@@ -135,7 +135,7 @@ bool ReadDouble(const YamlNode& node, const std::string& name, const Range& rang
   return true;
 }
 
-bool ReadInt(const YamlNode& node, const std::string& name, long long min, long long max, Problems* problems,
+bool ReadInt(const yaml::YamlNode& node, const std::string& name, long long min, long long max, Problems* problems,
              long long* out) {
   if (ReportIfEmpty(node, name, problems)) return false;
   if (!node.IsScalar() || !node.plain) {
@@ -159,7 +159,7 @@ bool ReadInt(const YamlNode& node, const std::string& name, long long min, long 
   return true;
 }
 
-bool ReadString(const YamlNode& node, const std::string& name, Problems* problems, std::string* out) {
+bool ReadString(const yaml::YamlNode& node, const std::string& name, Problems* problems, std::string* out) {
   if (ReportIfEmpty(node, name, problems)) return false;
   if (!node.IsScalar()) {
     problems->Add(Where(name, node, *problems) + " must be a string (found " + node.KindName() + ")");
@@ -169,7 +169,7 @@ bool ReadString(const YamlNode& node, const std::string& name, Problems* problem
   return true;
 }
 
-bool ReadDoubleList(const YamlNode& node, const std::string& name, int size, const Range& range_si,
+bool ReadDoubleList(const yaml::YamlNode& node, const std::string& name, int size, const Range& range_si,
                     Problems* problems, std::vector<double>* out, KeyUnit unit, std::vector<int>* lines) {
   if (ReportIfEmpty(node, name, problems)) return false;
   if (!node.IsSequence()) {
@@ -190,7 +190,7 @@ bool ReadDoubleList(const YamlNode& node, const std::string& name, int size, con
   *out = std::move(values);
   if (lines) {
     lines->clear();
-    for (const YamlNode& item : node.items) lines->push_back(item.line);
+    for (const yaml::YamlNode& item : node.items) lines->push_back(item.line);
   }
   return true;
 }
@@ -210,7 +210,7 @@ int EditDistance(const std::string& a, const std::string& b) {
   return d[n][m];
 }
 
-MapReader::MapReader(const YamlNode& node, std::string name, Problems* problems)
+MapReader::MapReader(const yaml::YamlNode& node, std::string name, Problems* problems)
     : node_(&node), name_(std::move(name)), problems_(problems), line_(node.line) {
   if (!node.IsMap()) {
     const std::string what = name_.empty() ? "the document" : "`" + name_ + "`";
@@ -234,7 +234,7 @@ int MapReader::KeyLine(const std::string& key) const {
   return line_;
 }
 
-const YamlNode* MapReader::Optional(const std::string& key) {
+const yaml::YamlNode* MapReader::Optional(const std::string& key) {
   if (std::find(allowed_.begin(), allowed_.end(), key) == allowed_.end()) allowed_.push_back(key);
   if (!node_) return nullptr;
   for (size_t i = 0; i < node_->keys.size(); ++i) {
@@ -243,8 +243,8 @@ const YamlNode* MapReader::Optional(const std::string& key) {
   return nullptr;
 }
 
-const YamlNode* MapReader::Required(const std::string& key) {
-  const YamlNode* value = Optional(key);
+const yaml::YamlNode* MapReader::Required(const std::string& key) {
+  const yaml::YamlNode* value = Optional(key);
   if (!value && node_) missing_.push_back("`" + key + "`");
   return value;
 }
@@ -255,31 +255,31 @@ void MapReader::Disallow(const std::string& key, const std::string& reason) {
 }
 
 bool MapReader::Double(const std::string& key, const Range& range, double* out) {
-  const YamlNode* value = Required(key);
+  const yaml::YamlNode* value = Required(key);
   return value && ReadDouble(*value, Path(key), range, problems_, out);
 }
 
 bool MapReader::OptionalDouble(const std::string& key, const Range& range, double* out) {
-  const YamlNode* value = Optional(key);
+  const yaml::YamlNode* value = Optional(key);
   return !value || ReadDouble(*value, Path(key), range, problems_, out);
 }
 
 bool MapReader::Int(const std::string& key, long long min, long long max, long long* out) {
-  const YamlNode* value = Required(key);
+  const yaml::YamlNode* value = Required(key);
   return value && ReadInt(*value, Path(key), min, max, problems_, out);
 }
 
 bool MapReader::String(const std::string& key, std::string* out) {
-  const YamlNode* value = Required(key);
+  const yaml::YamlNode* value = Required(key);
   return value && ReadString(*value, Path(key), problems_, out);
 }
 
 bool MapReader::OptionalString(const std::string& key, std::string* out) {
-  const YamlNode* value = Optional(key);
+  const yaml::YamlNode* value = Optional(key);
   return !value || ReadString(*value, Path(key), problems_, out);
 }
 
-const YamlNode* MapReader::FindWithUnit(const std::string& base, Unit unit, bool required, std::string* key,
+const yaml::YamlNode* MapReader::FindWithUnit(const std::string& base, Unit unit, bool required, std::string* key,
                                         KeyUnit* key_unit) {
   std::vector<std::pair<std::string, KeyUnit>> variants;
   switch (unit) {
@@ -291,9 +291,9 @@ const YamlNode* MapReader::FindWithUnit(const std::string& base, Unit unit, bool
     // C4: a bare `length: 250` could be mm or m.
     Disallow(base, "the unit goes in the key: `" + variants[0].first + "` or `" + variants[1].first + "`");
   }
-  const YamlNode* found = nullptr;
+  const yaml::YamlNode* found = nullptr;
   for (const auto& [name, variant_unit] : variants) {
-    const YamlNode* value = Optional(name);
+    const yaml::YamlNode* value = Optional(name);
     if (!value) continue;
     if (found) {
       problems_->Add("`" + Path(*key) + "` and `" + Path(name) + "` at " + problems_->At(KeyLine(name)) +
@@ -315,7 +315,7 @@ const YamlNode* MapReader::FindWithUnit(const std::string& base, Unit unit, bool
 bool MapReader::Quantity(const std::string& base, Unit unit, const Range& range_si, double* out_si, bool required) {
   std::string key;
   KeyUnit key_unit = KeyUnit::kSi;
-  const YamlNode* value = FindWithUnit(base, unit, required, &key, &key_unit);
+  const yaml::YamlNode* value = FindWithUnit(base, unit, required, &key, &key_unit);
   if (!value) return !required && node_;
   return ReadDouble(*value, Path(key), range_si, problems_, out_si, key_unit);
 }
@@ -325,7 +325,7 @@ bool MapReader::QuantityList(const std::string& base, Unit unit, int size, const
                              std::vector<int>* lines) {
   std::string key;
   KeyUnit key_unit = KeyUnit::kSi;
-  const YamlNode* value = FindWithUnit(base, unit, required, &key, &key_unit);
+  const yaml::YamlNode* value = FindWithUnit(base, unit, required, &key, &key_unit);
   if (!value) return !required && node_;
   if (key_used) *key_used = key;
   return ReadDoubleList(*value, Path(key), size, range_si, problems_, out_si, key_unit, lines);
@@ -377,7 +377,7 @@ void MapReader::Finish() {
 
 bool CheckVersion(MapReader* root, const std::string& format, int supported_major) {
   Problems* problems = root->problems();
-  const YamlNode* version = root->Optional("version");
+  const yaml::YamlNode* version = root->Optional("version");
   if (!version) {
     problems->Add("missing required key `version` (of " + format + ") in the document at " + problems->At(root->line()));
     return false;
@@ -406,7 +406,7 @@ bool CheckVersion(MapReader* root, const std::string& format, int supported_majo
 bool CheckFormatAndVersion(MapReader* root, const std::string& expected_format, int supported_major) {
   Problems* problems = root->problems();
   if (!root->ok()) return false;
-  const YamlNode* format = root->Optional("format");
+  const yaml::YamlNode* format = root->Optional("format");
   if (!format) {
     problems->Add("missing required key `format` (expected `format: " + expected_format + "`) in the document at " +
                   problems->At(root->line()));

@@ -1,5 +1,5 @@
-// Checking a YamlNode tree against a schema, collecting every problem of a file so that they are
-// reported together (C1-C3). Messages name the file, the line, the dotted key path and the value:
+// Checking a yaml::YamlNode tree (yaml/yaml_reader.h) against a schema, collecting every problem of a file so
+// that they are reported together (C1-C3). Messages name the file, the line, the dotted key path and the value:
 //
 //   unknown key `max_velocty` at robot.yaml:12; did you mean `max_velocity`?
 //   missing required keys `fx_px`, `cx_px` in `camera` at obs.yaml:5
@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "base/status.h"
-#include "io/yaml_reader.h"
+#include "yaml/yaml_reader.h"
 
 namespace selfcal::io {
 
@@ -69,13 +69,13 @@ double ToSi(double value, KeyUnit unit);
 // Node-level reads: `name` is the dotted key path used in messages. Each records one problem and returns
 // false when the node is of the wrong type, not finite or out of range. The value is converted from
 // `unit` to SI before the range check (the message shows the range in `unit`).
-bool ReadDouble(const YamlNode& node, const std::string& name, const Range& range_si, Problems* problems,
+bool ReadDouble(const yaml::YamlNode& node, const std::string& name, const Range& range_si, Problems* problems,
                 double* out, KeyUnit unit = KeyUnit::kSi);
-bool ReadInt(const YamlNode& node, const std::string& name, long long min, long long max, Problems* problems,
+bool ReadInt(const yaml::YamlNode& node, const std::string& name, long long min, long long max, Problems* problems,
              long long* out);
-bool ReadString(const YamlNode& node, const std::string& name, Problems* problems, std::string* out);
+bool ReadString(const yaml::YamlNode& node, const std::string& name, Problems* problems, std::string* out);
 // A sequence of numbers; `size` < 0 accepts any length. Line of every element in `lines` if given.
-bool ReadDoubleList(const YamlNode& node, const std::string& name, int size, const Range& range_si,
+bool ReadDoubleList(const yaml::YamlNode& node, const std::string& name, int size, const Range& range_si,
                     Problems* problems, std::vector<double>* out, KeyUnit unit = KeyUnit::kSi,
                     std::vector<int>* lines = nullptr);
 
@@ -89,7 +89,7 @@ class MapReader {
  public:
   // `name` is the map's dotted path ("" for the document root). A node that is not a map is reported
   // once and every read then fails without further messages.
-  MapReader(const YamlNode& node, std::string name, Problems* problems);
+  MapReader(const yaml::YamlNode& node, std::string name, Problems* problems);
   ~MapReader();
   MapReader(const MapReader&) = delete;
   MapReader& operator=(const MapReader&) = delete;
@@ -103,8 +103,8 @@ class MapReader {
 
   // Marks the key allowed and returns its value, or nullptr when absent (Required also records it
   // as missing).
-  const YamlNode* Optional(const std::string& key);
-  const YamlNode* Required(const std::string& key);
+  const yaml::YamlNode* Optional(const std::string& key);
+  const yaml::YamlNode* Required(const std::string& key);
   // The key is known but not allowed in this context: reported with the reason if present.
   void Disallow(const std::string& key, const std::string& reason);
   // Records a missing requirement described in words (e.g. "`robot` or `robot_file`").
@@ -132,9 +132,9 @@ class MapReader {
 
  private:
   // Finds which unit variant of `base` is present; records a problem if several are.
-  const YamlNode* FindWithUnit(const std::string& base, Unit unit, bool required, std::string* key, KeyUnit* key_unit);
+  const yaml::YamlNode* FindWithUnit(const std::string& base, Unit unit, bool required, std::string* key, KeyUnit* key_unit);
 
-  const YamlNode* node_;
+  const yaml::YamlNode* node_;
   std::string name_;
   Problems* problems_;
   int line_ = 0;

@@ -3,7 +3,6 @@
 
 #include <gtest/gtest.h>
 
-#include "bundle/bundle_adjustment.h"
 #include "identification/identifiability.h"
 #include "kinematics/autodiff_jacobian.h"
 #include "planning/candidate_pool.h"
@@ -12,47 +11,17 @@
 #include "planning/observability.h"
 #include "planning/plan_check.h"
 #include "planning/planner.h"
+#include "planning/planning_test_util.h"
 #include "planning/view_geometry.h"
-#include "support/sim_worlds.h"
 
 namespace selfcal::planning {
 namespace {
 
-struct World {
-  sim::SimResult sim;
-  PlanningProblem problem;
-  std::vector<Eigen::VectorXd> start;
-};
-
-// The PUMA 560 on the shipped initial arc, the simulated scene's dots as the rough dot positions.
-World MakeWorld() {
-  World w;
-  w.sim = testing::PumaArcWorld(0.0);
-  w.problem.robot = w.sim.truth.nominal;
-  w.problem.camera = w.sim.observations.camera;
-  w.problem.scene = Scene::FromDots(w.sim.truth.dots_in_base);
-  w.problem.constraints.image_margin_px = 2.0;  // the simulator keeps the true projections 10 px inside
-  for (const PoseObservation& p : w.sim.observations.poses) w.start.push_back(p.joints_rad);
-  return w;
-}
-
-std::vector<Eigen::VectorXd> Head(const std::vector<Eigen::VectorXd>& poses, int count) {
-  return std::vector<Eigen::VectorXd>(poses.begin(), poses.begin() + count);
-}
-
-bool HasIssue(const PlanCheck& check, PlanIssue issue) {
-  for (const PlanProblemItem& p : check.problems) {
-    if (p.issue == issue) return true;
-  }
-  return false;
-}
-
-std::vector<int> FreeColumns(const World& w) {
-  const identification::IdentifiabilityReport id = identification::AnalyzeIdentifiability(
-      w.problem.robot, KinematicParameters::Nominal(w.problem.robot), Head(w.start, 15), 0,
-      identification::IdentifiabilityOptions());
-  return id.free_indices;
-}
+using testing::FreeColumns;
+using testing::HasIssue;
+using testing::Head;
+using testing::MakeWorld;
+using testing::World;
 
 TEST(Planning, TwistJacobianHasTheSingularValuesOfTheAutodiffIdentificationJacobian) {
   const World w = MakeWorld();
@@ -247,38 +216,6 @@ TEST(Planning, PlannerRefusesAnInfeasibleStart) {
   const PlanResult r2 = PlanMeasurements(w.problem, plan, PlannerOptions());
   EXPECT_FALSE(r2.ok);
   EXPECT_NE(r2.message.find("pose 3 has 4 joint values"), std::string::npos) << r2.message;
-}
-
-TEST(Planning, FisherDesignMatchesTheBundleCramerRaoBound) {
-  const World w = MakeWorld();
-  const std::vector<int> free = FreeColumns(w);
-  FisherDesignOptions options;
-  options.pixel_noise_px = 0.2;
-  options.yardstick_sigma_m = 1e-6;
-  // The bound at the nominal model (the planner's view): the truth of the bound is the nominal robot.
-  sim::SimResult nominal_world = w.sim;
-  bundle::BundleTruth truth;
-  truth.rho = KinematicParameters::Nominal(w.problem.robot);
-  truth.fx_px = w.problem.camera.fx_px;
-  for (size_t j = 0; j < w.sim.truth.dots_in_base.size(); ++j) truth.dots_in_base[j] = w.sim.truth.dots_in_base[j];
-  ObservationSet geometry = w.sim.observations;
-  geometry.camera.fx_px = truth.fx_px;
-  // Every dot seen in every identification pose, as the design assumes (the simulator keeps them in view).
-  bundle::BundleOptions bundle_options;
-  bundle_options.yardstick_sigma_m = 1e-6;
-  const bundle::CramerRaoReport bound = bundle::BundleCramerRao(geometry, truth, 0.2, bundle_options);
-  ASSERT_TRUE(bound.ok) << bound.message;
-  ASSERT_EQ(bound.free_indices, free);
-  // The simulated yardstick is dots 0 and 1, as the design's.
-  FisherDesign design(w.problem, free, options);
-  std::vector<int> all;
-  for (int i = 0; i < 15; ++i) all.push_back(design.AddCandidate(w.start[i]));
-  const FisherValue v = design.Evaluate(all);
-  ASSERT_TRUE(v.ok);
-  for (size_t c = 0; c < free.size(); ++c) {
-    EXPECT_NEAR(v.stddev[c], bound.stddev[free[c]], 0.02 * bound.stddev[free[c]]) << free[c];
-  }
-  EXPECT_NEAR(v.stddev[free.size()], bound.fx_stddev, 0.02 * bound.fx_stddev);
 }
 
 TEST(Planning, DOptimalExchangeRaisesTheInformationDeterministically) {

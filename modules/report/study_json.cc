@@ -55,7 +55,7 @@ nlohmann::json BundleCellJson(const simulation::StudyCell& c) {
                               {"fx", Finite(Ratio(c.bundle_fx_px.Rms(), c.bundle_bound_fx_px.Rms()))}}},
           {"fig6_3d_error_mm", StatJson(c.bundle_error3d_mm)},
           {"predicted_3d_error_mm",
-           {{"description", "std of the 3-D error of each check distance predicted to first order (pipeline/"
+           {{"description", "std of the 3-D error of each check distance predicted to first order (calibration/"
                             "predicted_error.h), pooled over runs; compare actual_rms with the rms entries"},
             {"actual_rms", Finite(c.bundle_error3d_mm.Rms())},
             {"predicted", StatJson(c.bundle_predicted3d_mm)},

@@ -10,15 +10,13 @@
 #include <utility>
 
 #include "base/atomic_file.h"
-#include "capture/crc32.h"
+#include "base/crc32.h"
 #include "session/file_util.h"
 
 namespace selfcal::session {
 
 namespace {
 
-using capture::internal::Crc32;
-using capture::internal::Crc32Hex;
 using internal::SystemError;
 
 // "J1 " + 8 hex + " " + 8 hex + " ".

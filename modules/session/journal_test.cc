@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "base/atomic_file.h"
-#include "capture/crc32.h"
+#include "base/crc32.h"
 #include "session/file_util.h"
 #include "session/session_test_util.h"
 
@@ -65,7 +65,7 @@ TEST(JournalTest, RoundTrip) {
 TEST(JournalTest, LineFramingIsAsDocumented) {
   const std::string payload = R"({"type":"x"})";
   EXPECT_EQ(FrameJournalRecord(payload),
-            "J1 0000000c " + capture::internal::Crc32Hex(capture::internal::Crc32(payload)) + " " + payload + "\n");
+            "J1 0000000c " + Crc32Hex(Crc32(payload)) + " " + payload + "\n");
   TempDir dir;
   const std::string path = dir.File(kJournalFileName);
   Result<Journal> journal = Journal::Open(path);

@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "base/atomic_file.h"
-#include "capture/crc32.h"
+#include "base/crc32.h"
 #include "session/file_util.h"
 
 namespace selfcal::session {
@@ -351,9 +351,9 @@ Status VerifySampleImages(const Session& session, const SessionLog& log) {
     } else if (bytes->size() != frame.bytes) {
       problems.push_back(where + ": " + std::to_string(bytes->size()) + " bytes, the journal recorded " +
                          std::to_string(frame.bytes));
-    } else if (capture::internal::Crc32(*bytes) != frame.crc32) {
-      problems.push_back(where + ": CRC-32 " + capture::internal::Crc32Hex(capture::internal::Crc32(*bytes)) +
-                         ", the journal recorded " + capture::internal::Crc32Hex(frame.crc32));
+    } else if (Crc32(*bytes) != frame.crc32) {
+      problems.push_back(where + ": CRC-32 " + Crc32Hex(Crc32(*bytes)) +
+                         ", the journal recorded " + Crc32Hex(frame.crc32));
     }
   }
   if (problems.empty()) return Status::Ok();

@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "capture/crc32.h"
+#include "base/crc32.h"
 #include "session/session_test_util.h"
 
 namespace selfcal::session {
@@ -271,7 +271,7 @@ TEST(SamplesTest, VerifySampleImages) {
   ASSERT_TRUE(created.ok());
   Session& session = created.value();
   const std::string image = "PNG bytes of pose zero";
-  const std::string crc = capture::internal::Crc32Hex(capture::internal::Crc32(image));
+  const std::string crc = Crc32Hex(Crc32(image));
   ASSERT_TRUE(session.WriteImage("p00.png", image).ok());
   std::vector<json> records = {Started(2), Planned(0), Planned(1), Frame(0, 0, crc, static_cast<int>(image.size())),
                                Accepted(0)};

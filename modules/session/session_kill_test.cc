@@ -12,15 +12,13 @@
 #include <gtest/gtest.h>
 
 #include "base/atomic_file.h"
-#include "capture/crc32.h"
+#include "base/crc32.h"
 #include "session/session_dir.h"
 #include "session/session_test_util.h"
 
 namespace selfcal::session {
 namespace {
 
-using capture::internal::Crc32;
-using capture::internal::Crc32Hex;
 using testing::CreateTestSession;
 using testing::TempDir;
 using testing::TestInputs;

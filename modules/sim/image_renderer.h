@@ -103,7 +103,7 @@ RenderedImage RenderDots(const CameraIntrinsics& camera, const Rigid3& base_from
 // Names points (e.g. detected centroids) by the rendered dots of `image`: for each point, the id of the
 // visible dot whose projected centre is nearest and closer than radius_px (among `ids` when not empty),
 // kNoDot when there is none, kAmbiguousDot when another point names the same dot (neither keeps it).
-// The simulator's stand-in for identities (pipeline/rendered_observations.h, pipeline/sim_session.h).
+// The simulator's stand-in for identities (simulation/rendered_observations.h, simulation/sim_session.h).
 inline constexpr int kNoDot = -1;
 inline constexpr int kAmbiguousDot = -2;
 std::vector<int> NameByNearestDisc(const RenderedImage& image, const std::vector<Eigen::Vector2d>& points,

@@ -1,7 +1,7 @@
 // Monte Carlo study reproducing the paper's Table 2 (pose measurement errors) and Fig. 6 (3-D errors after
 // calibration) over seeded simulated runs, beside OpenCV's essential-matrix pose (true f_x), the two-view
 // Cramer-Rao bound of the same setup, and the nominal model (does calibration help?). Beyond the paper: the
-// kinematic bundle adjustment (pipeline/bundle_stage.h) on the same data, against the truth and its own
+// kinematic bundle adjustment (calibration/bundle_stage.h) on the same data, against the truth and its own
 // Cramer-Rao bound (bundle::BundleCramerRao), with the coverage of its reported sigmas. With
 // sim.flat_sheet the dots lie on one plane: the paper pipeline fails there (its rows count only the runs
 // it completed) while the bundle adjustment starts from the nominal model.
@@ -27,7 +27,7 @@ struct TrajectorySpec {
   std::vector<Eigen::VectorXd> joints;  // rad
 };
 
-// A row of observations measured on rendered images (pipeline/rendered_observations.h) instead of
+// A row of observations measured on rendered images (simulation/rendered_observations.h) instead of
 // projected points: grey-level noise and blur of the images; assumed_noise_px is the centroid noise the
 // solvers are told (and the bound is computed with).
 struct RenderedLevel {
@@ -105,7 +105,7 @@ struct StudyCell {
   // the verification relative poses (with their bound).
   Stat bundle_error3d_mm, bundle_pose_position_mm, bundle_pose_orientation_1e4rad;
   Stat bundle_bound_pose_position_mm, bundle_bound_pose_orientation_1e4rad;
-  // (c') The predicted std of that 3-D error (pipeline/predicted_error.h), per check distance pooled over
+  // (c') The predicted std of that 3-D error (calibration/predicted_error.h), per check distance pooled over
   // runs: from each run's own covariance and pixel noise (total, part (a) parameters, part (b) pixels), and
   // the bound: the same propagation of the bundle's Cramer-Rao covariance with the truth's model and f_x.
   // Compare bundle_error3d_mm.Rms() with their Rms() (the quadratic mean: E[error^2] = mean variance).

@@ -1,4 +1,4 @@
-#include "io/yaml_reader.h"
+#include "yaml/yaml_reader.h"
 
 #include <cstdio>
 #include <cstring>
@@ -12,9 +12,16 @@
 #include <yaml-cpp/mark.h>
 #include <yaml-cpp/parser.h>
 
-#include "io/atomic_file.h"
+#include "base/atomic_file.h"
 
-namespace selfcal::io {
+namespace selfcal::yaml {
+
+const YamlNode* YamlNode::Find(const std::string& key) const {
+  for (size_t i = 0; i < keys.size(); ++i) {
+    if (keys[i] == key) return &items[i];
+  }
+  return nullptr;
+}
 
 const char* YamlNode::KindName() const {
   switch (kind) {
@@ -31,6 +38,13 @@ namespace {
 Status UsageError(const std::string& message) { return Status::Error(ExitCode::kUsage, message); }
 
 std::string At(const std::string& name, int line) { return name + ":" + std::to_string(line); }
+
+bool Terse(const YamlRules& rules) { return rules.wording == YamlWording::kSequenceIndex; }
+
+// A refusal located in the file: "<problem> at FILE:LINE", or "FILE:LINE: <problem>" when terse.
+Status Refusal(const YamlRules& rules, const std::string& name, int line, const std::string& problem) {
+  return UsageError(Terse(rules) ? At(name, line) + ": " + problem : problem + " at " + At(name, line));
+}
 
 // A limit of ours hit while yaml-cpp parses: thrown from the event handler, so yaml-cpp never recurses
 // past the depth limit.
@@ -84,11 +98,27 @@ bool Printable(unsigned cp) {
   return cp >= 0x10000 && cp <= 0x10FFFF;
 }
 
-// Checks encoding and characters, drops a UTF-8 BOM and turns CRLF and lone CR into LF.
-Status Normalise(const std::string& name, std::string* text) {
+// A character that is not printable UTF-8: `byte` starts an invalid sequence (!decoded) or the code
+// point is a control character.
+Status BadCharacter(const YamlRules& rules, const std::string& name, int line, unsigned char byte, bool decoded,
+                    unsigned code_point) {
+  char hex[12];
+  std::snprintf(hex, sizeof(hex), "0x%02X", byte);
+  if (Terse(rules)) return UsageError(At(name, line) + ": invalid byte " + hex + " (binary or corrupted file?)");
+  std::string what = "invalid UTF-8 (byte " + std::string(hex) + ")";
+  if (decoded) {
+    std::snprintf(hex, sizeof(hex), "U+%04X", code_point);
+    what = "control character " + std::string(hex);
+  }
+  return UsageError(what + " at " + At(name, line) + "; is this a binary file? selfcal reads UTF-8 YAML");
+}
+
+// Checks encoding and characters, drops a UTF-8 BOM and turns CRLF and lone CR into LF. The terse
+// wording names a UTF-16 or UTF-32 byte order mark as the invalid byte it starts with.
+Status Normalise(const YamlRules& rules, const std::string& name, std::string* text) {
   const std::string& t = *text;
   const auto starts = [&](const char* prefix, size_t n) { return t.size() >= n && std::memcmp(t.data(), prefix, n) == 0; };
-  if (starts("\x00\x00\xFE\xFF", 4) || starts("\xFF\xFE\x00\x00", 4) || starts("\xFE\xFF", 2) || starts("\xFF\xFE", 2)) {
+  if (!Terse(rules) && (starts("\x00\x00\xFE\xFF", 4) || starts("\xFF\xFE\x00\x00", 4) || starts("\xFE\xFF", 2) || starts("\xFF\xFE", 2))) {
     return UsageError(name + " is UTF-16 or UTF-32 encoded; save it as UTF-8");
   }
   const size_t start = starts("\xEF\xBB\xBF", 3) ? 3 : 0;
@@ -98,17 +128,8 @@ Status Normalise(const std::string& name, std::string* text) {
   for (size_t i = start; i < t.size();) {
     unsigned cp = 0;
     const int length = DecodeUtf8(t, i, &cp);
-    if (length == 0) {
-      char hex[8];
-      std::snprintf(hex, sizeof(hex), "0x%02X", static_cast<unsigned char>(t[i]));
-      return UsageError("invalid UTF-8 (byte " + std::string(hex) + ") at " + At(name, line) +
-                        "; is this a binary file? selfcal reads UTF-8 YAML");
-    }
-    if (!Printable(cp)) {
-      char hex[12];
-      std::snprintf(hex, sizeof(hex), "U+%04X", cp);
-      return UsageError("control character " + std::string(hex) + " at " + At(name, line) +
-                        "; is this a binary file? selfcal reads UTF-8 YAML");
+    if (length == 0 || !Printable(cp)) {
+      return BadCharacter(rules, name, line, static_cast<unsigned char>(t[i]), length != 0, cp);
     }
     if (cp == '\r') {
       out.push_back('\n');
@@ -127,7 +148,7 @@ Status Normalise(const std::string& name, std::string* text) {
 // Flow collections ([ and {) nested deeper than the limit, found before yaml-cpp parses anything.
 // Quotes and comments are skipped; brackets inside plain scalars may over-count, which only matters for
 // files that are suspicious anyway.
-Status PrescanFlowDepth(const std::string& name, const std::string& text) {
+Status PrescanFlowDepth(const YamlRules& rules, const std::string& name, const std::string& text) {
   int depth = 0, line = 1;
   char quote = 0;
   char previous = '\n';
@@ -152,8 +173,8 @@ Status PrescanFlowDepth(const std::string& name, const std::string& text) {
     } else if ((c == '"' || c == '\'') && std::strchr(" \t\n[{,:", previous) != nullptr) {
       quote = c;
     } else if (c == '[' || c == '{') {
-      if (++depth > kMaxYamlDepth) {
-        return UsageError("YAML nested deeper than " + std::to_string(kMaxYamlDepth) + " levels at " + At(name, line));
+      if (++depth > rules.max_depth) {
+        return Refusal(rules, name, line, "YAML nested deeper than " + std::to_string(rules.max_depth) + " levels");
       }
     } else if ((c == ']' || c == '}') && depth > 0) {
       --depth;
@@ -165,10 +186,12 @@ Status PrescanFlowDepth(const std::string& name, const std::string& text) {
 
 class TreeBuilder : public YAML::EventHandler {
  public:
-  explicit TreeBuilder(YamlNode* root) : root_(root) {}
+  TreeBuilder(const YamlRules& rules, YamlNode* root) : rules_(rules), terse_(Terse(rules)), root_(root) {}
 
   void OnDocumentStart(const YAML::Mark& mark) override {
-    if (++documents_ > 1) throw TreeError(Line(mark), "more than one YAML document (a second `---`)");
+    if (++documents_ > 1) {
+      throw TreeError(Line(mark), terse_ ? "more than one YAML document" : "more than one YAML document (a second `---`)");
+    }
   }
   void OnDocumentEnd() override {}
   void OnNull(const YAML::Mark& mark, YAML::anchor_t anchor) override {
@@ -176,15 +199,16 @@ class TreeBuilder : public YAML::EventHandler {
     Add(MakeNode(YamlNode::Kind::kNull, mark));
   }
   void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override {
-    throw TreeError(Line(mark), "YAML aliases (*name) are not supported; write the values out");
+    throw TreeError(Line(mark), terse_ ? "YAML aliases are not allowed in a sequence index"
+                                       : "YAML aliases (*name) are not supported; write the values out");
   }
   void OnAnchor(const YAML::Mark& mark, const std::string&) override {
-    throw TreeError(Line(mark), "YAML anchors (&name) are not supported; write the values out");
+    throw TreeError(Line(mark), terse_ ? kTerseAnchors : "YAML anchors (&name) are not supported; write the values out");
   }
   void OnScalar(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t anchor,
                 const std::string& value) override {
     CheckAnchor(mark, anchor);
-    if (tag != "?" && tag != "!") throw TreeError(Line(mark), "explicit YAML tags (" + tag + ") are not supported");
+    if (tag != "?" && tag != "!") RefuseTag(mark, tag);
     YamlNode node = MakeNode(YamlNode::Kind::kScalar, mark);
     node.scalar = value;
     node.plain = tag == "?";
@@ -215,18 +239,24 @@ class TreeBuilder : public YAML::EventHandler {
     return node;
   }
 
-  static void CheckAnchor(const YAML::Mark& mark, YAML::anchor_t anchor) {
-    if (anchor != YAML::NullAnchor) throw TreeError(Line(mark), "YAML anchors (&name) are not supported");
+  static constexpr const char* kTerseAnchors = "YAML anchors are not allowed in a sequence index";
+
+  void CheckAnchor(const YAML::Mark& mark, YAML::anchor_t anchor) const {
+    if (anchor != YAML::NullAnchor) {
+      throw TreeError(Line(mark), terse_ ? kTerseAnchors : "YAML anchors (&name) are not supported");
+    }
+  }
+
+  [[noreturn]] void RefuseTag(const YAML::Mark& mark, const std::string& tag) const {
+    throw TreeError(Line(mark), "explicit YAML tags (" + tag + ") are not " + (terse_ ? "allowed" : "supported"));
   }
 
   void StartCollection(YamlNode::Kind kind, const YAML::Mark& mark, const std::string& tag, YAML::anchor_t anchor) {
     CheckAnchor(mark, anchor);
-    if (tag != "?" && tag != "!" && !tag.empty()) {
-      throw TreeError(Line(mark), "explicit YAML tags (" + tag + ") are not supported");
-    }
+    if (tag != "?" && tag != "!" && !tag.empty()) RefuseTag(mark, tag);
     YamlNode* node = Add(MakeNode(kind, mark));
-    if (static_cast<int>(stack_.size()) >= kMaxYamlDepth) {
-      throw TreeError(Line(mark), "YAML nested deeper than " + std::to_string(kMaxYamlDepth) + " levels");
+    if (static_cast<int>(stack_.size()) >= rules_.max_depth) {
+      throw TreeError(Line(mark), "YAML nested deeper than " + std::to_string(rules_.max_depth) + " levels");
     }
     stack_.push_back(Frame{node, {}});
   }
@@ -234,8 +264,8 @@ class TreeBuilder : public YAML::EventHandler {
   // Attaches a node to the collection being built; returns where it now lives (nullptr for map keys).
   // Pointers stay valid: a parent's item vector grows only after the previous child is complete.
   YamlNode* Add(YamlNode node) {
-    if (++count_ > kMaxYamlNodes) {
-      throw TreeError(node.line, "more than " + std::to_string(kMaxYamlNodes) + " YAML nodes");
+    if (++count_ > rules_.max_nodes) {
+      throw TreeError(node.line, "more than " + std::to_string(rules_.max_nodes) + " YAML nodes");
     }
     if (stack_.empty()) {
       *root_ = std::move(node);
@@ -249,7 +279,9 @@ class TreeBuilder : public YAML::EventHandler {
     }
     if (parent->keys.size() == parent->items.size()) {  // this node is a key
       if (!node.IsScalar()) {
-        throw TreeError(node.line, node.IsNull() ? "empty map key" : "map keys must be plain strings, not collections");
+        throw TreeError(node.line, terse_          ? "map keys must be plain strings"
+                                   : node.IsNull() ? "empty map key"
+                                                   : "map keys must be plain strings, not collections");
       }
       if (!frame.keys.insert(node.scalar).second) {
         throw TreeError(node.line, "duplicate key `" + node.scalar + "`");
@@ -263,6 +295,8 @@ class TreeBuilder : public YAML::EventHandler {
     return &parent->items.back();
   }
 
+  const YamlRules& rules_;
+  const bool terse_;
   YamlNode* root_;
   std::vector<Frame> stack_;
   size_t count_ = 0;
@@ -271,13 +305,13 @@ class TreeBuilder : public YAML::EventHandler {
 
 }  // namespace
 
-Result<YamlDocument> ParseYamlText(const std::string& text_in, const std::string& name) {
-  if (text_in.size() > kMaxYamlBytes) {
-    return UsageError(name + " is larger than " + std::to_string(kMaxYamlBytes) + " bytes");
+Result<YamlDocument> ParseYamlText(const std::string& text_in, const std::string& name, const YamlRules& rules) {
+  if (text_in.size() > rules.max_bytes) {
+    return UsageError(name + " is larger than " + std::to_string(rules.max_bytes) + " bytes");
   }
   std::string text = text_in;
-  if (Status s = Normalise(name, &text); !s.ok()) return s;
-  if (Status s = PrescanFlowDepth(name, text); !s.ok()) return s;
+  if (Status s = Normalise(rules, name, &text); !s.ok()) return s;
+  if (Status s = PrescanFlowDepth(rules, name, text); !s.ok()) return s;
 
   YamlDocument doc;
   doc.path = name;
@@ -285,11 +319,11 @@ Result<YamlDocument> ParseYamlText(const std::string& text_in, const std::string
   try {
     std::istringstream stream(text);
     YAML::Parser parser(stream);
-    TreeBuilder builder(&doc.root);
+    TreeBuilder builder(rules, &doc.root);
     found = parser.HandleNextDocument(builder);
     if (found) parser.HandleNextDocument(builder);  // a second document throws in OnDocumentStart
   } catch (const TreeError& e) {
-    return UsageError(std::string(e.what()) + " at " + At(name, e.line()));
+    return Refusal(rules, name, e.line(), e.what());
   } catch (const YAML::Exception& e) {
     const std::string where = e.mark.is_null() ? name : At(name, Line(e.mark));
     return UsageError("malformed YAML at " + where + ": " + e.msg);
@@ -310,4 +344,4 @@ Result<YamlDocument> LoadYamlFile(const std::string& path) {
   return ParseYamlText(*text, path);
 }
 
-}  // namespace selfcal::io
+}  // namespace selfcal::yaml

@@ -1,4 +1,5 @@
-// Strict YAML reading: the only way selfcal reads a YAML file (C1-C3, C8, P8).
+// Strict YAML reading: the only way selfcal reads a YAML file (C1-C3, C8, P8). Bottom layer (uses only
+// base), so that io's files and capture's recorded-sequence index share one reader.
 //
 // Two layers:
 //  1. LoadYamlFile / ParseYamlText turn bytes into a YamlNode tree with 1-based line numbers. Before
@@ -8,8 +9,9 @@
 //     the tree refuses deeper block nesting before yaml-cpp recurses further, anchors and aliases (no
 //     alias bombs), explicit tags, non-scalar or duplicate map keys, more than kMaxYamlNodes nodes, and
 //     more than one document. Every yaml-cpp exception becomes a Status; the code is always
-//     ExitCode::kUsage and the message names the file (and the line when known).
-//  2. Problems and MapReader (yaml_schema.h) check a tree against a schema.
+//     ExitCode::kUsage and the message names the file (and the line when known). YamlRules sets the
+//     limits and the wording of the refusals.
+//  2. Problems and MapReader (io/yaml_schema.h) check a tree against a schema.
 #pragma once
 
 #include <cstddef>
@@ -18,11 +20,24 @@
 
 #include "base/status.h"
 
-namespace selfcal::io {
+namespace selfcal::yaml {
 
 inline constexpr std::size_t kMaxYamlBytes = 10u * 1024u * 1024u;  // 10 MiB
 inline constexpr int kMaxYamlDepth = 64;                           // nested sequences and maps
 inline constexpr std::size_t kMaxYamlNodes = 1000000;
+
+// How refusals read. kUserFile (files people write: robot configs, observations, plans): "<problem> at
+// FILE:LINE" with advice. kSequenceIndex (capture's recorded-sequence index, which selfcal writes
+// itself): "FILE:LINE: <problem>" in the shorter words the index reader has always used.
+enum class YamlWording { kUserFile, kSequenceIndex };
+
+// What one kind of file may hold; the defaults are those of LoadYamlFile.
+struct YamlRules {
+  std::size_t max_bytes = kMaxYamlBytes;
+  int max_depth = kMaxYamlDepth;  // nested sequences and maps
+  std::size_t max_nodes = kMaxYamlNodes;
+  YamlWording wording = YamlWording::kUserFile;
+};
 
 struct YamlNode {
   enum class Kind { kNull, kScalar, kSequence, kMap };
@@ -39,6 +54,8 @@ struct YamlNode {
   bool IsSequence() const { return kind == Kind::kSequence; }
   bool IsScalar() const { return kind == Kind::kScalar; }
   bool IsNull() const { return kind == Kind::kNull; }
+  // kMap: the value of `key`, or nullptr when absent.
+  const YamlNode* Find(const std::string& key) const;
   // "map", "sequence", "string", "number-like scalar" or "empty value": for messages.
   const char* KindName() const;
 };
@@ -52,7 +69,8 @@ struct YamlDocument {
 // not UTF-8, empty, malformed YAML, limits above exceeded.
 Result<YamlDocument> LoadYamlFile(const std::string& path);
 
-// Parses text already in memory; `name` stands for the file in messages. Same checks as LoadYamlFile.
-Result<YamlDocument> ParseYamlText(const std::string& text, const std::string& name);
+// Parses text already in memory; `name` stands for the file in messages. Same checks as LoadYamlFile,
+// with the limits and wording of `rules`.
+Result<YamlDocument> ParseYamlText(const std::string& text, const std::string& name, const YamlRules& rules = {});
 
-}  // namespace selfcal::io
+}  // namespace selfcal::yaml

@@ -1,0 +1,104 @@
+// The strict YAML reader on its own: the tree, its line numbers and the refusals in both wordings. The
+// files built on it are tested through their readers (io's MalformedFiles, capture's RecordedSequenceV8).
+#include "yaml/yaml_reader.h"
+
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "support/temp_files.h"
+
+namespace selfcal::yaml {
+namespace {
+
+YamlRules IndexRules(int max_depth = 8) {
+  YamlRules rules;
+  rules.max_depth = max_depth;
+  rules.wording = YamlWording::kSequenceIndex;
+  return rules;
+}
+
+std::string Refusal(const std::string& text, const YamlRules& rules = {}) {
+  Result<YamlDocument> doc = ParseYamlText(text, "f.yaml", rules);
+  EXPECT_FALSE(doc.ok()) << text;
+  if (doc.ok()) return "";
+  EXPECT_EQ(doc.status().code(), ExitCode::kUsage);
+  return doc.status().message();
+}
+
+TEST(YamlReader, TreeKeepsLinesKeysAndQuoting) {
+  Result<YamlDocument> doc = ParseYamlText("# comment\na: 1\nb:\n  - \"x\"\n  - [2, 3]\nc:\n", "f.yaml");
+  ASSERT_TRUE(doc.ok()) << doc.status().ToString();
+  const YamlNode& root = doc->root;
+  ASSERT_TRUE(root.IsMap());
+  EXPECT_EQ(root.keys, (std::vector<std::string>{"a", "b", "c"}));
+  EXPECT_EQ(root.key_lines, (std::vector<int>{2, 3, 6}));
+  ASSERT_NE(root.Find("a"), nullptr);
+  EXPECT_EQ(root.Find("a")->scalar, "1");
+  EXPECT_TRUE(root.Find("a")->plain);
+  EXPECT_EQ(root.Find("missing"), nullptr);
+  const YamlNode& b = *root.Find("b");
+  ASSERT_TRUE(b.IsSequence());
+  ASSERT_EQ(b.items.size(), 2u);
+  EXPECT_FALSE(b.items[0].plain);
+  EXPECT_STREQ(b.items[0].KindName(), "a quoted string");
+  EXPECT_EQ(b.items[1].line, 5);
+  EXPECT_TRUE(root.Find("c")->IsNull());
+  EXPECT_EQ(root.Find("c")->line, 6);  // an empty value carries its key's line
+}
+
+TEST(YamlReader, BomAndCrlfAreAcceptedAndLinesCountOnce) {
+  Result<YamlDocument> doc = ParseYamlText("\xEF\xBB\xBF" "a: 1\r\nb: 2\r\n", "f.yaml");
+  ASSERT_TRUE(doc.ok()) << doc.status().ToString();
+  EXPECT_EQ(doc->root.key_lines, (std::vector<int>{1, 2}));
+}
+
+TEST(YamlReader, UserFileRefusalsSayWhereAfterTheProblem) {
+  EXPECT_EQ(Refusal("a: 1\nb: &x 2\n"), "YAML anchors (&name) are not supported; write the values out at f.yaml:2");
+  EXPECT_EQ(Refusal("a: 1\na: 2\n"), "duplicate key `a` at f.yaml:2");
+  EXPECT_EQ(Refusal("a: [[[1]]]\n", YamlRules{kMaxYamlBytes, 2, kMaxYamlNodes, YamlWording::kUserFile}),
+            "YAML nested deeper than 2 levels at f.yaml:1");
+  EXPECT_NE(Refusal("a: b\x01\n").find("control character U+0001 at f.yaml:1"), std::string::npos);
+  EXPECT_NE(Refusal("a: 1\nb: \xC3\x28\n").find("invalid UTF-8 (byte 0xC3) at f.yaml:2"), std::string::npos);
+  EXPECT_EQ(Refusal("\xFF\xFE" "a\0"), "f.yaml is UTF-16 or UTF-32 encoded; save it as UTF-8");
+  EXPECT_EQ(Refusal("a: 1\n---\nb: 2\n"), "more than one YAML document (a second `---`) at f.yaml:2");
+  EXPECT_EQ(Refusal("# only a comment\n"), "f.yaml is empty (no YAML document)");
+  EXPECT_EQ(Refusal("a: 12345\n", YamlRules{4, kMaxYamlDepth, kMaxYamlNodes, YamlWording::kUserFile}),
+            "f.yaml is larger than 4 bytes");
+  EXPECT_NE(Refusal("a: {\n").find("malformed YAML at f.yaml:"), std::string::npos);
+}
+
+TEST(YamlReader, SequenceIndexRefusalsSayWhereFirst) {
+  EXPECT_EQ(Refusal("a: 1\nb: &x 2\n", IndexRules()), "f.yaml:2: YAML anchors are not allowed in a sequence index");
+  EXPECT_EQ(Refusal("a: *x\n", IndexRules()), "malformed YAML at f.yaml:1: the referenced anchor is not defined");
+  EXPECT_EQ(Refusal("a: 1\na: 2\n", IndexRules()), "f.yaml:2: duplicate key `a`");
+  EXPECT_EQ(Refusal("a: [[[[[[[[[[]]]]]]]]]]\n", IndexRules()), "f.yaml:1: YAML nested deeper than 8 levels");
+  EXPECT_EQ(Refusal("a:\n- - - 1\n", IndexRules(2)), "f.yaml:2: YAML nested deeper than 2 levels");
+  EXPECT_EQ(Refusal("a: 1\nb: \x89PNG\n", IndexRules()), "f.yaml:2: invalid byte 0x89 (binary or corrupted file?)");
+  EXPECT_EQ(Refusal("a: b\x01\n", IndexRules()), "f.yaml:1: invalid byte 0x01 (binary or corrupted file?)");
+  EXPECT_EQ(Refusal("a: 1\n---\nb: 2\n", IndexRules()), "f.yaml:2: more than one YAML document");
+  EXPECT_EQ(Refusal("? [a]\n: 1\n", IndexRules()), "f.yaml:1: map keys must be plain strings");
+  EXPECT_EQ(Refusal("a: !!binary aGk=\n", IndexRules()), "f.yaml:1: explicit YAML tags (tag:yaml.org,2002:binary) are not allowed");
+}
+
+TEST(YamlReader, NodeLimitCountsEveryNode) {
+  YamlRules rules;
+  rules.max_nodes = 4;  // the map, two keys, one value
+  EXPECT_TRUE(ParseYamlText("a: 1\n", "f.yaml", rules).ok());
+  EXPECT_EQ(Refusal("a: 1\nb: 2\n", rules), "more than 4 YAML nodes at f.yaml:2");
+}
+
+TEST(YamlReader, LoadYamlFileNamesThePath) {
+  selfcal::testing::TempDir dir("selfcal_yaml_test");
+  const std::string path = dir.File("x.yaml");
+  selfcal::testing::WriteFile(path, "a: 1\n");
+  Result<YamlDocument> doc = LoadYamlFile(path);
+  ASSERT_TRUE(doc.ok()) << doc.status().ToString();
+  EXPECT_EQ(doc->path, path);
+  const Result<YamlDocument> absent = LoadYamlFile(dir.File("absent.yaml"));
+  ASSERT_FALSE(absent.ok());
+  EXPECT_NE(absent.status().message().find(dir.File("absent.yaml")), std::string::npos);
+}
+
+}  // namespace
+}  // namespace selfcal::yaml
