@@ -227,6 +227,217 @@ std::string Join(const std::vector<std::string>& names) {
   return out;
 }
 
+// Every problem with the caller's input, one per line; empty when usable.
+std::string CheckInputs(const ObservationSet& observations, const Eigen::VectorXd& rho_start, double fx_start,
+                        const BundleOptions& options) {
+  std::ostringstream problems;
+  problems << options.Validate() << observations.Validate();
+  if (rho_start.size() != observations.robot.num_parameters()) {
+    problems << "rho_start has " << rho_start.size() << " entries, the robot needs "
+             << observations.robot.num_parameters() << "\n";
+  } else if (!rho_start.allFinite()) {
+    problems << "rho_start is not finite\n";
+  }
+  if (!std::isfinite(fx_start) || fx_start <= 0) problems << "fx_start = " << fx_start << " must be finite and > 0\n";
+  return problems.str();
+}
+
+// Ids of the dots seen in fewer than two identification poses: they cannot be triangulated.
+std::vector<int> DotsSeenOnce(const ObservationSet& observations) {
+  std::map<int, int> views;
+  for (int p : observations.PosesWithRole(PoseRole::kIdentification)) {
+    for (const auto& entry : observations.poses[p].dots_px) ++views[entry.first];
+  }
+  std::vector<int> once;
+  for (const auto& [dot, count] : views) {
+    if (count < 2) once.push_back(dot);
+  }
+  return once;
+}
+
+// Dots from the start model; a dot that cannot be triangulated there (behind a camera, no parallax)
+// is dropped: its id is appended to `dropped`, it and its observations leave `data` and `state`.
+void TriangulateStartDots(const Eigen::VectorXd& rho_start, double fx_start, BundleData* data, BundleState* state,
+                          std::vector<int>* dropped) {
+  std::vector<Rigid3> base_from_cam;
+  for (const Eigen::VectorXd& q : data->joints) base_from_cam.push_back(BaseFromCam(data->robot, rho_start, q));
+  std::vector<identification::PointTrack> tracks(data->dot_ids.size());
+  for (const internal::Observation& o : data->observations) {
+    tracks[o.dot].base_from_cam.push_back(base_from_cam[o.pose]);
+    tracks[o.dot].pixels.push_back(o.pixel);
+  }
+  state->dots.resize(data->dot_ids.size());
+  std::vector<bool> ok(data->dot_ids.size());
+  for (size_t d = 0; d < tracks.size(); ++d) {
+    const identification::TriangulationResult t =
+        identification::TriangulatePoint(data->camera, fx_start, tracks[d], data->sigma_px);
+    ok[d] = t.ok && t.point.allFinite();
+    state->dots[d] = t.point;
+    if (!ok[d]) dropped->push_back(data->dot_ids[d]);
+  }
+  std::vector<bool> keep(data->observations.size());
+  for (size_t k = 0; k < keep.size(); ++k) keep[k] = ok[data->observations[k].dot];
+  const BundleData all = *data;
+  const BundleState all_state = *state;
+  std::vector<int> dot_map;
+  Subset(all, all_state, keep, data, state, &dot_map);
+}
+
+// K1: the gauge and the free set, from the rank of this problem's reduced Jacobian, copied into the
+// report. Evaluated at the nominal model, where nominally parallel axes are exactly parallel: at a
+// perturbed start the d offsets of a parallel pair look independent (rank is a tolerance game there) and
+// would run off to tens of metres (K2). False when the start model puts a dot behind a camera (K5).
+bool AnalyzeStartGauge(const BundleData& data, const BundleState& state, const BundleOptions& options,
+                       internal::Gauge* gauge, BundleReport* report) {
+  BundleState nominal = state;
+  nominal.rho = KinematicParameters::Nominal(data.robot);
+  if (!internal::AnalyzeGauge(data, nominal, options.estimate_fx, options.estimate_k1, options.rank_tolerance, gauge) &&
+      !internal::AnalyzeGauge(data, state, options.estimate_fx, options.estimate_k1, options.rank_tolerance, gauge)) {
+    return false;
+  }
+  report->free_indices = gauge->free_kinematic;
+  report->free_names = gauge->free_names;
+  report->fixed_names = gauge->fixed_names;
+  report->null_combinations = gauge->null_combinations;
+  report->condition_number = gauge->condition_number;
+  report->generic_rank =
+      identification::GenericRank(data.robot, KinematicParameters::Nominal(data.robot), options.rank_tolerance);
+  return true;
+}
+
+// Why the free set cannot be estimated from these poses (K3), or empty when it can.
+std::string WhyNotIdentifiable(const internal::Gauge& gauge, const BundleOptions& options, int num_poses,
+                               int generic_rank) {
+  if (options.estimate_fx && !gauge.fx_identifiable) {
+    return "f_x is not identifiable from these poses (null directions: " + Join(gauge.null_combinations) + ")";
+  }
+  if (options.estimate_k1 && !gauge.k1_identifiable) return "k1 is not identifiable from these poses";
+  if (gauge.free_kinematic.empty() ||
+      (options.require_generic_rank && static_cast<int>(gauge.free_kinematic.size()) < generic_rank)) {
+    std::ostringstream msg;
+    msg << "insufficient excitation (K3): these " << num_poses << " identification poses identify "
+        << gauge.free_kinematic.size() << " kinematic parameters, generic poses of this robot " << generic_rank
+        << "; fixed here: " << Join(gauge.fixed_names);
+    return msg.str();
+  }
+  return "";
+}
+
+// The screen's verdict per observation: kept when |r| is within screen_sigma robust standard deviations
+// (never tighter than the pixel noise). NaN is removed too.
+std::vector<bool> ScreenObservations(const std::vector<double>& errors, double sigma_px, const BundleOptions& options) {
+  std::vector<double> sorted;
+  for (double e : errors) {
+    if (std::isfinite(e)) sorted.push_back(e);
+  }
+  std::sort(sorted.begin(), sorted.end());
+  // Median of a 2-D Gaussian's norm: sigma sqrt(2 ln 2).
+  const double robust_sigma = sorted.empty() ? 0.0 : sorted[sorted.size() / 2] / std::sqrt(2.0 * std::log(2.0));
+  const double threshold = options.screen_sigma * std::max(sigma_px, robust_sigma);
+  std::vector<bool> keep(errors.size());
+  for (size_t k = 0; k < errors.size(); ++k) keep[k] = errors[k] <= threshold;
+  return keep;
+}
+
+// The globals and the subset's dots of `state` into `full_state` (dot c of the subset is dot_map[c]).
+void WriteBack(const BundleState& state, const std::vector<int>& dot_map, BundleState* full_state) {
+  full_state->rho = state.rho;
+  full_state->fx_px = state.fx_px;
+  full_state->k1 = state.k1;
+  for (size_t c = 0; c < dot_map.size(); ++c) full_state->dots[dot_map[c]] = state.dots[c];
+}
+
+struct ScreenedFit {
+  bool scale_lost = false;  // the screen removed the yardstick's views (S1)
+  ceres::Solver::Summary summary;  // of the final solve
+};
+
+// Robust solve, screen, refit (K7). Every round judges every observation against the current solution,
+// so one wrongly removed early (while outliers still pulled the fit) comes back. On entry `data` and
+// `state` are the whole problem at the start, on return the subset of the final fit and its solution.
+// Adds the iterations, the initial cost, the removed observations and the dots left out to the report.
+ScreenedFit SolveScreened(const std::vector<int>& free, const BundleOptions& options, BundleData* data,
+                          BundleState* state, BundleReport* report) {
+  ScreenedFit fit;
+  const BundleData full = *data;
+  BundleState full_state = *state;
+  std::vector<bool> keep(full.observations.size(), true);
+  std::vector<int> dot_map;
+  ceres::Solver::Summary& summary = fit.summary;
+  for (int round = 0;; ++round) {
+    Subset(full, full_state, keep, data, state, &dot_map);
+    if (data->yardsticks.empty()) {
+      fit.scale_lost = true;
+      return fit;
+    }
+    summary = Solve(*data, free, options, true, state);
+    if (round == 0) report->initial_cost = summary.initial_cost;
+    report->iterations += static_cast<int>(summary.iterations.size()) - 1;
+    if (summary.termination_type == ceres::FAILURE || summary.termination_type == ceres::USER_FAILURE) break;
+    WriteBack(*state, dot_map, &full_state);
+    if (round == options.max_screen_rounds) break;
+    std::vector<bool> next = ScreenObservations(ReprojectionErrors(full, full_state), data->sigma_px, options);
+    if (next == keep) break;
+    keep = std::move(next);
+  }
+  // The final fit is plain least squares unless the Huber loss was inactive at the robust solution.
+  if (summary.termination_type == ceres::CONVERGENCE || summary.termination_type == ceres::NO_CONVERGENCE) {
+    const std::vector<double> errors = ReprojectionErrors(*data, *state);
+    if (!errors.empty() && *std::max_element(errors.begin(), errors.end()) > options.huber_px) {
+      summary = Solve(*data, free, options, false, state);
+      report->iterations += static_cast<int>(summary.iterations.size()) - 1;
+      WriteBack(*state, dot_map, &full_state);
+    }
+  }
+  const std::vector<double> errors = ReprojectionErrors(full, full_state);
+  for (size_t k = 0; k < keep.size(); ++k) {
+    if (keep[k]) continue;
+    const internal::Observation& o = full.observations[k];
+    report->removed.push_back({full.pose_ids[o.pose], full.dot_ids[o.dot], errors[k]});
+  }
+  std::vector<bool> in_solve(full.dot_ids.size(), false);
+  for (int d : dot_map) in_solve[d] = true;
+  for (size_t d = 0; d < full.dot_ids.size(); ++d) {
+    if (!in_solve[d]) report->dropped_dots.push_back(full.dot_ids[d]);
+  }
+  return fit;
+}
+
+// Covariance of the free globals at the solution, dots as nuisance (K8), scaled by the residual
+// variance 2 cost / dof; the standard deviations and correlations from it.
+void EstimateCovariance(const BundleData& data, const BundleState& state, const std::vector<int>& free,
+                        const BundleOptions& options, double final_cost, BundleReport* report) {
+  internal::GlobalColumns columns;
+  columns.kinematic = free;
+  columns.fx = options.estimate_fx;
+  columns.k1 = options.estimate_k1;
+  const int num_unknowns = columns.size() + 3 * static_cast<int>(data.dot_ids.size());
+  const int dof = 2 * report->num_observations + static_cast<int>(data.yardsticks.size()) - num_unknowns;
+  Eigen::MatrixXd reduced, covariance;
+  if (dof <= 0) {
+    report->covariance_message = "uncertainty unavailable (no redundancy)";
+  } else if (!internal::ReducedJacobian(data, state, columns, &reduced)) {
+    report->covariance_message = "uncertainty unavailable (a dot ended behind a camera)";
+  } else if (internal::CovarianceFromJacobian(reduced, internal::GlobalNames(columns, data.robot.num_joints()),
+                                              &covariance, &report->covariance_message)) {
+    const double s2 = 2.0 * final_cost / dof;
+    report->covariance_free = s2 * covariance;
+    report->covariance_available = true;
+    const Eigen::VectorXd sd = report->covariance_free.diagonal().array().sqrt();
+    report->correlation_free = report->covariance_free;
+    for (int i = 0; i < sd.size(); ++i) {
+      for (int j = 0; j < sd.size(); ++j) {
+        report->correlation_free(i, j) =
+            sd[i] > 0 && sd[j] > 0 ? report->covariance_free(i, j) / (sd[i] * sd[j]) : 0.0;
+      }
+    }
+    const int nk = static_cast<int>(columns.kinematic.size());
+    for (int k = 0; k < nk; ++k) report->stddev[columns.kinematic[k]] = sd[k];
+    if (columns.fx) report->fx_stddev = sd[nk];
+    if (columns.k1) report->k1_stddev = sd[nk + (columns.fx ? 1 : 0)];
+  }
+}
+
 }  // namespace
 
 BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen::VectorXd& rho_start,
@@ -246,17 +457,8 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
     return report;
   };
 
-  std::ostringstream problems;
-  problems << options.Validate() << observations.Validate();
-  if (rho_start.size() != observations.robot.num_parameters()) {
-    problems << "rho_start has " << rho_start.size() << " entries, the robot needs "
-             << observations.robot.num_parameters() << "\n";
-  } else if (!rho_start.allFinite()) {
-    problems << "rho_start is not finite\n";
-  }
-  if (!std::isfinite(fx_start) || fx_start <= 0) problems << "fx_start = " << fx_start << " must be finite and > 0\n";
-  if (!problems.str().empty()) return finish(Outcome::kInvalidInput, "invalid input:\n" + problems.str());
-
+  const std::string problems = CheckInputs(observations, rho_start, fx_start, options);
+  if (!problems.empty()) return finish(Outcome::kInvalidInput, "invalid input:\n" + problems);
   const int num_poses = static_cast<int>(observations.PosesWithRole(PoseRole::kIdentification).size());
   if (num_poses < options.min_identification_poses) {
     return finish(Outcome::kDegenerate, "only " + std::to_string(num_poses) + " identification poses (need " +
@@ -266,147 +468,29 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
     return finish(Outcome::kScaleUnresolved, "no yardstick: the metric scale is unobservable from images alone");
   }
   BundleData data = internal::MakeBundleData(observations, options.yardstick_sigma_m);
-  {
-    std::map<int, int> views;
-    for (int p : observations.PosesWithRole(PoseRole::kIdentification)) {
-      for (const auto& entry : observations.poses[p].dots_px) ++views[entry.first];
-    }
-    for (const auto& [dot, count] : views) {
-      if (count < 2) report.dropped_dots.push_back(dot);
-    }
-  }
+  report.dropped_dots = DotsSeenOnce(observations);
   BundleState state;
   state.rho = rho_start;
   state.fx_px = fx_start;
   state.k1 = observations.camera.k1;
-
-  // Dots from the start model; a dot that cannot be triangulated there (behind a camera, no parallax)
-  // is dropped and named.
-  {
-    std::vector<Rigid3> base_from_cam;
-    for (const Eigen::VectorXd& q : data.joints) base_from_cam.push_back(BaseFromCam(data.robot, rho_start, q));
-    std::vector<identification::PointTrack> tracks(data.dot_ids.size());
-    for (const internal::Observation& o : data.observations) {
-      tracks[o.dot].base_from_cam.push_back(base_from_cam[o.pose]);
-      tracks[o.dot].pixels.push_back(o.pixel);
-    }
-    state.dots.resize(data.dot_ids.size());
-    std::vector<bool> ok(data.dot_ids.size());
-    for (size_t d = 0; d < tracks.size(); ++d) {
-      const identification::TriangulationResult t =
-          identification::TriangulatePoint(data.camera, fx_start, tracks[d], data.sigma_px);
-      ok[d] = t.ok && t.point.allFinite();
-      state.dots[d] = t.point;
-      if (!ok[d]) report.dropped_dots.push_back(data.dot_ids[d]);
-    }
-    std::vector<bool> keep(data.observations.size());
-    for (size_t k = 0; k < keep.size(); ++k) keep[k] = ok[data.observations[k].dot];
-    const BundleData all = data;
-    const BundleState all_state = state;
-    std::vector<int> dot_map;
-    Subset(all, all_state, keep, &data, &state, &dot_map);
-  }
+  TriangulateStartDots(rho_start, fx_start, &data, &state, &report.dropped_dots);
   if (data.yardsticks.empty()) {
     return finish(Outcome::kScaleUnresolved,
                   "no yardstick has both ends seen (and triangulable) in two or more identification poses (S1)");
   }
 
-  // K1: the gauge and the free set, from the rank of this problem's reduced Jacobian.
-  // Evaluated at the nominal model, where nominally parallel axes are exactly parallel: at a perturbed
-  // start the d offsets of a parallel pair look independent (rank is a tolerance game there) and would
-  // run off to tens of metres (K2).
   internal::Gauge gauge;
-  {
-    BundleState nominal = state;
-    nominal.rho = KinematicParameters::Nominal(data.robot);
-    if (!internal::AnalyzeGauge(data, nominal, options.estimate_fx, options.estimate_k1, options.rank_tolerance,
-                                &gauge) &&
-        !internal::AnalyzeGauge(data, state, options.estimate_fx, options.estimate_k1, options.rank_tolerance, &gauge)) {
-      return finish(Outcome::kFailure, "the start model puts a triangulated dot behind a camera (K5)");
-    }
+  if (!AnalyzeStartGauge(data, state, options, &gauge, &report)) {
+    return finish(Outcome::kFailure, "the start model puts a triangulated dot behind a camera (K5)");
   }
-  report.free_indices = gauge.free_kinematic;
-  report.free_names = gauge.free_names;
-  report.fixed_names = gauge.fixed_names;
-  report.null_combinations = gauge.null_combinations;
-  report.condition_number = gauge.condition_number;
-  report.generic_rank = identification::GenericRank(data.robot, KinematicParameters::Nominal(data.robot), options.rank_tolerance);
-  if (options.estimate_fx && !gauge.fx_identifiable) {
-    return finish(Outcome::kDegenerate, "f_x is not identifiable from these poses (null directions: " +
-                                            Join(gauge.null_combinations) + ")");
-  }
-  if (options.estimate_k1 && !gauge.k1_identifiable) {
-    return finish(Outcome::kDegenerate, "k1 is not identifiable from these poses");
-  }
-  if (gauge.free_kinematic.empty() ||
-      (options.require_generic_rank && static_cast<int>(gauge.free_kinematic.size()) < report.generic_rank)) {
-    std::ostringstream msg;
-    msg << "insufficient excitation (K3): these " << num_poses << " identification poses identify "
-        << gauge.free_kinematic.size() << " kinematic parameters, generic poses of this robot "
-        << report.generic_rank << "; fixed here: " << Join(gauge.fixed_names);
-    return finish(Outcome::kDegenerate, msg.str());
-  }
+  const std::string not_identifiable = WhyNotIdentifiable(gauge, options, num_poses, report.generic_rank);
+  if (!not_identifiable.empty()) return finish(Outcome::kDegenerate, not_identifiable);
 
-  // Robust solve, screen, refit (K7). Every round judges every observation against the current
-  // solution, so one wrongly removed early (while outliers still pulled the fit) comes back.
-  const BundleData full = data;
-  BundleState full_state = state;
-  std::vector<bool> keep(full.observations.size(), true);
-  std::vector<int> dot_map;
-  auto write_back = [&]() {
-    full_state.rho = state.rho;
-    full_state.fx_px = state.fx_px;
-    full_state.k1 = state.k1;
-    for (size_t c = 0; c < dot_map.size(); ++c) full_state.dots[dot_map[c]] = state.dots[c];
-  };
-  ceres::Solver::Summary summary;
-  for (int round = 0;; ++round) {
-    Subset(full, full_state, keep, &data, &state, &dot_map);
-    if (data.yardsticks.empty()) {
-      return finish(Outcome::kScaleUnresolved, "the residual screen removed the yardstick's views (S1)");
-    }
-    summary = Solve(data, gauge.free_kinematic, options, true, &state);
-    if (round == 0) report.initial_cost = summary.initial_cost;
-    report.iterations += static_cast<int>(summary.iterations.size()) - 1;
-    if (summary.termination_type == ceres::FAILURE || summary.termination_type == ceres::USER_FAILURE) break;
-    write_back();
-    if (round == options.max_screen_rounds) break;
-    const std::vector<double> errors = ReprojectionErrors(full, full_state);
-    std::vector<double> sorted;
-    for (double e : errors) {
-      if (std::isfinite(e)) sorted.push_back(e);
-    }
-    std::sort(sorted.begin(), sorted.end());
-    // Median of a 2-D Gaussian's norm: sigma sqrt(2 ln 2).
-    const double robust_sigma = sorted.empty() ? 0.0 : sorted[sorted.size() / 2] / std::sqrt(2.0 * std::log(2.0));
-    const double threshold = options.screen_sigma * std::max(data.sigma_px, robust_sigma);
-    std::vector<bool> next(errors.size());
-    for (size_t k = 0; k < errors.size(); ++k) next[k] = errors[k] <= threshold;  // NaN is removed too
-    if (next == keep) break;
-    keep = std::move(next);
+  const ScreenedFit fit = SolveScreened(gauge.free_kinematic, options, &data, &state, &report);
+  if (fit.scale_lost) {
+    return finish(Outcome::kScaleUnresolved, "the residual screen removed the yardstick's views (S1)");
   }
-  // The final fit is plain least squares unless the Huber loss was inactive at the robust solution.
-  if (summary.termination_type == ceres::CONVERGENCE || summary.termination_type == ceres::NO_CONVERGENCE) {
-    const std::vector<double> errors = ReprojectionErrors(data, state);
-    if (!errors.empty() && *std::max_element(errors.begin(), errors.end()) > options.huber_px) {
-      summary = Solve(data, gauge.free_kinematic, options, false, &state);
-      report.iterations += static_cast<int>(summary.iterations.size()) - 1;
-      write_back();
-    }
-  }
-  {
-    const std::vector<double> errors = ReprojectionErrors(full, full_state);
-    for (size_t k = 0; k < keep.size(); ++k) {
-      if (keep[k]) continue;
-      const internal::Observation& o = full.observations[k];
-      report.removed.push_back({full.pose_ids[o.pose], full.dot_ids[o.dot], errors[k]});
-    }
-    std::vector<bool> in_solve(full.dot_ids.size(), false);
-    for (int d : dot_map) in_solve[d] = true;
-    for (size_t d = 0; d < full.dot_ids.size(); ++d) {
-      if (!in_solve[d]) report.dropped_dots.push_back(full.dot_ids[d]);
-    }
-  }
+  const ceres::Solver::Summary& summary = fit.summary;
   report.final_cost = summary.final_cost;
   report.termination = std::string(ceres::TerminationTypeToString(summary.termination_type)) + ": " + summary.message;
   if (summary.termination_type != ceres::CONVERGENCE && summary.termination_type != ceres::NO_CONVERGENCE) {
@@ -422,36 +506,7 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
     for (double e : ReprojectionErrors(data, state)) sum2 += e * e;
     report.rms_reprojection_px = report.num_observations > 0 ? std::sqrt(sum2 / report.num_observations) : 0.0;
   }
-
-  // Covariance of the free globals, dots as nuisance (K8).
-  internal::GlobalColumns columns;
-  columns.kinematic = gauge.free_kinematic;
-  columns.fx = options.estimate_fx;
-  columns.k1 = options.estimate_k1;
-  const int num_unknowns = columns.size() + 3 * static_cast<int>(data.dot_ids.size());
-  const int dof = 2 * report.num_observations + static_cast<int>(data.yardsticks.size()) - num_unknowns;
-  Eigen::MatrixXd reduced, covariance;
-  if (dof <= 0) {
-    report.covariance_message = "uncertainty unavailable (no redundancy)";
-  } else if (!internal::ReducedJacobian(data, state, columns, &reduced)) {
-    report.covariance_message = "uncertainty unavailable (a dot ended behind a camera)";
-  } else if (internal::CovarianceFromJacobian(reduced, internal::GlobalNames(columns, data.robot.num_joints()),
-                                              &covariance, &report.covariance_message)) {
-    const double s2 = 2.0 * summary.final_cost / dof;
-    report.covariance_free = s2 * covariance;
-    report.covariance_available = true;
-    const Eigen::VectorXd sd = report.covariance_free.diagonal().array().sqrt();
-    report.correlation_free = report.covariance_free;
-    for (int i = 0; i < sd.size(); ++i) {
-      for (int j = 0; j < sd.size(); ++j) {
-        report.correlation_free(i, j) = sd[i] > 0 && sd[j] > 0 ? report.covariance_free(i, j) / (sd[i] * sd[j]) : 0.0;
-      }
-    }
-    const int nk = static_cast<int>(columns.kinematic.size());
-    for (int k = 0; k < nk; ++k) report.stddev[columns.kinematic[k]] = sd[k];
-    if (columns.fx) report.fx_stddev = sd[nk];
-    if (columns.k1) report.k1_stddev = sd[nk + (columns.fx ? 1 : 0)];
-  }
+  EstimateCovariance(data, state, gauge.free_kinematic, options, summary.final_cost, &report);
 
   std::ostringstream msg;
   msg << (summary.termination_type == ceres::CONVERGENCE ? "converged" : "not converged") << ": "

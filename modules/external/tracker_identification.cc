@@ -306,6 +306,120 @@ ErrorStats RelativePoseErrors(const RobotModel& model, const Eigen::VectorXd& rh
   return Summarise(position, rotation);
 }
 
+namespace {
+
+// Most common value per joint: the configuration every sweep starts from.
+Eigen::VectorXd MostCommonJoints(const std::vector<Eigen::VectorXd>& q, int n) {
+  Eigen::VectorXd q_ref(n);
+  for (int j = 0; j < n; ++j) {
+    std::map<double, int> counts;
+    for (const auto& qi : q) ++counts[qi[j]];
+    q_ref[j] = std::max_element(counts.begin(), counts.end(), [](const auto& l, const auto& r) {
+                 return l.second < r.second;
+               })->first;
+  }
+  return q_ref;
+}
+
+// Identification and holdout rows (every holdout_every-th from row 1), and the reference: the
+// identification row closest to q_ref (modulo 2 pi).
+void SplitRows(const std::vector<Eigen::VectorXd>& q, int holdout_every, TrackerIdentificationReport* report) {
+  const int num_rows = static_cast<int>(q.size());
+  const int n = static_cast<int>(report->q_ref.size());
+  for (int i = 0; i < num_rows; ++i) {
+    const bool held = holdout_every >= 2 && i % holdout_every == 1;
+    (held ? report->holdout_rows : report->identification_rows).push_back(i);
+  }
+  double best = 1e300;
+  for (int i : report->identification_rows) {
+    double dist = 0;
+    for (int j = 0; j < n; ++j) dist += std::abs(WrapAngle(q[i][j] - report->q_ref[j]));
+    if (dist < best - 1e-12) {
+      best = dist;
+      report->reference_row = i;
+    }
+  }
+}
+
+// Rows at q_ref (modulo 2 pi, e.g. J4 = +-360 deg): the same pose measured again; their count and the
+// largest distance between their nest positions (m).
+void MeasureRepeats(const std::vector<Eigen::VectorXd>& q, const std::vector<Rigid3>& tracker_from_nest,
+                    TrackerIdentificationReport* report) {
+  const int num_rows = static_cast<int>(q.size());
+  const int n = static_cast<int>(report->q_ref.size());
+  std::vector<int> repeats;
+  for (int i = 0; i < num_rows; ++i) {
+    bool same = true;
+    for (int j = 0; j < n; ++j) same = same && std::abs(WrapAngle(q[i][j] - report->q_ref[j])) < 1e-9;
+    if (same) repeats.push_back(i);
+  }
+  report->repeat_rows = static_cast<int>(repeats.size());
+  for (size_t a = 0; a < repeats.size(); ++a) {
+    for (size_t b = a + 1; b < repeats.size(); ++b) {
+      report->repeat_max_m = std::max(
+          report->repeat_max_m, (tracker_from_nest[repeats[a]].translation - tracker_from_nest[repeats[b]].translation).norm());
+    }
+  }
+}
+
+// Axis fits from the identification rows only: for joint j, the rows where every other joint is at
+// q_ref. False, with the reason in *why, when a joint's sweep does not determine its axis.
+bool FitAxes(const std::vector<SmrTriple>& points, const std::vector<Rigid3>& tracker_from_nest,
+             const std::vector<Eigen::VectorXd>& q, TrackerIdentificationReport* report, std::string* why) {
+  const int n = static_cast<int>(report->q_ref.size());
+  for (int j = 0; j < n; ++j) {
+    AxisFit fit;
+    fit.joint = j + 1;
+    std::vector<SmrTriple> sweep_points;
+    std::vector<Rigid3> sweep_poses;
+    std::vector<double> sweep_q;
+    for (int i : report->identification_rows) {
+      bool others_at_ref = true;
+      for (int k = 0; k < n; ++k) others_at_ref = others_at_ref && (k == j || q[i][k] == report->q_ref[k]);
+      if (!others_at_ref) continue;
+      fit.rows.push_back(i);
+      sweep_points.push_back(points[i]);
+      sweep_poses.push_back(tracker_from_nest[i]);
+      sweep_q.push_back(q[i][j]);
+    }
+    if (!FitJointAxis(sweep_points, sweep_poses, sweep_q, &fit, why)) return false;
+    report->axes.push_back(fit);
+  }
+  return true;
+}
+
+// Identification over the identifiable set, from the identification rows' nest poses relative to the
+// reference row's.
+void IdentifyFromRows(const std::vector<Eigen::VectorXd>& q, const std::vector<Rigid3>& tracker_from_nest,
+                      const TrackerIdentificationOptions& options, TrackerIdentificationReport* report) {
+  std::vector<Eigen::VectorXd> id_q;
+  int id_reference = -1;
+  std::vector<identification::RelativePoseMeasurement> measurements;
+  const Rigid3 nest_ref_from_tracker = tracker_from_nest[report->reference_row].Inverse();
+  for (int i : report->identification_rows) {
+    if (i == report->reference_row) id_reference = static_cast<int>(id_q.size());
+    else {
+      identification::RelativePoseMeasurement m;
+      m.pose_index = static_cast<int>(id_q.size());
+      m.cam_ref_from_cam_i = nest_ref_from_tracker * tracker_from_nest[i];
+      measurements.push_back(m);
+    }
+    id_q.push_back(q[i]);
+  }
+  identification::IdentifiabilityOptions id_options;
+  id_options.scale_known = true;
+  id_options.sigma_position_m = options.identification.sigma_position_m;
+  id_options.sigma_rotation_rad = options.identification.sigma_rotation_rad;
+  report->identifiability =
+      identification::AnalyzeIdentifiability(report->nominal, report->rho_nominal, id_q, id_reference, id_options);
+  report->identification = identification::IdentifyFromRelativePoses(
+      report->nominal, report->rho_nominal, report->identifiability.free_indices, id_q, id_reference, measurements,
+      options.identification);
+  report->rho_identified = report->identification.rho;
+}
+
+}  // namespace
+
 TrackerIdentificationReport RunTrackerIdentification(const std::vector<SmrTriple>& points,
                                                      const std::vector<Eigen::VectorXd>& controller_joints,
                                                      const TrackerIdentificationOptions& options) {
@@ -333,102 +447,23 @@ TrackerIdentificationReport RunTrackerIdentification(const std::vector<SmrTriple
     tracker_from_nest.push_back(FrameFromThreePoints(points[i][0], points[i][1], points[i][2]));
     q.push_back(ModelJointsFromController(controller_joints[i], options.j3_coupling));
   }
+  report.q_ref = MostCommonJoints(q, n);
+  SplitRows(q, options.holdout_every, &report);
+  MeasureRepeats(q, tracker_from_nest, &report);
 
-  // Most common value per joint: the configuration every sweep starts from.
-  report.q_ref.resize(n);
-  for (int j = 0; j < n; ++j) {
-    std::map<double, int> counts;
-    for (const auto& qi : q) ++counts[qi[j]];
-    report.q_ref[j] = std::max_element(counts.begin(), counts.end(), [](const auto& l, const auto& r) {
-                        return l.second < r.second;
-                      })->first;
-  }
-
-  for (int i = 0; i < num_rows; ++i) {
-    const bool held = options.holdout_every >= 2 && i % options.holdout_every == 1;
-    (held ? report.holdout_rows : report.identification_rows).push_back(i);
-  }
-  // Reference: the identification row closest to q_ref (modulo 2 pi).
-  double best = 1e300;
-  for (int i : report.identification_rows) {
-    double dist = 0;
-    for (int j = 0; j < n; ++j) dist += std::abs(WrapAngle(q[i][j] - report.q_ref[j]));
-    if (dist < best - 1e-12) {
-      best = dist;
-      report.reference_row = i;
-    }
-  }
-
-  // Rows at q_ref (modulo 2 pi, e.g. J4 = +-360 deg): the same pose measured again.
-  std::vector<int> repeats;
-  for (int i = 0; i < num_rows; ++i) {
-    bool same = true;
-    for (int j = 0; j < n; ++j) same = same && std::abs(WrapAngle(q[i][j] - report.q_ref[j])) < 1e-9;
-    if (same) repeats.push_back(i);
-  }
-  report.repeat_rows = static_cast<int>(repeats.size());
-  for (size_t a = 0; a < repeats.size(); ++a) {
-    for (size_t b = a + 1; b < repeats.size(); ++b) {
-      report.repeat_max_m = std::max(
-          report.repeat_max_m, (tracker_from_nest[repeats[a]].translation - tracker_from_nest[repeats[b]].translation).norm());
-    }
-  }
-
-  // Axis fits from the identification rows only.
+  std::string why;
+  if (!FitAxes(points, tracker_from_nest, q, &report, &why)) return fail(Outcome::kDegenerate, why);
   std::vector<Eigen::Vector3d> directions, axis_points;
-  for (int j = 0; j < n; ++j) {
-    AxisFit fit;
-    fit.joint = j + 1;
-    std::vector<SmrTriple> sweep_points;
-    std::vector<Rigid3> sweep_poses;
-    std::vector<double> sweep_q;
-    for (int i : report.identification_rows) {
-      bool others_at_ref = true;
-      for (int k = 0; k < n; ++k) others_at_ref = others_at_ref && (k == j || q[i][k] == report.q_ref[k]);
-      if (!others_at_ref) continue;
-      fit.rows.push_back(i);
-      sweep_points.push_back(points[i]);
-      sweep_poses.push_back(tracker_from_nest[i]);
-      sweep_q.push_back(q[i][j]);
-    }
-    std::string why;
-    if (!FitJointAxis(sweep_points, sweep_poses, sweep_q, &fit, &why)) return fail(Outcome::kDegenerate, why);
+  for (const AxisFit& fit : report.axes) {
     directions.push_back(fit.direction);
     axis_points.push_back(fit.point);
-    report.axes.push_back(fit);
   }
-
   report.nominal = ModelFromAxisLines("axis-fit", directions, axis_points, report.q_ref, options.parallel_tol_rad);
   const Eigen::VectorXd rho0 = KinematicParameters::Nominal(report.nominal);
   report.nominal.flange_from_cam =
       BaseFromFlange(report.nominal, rho0, q[report.reference_row]).Inverse() * tracker_from_nest[report.reference_row];
   report.rho_nominal = KinematicParameters::Nominal(report.nominal);
-
-  // Identification over the identifiable set.
-  std::vector<Eigen::VectorXd> id_q;
-  int id_reference = -1;
-  std::vector<identification::RelativePoseMeasurement> measurements;
-  const Rigid3 nest_ref_from_tracker = tracker_from_nest[report.reference_row].Inverse();
-  for (int i : report.identification_rows) {
-    if (i == report.reference_row) id_reference = static_cast<int>(id_q.size());
-    else {
-      identification::RelativePoseMeasurement m;
-      m.pose_index = static_cast<int>(id_q.size());
-      m.cam_ref_from_cam_i = nest_ref_from_tracker * tracker_from_nest[i];
-      measurements.push_back(m);
-    }
-    id_q.push_back(q[i]);
-  }
-  identification::IdentifiabilityOptions id_options;
-  id_options.scale_known = true;
-  id_options.sigma_position_m = options.identification.sigma_position_m;
-  id_options.sigma_rotation_rad = options.identification.sigma_rotation_rad;
-  report.identifiability =
-      identification::AnalyzeIdentifiability(report.nominal, report.rho_nominal, id_q, id_reference, id_options);
-  report.identification = identification::IdentifyFromRelativePoses(
-      report.nominal, report.rho_nominal, report.identifiability.free_indices, id_q, id_reference, measurements,
-      options.identification);
-  report.rho_identified = report.identification.rho;
+  IdentifyFromRows(q, tracker_from_nest, options, &report);
 
   report.insample_before = RelativePoseErrors(report.nominal, report.rho_nominal, q, tracker_from_nest,
                                               report.reference_row, report.identification_rows);

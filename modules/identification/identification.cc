@@ -229,6 +229,182 @@ std::string CheckInputs(const RobotModel& model, const Eigen::VectorXd& rho_star
   return out.str();
 }
 
+// The residual blocks, one per measurement; *num_residuals is their total. Owned by the ceres::Problem
+// once added; the raw pointers stay valid as long as it lives.
+std::vector<std::unique_ptr<RelativePoseCost>> MakeCosts(std::shared_ptr<const SharedInputs> shared,
+                                                         const std::vector<Eigen::VectorXd>& joint_poses,
+                                                         const std::vector<RelativePoseMeasurement>& measurements,
+                                                         int* num_residuals) {
+  std::vector<std::unique_ptr<RelativePoseCost>> costs;
+  *num_residuals = 0;
+  for (const RelativePoseMeasurement& m : measurements) {
+    costs.push_back(std::make_unique<RelativePoseCost>(shared, joint_poses[m.pose_index], m.cam_ref_from_cam_i,
+                                                       m.translation_valid));
+    *num_residuals += costs.back()->num_residuals();
+  }
+  return costs;
+}
+
+// K5: every block must give finite residuals and derivatives at the start, before Ceres sees it. The
+// blocks that do not, named; empty when all do.
+std::string NonFiniteBlocks(const std::vector<std::unique_ptr<RelativePoseCost>>& costs,
+                            const std::vector<RelativePoseMeasurement>& measurements, const Eigen::VectorXd& rho,
+                            int num_parameters) {
+  std::vector<double> residuals(6), jac(6 * num_parameters);
+  const double* parameters[1] = {rho.data()};
+  double* jacobians[1] = {jac.data()};
+  std::ostringstream bad;
+  int num_bad = 0;
+  for (size_t k = 0; k < costs.size(); ++k) {
+    if (!costs[k]->Evaluate(parameters, residuals.data(), jacobians)) {
+      bad << (num_bad++ ? ", " : "") << "measurement " << k << " (pose " << measurements[k].pose_index << ")";
+    }
+  }
+  return bad.str();
+}
+
+// Levenberg-Marquardt on rho in place, the entries outside `free` held by a SubsetManifold. Hands the
+// blocks to `problem`; `blocks` keeps non-owning pointers to them, valid as long as the problem lives.
+ceres::Solver::Summary Solve(std::vector<std::unique_ptr<RelativePoseCost>> costs, const std::vector<int>& free,
+                             const IdentificationOptions& options, Eigen::VectorXd* rho, ceres::Problem* problem_ptr,
+                             std::vector<const RelativePoseCost*>* blocks) {
+  const int n = static_cast<int>(rho->size());
+  ceres::Problem& problem = *problem_ptr;
+  for (auto& cost : costs) {
+    blocks->push_back(cost.get());
+    problem.AddResidualBlock(cost.release(), nullptr, rho->data());
+  }
+  std::vector<int> constant;
+  {
+    std::vector<bool> is_free(n, false);
+    for (int i : free) is_free[i] = true;
+    for (int i = 0; i < n; ++i) {
+      if (!is_free[i]) constant.push_back(i);
+    }
+  }
+  if (!constant.empty()) problem.SetManifold(rho->data(), new ceres::SubsetManifold(n, constant));
+
+  ceres::Solver::Options solver_options;
+  solver_options.minimizer_type = ceres::TRUST_REGION;
+  solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.num_threads = 1;
+  solver_options.logging_type = ceres::SILENT;
+  solver_options.minimizer_progress_to_stdout = false;
+  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.function_tolerance = options.function_tolerance;
+  solver_options.gradient_tolerance = options.gradient_tolerance;
+  solver_options.parameter_tolerance = options.parameter_tolerance;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+  return summary;
+}
+
+// The whitened Jacobian of the free parameters at rho (rows in block order) and the RMS errors.
+struct SolutionResiduals {
+  Eigen::MatrixXd jacobian;
+  double rms_rotation_rad = 0, rms_position_m = 0;  // over measurements, of the error norms
+};
+
+SolutionResiduals EvaluateSolution(const std::vector<const RelativePoseCost*>& blocks, const Eigen::VectorXd& rho,
+                                   const std::vector<int>& free, int num_residuals,
+                                   const IdentificationOptions& options) {
+  const int n = static_cast<int>(rho.size());
+  const int num_free = static_cast<int>(free.size());
+  SolutionResiduals out;
+  out.jacobian = Eigen::MatrixXd::Zero(num_residuals, num_free);
+  double sum_sq_position = 0, sum_sq_rotation = 0;
+  int num_position = 0;
+  std::vector<double> residuals(6), jac(6 * n);
+  const double* parameters[1] = {rho.data()};
+  double* jacobians[1] = {jac.data()};
+  int row = 0;
+  for (const RelativePoseCost* cost : blocks) {
+    const int m = cost->num_residuals();
+    cost->Evaluate(parameters, residuals.data(), jacobians);
+    for (int r = 0; r < m; ++r) {
+      for (int k = 0; k < num_free; ++k) out.jacobian(row + r, k) = jac[r * n + free[k]];
+    }
+    const Eigen::Map<const Eigen::Vector3d> rot(residuals.data());
+    sum_sq_rotation += rot.squaredNorm() * options.sigma_rotation_rad * options.sigma_rotation_rad;
+    if (m == 6) {
+      const Eigen::Map<const Eigen::Vector3d> pos(residuals.data() + 3);
+      sum_sq_position += pos.squaredNorm() * options.sigma_position_m * options.sigma_position_m;
+      ++num_position;
+    }
+    row += m;
+  }
+  out.rms_rotation_rad = std::sqrt(sum_sq_rotation / static_cast<double>(blocks.size()));
+  out.rms_position_m = num_position > 0 ? std::sqrt(sum_sq_position / num_position) : 0.0;
+  return out;
+}
+
+// Names of the free parameters involved in a null direction of the column-normalised Jacobian.
+std::vector<std::string> DeficientNames(const Eigen::JacobiSVD<Eigen::MatrixXd>& svd, int num_residuals,
+                                        const std::vector<int>& free, const KinematicParameters& params) {
+  const int num_free = static_cast<int>(free.size());
+  const Eigen::VectorXd sv = svd.singularValues();
+  const double sigma_max = sv.size() > 0 ? sv[0] : 0.0;
+  std::vector<std::string> deficient;
+  const int rank_limit = std::min(num_residuals, num_free);
+  std::vector<bool> involved(num_free, false);
+  for (int k = 0; k < num_free; ++k) {
+    const bool is_null = k >= rank_limit || !(sv[k] > kCovarianceRankTolerance * sigma_max);
+    if (!is_null) continue;
+    for (int j = 0; j < num_free; ++j) involved[j] = involved[j] || std::abs(svd.matrixV()(j, k)) > 0.05;
+  }
+  for (int j = 0; j < num_free; ++j) {
+    if (involved[j]) deficient.push_back(params.name(free[j]));
+  }
+  return deficient;
+}
+
+// Covariance s^2 (J^T J)^-1 through the SVD of the column-normalised J (K8: never garbage sigmas), with
+// the standard deviations and correlations from it; or the reason it is unavailable.
+void EstimateCovariance(const Eigen::MatrixXd& jacobian, const std::vector<int>& free,
+                        const KinematicParameters& params, double final_cost, IdentificationReport* report) {
+  const int num_residuals = static_cast<int>(jacobian.rows());
+  const int num_free = static_cast<int>(free.size());
+  const int dof = num_residuals - num_free;
+  const Eigen::VectorXd norms = jacobian.colwise().norm().transpose();
+  const double max_norm = norms.size() > 0 ? norms.maxCoeff() : 0.0;
+  Eigen::MatrixXd normalized = Eigen::MatrixXd::Zero(num_residuals, num_free);
+  // A column below the tolerance is round-off (a parameter the data cannot see): it stays zero so that
+  // it shows as a null direction instead of a unit-norm noise pattern.
+  for (int k = 0; k < num_free; ++k) {
+    if (max_norm > 0 && norms[k] > kCovarianceRankTolerance * max_norm) normalized.col(k) = jacobian.col(k) / norms[k];
+  }
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(normalized, Eigen::ComputeFullV);
+  const Eigen::VectorXd sv = svd.singularValues();
+  const std::vector<std::string> deficient = DeficientNames(svd, num_residuals, free, params);
+  if (!deficient.empty()) {
+    report->covariance_message = "uncertainty unavailable (rank deficient: " + JoinNames(deficient) + ")";
+    return;
+  }
+  if (dof <= 0) {
+    report->covariance_message = "uncertainty unavailable (no redundancy: " + std::to_string(num_residuals) +
+                                 " residuals for " + std::to_string(num_free) + " free parameters)";
+    return;
+  }
+  const double s2 = 2.0 * final_cost / dof;
+  const Eigen::MatrixXd v = svd.matrixV();
+  const Eigen::VectorXd inv_sv2 = sv.head(num_free).array().square().inverse();
+  const Eigen::MatrixXd normalized_cov = v * inv_sv2.asDiagonal() * v.transpose();
+  const Eigen::VectorXd inv_norms = norms.array().inverse();
+  report->covariance_free = s2 * (inv_norms.asDiagonal() * normalized_cov * inv_norms.asDiagonal());
+  report->covariance_available = true;
+  report->covariance_message = "ok";
+  const Eigen::VectorXd sd = report->covariance_free.diagonal().array().sqrt();
+  report->correlation_free = report->covariance_free;
+  for (int i = 0; i < num_free; ++i) {
+    report->stddev[free[i]] = sd[i];
+    for (int j = 0; j < num_free; ++j) {
+      report->correlation_free(i, j) =
+          sd[i] > 0 && sd[j] > 0 ? report->covariance_free(i, j) / (sd[i] * sd[j]) : 0.0;
+    }
+  }
+}
+
 }  // namespace
 
 std::string IdentificationOptions::Validate() const {
@@ -283,7 +459,6 @@ IdentificationReport IdentifyFromRelativePoses(const RobotModel& model, const Ei
   std::vector<int> free = free_indices;
   std::sort(free.begin(), free.end());
   report.free_indices = free;
-  const int num_free = static_cast<int>(free.size());
   const KinematicParameters params(model.num_joints());
 
   auto shared = std::make_shared<SharedInputs>();
@@ -292,15 +467,8 @@ IdentificationReport IdentifyFromRelativePoses(const RobotModel& model, const Ei
   shared->q_ref = joint_poses[reference_index];
   shared->inv_sigma_position = 1.0 / options.sigma_position_m;
   shared->inv_sigma_rotation = 1.0 / options.sigma_rotation_rad;
-
-  // Owned by the ceres::Problem once added; the raw pointers stay valid as long as it lives.
-  std::vector<std::unique_ptr<RelativePoseCost>> costs;
   int num_residuals = 0;
-  for (const RelativePoseMeasurement& m : measurements) {
-    costs.push_back(std::make_unique<RelativePoseCost>(shared, joint_poses[m.pose_index], m.cam_ref_from_cam_i,
-                                                       m.translation_valid));
-    num_residuals += costs.back()->num_residuals();
-  }
+  std::vector<std::unique_ptr<RelativePoseCost>> costs = MakeCosts(shared, joint_poses, measurements, &num_residuals);
 
   if (!rho_start.allFinite()) {
     std::vector<std::string> names;
@@ -311,57 +479,18 @@ IdentificationReport IdentifyFromRelativePoses(const RobotModel& model, const Ei
     report.message = "non-finite start parameters (K5): " + JoinNames(names);
     return report;
   }
-  // K5: every block must give finite residuals and derivatives at the start, before Ceres sees it.
-  {
-    std::vector<double> residuals(6), jac(6 * n);
-    const double* parameters[1] = {rho_start.data()};
-    double* jacobians[1] = {jac.data()};
-    std::ostringstream bad;
-    int num_bad = 0;
-    for (size_t k = 0; k < costs.size(); ++k) {
-      if (!costs[k]->Evaluate(parameters, residuals.data(), jacobians)) {
-        bad << (num_bad++ ? ", " : "") << "measurement " << k << " (pose " << measurements[k].pose_index << ")";
-      }
-    }
-    if (num_bad > 0) {
-      report.outcome = Outcome::kFailure;
-      report.message = "non-finite residual or Jacobian at the start (K5): " + bad.str();
-      return report;
-    }
+  const std::string bad = NonFiniteBlocks(costs, measurements, rho_start, n);
+  if (!bad.empty()) {
+    report.outcome = Outcome::kFailure;
+    report.message = "non-finite residual or Jacobian at the start (K5): " + bad;
+    return report;
   }
 
   Eigen::VectorXd rho = rho_start;
   ceres::Problem::Options problem_options;
   ceres::Problem problem(problem_options);
   std::vector<const RelativePoseCost*> blocks;
-  for (auto& cost : costs) {
-    blocks.push_back(cost.get());
-    problem.AddResidualBlock(cost.release(), nullptr, rho.data());
-  }
-  std::vector<int> constant;
-  {
-    std::vector<bool> is_free(n, false);
-    for (int i : free) is_free[i] = true;
-    for (int i = 0; i < n; ++i) {
-      if (!is_free[i]) constant.push_back(i);
-    }
-  }
-  if (!constant.empty()) problem.SetManifold(rho.data(), new ceres::SubsetManifold(n, constant));
-
-  ceres::Solver::Options solver_options;
-  solver_options.minimizer_type = ceres::TRUST_REGION;
-  solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
-  solver_options.num_threads = 1;
-  solver_options.logging_type = ceres::SILENT;
-  solver_options.minimizer_progress_to_stdout = false;
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.function_tolerance = options.function_tolerance;
-  solver_options.gradient_tolerance = options.gradient_tolerance;
-  solver_options.parameter_tolerance = options.parameter_tolerance;
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, &problem, &summary);
-
+  const ceres::Solver::Summary summary = Solve(std::move(costs), free, options, &rho, &problem, &blocks);
   report.initial_cost = summary.initial_cost;
   report.final_cost = summary.final_cost;
   report.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
@@ -384,86 +513,10 @@ IdentificationReport IdentifyFromRelativePoses(const RobotModel& model, const Ei
   report.rho = rho;
   report.message = report.outcome == Outcome::kConverged ? "converged" : "not converged: " + report.termination;
 
-  // Jacobian of the free parameters and the residuals at the solution.
-  Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(num_residuals, num_free);
-  double sum_sq_position = 0, sum_sq_rotation = 0;
-  int num_position = 0;
-  {
-    std::vector<double> residuals(6), jac(6 * n);
-    const double* parameters[1] = {rho.data()};
-    double* jacobians[1] = {jac.data()};
-    int row = 0;
-    for (const RelativePoseCost* cost : blocks) {
-      const int m = cost->num_residuals();
-      cost->Evaluate(parameters, residuals.data(), jacobians);
-      for (int r = 0; r < m; ++r) {
-        for (int k = 0; k < num_free; ++k) jacobian(row + r, k) = jac[r * n + free[k]];
-      }
-      const Eigen::Map<const Eigen::Vector3d> rot(residuals.data());
-      sum_sq_rotation += rot.squaredNorm() * options.sigma_rotation_rad * options.sigma_rotation_rad;
-      if (m == 6) {
-        const Eigen::Map<const Eigen::Vector3d> pos(residuals.data() + 3);
-        sum_sq_position += pos.squaredNorm() * options.sigma_position_m * options.sigma_position_m;
-        ++num_position;
-      }
-      row += m;
-    }
-  }
-  // RMS over measurements of the error norms (m, rad).
-  report.rms_rotation_rad = std::sqrt(sum_sq_rotation / static_cast<double>(measurements.size()));
-  report.rms_position_m = num_position > 0 ? std::sqrt(sum_sq_position / num_position) : 0.0;
-
-  // Covariance s^2 (J^T J)^-1 through the SVD of the column-normalised J (K8: never garbage sigmas).
-  const int dof = num_residuals - num_free;
-  const Eigen::VectorXd norms = jacobian.colwise().norm().transpose();
-  const double max_norm = norms.size() > 0 ? norms.maxCoeff() : 0.0;
-  Eigen::MatrixXd normalized = Eigen::MatrixXd::Zero(num_residuals, num_free);
-  // A column below the tolerance is round-off (a parameter the data cannot see): it stays zero so that
-  // it shows as a null direction instead of a unit-norm noise pattern.
-  for (int k = 0; k < num_free; ++k) {
-    if (max_norm > 0 && norms[k] > kCovarianceRankTolerance * max_norm) normalized.col(k) = jacobian.col(k) / norms[k];
-  }
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(normalized, Eigen::ComputeFullV);
-  const Eigen::VectorXd sv = svd.singularValues();
-  const double sigma_max = sv.size() > 0 ? sv[0] : 0.0;
-  std::vector<std::string> deficient;
-  {
-    const int rank_limit = std::min(num_residuals, num_free);
-    std::vector<bool> involved(num_free, false);
-    for (int k = 0; k < num_free; ++k) {
-      const bool is_null = k >= rank_limit || !(sv[k] > kCovarianceRankTolerance * sigma_max);
-      if (!is_null) continue;
-      for (int j = 0; j < num_free; ++j) involved[j] = involved[j] || std::abs(svd.matrixV()(j, k)) > 0.05;
-    }
-    for (int j = 0; j < num_free; ++j) {
-      if (involved[j]) deficient.push_back(params.name(free[j]));
-    }
-  }
-  if (!deficient.empty()) {
-    report.covariance_message = "uncertainty unavailable (rank deficient: " + JoinNames(deficient) + ")";
-    return report;
-  }
-  if (dof <= 0) {
-    report.covariance_message = "uncertainty unavailable (no redundancy: " + std::to_string(num_residuals) +
-                                " residuals for " + std::to_string(num_free) + " free parameters)";
-    return report;
-  }
-  const double s2 = 2.0 * summary.final_cost / dof;
-  const Eigen::MatrixXd v = svd.matrixV();
-  const Eigen::VectorXd inv_sv2 = sv.head(num_free).array().square().inverse();
-  const Eigen::MatrixXd normalized_cov = v * inv_sv2.asDiagonal() * v.transpose();
-  const Eigen::VectorXd inv_norms = norms.array().inverse();
-  report.covariance_free = s2 * (inv_norms.asDiagonal() * normalized_cov * inv_norms.asDiagonal());
-  report.covariance_available = true;
-  report.covariance_message = "ok";
-  const Eigen::VectorXd sd = report.covariance_free.diagonal().array().sqrt();
-  report.correlation_free = report.covariance_free;
-  for (int i = 0; i < num_free; ++i) {
-    report.stddev[free[i]] = sd[i];
-    for (int j = 0; j < num_free; ++j) {
-      report.correlation_free(i, j) = sd[i] > 0 && sd[j] > 0 ? report.covariance_free(i, j) / (sd[i] * sd[j]) : 0.0;
-    }
-  }
+  const SolutionResiduals solution = EvaluateSolution(blocks, rho, free, num_residuals, options);
+  report.rms_rotation_rad = solution.rms_rotation_rad;
+  report.rms_position_m = solution.rms_position_m;
+  EstimateCovariance(solution.jacobian, free, params, summary.final_cost, &report);
   return report;
 }
 

@@ -62,6 +62,170 @@ void GaussianBlur(std::vector<double>* image, int width, int height, double sigm
   }
 }
 
+
+// Pixel bounds of a projected rim (px, pixel centres at integers).
+struct RimBounds {
+  double umin = 1e300, umax = -1e300, vmin = 1e300, vmax = -1e300;
+};
+
+// The rim of the disc (centre c, plane axes e1, e2, radius r; camera frame, m) as seen by the camera:
+// false when part of it is not in front. Its projection gives the bounding box and, by Green's theorem,
+// the exact area and centroid: A = 1/2 int(x y' - y x'), A cx = 1/2 int(x^2 y'), A cy = -1/2 int(y^2 x')
+// (coordinates relative to the projected centre for conditioning). Fills the dot's geometric fields
+// and `rim`, the projected rim points.
+bool TraceRim(const CameraIntrinsics& camera, const Eigen::Vector3d& c, const Eigen::Vector3d& e1,
+              const Eigen::Vector3d& e2, double r, RenderedDot* dot, std::vector<Eigen::Vector2d>* rim,
+              RimBounds* bounds) {
+  bool in_front = c.z() > 0;
+  for (int k = 0; k < kRimPoints && in_front; ++k) {
+    const double t = 2 * kPi * k / kRimPoints;
+    in_front = (c + r * (std::cos(t) * e1 + std::sin(t) * e2)).z() > 1e-9;
+  }
+  if (!in_front) return false;
+  dot->in_front = true;
+  dot->projected_centre_px = *Project(camera, c);
+  const Eigen::Vector2d origin = dot->projected_centre_px;
+  double area2 = 0, mx = 0, my = 0;
+  double& umin = bounds->umin;
+  double& umax = bounds->umax;
+  double& vmin = bounds->vmin;
+  double& vmax = bounds->vmax;
+  rim->reserve(kRimPoints);
+  for (int k = 0; k < kRimPoints; ++k) {
+    const double t = 2 * kPi * k / kRimPoints;
+    const Eigen::Vector3d p = c + r * (std::cos(t) * e1 + std::sin(t) * e2);
+    const Eigen::Vector3d dp = r * (-std::sin(t) * e1 + std::cos(t) * e2);
+    Eigen::Vector2d uv, duv;
+    ProjectWithDerivative(camera, p, dp, &uv, &duv);
+    rim->push_back(uv);
+    umin = std::min(umin, uv.x()), umax = std::max(umax, uv.x());
+    vmin = std::min(vmin, uv.y()), vmax = std::max(vmax, uv.y());
+    const Eigen::Vector2d q = uv - origin;
+    area2 += q.x() * duv.y() - q.y() * duv.x();
+    mx += q.x() * q.x() * duv.y();
+    my -= q.y() * q.y() * duv.x();
+  }
+  const double dt = 2 * kPi / kRimPoints;
+  const double area = 0.5 * area2 * dt;
+  dot->area_px2 = std::abs(area);
+  dot->area_centroid_px = origin + Eigen::Vector2d(0.5 * mx * dt / area, 0.5 * my * dt / area);
+  dot->min_radius_px = 1e300;
+  for (const Eigen::Vector2d& uv : *rim) {
+    const double distance = (uv - dot->area_centroid_px).norm();
+    dot->max_radius_px = std::max(dot->max_radius_px, distance);
+    dot->min_radius_px = std::min(dot->min_radius_px, distance);
+  }
+  dot->fully_inside =
+      umin >= -0.5 && vmin >= -0.5 && umax <= camera.width_px - 0.5 && vmax <= camera.height_px - 0.5;
+  return true;
+}
+
+// The s x s samples of every pixel in the bounds (one pixel of margin: the rim points are 1.4 degrees
+// apart) that see the disc (centre c, normal n, radius r; camera frame, m). Sets the dot's sample area
+// and centroid; ORs its samples into `mask` (one bit per sample, all dots) and marks the dots whose
+// samples it shares as overlapping neighbours (`owner`: the last dot that darkened a sample there).
+void SampleDisc(const CameraIntrinsics& camera, const Eigen::Vector3d& c, const Eigen::Vector3d& n, double r, int s,
+                const RimBounds& bounds, size_t d, std::vector<RenderedDot>* dots, std::vector<uint64_t>* mask,
+                std::vector<int>* owner) {
+  const int width = camera.width_px, height = camera.height_px;
+  const double inv_s2 = 1.0 / (s * s);
+  RenderedDot& dot = (*dots)[d];
+  const int i0 = std::max(0, static_cast<int>(std::floor(bounds.umin + 0.5)) - 1);
+  const int i1 = std::min(width - 1, static_cast<int>(std::ceil(bounds.umax - 0.5)) + 1);
+  const int j0 = std::max(0, static_cast<int>(std::floor(bounds.vmin + 0.5)) - 1);
+  const int j1 = std::min(height - 1, static_cast<int>(std::ceil(bounds.vmax - 0.5)) + 1);
+  const double n_dot_c = n.dot(c);
+  long long dark = 0;
+  double su = 0, sv = 0;
+  for (int j = j0; j <= j1; ++j) {
+    for (int i = i0; i <= i1; ++i) {
+      uint64_t bits = 0;
+      for (int b = 0; b < s; ++b) {
+        const double v = j - 0.5 + (b + 0.5) / s;
+        for (int a = 0; a < s; ++a) {
+          const double u = i - 0.5 + (a + 0.5) / s;
+          const Eigen::Vector2d xy = PixelToNormalized(camera, camera.fx_px, Eigen::Vector2d(u, v));
+          const Eigen::Vector3d ray(xy.x(), xy.y(), 1.0);
+          const double denominator = n.dot(ray);
+          if (denominator == 0) continue;
+          const double t = n_dot_c / denominator;
+          if (t <= 0) continue;
+          if ((t * ray - c).squaredNorm() <= r * r) {
+            bits |= uint64_t{1} << (b * s + a);
+            ++dark;
+            su += u;
+            sv += v;
+          }
+        }
+      }
+      if (bits == 0) continue;
+      const size_t at = static_cast<size_t>(j) * width + i;
+      if (((*mask)[at] & bits) != 0 && (*owner)[at] >= 0) {
+        RenderedDot& other = (*dots)[(*owner)[at]];
+        dot.overlapping = other.overlapping = true;
+        if (std::find(dot.neighbours.begin(), dot.neighbours.end(), other.id) == dot.neighbours.end()) {
+          dot.neighbours.push_back(other.id);
+          other.neighbours.push_back(dot.id);
+        }
+      }
+      (*mask)[at] |= bits;
+      (*owner)[at] = dot.id;
+    }
+  }
+  dot.visible = dark > 0;
+  dot.clipped = dot.visible && !dot.fully_inside;
+  dot.sample_area_px2 = dark * inv_s2;
+  if (dark > 0) dot.sample_centroid_px = Eigen::Vector2d(su / dark, sv / dark);
+}
+
+// Near neighbours: rims closer than merge_gap_px (cheap test on the bounding circles first).
+void MarkNearNeighbours(const std::vector<std::vector<Eigen::Vector2d>>& rims, double merge_gap_px,
+                        std::vector<RenderedDot>* dots) {
+  for (size_t a = 0; a < dots->size(); ++a) {
+    RenderedDot& da = (*dots)[a];
+    if (!da.visible) continue;
+    for (size_t b = a + 1; b < dots->size(); ++b) {
+      RenderedDot& db = (*dots)[b];
+      if (!db.visible) continue;
+      const double centre_distance = (da.area_centroid_px - db.area_centroid_px).norm();
+      if (centre_distance > da.max_radius_px + db.max_radius_px + merge_gap_px) continue;
+      double closest = 1e300;
+      for (const Eigen::Vector2d& p : rims[a]) {
+        for (const Eigen::Vector2d& q : rims[b]) closest = std::min(closest, (p - q).squaredNorm());
+      }
+      if (da.overlapping && std::count(da.neighbours.begin(), da.neighbours.end(), db.id) > 0) closest = 0;
+      if (std::sqrt(closest) < merge_gap_px) {
+        da.near_other = db.near_other = true;
+        if (std::count(da.neighbours.begin(), da.neighbours.end(), db.id) == 0) {
+          da.neighbours.push_back(db.id);
+          db.neighbours.push_back(da.id);
+        }
+      }
+    }
+  }
+}
+
+// Image formation: coverage -> grey, blur, noise, quantisation.
+void FormImage(const std::vector<uint64_t>& mask, int width, int height, const RenderOptions& options,
+               uint64_t noise_seed, vpImage<unsigned char>* image) {
+  const int s = options.supersampling;
+  const double inv_s2 = 1.0 / (s * s);
+  std::vector<double> grey(mask.size(), options.background_grey);
+  const double contrast = options.background_grey - options.dot_grey;
+  for (size_t k = 0; k < mask.size(); ++k) {
+    if (mask[k] != 0) grey[k] -= contrast * __builtin_popcountll(mask[k]) * inv_s2;
+  }
+  if (options.blur_sigma_px > 0) GaussianBlur(&grey, width, height, options.blur_sigma_px);
+  image->resize(static_cast<unsigned>(height), static_cast<unsigned>(width));
+  std::mt19937_64 rng(noise_seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (size_t k = 0; k < grey.size(); ++k) {
+    double g = grey[k];
+    if (options.noise_std_grey > 0) g += options.noise_std_grey * noise(rng);
+    image->bitmap[k] = static_cast<unsigned char>(std::clamp(std::lround(g), 0L, 255L));
+  }
+}
+
 }  // namespace
 
 std::string RenderOptions::Validate() const {
@@ -126,8 +290,6 @@ RenderedImage RenderDots(const CameraIntrinsics& camera, const Rigid3& base_from
     SELFCAL_CHECK(std::isfinite(scene.radius_m) && scene.radius_m > 0, "dot radius " << scene.radius_m);
   }
   const int width = camera.width_px, height = camera.height_px;
-  const int s = options.supersampling;
-  const double inv_s2 = 1.0 / (s * s);
   const Rigid3 cam_from_base = base_from_cam.Inverse();
   const double r = scene.radius_m;
 
@@ -138,143 +300,17 @@ RenderedImage RenderDots(const CameraIntrinsics& camera, const Rigid3& base_from
   std::vector<std::vector<Eigen::Vector2d>> rims(out.dots.size());
 
   for (size_t d = 0; d < out.dots.size(); ++d) {
-    RenderedDot& dot = out.dots[d];
-    dot.id = static_cast<int>(d);
+    out.dots[d].id = static_cast<int>(d);
     const Eigen::Vector3d c = cam_from_base * scene.centres_in_base[d];
     const Eigen::Vector3d n = (cam_from_base.rotation * scene.normals_in_base[d]).normalized();
     Eigen::Vector3d e1, e2;
     PlaneAxes(n, &e1, &e2);
-
-    // The rim: in front of the camera? Its projection gives the bounding box and, by Green's theorem,
-    // the exact area and centroid: A = 1/2 int(x y' - y x'), A cx = 1/2 int(x^2 y'), A cy = -1/2 int(y^2 x')
-    // (coordinates relative to the projected centre for conditioning).
-    bool in_front = c.z() > 0;
-    for (int k = 0; k < kRimPoints && in_front; ++k) {
-      const double t = 2 * kPi * k / kRimPoints;
-      in_front = (c + r * (std::cos(t) * e1 + std::sin(t) * e2)).z() > 1e-9;
-    }
-    if (!in_front) continue;
-    dot.in_front = true;
-    dot.projected_centre_px = *Project(camera, c);
-    const Eigen::Vector2d origin = dot.projected_centre_px;
-    double area2 = 0, mx = 0, my = 0;
-    double umin = 1e300, umax = -1e300, vmin = 1e300, vmax = -1e300;
-    std::vector<Eigen::Vector2d>& rim = rims[d];
-    rim.reserve(kRimPoints);
-    for (int k = 0; k < kRimPoints; ++k) {
-      const double t = 2 * kPi * k / kRimPoints;
-      const Eigen::Vector3d p = c + r * (std::cos(t) * e1 + std::sin(t) * e2);
-      const Eigen::Vector3d dp = r * (-std::sin(t) * e1 + std::cos(t) * e2);
-      Eigen::Vector2d uv, duv;
-      ProjectWithDerivative(camera, p, dp, &uv, &duv);
-      rim.push_back(uv);
-      umin = std::min(umin, uv.x()), umax = std::max(umax, uv.x());
-      vmin = std::min(vmin, uv.y()), vmax = std::max(vmax, uv.y());
-      const Eigen::Vector2d q = uv - origin;
-      area2 += q.x() * duv.y() - q.y() * duv.x();
-      mx += q.x() * q.x() * duv.y();
-      my -= q.y() * q.y() * duv.x();
-    }
-    const double dt = 2 * kPi / kRimPoints;
-    const double area = 0.5 * area2 * dt;
-    dot.area_px2 = std::abs(area);
-    dot.area_centroid_px = origin + Eigen::Vector2d(0.5 * mx * dt / area, 0.5 * my * dt / area);
-    dot.min_radius_px = 1e300;
-    for (const Eigen::Vector2d& uv : rim) {
-      const double distance = (uv - dot.area_centroid_px).norm();
-      dot.max_radius_px = std::max(dot.max_radius_px, distance);
-      dot.min_radius_px = std::min(dot.min_radius_px, distance);
-    }
-    dot.fully_inside = umin >= -0.5 && vmin >= -0.5 && umax <= width - 0.5 && vmax <= height - 0.5;
-
-    // Supersampling over the bounding box (one pixel of margin: the rim points are 1.4 degrees apart).
-    const int i0 = std::max(0, static_cast<int>(std::floor(umin + 0.5)) - 1);
-    const int i1 = std::min(width - 1, static_cast<int>(std::ceil(umax - 0.5)) + 1);
-    const int j0 = std::max(0, static_cast<int>(std::floor(vmin + 0.5)) - 1);
-    const int j1 = std::min(height - 1, static_cast<int>(std::ceil(vmax - 0.5)) + 1);
-    const double n_dot_c = n.dot(c);
-    long long dark = 0;
-    double su = 0, sv = 0;
-    for (int j = j0; j <= j1; ++j) {
-      for (int i = i0; i <= i1; ++i) {
-        uint64_t bits = 0;
-        for (int b = 0; b < s; ++b) {
-          const double v = j - 0.5 + (b + 0.5) / s;
-          for (int a = 0; a < s; ++a) {
-            const double u = i - 0.5 + (a + 0.5) / s;
-            const Eigen::Vector2d xy = PixelToNormalized(camera, camera.fx_px, Eigen::Vector2d(u, v));
-            const Eigen::Vector3d ray(xy.x(), xy.y(), 1.0);
-            const double denominator = n.dot(ray);
-            if (denominator == 0) continue;
-            const double t = n_dot_c / denominator;
-            if (t <= 0) continue;
-            if ((t * ray - c).squaredNorm() <= r * r) {
-              bits |= uint64_t{1} << (b * s + a);
-              ++dark;
-              su += u;
-              sv += v;
-            }
-          }
-        }
-        if (bits == 0) continue;
-        const size_t at = static_cast<size_t>(j) * width + i;
-        if ((mask[at] & bits) != 0 && owner[at] >= 0) {
-          RenderedDot& other = out.dots[owner[at]];
-          dot.overlapping = other.overlapping = true;
-          if (std::find(dot.neighbours.begin(), dot.neighbours.end(), other.id) == dot.neighbours.end()) {
-            dot.neighbours.push_back(other.id);
-            other.neighbours.push_back(dot.id);
-          }
-        }
-        mask[at] |= bits;
-        owner[at] = dot.id;
-      }
-    }
-    dot.visible = dark > 0;
-    dot.clipped = dot.visible && !dot.fully_inside;
-    dot.sample_area_px2 = dark * inv_s2;
-    if (dark > 0) dot.sample_centroid_px = Eigen::Vector2d(su / dark, sv / dark);
+    RimBounds bounds;
+    if (!TraceRim(camera, c, e1, e2, r, &out.dots[d], &rims[d], &bounds)) continue;
+    SampleDisc(camera, c, n, r, options.supersampling, bounds, d, &out.dots, &mask, &owner);
   }
-
-  // Near neighbours: rims closer than merge_gap_px (cheap test on the bounding circles first).
-  for (size_t a = 0; a < out.dots.size(); ++a) {
-    RenderedDot& da = out.dots[a];
-    if (!da.visible) continue;
-    for (size_t b = a + 1; b < out.dots.size(); ++b) {
-      RenderedDot& db = out.dots[b];
-      if (!db.visible) continue;
-      const double centre_distance = (da.area_centroid_px - db.area_centroid_px).norm();
-      if (centre_distance > da.max_radius_px + db.max_radius_px + options.merge_gap_px) continue;
-      double closest = 1e300;
-      for (const Eigen::Vector2d& p : rims[a]) {
-        for (const Eigen::Vector2d& q : rims[b]) closest = std::min(closest, (p - q).squaredNorm());
-      }
-      if (da.overlapping && std::count(da.neighbours.begin(), da.neighbours.end(), db.id) > 0) closest = 0;
-      if (std::sqrt(closest) < options.merge_gap_px) {
-        da.near_other = db.near_other = true;
-        if (std::count(da.neighbours.begin(), da.neighbours.end(), db.id) == 0) {
-          da.neighbours.push_back(db.id);
-          db.neighbours.push_back(da.id);
-        }
-      }
-    }
-  }
-
-  // Image formation: coverage -> grey, blur, noise, quantisation.
-  std::vector<double> grey(mask.size(), options.background_grey);
-  const double contrast = options.background_grey - options.dot_grey;
-  for (size_t k = 0; k < mask.size(); ++k) {
-    if (mask[k] != 0) grey[k] -= contrast * __builtin_popcountll(mask[k]) * inv_s2;
-  }
-  if (options.blur_sigma_px > 0) GaussianBlur(&grey, width, height, options.blur_sigma_px);
-  out.image.resize(static_cast<unsigned>(height), static_cast<unsigned>(width));
-  std::mt19937_64 rng(noise_seed);
-  std::normal_distribution<double> noise(0.0, 1.0);
-  for (size_t k = 0; k < grey.size(); ++k) {
-    double g = grey[k];
-    if (options.noise_std_grey > 0) g += options.noise_std_grey * noise(rng);
-    out.image.bitmap[k] = static_cast<unsigned char>(std::clamp(std::lround(g), 0L, 255L));
-  }
+  MarkNearNeighbours(rims, options.merge_gap_px, &out.dots);
+  FormImage(mask, width, height, options, noise_seed, &out.image);
   return out;
 }
 

@@ -79,6 +79,162 @@ ObservationSet Observe(const SimResult& world, const std::vector<Eigen::VectorXd
   return set;
 }
 
+// Hidden kinematic errors into truth->rho_true, on the identifiable parameters unless asked otherwise,
+// and the true focal. Draws from `rng` through `gauss` in a fixed order (the world's stream).
+void PerturbModel(const RobotModel& nominal, const std::vector<Eigen::VectorXd>& trajectory, const SimOptions& options,
+                  std::mt19937_64* rng, std::normal_distribution<double>* gauss, SimTruth* truth) {
+  const KinematicParameters params(nominal.num_joints());
+  const Eigen::VectorXd rho_nominal = KinematicParameters::Nominal(nominal);
+  std::vector<int> to_perturb;
+  if (options.perturb_gauge_parameters) {
+    for (int i = 0; i < params.size(); ++i) to_perturb.push_back(i);
+  } else {
+    std::vector<Eigen::VectorXd> id_poses(trajectory.begin(), trajectory.begin() + options.num_identification_poses);
+    identification::IdentifiabilityOptions id_options;
+    to_perturb = identification::AnalyzeIdentifiability(nominal, rho_nominal, id_poses, 0, id_options).free_indices;
+  }
+  truth->rho_true = rho_nominal;
+  std::vector<double> draws(params.size());
+  for (double& d : draws) d = (*gauss)(*rng);  // one draw per parameter whatever is perturbed: stable streams
+  for (int i : to_perturb) {
+    const bool cam = i >= params.CamOffset();
+    const bool length = params.kind(i) == ParameterKind::kLength;
+    const double std_dev = cam ? (length ? options.cam_length_error_std_m : options.cam_angle_error_std_rad)
+                               : (length ? options.length_error_std_m : options.angle_error_std_rad);
+    truth->rho_true[i] += std_dev * draws[i];
+  }
+  truth->perturbed_indices = to_perturb;
+  truth->camera_true = options.camera;
+  truth->camera_true.fx_px = options.fx_nominal_px * (1.0 + options.fx_relative_error_std * (*gauss)(*rng));
+}
+
+// Scene: rejection sampling in a box around where the cameras look, every dot in every view. Dots 0
+// and 1 are the yardstick's ends. Appends to truth->dots_in_base, drawing from the world's stream.
+class ScenePlacer {
+ public:
+  ScenePlacer(const SimOptions& options, SimTruth* truth, std::mt19937_64* rng, std::normal_distribution<double>* gauss)
+      : options_(options), truth_(*truth), rng_(*rng), gauss_(*gauss), placed_(truth->base_from_cam.size()),
+        spaced_(options.separation_dot_radius_m > 0) {
+    for (const Rigid3& c : truth_.base_from_cam) cam_from_base_.push_back(c.Inverse());
+  }
+
+  void Place(const Eigen::Vector3d& centre) {
+    if (options_.flat_sheet) {
+      PlaceOnSheet(centre);
+    } else {
+      PlaceInVolume(centre);
+    }
+  }
+
+ private:
+  static constexpr int kMaxTries = 200000;
+  static constexpr double kHalfSize = 0.3;  // m, of the box around the centre
+
+  // Per view, the projected centre and radius (px) of every dot placed so far (spacing rule only).
+  struct Disc {
+    Eigen::Vector2d uv;
+    double radius_px;
+  };
+
+  bool VisibleEverywhere(const Eigen::Vector3d& p) const {
+    for (size_t v = 0; v < truth_.base_from_cam.size(); ++v) {
+      if (!Visible(truth_.camera_true, truth_.base_from_cam[v], p, options_.image_margin_px, options_.min_depth_m)) {
+        return false;
+      }
+      if (!spaced_) continue;
+      const Eigen::Vector3d pc = cam_from_base_[v] * p;
+      const Eigen::Vector2d uv = *Project(truth_.camera_true, pc);
+      const double r = truth_.camera_true.fx_px * options_.separation_dot_radius_m / pc.z();
+      for (const Disc& d : placed_[v]) {
+        const double gap = (uv - d.uv).norm() - r - d.radius_px;
+        if (gap < options_.min_rim_gap_diameters * 2.0 * std::max(r, d.radius_px)) return false;
+      }
+    }
+    return true;
+  }
+
+  // Records p's discs for the spacing rule (call after accepting p).
+  void Record(const Eigen::Vector3d& p) {
+    truth_.dots_in_base.push_back(p);
+    if (!spaced_) return;
+    for (size_t v = 0; v < truth_.base_from_cam.size(); ++v) {
+      const Eigen::Vector3d pc = cam_from_base_[v] * p;
+      placed_[v].push_back({*Project(truth_.camera_true, pc),
+                            truth_.camera_true.fx_px * options_.separation_dot_radius_m / pc.z()});
+    }
+  }
+
+  // The yardstick's two ends, checked against each other as well.
+  void PlacePair(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    if (!VisibleEverywhere(a)) return;
+    Record(a);
+    if (VisibleEverywhere(b)) {
+      Record(b);
+      return;
+    }
+    truth_.dots_in_base.clear();
+    for (auto& view : placed_) view.clear();
+  }
+
+  void PlaceOnSheet(const Eigen::Vector3d& centre) {
+    std::uniform_real_distribution<double> uniform(-kHalfSize, kHalfSize);
+    int tries = 0;
+    // The sheet's in-plane axes e1, e2 (orthonormal, perpendicular to the mean optical axis n).
+    Eigen::Vector3d n = Eigen::Vector3d::Zero();
+    for (const Rigid3& c : truth_.base_from_cam) n += c.rotation.col(2);
+    n.normalize();
+    const Eigen::Vector3d helper = std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+    const Eigen::Vector3d e1 = n.cross(helper).normalized();
+    const Eigen::Vector3d e2 = n.cross(e1);
+    auto on_sheet = [&](double u, double v) { return Eigen::Vector3d(centre + u * e1 + v * e2); };
+    std::mt19937_64& rng = rng_;
+    std::normal_distribution<double>& gauss = gauss_;
+    while (truth_.dots_in_base.size() < 2 && tries < kMaxTries) {
+      ++tries;
+      const double mu = 0.3 * uniform(rng), mv = 0.3 * uniform(rng);
+      const Eigen::Vector2d dir = Eigen::Vector2d(gauss(rng), gauss(rng)).normalized();
+      const double h = 0.5 * options_.yardstick_length_m;
+      const Eigen::Vector3d a = on_sheet(mu - h * dir.x(), mv - h * dir.y());
+      const Eigen::Vector3d b = on_sheet(mu + h * dir.x(), mv + h * dir.y());
+      PlacePair(a, b);
+    }
+    while (static_cast<int>(truth_.dots_in_base.size()) < options_.num_dots && tries < kMaxTries) {
+      ++tries;
+      const Eigen::Vector3d p = on_sheet(uniform(rng), uniform(rng));
+      if (VisibleEverywhere(p)) Record(p);
+    }
+  }
+
+  void PlaceInVolume(const Eigen::Vector3d& centre) {
+    std::uniform_real_distribution<double> uniform(-kHalfSize, kHalfSize);
+    int tries = 0;
+    std::mt19937_64& rng = rng_;
+    std::normal_distribution<double>& gauss = gauss_;
+    // The yardstick: dots 0 and 1, yardstick_length_m apart along a random direction through the centre.
+    while (truth_.dots_in_base.size() < 2 && tries < kMaxTries) {
+      ++tries;
+      const Eigen::Vector3d mid = centre + 0.3 * Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
+      const Eigen::Vector3d dir = Eigen::Vector3d(gauss(rng), gauss(rng), 0.3 * gauss(rng)).normalized();
+      const Eigen::Vector3d a = mid - 0.5 * options_.yardstick_length_m * dir;
+      const Eigen::Vector3d b = mid + 0.5 * options_.yardstick_length_m * dir;
+      PlacePair(a, b);
+    }
+    while (static_cast<int>(truth_.dots_in_base.size()) < options_.num_dots && tries < kMaxTries) {
+      ++tries;
+      const Eigen::Vector3d p = centre + Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
+      if (VisibleEverywhere(p)) Record(p);
+    }
+  }
+
+  const SimOptions& options_;
+  SimTruth& truth_;
+  std::mt19937_64& rng_;
+  std::normal_distribution<double>& gauss_;
+  std::vector<std::vector<Disc>> placed_;
+  const bool spaced_;
+  std::vector<Rigid3> cam_from_base_;
+};
+
 }  // namespace
 
 std::vector<KnownDistance> CheckPairs(const std::vector<Eigen::Vector3d>& dots) {
@@ -112,125 +268,10 @@ SimResult Simulate(const RobotModel& nominal, const std::vector<Eigen::VectorXd>
   SimTruth& truth = result.truth;
   truth.nominal = nominal;
   truth.nominal.flange_from_cam = nominal.flange_from_cam;
-
-  // Hidden kinematic errors, on the identifiable parameters unless asked otherwise.
-  const KinematicParameters params(nominal.num_joints());
-  const Eigen::VectorXd rho_nominal = KinematicParameters::Nominal(nominal);
-  std::vector<int> to_perturb;
-  if (options.perturb_gauge_parameters) {
-    for (int i = 0; i < params.size(); ++i) to_perturb.push_back(i);
-  } else {
-    std::vector<Eigen::VectorXd> id_poses(trajectory.begin(), trajectory.begin() + options.num_identification_poses);
-    identification::IdentifiabilityOptions id_options;
-    to_perturb = identification::AnalyzeIdentifiability(nominal, rho_nominal, id_poses, 0, id_options).free_indices;
-  }
-  truth.rho_true = rho_nominal;
-  std::vector<double> draws(params.size());
-  for (double& d : draws) d = gauss(rng);  // one draw per parameter whatever is perturbed: stable streams
-  for (int i : to_perturb) {
-    const bool cam = i >= params.CamOffset();
-    const bool length = params.kind(i) == ParameterKind::kLength;
-    const double std_dev = cam ? (length ? options.cam_length_error_std_m : options.cam_angle_error_std_rad)
-                               : (length ? options.length_error_std_m : options.angle_error_std_rad);
-    truth.rho_true[i] += std_dev * draws[i];
-  }
-  truth.perturbed_indices = to_perturb;
-  truth.camera_true = options.camera;
-  truth.camera_true.fx_px = options.fx_nominal_px * (1.0 + options.fx_relative_error_std * gauss(rng));
-
+  PerturbModel(nominal, trajectory, options, &rng, &gauss, &truth);
   for (const Eigen::VectorXd& q : trajectory) truth.base_from_cam.push_back(BaseFromCam(nominal, truth.rho_true, q));
 
-  // Scene: rejection sampling in a box around where the cameras look, every dot in every view.
-  const Eigen::Vector3d centre = ConvergencePoint(truth.base_from_cam);
-  const double half_size = 0.3;
-  std::uniform_real_distribution<double> uniform(-half_size, half_size);
-  // Per view, the projected centre and radius (px) of every dot placed so far (spacing rule only).
-  struct Disc {
-    Eigen::Vector2d uv;
-    double radius_px;
-  };
-  std::vector<std::vector<Disc>> placed(truth.base_from_cam.size());
-  const bool spaced = options.separation_dot_radius_m > 0;
-  std::vector<Rigid3> cam_from_base;
-  for (const Rigid3& c : truth.base_from_cam) cam_from_base.push_back(c.Inverse());
-  auto visible_everywhere = [&](const Eigen::Vector3d& p) {
-    for (size_t v = 0; v < truth.base_from_cam.size(); ++v) {
-      if (!Visible(truth.camera_true, truth.base_from_cam[v], p, options.image_margin_px, options.min_depth_m)) {
-        return false;
-      }
-      if (!spaced) continue;
-      const Eigen::Vector3d pc = cam_from_base[v] * p;
-      const Eigen::Vector2d uv = *Project(truth.camera_true, pc);
-      const double r = truth.camera_true.fx_px * options.separation_dot_radius_m / pc.z();
-      for (const Disc& d : placed[v]) {
-        const double gap = (uv - d.uv).norm() - r - d.radius_px;
-        if (gap < options.min_rim_gap_diameters * 2.0 * std::max(r, d.radius_px)) return false;
-      }
-    }
-    return true;
-  };
-  // Records p's discs for the spacing rule (call after accepting p).
-  auto place = [&](const Eigen::Vector3d& p) {
-    truth.dots_in_base.push_back(p);
-    if (!spaced) return;
-    for (size_t v = 0; v < truth.base_from_cam.size(); ++v) {
-      const Eigen::Vector3d pc = cam_from_base[v] * p;
-      placed[v].push_back({*Project(truth.camera_true, pc),
-                           truth.camera_true.fx_px * options.separation_dot_radius_m / pc.z()});
-    }
-  };
-  // The yardstick's two ends, checked against each other as well.
-  auto place_pair = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-    if (!visible_everywhere(a)) return;
-    place(a);
-    if (visible_everywhere(b)) {
-      place(b);
-      return;
-    }
-    truth.dots_in_base.clear();
-    for (auto& view : placed) view.clear();
-  };
-  const int max_tries = 200000;
-  int tries = 0;
-  if (options.flat_sheet) {
-    // The sheet's in-plane axes e1, e2 (orthonormal, perpendicular to the mean optical axis n).
-    Eigen::Vector3d n = Eigen::Vector3d::Zero();
-    for (const Rigid3& c : truth.base_from_cam) n += c.rotation.col(2);
-    n.normalize();
-    const Eigen::Vector3d helper = std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-    const Eigen::Vector3d e1 = n.cross(helper).normalized();
-    const Eigen::Vector3d e2 = n.cross(e1);
-    auto on_sheet = [&](double u, double v) { return Eigen::Vector3d(centre + u * e1 + v * e2); };
-    while (truth.dots_in_base.size() < 2 && tries < max_tries) {
-      ++tries;
-      const double mu = 0.3 * uniform(rng), mv = 0.3 * uniform(rng);
-      const Eigen::Vector2d dir = Eigen::Vector2d(gauss(rng), gauss(rng)).normalized();
-      const double h = 0.5 * options.yardstick_length_m;
-      const Eigen::Vector3d a = on_sheet(mu - h * dir.x(), mv - h * dir.y());
-      const Eigen::Vector3d b = on_sheet(mu + h * dir.x(), mv + h * dir.y());
-      place_pair(a, b);
-    }
-    while (static_cast<int>(truth.dots_in_base.size()) < options.num_dots && tries < max_tries) {
-      ++tries;
-      const Eigen::Vector3d p = on_sheet(uniform(rng), uniform(rng));
-      if (visible_everywhere(p)) place(p);
-    }
-  } else {
-    // The yardstick: dots 0 and 1, yardstick_length_m apart along a random direction through the centre.
-    while (truth.dots_in_base.size() < 2 && tries < max_tries) {
-      ++tries;
-      const Eigen::Vector3d mid = centre + 0.3 * Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
-      const Eigen::Vector3d dir = Eigen::Vector3d(gauss(rng), gauss(rng), 0.3 * gauss(rng)).normalized();
-      const Eigen::Vector3d a = mid - 0.5 * options.yardstick_length_m * dir;
-      const Eigen::Vector3d b = mid + 0.5 * options.yardstick_length_m * dir;
-      place_pair(a, b);
-    }
-    while (static_cast<int>(truth.dots_in_base.size()) < options.num_dots && tries < max_tries) {
-      ++tries;
-      const Eigen::Vector3d p = centre + Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
-      if (visible_everywhere(p)) place(p);
-    }
-  }
+  ScenePlacer(options, &truth, &rng, &gauss).Place(ConvergencePoint(truth.base_from_cam));
   if (static_cast<int>(truth.dots_in_base.size()) < options.num_dots) {
     result.message = "could not place " + std::to_string(options.num_dots) +
                      " dots in view of every pose: the views share too little of the scene";

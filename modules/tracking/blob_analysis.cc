@@ -120,6 +120,159 @@ std::string Describe(const char* what, double value, const char* limit_name, dou
   return s.str();
 }
 
+// Seeds for the blob's pixels: the required one alone if given; else vpDot2's first border pixel (its
+// border list is empty when track() fell back to a window search), then every dark pixel of the box's
+// top row, which the blob touches.
+std::vector<std::pair<int, int>> BlobSeeds(const vpDot2& dot, const PixelBox& bbox,
+                                           const std::pair<int, int>* required_seed) {
+  std::vector<std::pair<int, int>> seeds;
+  if (required_seed != nullptr) {
+    seeds.push_back(*required_seed);
+    return seeds;
+  }
+  const std::list<vpImagePoint> edges = dot.getEdges();
+  if (!edges.empty()) {
+    seeds.emplace_back(static_cast<int>(std::lround(edges.front().get_u())),
+                       static_cast<int>(std::lround(edges.front().get_v())));
+  }
+  for (int u = bbox.u_min; u <= bbox.u_max; ++u) seeds.emplace_back(u, bbox.v_min);
+  return seeds;
+}
+
+// The blob's grey levels and the raw sums of its pixel centres, relative to the bbox corner (px).
+struct BlobSums {
+  std::vector<double> values;
+  double su = 0, sv = 0, suu = 0, suv = 0, svv = 0;
+};
+
+// Area, dot level and second moments from the blob's own pixels (pixel centres, in double: vpDot2's
+// moments are accumulated from float increments such as u^3 / 3 and lose most of their digits for
+// small blobs far from the image origin; a 3 px disc at u = 512 came out with an axis ratio of 0.7).
+BlobSums SumBlob(const vpImage<unsigned char>& image, const Window& win, const PixelBox& bbox) {
+  BlobSums b;
+  for (int v = bbox.v_min; v <= bbox.v_max; ++v) {
+    for (int u = bbox.u_min; u <= bbox.u_max; ++u) {
+      if (win.At(u, v) != kBlob) continue;
+      b.values.push_back(image[v][u]);
+      const double x = u - bbox.u_min, y = v - bbox.v_min;  // local, to keep the sums small
+      b.su += x;
+      b.sv += y;
+      b.suu += x * x;
+      b.suv += x * y;
+      b.svv += y * y;
+    }
+  }
+  return b;
+}
+
+// Background: the free pixels of the ring between the bbox dilated by gap and by gap + width.
+std::vector<double> BackgroundRing(const vpImage<unsigned char>& image, const Window& win, const PixelBox& bbox,
+                                   const DotAcceptanceOptions& options) {
+  std::vector<double> ring;
+  const int g = options.ring_gap_px, r = options.ring_gap_px + options.ring_width_px;
+  for (int v = bbox.v_min - r; v <= bbox.v_max + r; ++v) {
+    for (int u = bbox.u_min - r; u <= bbox.u_max + r; ++u) {
+      if (u >= bbox.u_min - g && u <= bbox.u_max + g && v >= bbox.v_min - g && v <= bbox.v_max + g) continue;
+      if (!win.Contains(u, v) || win.At(u, v) != kFree) continue;
+      ring.push_back(image[v][u]);
+    }
+  }
+  return ring;
+}
+
+// D2: the largest coverage by the dot of a blob pixel within `margin` px of the image border; nullopt
+// when the bbox keeps clear of the margin. A (nearly) fully dark one there means the dot goes on past
+// the edge and its centroid is biased.
+std::optional<double> WorstBorderCoverage(const vpImage<unsigned char>& image, const Window& win,
+                                          const DotDetection& d, int margin) {
+  const int width = static_cast<int>(image.getWidth());
+  const int height = static_cast<int>(image.getHeight());
+  const int m = margin;
+  if (!(d.bbox.u_min < m || d.bbox.v_min < m || d.bbox.u_max > width - 1 - m || d.bbox.v_max > height - 1 - m)) {
+    return std::nullopt;
+  }
+  double worst = 0;
+  for (int v = d.bbox.v_min; v <= d.bbox.v_max; ++v) {
+    for (int u = d.bbox.u_min; u <= d.bbox.u_max; ++u) {
+      if (win.At(u, v) != kBlob) continue;
+      if (u >= m && v >= m && u <= width - 1 - m && v <= height - 1 - m) continue;
+      const double coverage =
+          d.contrast > 0 ? (d.background_level - image[v][u]) / d.contrast : 1.0;
+      worst = std::max(worst, coverage);
+    }
+  }
+  return worst;
+}
+
+// The ellipse of the second moments: semi-axes (2 sqrt of the eigenvalues), angle and fill ratio.
+void SetEllipse(DotDetection* d) {
+  const double half_sum = 0.5 * (d->n20_px2 + d->n02_px2);
+  const double root =
+      std::sqrt(0.25 * (d->n20_px2 - d->n02_px2) * (d->n20_px2 - d->n02_px2) + d->n11_px2 * d->n11_px2);
+  d->semi_major_px = 2.0 * std::sqrt(std::max(0.0, half_sum + root));
+  d->semi_minor_px = 2.0 * std::sqrt(std::max(0.0, half_sum - root));
+  d->angle_rad = 0.5 * std::atan2(2.0 * d->n11_px2, d->n20_px2 - d->n02_px2);
+  d->fill_ratio = d->semi_minor_px > 0 ? d->area_px2 / (M_PI * d->semi_major_px * d->semi_minor_px) : 0.0;
+}
+
+// vpDot2's ellipsoid test, counted here instead of silently inside vpDot2: samples on a shrunken
+// ellipse that are not dark (inner) and on a grown one that are (outer). Empty when it passes.
+std::string EllipseTestFailure(const vpImage<unsigned char>& image, int threshold, const DotDetection& d,
+                               const DotAcceptanceOptions& options) {
+  const int width = static_cast<int>(image.getWidth());
+  const int height = static_cast<int>(image.getHeight());
+  const double p = options.ellipse_shape_precision;
+  const double c = std::cos(d.angle_rad), s = std::sin(d.angle_rad);
+  const int max_bad = static_cast<int>(kEllipseSamples * options.ellipse_bad_points_fraction);
+  int inner_bad = 0, outer_bad = 0;
+  for (int k = 0; k < kEllipseSamples; ++k) {
+    const double t = 2.0 * M_PI * k / kEllipseSamples;
+    const double ai = p * std::max(0.0, d.semi_major_px - 1.0) * std::cos(t);
+    const double bi = p * std::max(0.0, d.semi_minor_px - 1.0) * std::sin(t);
+    const int ui = static_cast<int>(std::lround(d.cog_binary_px.x() + c * ai - s * bi));
+    const int vi = static_cast<int>(std::lround(d.cog_binary_px.y() + s * ai + c * bi));
+    if (ui < 0 || vi < 0 || ui >= width || vi >= height || static_cast<int>(image[vi][ui]) > threshold) ++inner_bad;
+    const double ao = (2.0 - p) * (d.semi_major_px + 1.0) * std::cos(t);
+    const double bo = (2.0 - p) * (d.semi_minor_px + 1.0) * std::sin(t);
+    const int uo = static_cast<int>(std::lround(d.cog_binary_px.x() + c * ao - s * bo));
+    const int vo = static_cast<int>(std::lround(d.cog_binary_px.y() + s * ao + c * bo));
+    if (uo < 0 || vo < 0 || uo >= width || vo >= height) continue;
+    if (static_cast<int>(image[vo][uo]) <= threshold) ++outer_bad;
+  }
+  if (inner_bad <= max_bad && outer_bad <= max_bad) return "";
+  std::ostringstream s_detail;
+  s_detail << "ellipsoid test: " << inner_bad << " inner and " << outer_bad << " outer samples of "
+           << kEllipseSamples << " wrong (max " << max_bad << ")";
+  return s_detail.str();
+}
+
+// Intensity-weighted centroid: weights (background - I)+ over the bbox dilated by refine_margin_px,
+// other blobs (and their rims) excluded. Replaces d->centroid_px when it lies inside the bbox.
+void RefineCentroid(const vpImage<unsigned char>& image, const Window& win, int refine_margin_px, DotDetection* d) {
+  const int width = static_cast<int>(image.getWidth());
+  const int height = static_cast<int>(image.getHeight());
+  const int rm = refine_margin_px;
+  double sw = 0, su = 0, sv = 0;
+  for (int v = std::max(0, d->bbox.v_min - rm); v <= std::min(height - 1, d->bbox.v_max + rm); ++v) {
+    for (int u = std::max(0, d->bbox.u_min - rm); u <= std::min(width - 1, d->bbox.u_max + rm); ++u) {
+      if (win.At(u, v) == kOther) continue;
+      const double w = d->background_level - static_cast<double>(image[v][u]);
+      if (w <= 0) continue;
+      sw += w;
+      su += w * u;
+      sv += w * v;
+    }
+  }
+  if (sw > 0) {
+    const Eigen::Vector2d c_w(su / sw, sv / sw);
+    if (c_w.allFinite() && c_w.x() >= d->bbox.u_min && c_w.x() <= d->bbox.u_max && c_w.y() >= d->bbox.v_min &&
+        c_w.y() <= d->bbox.v_max) {
+      d->centroid_px = c_w;
+      d->refined = true;
+    }
+  }
+}
+
 }  // namespace
 
 Levels DarkestAndMedian(const vpImage<unsigned char>& image, const PixelBox& box) {
@@ -188,19 +341,7 @@ BlobVerdict MeasureBlob(const vpImage<unsigned char>& image, int threshold, cons
       d.bbox.width() <= 0 || d.bbox.height() <= 0) {
     return Reject(RejectReason::kTrackerFailed, "vpDot2 returned a bounding box outside the image");
   }
-  // Seeds for the blob's pixels: vpDot2's first border pixel (its border list is empty when track() fell
-  // back to a window search), then every dark pixel of the box's top row, which the blob touches.
-  std::vector<std::pair<int, int>> seeds;
-  if (required_seed != nullptr) {
-    seeds.push_back(*required_seed);
-  } else {
-    const std::list<vpImagePoint> edges = dot.getEdges();
-    if (!edges.empty()) {
-      seeds.emplace_back(static_cast<int>(std::lround(edges.front().get_u())),
-                         static_cast<int>(std::lround(edges.front().get_v())));
-    }
-    for (int u = d.bbox.u_min; u <= d.bbox.u_max; ++u) seeds.emplace_back(u, d.bbox.v_min);
-  }
+  const std::vector<std::pair<int, int>> seeds = BlobSeeds(dot, d.bbox, required_seed);
   const int margin = std::max(options.refine_margin_px, options.ring_gap_px + options.ring_width_px);
   const std::optional<Window> classified = ClassifyWindow(image, threshold, d.bbox, margin, seeds);
   if (!classified) {
@@ -210,24 +351,8 @@ BlobVerdict MeasureBlob(const vpImage<unsigned char>& image, int threshold, cons
   }
   const Window& win = *classified;
 
-  // Area, dot level and second moments from the blob's own pixels (pixel centres, in double: vpDot2's
-  // moments are accumulated from float increments such as u^3 / 3 and lose most of their digits for
-  // small blobs far from the image origin; a 3 px disc at u = 512 came out with an axis ratio of 0.7).
-  std::vector<double> blob_values;
-  double su = 0, sv = 0, suu = 0, suv = 0, svv = 0;
-  for (int v = d.bbox.v_min; v <= d.bbox.v_max; ++v) {
-    for (int u = d.bbox.u_min; u <= d.bbox.u_max; ++u) {
-      if (win.At(u, v) != kBlob) continue;
-      blob_values.push_back(image[v][u]);
-      const double x = u - d.bbox.u_min, y = v - d.bbox.v_min;  // local, to keep the sums small
-      su += x;
-      sv += y;
-      suu += x * x;
-      suv += x * y;
-      svv += y * y;
-    }
-  }
-  d.area_px2 = static_cast<double>(blob_values.size());
+  BlobSums blob = SumBlob(image, win, d.bbox);
+  d.area_px2 = static_cast<double>(blob.values.size());
   if (d.area_px2 < options.min_area_px2) {
     return Reject(RejectReason::kTooSmall, Describe("area", d.area_px2, "min", options.min_area_px2));
   }
@@ -235,89 +360,37 @@ BlobVerdict MeasureBlob(const vpImage<unsigned char>& image, int threshold, cons
     return Reject(RejectReason::kTooLarge, Describe("area", d.area_px2, "max", options.max_area_px2));
   }
 
-  // Background: median of the ring between the bbox dilated by gap and by gap + width.
-  std::vector<double> ring;
-  const int g = options.ring_gap_px, r = options.ring_gap_px + options.ring_width_px;
-  for (int v = d.bbox.v_min - r; v <= d.bbox.v_max + r; ++v) {
-    for (int u = d.bbox.u_min - r; u <= d.bbox.u_max + r; ++u) {
-      if (u >= d.bbox.u_min - g && u <= d.bbox.u_max + g && v >= d.bbox.v_min - g && v <= d.bbox.v_max + g) continue;
-      if (!win.Contains(u, v) || win.At(u, v) != kFree) continue;
-      ring.push_back(image[v][u]);
-    }
-  }
+  std::vector<double> ring = BackgroundRing(image, win, d.bbox, options);
   if (ring.size() < 8) {
     return Reject(RejectReason::kLowContrast, "fewer than 8 background pixels around the blob");
   }
   d.background_level = Median(&ring);
-  d.dot_level = Median(&blob_values);
+  d.dot_level = Median(&blob.values);
   d.contrast = d.background_level - d.dot_level;
 
-  // D2: the blob's pixels within the border margin must be only partly covered by the dot; a (nearly)
-  // fully dark one there means the dot goes on past the edge and its centroid is biased.
-  const int m = options.border_margin_px;
-  if (d.bbox.u_min < m || d.bbox.v_min < m || d.bbox.u_max > width - 1 - m || d.bbox.v_max > height - 1 - m) {
-    double worst = 0;
-    for (int v = d.bbox.v_min; v <= d.bbox.v_max; ++v) {
-      for (int u = d.bbox.u_min; u <= d.bbox.u_max; ++u) {
-        if (win.At(u, v) != kBlob) continue;
-        if (u >= m && v >= m && u <= width - 1 - m && v <= height - 1 - m) continue;
-        const double coverage =
-            d.contrast > 0 ? (d.background_level - image[v][u]) / d.contrast : 1.0;
-        worst = std::max(worst, coverage);
-      }
-    }
-    if (worst >= options.max_edge_coverage) {
-      return Reject(RejectReason::kBorder, Describe("coverage of a pixel within the border margin", worst,
-                                                    "max", options.max_edge_coverage));
-    }
+  const std::optional<double> worst = WorstBorderCoverage(image, win, d, options.border_margin_px);
+  if (worst && *worst >= options.max_edge_coverage) {
+    return Reject(RejectReason::kBorder, Describe("coverage of a pixel within the border margin", *worst, "max",
+                                                  options.max_edge_coverage));
   }
   const double n = d.area_px2;
-  d.n20_px2 = suu / n - (su / n) * (su / n);
-  d.n11_px2 = suv / n - (su / n) * (sv / n);
-  d.n02_px2 = svv / n - (sv / n) * (sv / n);
+  d.n20_px2 = blob.suu / n - (blob.su / n) * (blob.su / n);
+  d.n11_px2 = blob.suv / n - (blob.su / n) * (blob.sv / n);
+  d.n02_px2 = blob.svv / n - (blob.sv / n) * (blob.sv / n);
 
   // D7: vpDot2's centre of gravity and the moments must be finite.
   if (!d.cog_binary_px.allFinite() || !std::isfinite(d.polygon_area_px2) || !std::isfinite(d.n20_px2) ||
       !std::isfinite(d.n11_px2) || !std::isfinite(d.n02_px2)) {
     return Reject(RejectReason::kNonFinite, "non-finite vpDot2 centre of gravity or moments");
   }
-  const double half_sum = 0.5 * (d.n20_px2 + d.n02_px2);
-  const double root = std::sqrt(0.25 * (d.n20_px2 - d.n02_px2) * (d.n20_px2 - d.n02_px2) + d.n11_px2 * d.n11_px2);
-  d.semi_major_px = 2.0 * std::sqrt(std::max(0.0, half_sum + root));
-  d.semi_minor_px = 2.0 * std::sqrt(std::max(0.0, half_sum - root));
-  d.angle_rad = 0.5 * std::atan2(2.0 * d.n11_px2, d.n20_px2 - d.n02_px2);
-  d.fill_ratio = d.semi_minor_px > 0 ? d.area_px2 / (M_PI * d.semi_major_px * d.semi_minor_px) : 0.0;
+  SetEllipse(&d);
 
   if (!(d.contrast >= options.min_contrast)) {
     return Reject(RejectReason::kLowContrast, Describe("contrast", d.contrast, "min", options.min_contrast));
   }
-
-  // vpDot2's ellipsoid test, counted here instead of silently inside vpDot2.
   if (options.ellipse_shape_precision > 0) {
-    const double p = options.ellipse_shape_precision;
-    const double c = std::cos(d.angle_rad), s = std::sin(d.angle_rad);
-    const int max_bad = static_cast<int>(kEllipseSamples * options.ellipse_bad_points_fraction);
-    int inner_bad = 0, outer_bad = 0;
-    for (int k = 0; k < kEllipseSamples; ++k) {
-      const double t = 2.0 * M_PI * k / kEllipseSamples;
-      const double ai = p * std::max(0.0, d.semi_major_px - 1.0) * std::cos(t);
-      const double bi = p * std::max(0.0, d.semi_minor_px - 1.0) * std::sin(t);
-      const int ui = static_cast<int>(std::lround(d.cog_binary_px.x() + c * ai - s * bi));
-      const int vi = static_cast<int>(std::lround(d.cog_binary_px.y() + s * ai + c * bi));
-      if (ui < 0 || vi < 0 || ui >= width || vi >= height || static_cast<int>(image[vi][ui]) > threshold) ++inner_bad;
-      const double ao = (2.0 - p) * (d.semi_major_px + 1.0) * std::cos(t);
-      const double bo = (2.0 - p) * (d.semi_minor_px + 1.0) * std::sin(t);
-      const int uo = static_cast<int>(std::lround(d.cog_binary_px.x() + c * ao - s * bo));
-      const int vo = static_cast<int>(std::lround(d.cog_binary_px.y() + s * ao + c * bo));
-      if (uo < 0 || vo < 0 || uo >= width || vo >= height) continue;
-      if (static_cast<int>(image[vo][uo]) <= threshold) ++outer_bad;
-    }
-    if (inner_bad > max_bad || outer_bad > max_bad) {
-      std::ostringstream s_detail;
-      s_detail << "ellipsoid test: " << inner_bad << " inner and " << outer_bad << " outer samples of "
-               << kEllipseSamples << " wrong (max " << max_bad << ")";
-      return Reject(RejectReason::kEllipseTest, s_detail.str());
-    }
+    const std::string failure = EllipseTestFailure(image, threshold, d, options);
+    if (!failure.empty()) return Reject(RejectReason::kEllipseTest, failure);
   }
   const double axis_ratio = d.semi_major_px > 0 ? d.semi_minor_px / d.semi_major_px : 0.0;
   if (axis_ratio < options.min_axis_ratio) {
@@ -329,31 +402,7 @@ BlobVerdict MeasureBlob(const vpImage<unsigned char>& image, int threshold, cons
              << options.max_fill_ratio << "]";
     return Reject(RejectReason::kFillRatio, s_detail.str());
   }
-
-  // Intensity-weighted centroid: weights (background - I)+ over the bbox dilated by refine_margin_px,
-  // other blobs (and their rims) excluded.
-  if (options.refine_centroid) {
-    const int rm = options.refine_margin_px;
-    double sw = 0, su = 0, sv = 0;
-    for (int v = std::max(0, d.bbox.v_min - rm); v <= std::min(height - 1, d.bbox.v_max + rm); ++v) {
-      for (int u = std::max(0, d.bbox.u_min - rm); u <= std::min(width - 1, d.bbox.u_max + rm); ++u) {
-        if (win.At(u, v) == kOther) continue;
-        const double w = d.background_level - static_cast<double>(image[v][u]);
-        if (w <= 0) continue;
-        sw += w;
-        su += w * u;
-        sv += w * v;
-      }
-    }
-    if (sw > 0) {
-      const Eigen::Vector2d c_w(su / sw, sv / sw);
-      if (c_w.allFinite() && c_w.x() >= d.bbox.u_min && c_w.x() <= d.bbox.u_max && c_w.y() >= d.bbox.v_min &&
-          c_w.y() <= d.bbox.v_max) {
-        d.centroid_px = c_w;
-        d.refined = true;
-      }
-    }
-  }
+  if (options.refine_centroid) RefineCentroid(image, win, options.refine_margin_px, &d);
   BlobVerdict ok;
   ok.accepted = true;
   return ok;

@@ -170,6 +170,226 @@ GridIdentityReport Fail(GridIdentityReport report, GridOutcome outcome, const st
   return report;
 }
 
+// Seeds: detections nearest the median position first (inside the grid, away from clutter).
+std::vector<int> SeedOrder(const std::vector<Eigen::Vector2d>& pts) {
+  const Eigen::Vector2d middle(Median([&] { std::vector<double> v; for (const auto& p : pts) v.push_back(p.x()); return v; }()),
+                               Median([&] { std::vector<double> v; for (const auto& p : pts) v.push_back(p.y()); return v; }()));
+  std::vector<int> order(pts.size());
+  for (size_t k = 0; k < pts.size(); ++k) order[k] = static_cast<int>(k);
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return (pts[static_cast<size_t>(a)] - middle).squaredNorm() < (pts[static_cast<size_t>(b)] - middle).squaredNorm();
+  });
+  return order;
+}
+
+// The lattice with the most dots grown from the first `attempts` seeds; stops early at a full grid.
+std::optional<Lattice> GrowBest(const Grower& grower, const std::vector<int>& order, int attempts, int grid_size) {
+  std::optional<Lattice> best;
+  for (int a = 0; a < attempts; ++a) {
+    std::optional<Lattice> lat = grower.Grow(order[static_cast<size_t>(a)]);
+    if (!lat) continue;
+    if (!best || lat->Assigned() > best->Assigned()) best = std::move(lat);
+    if (best->Assigned() >= grid_size) break;
+  }
+  return best;
+}
+
+// The lattice's extent in cells and the homography image_from_cell fitted to all its dots.
+struct LatticeFrame {
+  int i_min = 1 << 30, i_max = -(1 << 30), j_min = 1 << 30, j_max = -(1 << 30);
+  Eigen::Matrix3d image_from_cell;
+  Eigen::Vector2d ImageOf(int i, int j) const { return MapPoint(image_from_cell, Eigen::Vector2d(i, j)); }
+};
+
+void FindExtent(const Lattice& lat, LatticeFrame* frame) {
+  for (const auto& [cell, det] : lat.det_at) {
+    frame->i_min = std::min(frame->i_min, cell.first);
+    frame->i_max = std::max(frame->i_max, cell.first);
+    frame->j_min = std::min(frame->j_min, cell.second);
+    frame->j_max = std::max(frame->j_max, cell.second);
+  }
+}
+
+// D6 over the whole lattice (the seed cell was taken without this check): every assigned position must
+// have exactly one detection within the match tolerance. Empty when so, else what is wrong.
+std::string CheckUniqueMatches(const Lattice& lat, const LatticeFrame& frame, const std::vector<Eigen::Vector2d>& pts,
+                               double match_tolerance) {
+  for (const auto& [cell, det] : lat.det_at) {
+    const Eigen::Vector2d p = frame.ImageOf(cell.first, cell.second);
+    const double step = std::min((frame.ImageOf(cell.first + 1, cell.second) - p).norm(),
+                                 (frame.ImageOf(cell.first, cell.second + 1) - p).norm());
+    int near = 0;
+    for (const Eigen::Vector2d& q : pts) near += (q - p).norm() <= match_tolerance * step ? 1 : 0;
+    if (near != 1) {
+      std::ostringstream s;
+      s << near << " detections within " << match_tolerance * step << " px of lattice cell (" << cell.first << ", "
+        << cell.second << ") at (" << p.x() << ", " << p.y() << ")";
+      return s.str();
+    }
+  }
+  return "";
+}
+
+// Orientation: the origin corner (i0, j0), the inward steps (di, dj), and whether columns run along i.
+struct Orientation {
+  int i0, j0, di, dj;
+  bool col_along_i;
+};
+
+Orientation Orient(const LatticeFrame& frame, int i0, int j0) {
+  Orientation o{i0, j0, i0 == frame.i_min ? 1 : -1, j0 == frame.j_min ? 1 : -1, true};
+  const Eigen::Vector2d a = frame.ImageOf(i0 + o.di, j0) - frame.ImageOf(i0, j0);
+  const Eigen::Vector2d b = frame.ImageOf(i0, j0 + o.dj) - frame.ImageOf(i0, j0);
+  o.col_along_i = Cross2(a, b) < 0;  // d_col x d_row < 0 (counter-clockwise on screen)
+  return o;
+}
+
+// Whether every dot of the lattice lands inside rows x cols in orientation `o`.
+bool Fits(const Lattice& lat, const Orientation& o, int rows, int cols) {
+  for (const auto& [cell, det] : lat.det_at) {
+    const int si = o.di * (cell.first - o.i0), sj = o.dj * (cell.second - o.j0);
+    const int col = o.col_along_i ? si : sj, row = o.col_along_i ? sj : si;
+    if (col < 0 || col >= cols || row < 0 || row >= rows) return false;
+  }
+  return true;
+}
+
+struct AreaRatios {
+  int origin = -1;  // detection with the largest ratio, -1 if none
+  double best = 0, runner_up = 0;
+};
+
+// Each dot's area over the median area of its lattice neighbours: the largest and the next.
+AreaRatios LargestAreaRatios(const Lattice& lat, const std::vector<DotDetection>& detections) {
+  AreaRatios r;
+  for (const auto& [cell, det] : lat.det_at) {
+    std::vector<double> around;
+    for (int di = -1; di <= 1; ++di) {
+      for (int dj = -1; dj <= 1; ++dj) {
+        if (di == 0 && dj == 0) continue;
+        const auto it = lat.det_at.find({cell.first + di, cell.second + dj});
+        if (it != lat.det_at.end()) around.push_back(detections[static_cast<size_t>(it->second)].area_px2);
+      }
+    }
+    const double ratio = detections[static_cast<size_t>(det)].area_px2 / Median(around);
+    if (!std::isfinite(ratio)) continue;
+    if (ratio > r.best) {
+      r.runner_up = r.best;
+      r.best = ratio;
+      r.origin = det;
+    } else if (ratio > r.runner_up) {
+      r.runner_up = ratio;
+    }
+  }
+  return r;
+}
+
+// The orientation from the larger origin dot; false, with `report` failed, when the marker is missing,
+// ambiguous, off the corners, or the dots do not fit from it.
+bool OrientFromMarker(const Lattice& lat, const LatticeFrame& frame, const std::vector<DotDetection>& detections,
+                      const GridIdentityOptions& options, const std::string& extent, Orientation* chosen,
+                      GridIdentityReport* report) {
+  const AreaRatios r = LargestAreaRatios(lat, detections);
+  report->origin_area_ratio = r.best;
+  report->runner_up_area_ratio = r.runner_up;
+  std::ostringstream ratios;
+  ratios << "largest area ratio " << r.best << " (min " << options.min_origin_area_ratio << "), next " << r.runner_up
+         << " (max " << options.max_runner_up_area_ratio << ")";
+  if (r.origin < 0 || r.best < options.min_origin_area_ratio) {
+    *report = Fail(*report, GridOutcome::kNoOriginDot, ratios.str());
+    return false;
+  }
+  if (r.runner_up >= options.max_runner_up_area_ratio) {
+    *report = Fail(*report, GridOutcome::kAmbiguousOrigin, ratios.str());
+    return false;
+  }
+  report->origin_detection_index = r.origin;
+  const Cell oc = *lat.cell_of[static_cast<size_t>(r.origin)];
+  if ((oc.first != frame.i_min && oc.first != frame.i_max) || (oc.second != frame.j_min && oc.second != frame.j_max)) {
+    *report = Fail(*report, GridOutcome::kOriginNotAtCorner, "the larger dot is not at a corner of the " + extent);
+    return false;
+  }
+  *chosen = Orient(frame, oc.first, oc.second);
+  if (!Fits(lat, *chosen, options.rows, options.cols)) {
+    *report = Fail(*report, GridOutcome::kWrongSize,
+                   extent + ": from the origin with the front-side handedness the dots do not fit " +
+                       std::to_string(options.rows) + " rows x " + std::to_string(options.cols) +
+                       " columns (mirrored image, or rows and columns swapped in the configuration)");
+    return false;
+  }
+  report->orientation_from_marker = true;
+  return true;
+}
+
+// Without a marker: of the corners the dots fit from, the one nearest the image's top left (smallest
+// x + y). False, with `report` failed, when none fits.
+bool OrientBySymmetry(const Lattice& lat, const LatticeFrame& frame, const GridIdentityOptions& options,
+                      const std::string& extent, Orientation* chosen, GridIdentityReport* report) {
+  bool any = false;
+  double best_key = 0;
+  for (const int i0 : {frame.i_min, frame.i_max}) {
+    for (const int j0 : {frame.j_min, frame.j_max}) {
+      const Orientation o = Orient(frame, i0, j0);
+      if (!Fits(lat, o, options.rows, options.cols)) continue;
+      const Eigen::Vector2d p = frame.ImageOf(i0, j0);
+      const double key = p.x() + p.y();
+      if (!any || key < best_key) {
+        any = true;
+        best_key = key;
+        *chosen = o;
+      }
+    }
+  }
+  if (!any) {
+    *report = Fail(*report, GridOutcome::kWrongSize, extent + ": no corner fits " + std::to_string(options.rows) +
+                                                         " rows x " + std::to_string(options.cols) + " columns");
+    return false;
+  }
+  const auto it = lat.det_at.find({chosen->i0, chosen->j0});
+  report->origin_detection_index = it != lat.det_at.end() ? it->second : -1;
+  report->orientation_from_marker = false;
+  return true;
+}
+
+// Ids of the lattice's dots in orientation `o`, sorted by id, into report->dots; their (col, row) and
+// pixel positions in lattice order into grid_pts and image_pts (the homography fit's input order).
+void AssignIds(const Lattice& lat, const Orientation& o, const std::vector<Eigen::Vector2d>& pts, int cols,
+               GridIdentityReport* report, std::vector<Eigen::Vector2d>* grid_pts,
+               std::vector<Eigen::Vector2d>* image_pts) {
+  for (const auto& [cell, det] : lat.det_at) {
+    const int si = o.di * (cell.first - o.i0), sj = o.dj * (cell.second - o.j0);
+    GridDot g;
+    g.col = o.col_along_i ? si : sj;
+    g.row = o.col_along_i ? sj : si;
+    g.id = g.row * cols + g.col;
+    g.detection_index = det;
+    g.centroid_px = pts[static_cast<size_t>(det)];
+    report->dots.push_back(g);
+    grid_pts->emplace_back(g.col, g.row);
+    image_pts->push_back(g.centroid_px);
+  }
+  std::sort(report->dots.begin(), report->dots.end(), [](const GridDot& a, const GridDot& b) { return a.id < b.id; });
+}
+
+// Each dot's residual to the grid homography h, their RMS and maximum, and the median spacing (px).
+void MeasureResiduals(const Eigen::Matrix3d& h, GridIdentityReport* report) {
+  double sum2 = 0, worst = 0;
+  for (GridDot& g : report->dots) {
+    g.residual_px = (MapPoint(h, Eigen::Vector2d(g.col, g.row)) - g.centroid_px).norm();
+    sum2 += g.residual_px * g.residual_px;
+    worst = std::max(worst, g.residual_px);
+  }
+  report->rms_residual_px = std::sqrt(sum2 / static_cast<double>(report->dots.size()));
+  report->max_residual_px = worst;
+  std::vector<double> steps;
+  for (const GridDot& g : report->dots) {
+    const Eigen::Vector2d p = MapPoint(h, Eigen::Vector2d(g.col, g.row));
+    steps.push_back((MapPoint(h, Eigen::Vector2d(g.col + 1, g.row)) - p).norm());
+    steps.push_back((MapPoint(h, Eigen::Vector2d(g.col, g.row + 1)) - p).norm());
+  }
+  report->median_spacing_px = Median(steps);
+}
+
 }  // namespace
 
 const char* GridOutcomeName(GridOutcome outcome) {
@@ -230,23 +450,10 @@ GridIdentityReport IdentifyGrid(const std::vector<DotDetection>& detections, con
     return Fail(report, GridOutcome::kTooFewDots, s.str());
   }
 
-  // Seeds: detections nearest the median position first (inside the grid, away from clutter).
-  const Eigen::Vector2d middle(Median([&] { std::vector<double> v; for (const auto& p : pts) v.push_back(p.x()); return v; }()),
-                               Median([&] { std::vector<double> v; for (const auto& p : pts) v.push_back(p.y()); return v; }()));
-  std::vector<int> order(pts.size());
-  for (size_t k = 0; k < pts.size(); ++k) order[k] = static_cast<int>(k);
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
-    return (pts[static_cast<size_t>(a)] - middle).squaredNorm() < (pts[static_cast<size_t>(b)] - middle).squaredNorm();
-  });
+  const std::vector<int> order = SeedOrder(pts);
   const Grower grower(pts, options.match_tolerance, 2 * std::max(rows, cols));
-  std::optional<Lattice> best;
   const int attempts = std::min<int>(options.max_seed_attempts, static_cast<int>(order.size()));
-  for (int a = 0; a < attempts; ++a) {
-    std::optional<Lattice> lat = grower.Grow(order[static_cast<size_t>(a)]);
-    if (!lat) continue;
-    if (!best || lat->Assigned() > best->Assigned()) best = std::move(lat);
-    if (best->Assigned() >= rows * cols) break;
-  }
+  const std::optional<Lattice> best = GrowBest(grower, order, attempts, rows * cols);
   if (!best) {
     return Fail(report, GridOutcome::kNoLattice,
                 "no seed among the " + std::to_string(attempts) + " nearest the middle closed a 2 x 2 lattice cell");
@@ -256,177 +463,49 @@ GridIdentityReport IdentifyGrid(const std::vector<DotDetection>& detections, con
   report.unassigned_detections = static_cast<int>(pts.size()) - lat.Assigned();
   if (lat.ambiguities > 0) return Fail(report, GridOutcome::kAmbiguousMatch, lat.ambiguity_note);
 
-  int i_min = 1 << 30, i_max = -(1 << 30), j_min = 1 << 30, j_max = -(1 << 30);
-  for (const auto& [cell, det] : lat.det_at) {
-    i_min = std::min(i_min, cell.first);
-    i_max = std::max(i_max, cell.first);
-    j_min = std::min(j_min, cell.second);
-    j_max = std::max(j_max, cell.second);
-  }
-  const int n_i = i_max - i_min + 1, n_j = j_max - j_min + 1;
-  std::ostringstream extent;
-  extent << "lattice of " << n_i << " x " << n_j << " cells with " << lat.Assigned() << " dots, configured " << rows
-         << " x " << cols;
+  LatticeFrame frame;
+  FindExtent(lat, &frame);
+  const int n_i = frame.i_max - frame.i_min + 1, n_j = frame.j_max - frame.j_min + 1;
+  std::ostringstream extent_stream;
+  extent_stream << "lattice of " << n_i << " x " << n_j << " cells with " << lat.Assigned() << " dots, configured "
+                << rows << " x " << cols;
+  const std::string extent = extent_stream.str();
   if (std::max(n_i, n_j) > std::max(rows, cols) || std::min(n_i, n_j) > std::min(rows, cols)) {
-    return Fail(report, GridOutcome::kWrongSize, extent.str());
+    return Fail(report, GridOutcome::kWrongSize, extent);
   }
   if (options.require_complete && lat.Assigned() < rows * cols) {
-    return Fail(report, GridOutcome::kIncomplete, extent.str());
+    return Fail(report, GridOutcome::kIncomplete, extent);
   }
   const std::optional<Eigen::Matrix3d> image_from_cell = grower.FitOf(lat, nullptr);
-  if (!image_from_cell) return Fail(report, GridOutcome::kNoLattice, "degenerate lattice: " + extent.str());
-  auto image_of = [&](int i, int j) { return MapPoint(*image_from_cell, Eigen::Vector2d(i, j)); };
-  // D6 over the whole lattice (the seed cell was taken without this check): every assigned position must
-  // have exactly one detection within the match tolerance.
-  for (const auto& [cell, det] : lat.det_at) {
-    const Eigen::Vector2d p = image_of(cell.first, cell.second);
-    const double step = std::min((image_of(cell.first + 1, cell.second) - p).norm(),
-                                 (image_of(cell.first, cell.second + 1) - p).norm());
-    int near = 0;
-    for (const Eigen::Vector2d& q : pts) near += (q - p).norm() <= options.match_tolerance * step ? 1 : 0;
-    if (near != 1) {
-      std::ostringstream s;
-      s << near << " detections within " << options.match_tolerance * step << " px of lattice cell (" << cell.first
-        << ", " << cell.second << ") at (" << p.x() << ", " << p.y() << ")";
-      return Fail(report, GridOutcome::kAmbiguousMatch, s.str());
-    }
-  }
-
-  // Orientation: the origin corner (i0, j0), the inward steps (di, dj), and whether columns run along i.
-  struct Orientation {
-    int i0, j0, di, dj;
-    bool col_along_i;
-  };
-  auto orient = [&](int i0, int j0) {
-    Orientation o{i0, j0, i0 == i_min ? 1 : -1, j0 == j_min ? 1 : -1, true};
-    const Eigen::Vector2d a = image_of(i0 + o.di, j0) - image_of(i0, j0);
-    const Eigen::Vector2d b = image_of(i0, j0 + o.dj) - image_of(i0, j0);
-    o.col_along_i = Cross2(a, b) < 0;  // d_col x d_row < 0 (counter-clockwise on screen)
-    return o;
-  };
-  auto fits = [&](const Orientation& o) {
-    for (const auto& [cell, det] : lat.det_at) {
-      const int si = o.di * (cell.first - o.i0), sj = o.dj * (cell.second - o.j0);
-      const int col = o.col_along_i ? si : sj, row = o.col_along_i ? sj : si;
-      if (col < 0 || col >= cols || row < 0 || row >= rows) return false;
-    }
-    return true;
-  };
+  if (!image_from_cell) return Fail(report, GridOutcome::kNoLattice, "degenerate lattice: " + extent);
+  frame.image_from_cell = *image_from_cell;
+  const std::string ambiguous = CheckUniqueMatches(lat, frame, pts, options.match_tolerance);
+  if (!ambiguous.empty()) return Fail(report, GridOutcome::kAmbiguousMatch, ambiguous);
 
   Orientation chosen{};
-  if (options.origin_marker == OriginMarker::kLargerDot) {
-    // Each dot's area over the median area of its lattice neighbours.
-    int origin = -1;
-    double best_ratio = 0, runner_up = 0;
-    for (const auto& [cell, det] : lat.det_at) {
-      std::vector<double> around;
-      for (int di = -1; di <= 1; ++di) {
-        for (int dj = -1; dj <= 1; ++dj) {
-          if (di == 0 && dj == 0) continue;
-          const auto it = lat.det_at.find({cell.first + di, cell.second + dj});
-          if (it != lat.det_at.end()) around.push_back(detections[static_cast<size_t>(it->second)].area_px2);
-        }
-      }
-      const double ratio = detections[static_cast<size_t>(det)].area_px2 / Median(around);
-      if (!std::isfinite(ratio)) continue;
-      if (ratio > best_ratio) {
-        runner_up = best_ratio;
-        best_ratio = ratio;
-        origin = det;
-      } else if (ratio > runner_up) {
-        runner_up = ratio;
-      }
-    }
-    report.origin_area_ratio = best_ratio;
-    report.runner_up_area_ratio = runner_up;
-    std::ostringstream ratios;
-    ratios << "largest area ratio " << best_ratio << " (min " << options.min_origin_area_ratio << "), next "
-           << runner_up << " (max " << options.max_runner_up_area_ratio << ")";
-    if (origin < 0 || best_ratio < options.min_origin_area_ratio) {
-      return Fail(report, GridOutcome::kNoOriginDot, ratios.str());
-    }
-    if (runner_up >= options.max_runner_up_area_ratio) {
-      return Fail(report, GridOutcome::kAmbiguousOrigin, ratios.str());
-    }
-    report.origin_detection_index = origin;
-    const Cell oc = *lat.cell_of[static_cast<size_t>(origin)];
-    if ((oc.first != i_min && oc.first != i_max) || (oc.second != j_min && oc.second != j_max)) {
-      return Fail(report, GridOutcome::kOriginNotAtCorner, "the larger dot is not at a corner of the " + extent.str());
-    }
-    chosen = orient(oc.first, oc.second);
-    if (!fits(chosen)) {
-      return Fail(report, GridOutcome::kWrongSize,
-                  extent.str() + ": from the origin with the front-side handedness the dots do not fit " +
-                      std::to_string(rows) + " rows x " + std::to_string(cols) +
-                      " columns (mirrored image, or rows and columns swapped in the configuration)");
-    }
-    report.orientation_from_marker = true;
-  } else {
-    bool any = false;
-    double best_key = 0;
-    for (const int i0 : {i_min, i_max}) {
-      for (const int j0 : {j_min, j_max}) {
-        const Orientation o = orient(i0, j0);
-        if (!fits(o)) continue;
-        const Eigen::Vector2d p = image_of(i0, j0);
-        const double key = p.x() + p.y();
-        if (!any || key < best_key) {
-          any = true;
-          best_key = key;
-          chosen = o;
-        }
-      }
-    }
-    if (!any) return Fail(report, GridOutcome::kWrongSize, extent.str() + ": no corner fits " + std::to_string(rows) + " rows x " + std::to_string(cols) + " columns");
-    const auto it = lat.det_at.find({chosen.i0, chosen.j0});
-    report.origin_detection_index = it != lat.det_at.end() ? it->second : -1;
-    report.orientation_from_marker = false;
-  }
+  const bool oriented = options.origin_marker == OriginMarker::kLargerDot
+                            ? OrientFromMarker(lat, frame, detections, options, extent, &chosen, &report)
+                            : OrientBySymmetry(lat, frame, options, extent, &chosen, &report);
+  if (!oriented) return report;
 
   // Ids, and the homography of the whole grid in (col, row) units.
   std::vector<Eigen::Vector2d> grid_pts, image_pts;
-  for (const auto& [cell, det] : lat.det_at) {
-    const int si = chosen.di * (cell.first - chosen.i0), sj = chosen.dj * (cell.second - chosen.j0);
-    GridDot g;
-    g.col = chosen.col_along_i ? si : sj;
-    g.row = chosen.col_along_i ? sj : si;
-    g.id = g.row * cols + g.col;
-    g.detection_index = det;
-    g.centroid_px = pts[static_cast<size_t>(det)];
-    report.dots.push_back(g);
-    grid_pts.emplace_back(g.col, g.row);
-    image_pts.push_back(g.centroid_px);
-  }
-  std::sort(report.dots.begin(), report.dots.end(), [](const GridDot& a, const GridDot& b) { return a.id < b.id; });
+  AssignIds(lat, chosen, pts, cols, &report, &grid_pts, &image_pts);
   const std::optional<Eigen::Matrix3d> h = FitHomography(grid_pts, image_pts);
-  if (!h) return Fail(report, GridOutcome::kNoLattice, "degenerate grid homography: " + extent.str());
+  if (!h) return Fail(report, GridOutcome::kNoLattice, "degenerate grid homography: " + extent);
   report.image_from_grid = *h;
-  double sum2 = 0, worst = 0;
-  for (GridDot& g : report.dots) {
-    g.residual_px = (MapPoint(*h, Eigen::Vector2d(g.col, g.row)) - g.centroid_px).norm();
-    sum2 += g.residual_px * g.residual_px;
-    worst = std::max(worst, g.residual_px);
-  }
-  report.rms_residual_px = std::sqrt(sum2 / static_cast<double>(report.dots.size()));
-  report.max_residual_px = worst;
-  std::vector<double> steps;
-  for (const GridDot& g : report.dots) {
-    const Eigen::Vector2d p = MapPoint(*h, Eigen::Vector2d(g.col, g.row));
-    steps.push_back((MapPoint(*h, Eigen::Vector2d(g.col + 1, g.row)) - p).norm());
-    steps.push_back((MapPoint(*h, Eigen::Vector2d(g.col, g.row + 1)) - p).norm());
-  }
-  report.median_spacing_px = Median(steps);
+  MeasureResiduals(*h, &report);
   const double limit = options.max_residual_spacing * report.median_spacing_px;
-  if (!(worst <= limit)) {
+  if (!(report.max_residual_px <= limit)) {
     std::ostringstream s;
-    s << "a dot is " << worst << " px from the grid homography (max " << limit << " = "
+    s << "a dot is " << report.max_residual_px << " px from the grid homography (max " << limit << " = "
       << options.max_residual_spacing << " x spacing " << report.median_spacing_px << ", rms "
       << report.rms_residual_px << ")";
     return Fail(report, GridOutcome::kLargeResidual, s.str());
   }
   report.outcome = GridOutcome::kSuccess;
   std::ostringstream s;
-  s << report.dots.size() << " ids from a " << extent.str()
+  s << report.dots.size() << " ids from a " << extent
     << (report.orientation_from_marker ? ", origin from the larger dot" : ", orientation up to the grid's symmetry (no marker)");
   report.message = s.str();
   return report;

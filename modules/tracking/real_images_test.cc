@@ -189,17 +189,16 @@ int CirclesGridAgreement(const vpImage<unsigned char>& img, const GridIdentityRe
   return agreeing;
 }
 
-TEST(RealImages, RosIndustrialDotGrid10x10) {
-  if (!Exists(kDotGridDir + "/images/0.png")) {
-    GTEST_SKIP() << "data folder absent: " << kDotGridDir;
-  }
-  constexpr int kImages = 15, kN = 10;
-  constexpr double kSpacing = 0.0254;
-  const auto intr = ReadFlatYaml(kDotGridDir + "/rct_camera_intr_calibrated.yaml");
-  ASSERT_EQ(intr.count("fx") + intr.count("fy") + intr.count("cx") + intr.count("cy"), 4u);
-  const cv::Matx33d k_cam(intr.at("fx"), 0, intr.at("cx"), 0, intr.at("fy"), intr.at("cy"), 0, 0, 1);
+constexpr int kDotGridImages = 15, kDotGridN = 10;
+constexpr double kDotGridSpacing = 0.0254;  // m
 
-  // The blob detector configured as in the data's cal_data.yaml (industrial_calibration's finder).
+double MedianOf(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+// The blob detector configured as in the data's cal_data.yaml (industrial_calibration's finder).
+cv::Ptr<cv::FeatureDetector> DotGridBlobDetector() {
   cv::SimpleBlobDetector::Params params;
   params.minThreshold = 20;
   params.maxThreshold = 220;
@@ -214,83 +213,89 @@ TEST(RealImages, RosIndustrialDotGrid10x10) {
   params.filterByInertia = false;
   params.filterByConvexity = true;
   params.minConvexity = 0.95f;
-  const cv::Ptr<cv::FeatureDetector> blobs = cv::SimpleBlobDetector::create(params);
+  return cv::SimpleBlobDetector::create(params);
+}
 
-  std::vector<Pose> base_from_wrist, cam_from_target;
-  std::vector<std::vector<cv::Point2f>> all_grid, all_image;
-  std::vector<std::vector<cv::Point3d>> all_obj;
-  std::vector<double> corner_distance_px;
+// What the dot-grid test collects image by image for the checks over all images.
+struct DotGridImages {
+  std::vector<Pose> base_from_wrist;
+  std::vector<std::vector<cv::Point2f>> grid, image;  // per image, in id order
+  std::vector<std::vector<cv::Point3d>> obj;          // target points (m), in id order
+  std::vector<double> corner_distance_px;             // origin to the nearest other corner
   int found_total = 0, identified = 0, cv_checked = 0;
-  for (int n = 0; n < kImages; ++n) {
-    SCOPED_TRACE("image " + std::to_string(n));
-    vpImage<unsigned char> img;
-    vpImageIo::read(img, kDotGridDir + "/images/" + std::to_string(n) + ".png");
-    const DetectionReport det = DetectDots(img, DotDetectorOptions());
-    GridIdentityOptions go;
-    go.rows = go.cols = kN;
-    const GridIdentityReport r = IdentifyGrid(det.dots, go);
-    ASSERT_EQ(r.outcome, GridOutcome::kSuccess) << GridOutcomeName(r.outcome) << ": " << r.message << " ("
-                                                << det.dots.size() << " dots, rejected " << det.rejections.ToString() << ")";
-    ASSERT_EQ(r.dots.size(), 100u);
-    found_total += static_cast<int>(r.dots.size());
+};
 
-    // (a) every dot on OpenCV's homography of the ideal grid; checked below, after the lens distortion
-    // (no model in the data's intrinsics) is taken out. Here: a dot off by a lattice step would be ~18 px.
-    const double worst = MaxHomographyResidual(r, kSpacing);
-    EXPECT_LT(worst, 4.0);
-    std::vector<cv::Point2f> grid_pts, image_pts;
-    for (const GridDot& g : r.dots) {
-      grid_pts.emplace_back(static_cast<float>(g.col), static_cast<float>(g.row));
-      image_pts.emplace_back(static_cast<float>(g.centroid_px.x()), static_cast<float>(g.centroid_px.y()));
-    }
-    all_grid.push_back(grid_pts);
-    all_image.push_back(image_pts);
-    // (b) the origin is the larger dot: the largest area, at least twice the median.
-    std::vector<double> areas;
-    for (const GridDot& g : r.dots) areas.push_back(det.dots[static_cast<size_t>(g.detection_index)].area_px2);
-    const double origin_area = areas[0];
-    std::nth_element(areas.begin(), areas.begin() + 50, areas.end());
-    EXPECT_GT(origin_area, 2.0 * areas[50]);
-    EXPECT_EQ(origin_area, *std::max_element(areas.begin(), areas.end()));
-    // (c) OpenCV's circle grid finder orders the same lattice: exactly one symmetry maps its order to ours.
-    const int agree = CirclesGridAgreement(img, r, kN, 1.5, blobs);
-    if (agree >= 0) {
-      ++cv_checked;
-      EXPECT_EQ(agree, 1);
-    }
-    // (d) PnP with the ids (below, once the lens distortion is known): the printed face (+z towards the
-    // viewer) must face the camera.
-    std::vector<cv::Point3d> obj;
-    for (const GridDot& g : r.dots) {
-      const Eigen::Vector3d p = GridPointInTarget(g.row, g.col, kSpacing);
-      obj.emplace_back(p.x(), p.y(), p.z());
-    }
-    all_obj.push_back(obj);
-    const auto pose = ReadFlatYaml(kDotGridDir + "/poses/" + std::to_string(n) + ".yaml");
-    Pose bw;
-    bw.r = Eigen::Quaterniond(pose.at("qw"), pose.at("qx"), pose.at("qy"), pose.at("qz")).normalized().toRotationMatrix();
-    bw.t = Eigen::Vector3d(pose.at("x"), pose.at("y"), pose.at("z"));
-    base_from_wrist.push_back(bw);
-    corner_distance_px.push_back(std::min({(r.dots[kN - 1].centroid_px - r.dots[0].centroid_px).norm(),
-                                           (r.dots[kN * (kN - 1)].centroid_px - r.dots[0].centroid_px).norm(),
-                                           (r.dots[kN * kN - 1].centroid_px - r.dots[0].centroid_px).norm()}));
-    ++identified;
-    std::cout << "[ dotgrid ] image " << n << ": " << det.dots.size() << " dots detected ("
-              << det.rejections.ToString() << "), 100 identified, homography max residual " << worst
-              << " px, grid rms " << r.rms_residual_px << " px, origin area ratio " << r.origin_area_ratio
-              << (agree >= 0 ? ", findCirclesGrid agrees" : ", findCirclesGrid failed") << "\n";
+// Image n: every dot found and identified, checks (a)-(c) of the file comment, and its data for the
+// checks over all images.
+void CheckDotGridImage(int n, const cv::Ptr<cv::FeatureDetector>& blobs, DotGridImages* all) {
+  constexpr int kN = kDotGridN;
+  vpImage<unsigned char> img;
+  vpImageIo::read(img, kDotGridDir + "/images/" + std::to_string(n) + ".png");
+  const DetectionReport det = DetectDots(img, DotDetectorOptions());
+  GridIdentityOptions go;
+  go.rows = go.cols = kN;
+  const GridIdentityReport r = IdentifyGrid(det.dots, go);
+  ASSERT_EQ(r.outcome, GridOutcome::kSuccess) << GridOutcomeName(r.outcome) << ": " << r.message << " ("
+                                              << det.dots.size() << " dots, rejected " << det.rejections.ToString() << ")";
+  ASSERT_EQ(r.dots.size(), 100u);
+  all->found_total += static_cast<int>(r.dots.size());
+
+  // (a) every dot on OpenCV's homography of the ideal grid; checked below, after the lens distortion
+  // (no model in the data's intrinsics) is taken out. Here: a dot off by a lattice step would be ~18 px.
+  const double worst = MaxHomographyResidual(r, kDotGridSpacing);
+  EXPECT_LT(worst, 4.0);
+  std::vector<cv::Point2f> grid_pts, image_pts;
+  for (const GridDot& g : r.dots) {
+    grid_pts.emplace_back(static_cast<float>(g.col), static_cast<float>(g.row));
+    image_pts.emplace_back(static_cast<float>(g.centroid_px.x()), static_cast<float>(g.centroid_px.y()));
   }
+  all->grid.push_back(grid_pts);
+  all->image.push_back(image_pts);
+  // (b) the origin is the larger dot: the largest area, at least twice the median.
+  std::vector<double> areas;
+  for (const GridDot& g : r.dots) areas.push_back(det.dots[static_cast<size_t>(g.detection_index)].area_px2);
+  const double origin_area = areas[0];
+  std::nth_element(areas.begin(), areas.begin() + 50, areas.end());
+  EXPECT_GT(origin_area, 2.0 * areas[50]);
+  EXPECT_EQ(origin_area, *std::max_element(areas.begin(), areas.end()));
+  // (c) OpenCV's circle grid finder orders the same lattice: exactly one symmetry maps its order to ours.
+  const int agree = CirclesGridAgreement(img, r, kN, 1.5, blobs);
+  if (agree >= 0) {
+    ++all->cv_checked;
+    EXPECT_EQ(agree, 1);
+  }
+  // (d) PnP with the ids (later, once the lens distortion is known): the target points.
+  std::vector<cv::Point3d> obj;
+  for (const GridDot& g : r.dots) {
+    const Eigen::Vector3d p = GridPointInTarget(g.row, g.col, kDotGridSpacing);
+    obj.emplace_back(p.x(), p.y(), p.z());
+  }
+  all->obj.push_back(obj);
+  const auto pose = ReadFlatYaml(kDotGridDir + "/poses/" + std::to_string(n) + ".yaml");
+  Pose bw;
+  bw.r = Eigen::Quaterniond(pose.at("qw"), pose.at("qx"), pose.at("qy"), pose.at("qz")).normalized().toRotationMatrix();
+  bw.t = Eigen::Vector3d(pose.at("x"), pose.at("y"), pose.at("z"));
+  all->base_from_wrist.push_back(bw);
+  all->corner_distance_px.push_back(std::min({(r.dots[kN - 1].centroid_px - r.dots[0].centroid_px).norm(),
+                                              (r.dots[kN * (kN - 1)].centroid_px - r.dots[0].centroid_px).norm(),
+                                              (r.dots[kN * kN - 1].centroid_px - r.dots[0].centroid_px).norm()}));
+  ++all->identified;
+  std::cout << "[ dotgrid ] image " << n << ": " << det.dots.size() << " dots detected ("
+            << det.rejections.ToString() << "), 100 identified, homography max residual " << worst
+            << " px, grid rms " << r.rms_residual_px << " px, origin area ratio " << r.origin_area_ratio
+            << (agree >= 0 ? ", findCirclesGrid agrees" : ", findCirclesGrid failed") << "\n";
+}
 
-  // (a) continued: with one radial distortion (k1, k2) for the camera, fitted to all 1500 dots, every dot of
-  // every image lies within 1 px of its image's homography. The plain homography leaves up to ~3 px in the
-  // image corner (image 2, dots 1-2 px from the left and bottom edges): lens distortion, the same for all.
-  // The origin dot gets 1.5 px: its radius is twice the others', and the centroid's perspective and
-  // distortion biases grow with the radius squared (image 2's sits in the corner, touching the edge).
-  const auto [k1, k2] = FitRadialDistortion(all_grid, all_image, k_cam);
+// (a) continued: with one radial distortion (k1, k2) for the camera, fitted to all 1500 dots, every dot of
+// every image lies within 1 px of its image's homography. The plain homography leaves up to ~3 px in the
+// image corner (image 2, dots 1-2 px from the left and bottom edges): lens distortion, the same for all.
+// The origin dot gets 1.5 px: its radius is twice the others', and the centroid's perspective and
+// distortion biases grow with the radius squared (image 2's sits in the corner, touching the edge).
+void CheckUndistortedHomographies(const DotGridImages& all, const cv::Matx33d& k_cam, double k1, double k2) {
   double worst_undistorted = 0;
   std::string worst_where;
-  for (size_t i = 0; i < all_grid.size(); ++i) {
-    const std::vector<double> res = HomographyResiduals(all_grid[i], Undistort(all_image[i], k_cam, k1, k2));
+  for (size_t i = 0; i < all.grid.size(); ++i) {
+    const std::vector<double> res = HomographyResiduals(all.grid[i], Undistort(all.image[i], k_cam, k1, k2));
     for (size_t id = 0; id < res.size(); ++id) {
       EXPECT_LT(res[id], id == 0 ? 1.5 : 1.0) << "image " << i << " id " << id << " with k1 " << k1 << " k2 " << k2;
       if (res[id] > worst_undistorted) {
@@ -301,12 +306,16 @@ TEST(RealImages, RosIndustrialDotGrid10x10) {
   }
   std::cout << "[ dotgrid ] radial distortion fitted over all images: k1 " << k1 << ", k2 " << k2
             << "; worst homography residual then " << worst_undistorted << " px (" << worst_where << ")\n";
+}
 
-  // (d) continued: PnP on the undistorted centroids.
-  for (size_t i = 0; i < all_obj.size(); ++i) {
-    const std::vector<cv::Point2f> und = Undistort(all_image[i], k_cam, k1, k2);
+// (d) continued: PnP on the undistorted centroids; the printed face (+z towards the viewer) must face
+// the camera.
+void SolvePnPPoses(const DotGridImages& all, const cv::Matx33d& k_cam, double k1, double k2,
+                   std::vector<Pose>* cam_from_target) {
+  for (size_t i = 0; i < all.obj.size(); ++i) {
+    const std::vector<cv::Point2f> und = Undistort(all.image[i], k_cam, k1, k2);
     cv::Vec3d rvec, tvec;
-    ASSERT_TRUE(cv::solvePnP(all_obj[i], und, k_cam, cv::noArray(), rvec, tvec));
+    ASSERT_TRUE(cv::solvePnP(all.obj[i], und, k_cam, cv::noArray(), rvec, tvec));
     cv::Matx33d rm;
     cv::Rodrigues(rvec, rm);
     Pose ct;
@@ -315,14 +324,18 @@ TEST(RealImages, RosIndustrialDotGrid10x10) {
       ct.t(a) = tvec(a);
     }
     EXPECT_LT(ct.r(2, 2), 0.0) << "image " << i << ": the target's +z does not point at the camera (seen from behind?)";
-    cam_from_target.push_back(ct);
+    cam_from_target->push_back(ct);
   }
+}
 
-  // (e) relative rotations: the camera's (from the ids) against the wrist's (from the robot).
+// (e) relative rotations: the camera's (from the ids) against the wrist's (from the robot). Returns the
+// differences (deg) over all pairs.
+std::vector<double> CheckRelativeRotations(const std::vector<Pose>& base_from_wrist,
+                                           const std::vector<Pose>& cam_from_target) {
   std::vector<double> diffs;
-  std::vector<std::vector<double>> per_image(kImages);
-  for (int i = 0; i < kImages; ++i) {
-    for (int j = i + 1; j < kImages; ++j) {
+  std::vector<std::vector<double>> per_image(kDotGridImages);
+  for (int i = 0; i < kDotGridImages; ++i) {
+    for (int j = i + 1; j < kDotGridImages; ++j) {
       const double cam = AngleDeg(cam_from_target[static_cast<size_t>(i)].r * cam_from_target[static_cast<size_t>(j)].r.transpose());
       const double wrist = AngleDeg(base_from_wrist[static_cast<size_t>(i)].r.transpose() * base_from_wrist[static_cast<size_t>(j)].r);
       diffs.push_back(std::abs(cam - wrist));
@@ -330,45 +343,69 @@ TEST(RealImages, RosIndustrialDotGrid10x10) {
       per_image[static_cast<size_t>(j)].push_back(diffs.back());
     }
   }
-  auto median = [](std::vector<double> v) {
-    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-    return v[v.size() / 2];
-  };
   // README: median 1.6 deg on these Kinect-quality images; a wrong origin corner in one image would shift
   // its pairs by tens of degrees.
-  EXPECT_LT(median(diffs), 3.0);
-  for (int i = 0; i < kImages; ++i) EXPECT_LT(median(per_image[static_cast<size_t>(i)]), 5.0) << "image " << i;
+  EXPECT_LT(MedianOf(diffs), 3.0);
+  for (int i = 0; i < kDotGridImages; ++i) EXPECT_LT(MedianOf(per_image[static_cast<size_t>(i)]), 5.0) << "image " << i;
+  return diffs;
+}
 
-  // (f) each image's origin dot where the other 14 images put it: hand-eye from them, the target's origin
-  // in the base frame averaged over them, projected into the left-out image.
-  int misplaced = 0;
+// (f) each image's origin dot where the other 14 images put it: hand-eye from them, the target's origin
+// in the base frame averaged over them, projected into the left-out image. Returns the worst error (px)
+// and counts the misplaced origins.
+double CheckOriginPredictions(const DotGridImages& all, const std::vector<Pose>& cam_from_target,
+                              const cv::Matx33d& k_cam, double k1, double k2, int* misplaced) {
   double worst_origin = 0;
-  for (int k = 0; k < kImages; ++k) {
+  for (int k = 0; k < kDotGridImages; ++k) {
     std::vector<Pose> bw, ct;
-    for (int i = 0; i < kImages; ++i) {
+    for (int i = 0; i < kDotGridImages; ++i) {
       if (i == k) continue;
-      bw.push_back(base_from_wrist[static_cast<size_t>(i)]);
+      bw.push_back(all.base_from_wrist[static_cast<size_t>(i)]);
       ct.push_back(cam_from_target[static_cast<size_t>(i)]);
     }
     const Pose wrist_from_cam = HandEye(bw, ct);
     Eigen::Vector3d origin_in_base = Eigen::Vector3d::Zero();
     for (size_t i = 0; i < bw.size(); ++i) origin_in_base += (bw[i] * wrist_from_cam * ct[i]).t;
     origin_in_base /= static_cast<double>(bw.size());
-    const Pose cam_from_base = (base_from_wrist[static_cast<size_t>(k)] * wrist_from_cam).Inverse();
+    const Pose cam_from_base = (all.base_from_wrist[static_cast<size_t>(k)] * wrist_from_cam).Inverse();
     const Eigen::Vector3d p = cam_from_base.r * origin_in_base + cam_from_base.t;
     const Eigen::Vector2d uv(k_cam(0, 0) * p.x() / p.z() + k_cam(0, 2), k_cam(1, 1) * p.y() / p.z() + k_cam(1, 2));
-    const cv::Point2f origin_und = Undistort({all_image[static_cast<size_t>(k)][0]}, k_cam, k1, k2)[0];
+    const cv::Point2f origin_und = Undistort({all.image[static_cast<size_t>(k)][0]}, k_cam, k1, k2)[0];
     const double err = (uv - Eigen::Vector2d(origin_und.x, origin_und.y)).norm();
     worst_origin = std::max(worst_origin, err);
     // Another corner is >= corner_distance away; a quarter of it separates "right corner, some hand-eye
     // error" (the README's 6-10 mm target spread is ~5-10 px) from "wrong corner".
-    EXPECT_LT(err, 0.25 * corner_distance_px[static_cast<size_t>(k)]) << "image " << k;
-    misplaced += err >= 0.25 * corner_distance_px[static_cast<size_t>(k)] ? 1 : 0;
+    EXPECT_LT(err, 0.25 * all.corner_distance_px[static_cast<size_t>(k)]) << "image " << k;
+    *misplaced += err >= 0.25 * all.corner_distance_px[static_cast<size_t>(k)] ? 1 : 0;
   }
-  std::cout << "[ dotgrid ] " << identified << "/15 images, " << found_total << " dots identified; relative rotation "
-            << "camera vs wrist: median " << median(diffs) << " deg, max " << *std::max_element(diffs.begin(), diffs.end())
+  return worst_origin;
+}
+
+TEST(RealImages, RosIndustrialDotGrid10x10) {
+  if (!Exists(kDotGridDir + "/images/0.png")) {
+    GTEST_SKIP() << "data folder absent: " << kDotGridDir;
+  }
+  const auto intr = ReadFlatYaml(kDotGridDir + "/rct_camera_intr_calibrated.yaml");
+  ASSERT_EQ(intr.count("fx") + intr.count("fy") + intr.count("cx") + intr.count("cy"), 4u);
+  const cv::Matx33d k_cam(intr.at("fx"), 0, intr.at("cx"), 0, intr.at("fy"), intr.at("cy"), 0, 0, 1);
+  const cv::Ptr<cv::FeatureDetector> blobs = DotGridBlobDetector();
+
+  DotGridImages all;
+  for (int n = 0; n < kDotGridImages; ++n) {
+    SCOPED_TRACE("image " + std::to_string(n));
+    ASSERT_NO_FATAL_FAILURE(CheckDotGridImage(n, blobs, &all));
+  }
+  const auto [k1, k2] = FitRadialDistortion(all.grid, all.image, k_cam);
+  CheckUndistortedHomographies(all, k_cam, k1, k2);
+  std::vector<Pose> cam_from_target;
+  ASSERT_NO_FATAL_FAILURE(SolvePnPPoses(all, k_cam, k1, k2, &cam_from_target));
+  const std::vector<double> diffs = CheckRelativeRotations(all.base_from_wrist, cam_from_target);
+  int misplaced = 0;
+  const double worst_origin = CheckOriginPredictions(all, cam_from_target, k_cam, k1, k2, &misplaced);
+  std::cout << "[ dotgrid ] " << all.identified << "/15 images, " << all.found_total << " dots identified; relative rotation "
+            << "camera vs wrist: median " << MedianOf(diffs) << " deg, max " << *std::max_element(diffs.begin(), diffs.end())
             << " deg; origin predicted from the other 14 images: worst " << worst_origin << " px, " << misplaced
-            << " misplaced; findCirclesGrid cross-check on " << cv_checked << " images\n";
+            << " misplaced; findCirclesGrid cross-check on " << all.cv_checked << " images\n";
 }
 
 TEST(RealImages, VispCirclesGrid6x6) {

@@ -1,4 +1,5 @@
-// Pure epipolar geometry: 8-point, Bougnoux focal, Theorem 1 factorisation, triangulation, distances.
+// Pure epipolar geometry: 8-point, Bougnoux focal, Theorem 1 factorisation, triangulation, cheirality
+// (the choice among candidates, G5), distances.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -164,6 +165,62 @@ CheiralityCount CountCheirality(const Rigid3& cam2_from_cam1, const std::vector<
     if (ray1.dot(ray2) <= cos_min) ++count.behind;
   }
   return count;
+}
+
+namespace {
+
+// G5: the winner must hold more than half of the inliers in front of both cameras and leave at most 10 %
+// confidently behind (ORB-SLAM2 asks 90 % in front; the slack is for outliers that slipped under the
+// threshold). Every other candidate must be out of the running: either it holds clearly fewer points in
+// front (below 0.7 of the winner, ORB-SLAM2's rule), or it puts clearly more points confidently behind a
+// camera than the winner does: at least max(3, 5 % of the inliers) more. "Confidently" means a
+// triangulation angle of at least two threshold-sized pixel errors, where noise flips a depth sign with
+// probability well under 1 %. The second test matters for planes: the dual decomposition of a lateral
+// motion typically keeps two thirds of the points in front, too many for the ratio, yet puts several
+// clearly behind, which no single plane seen by both cameras can do.
+constexpr double kSecondBestRatio = 0.7;
+constexpr double kMinInFrontFraction = 0.5;
+constexpr double kMaxBehindFraction = 0.1;
+constexpr double kRefutingBehindFraction = 0.05;
+constexpr int kRefutingBehindMin = 3;
+
+}  // namespace
+
+// Candidates that coincide (Faugeras' solutions repeat when two singular values of H are equal) are one
+// hypothesis and must not compete. min_parallax_rad: below it the sign of a depth may be noise.
+CheiralityChoice ChooseByCheirality(const std::vector<Rigid3>& candidates, const std::vector<Eigen::Vector2d>& n1,
+                                    const std::vector<Eigen::Vector2d>& n2, const std::vector<int>& indices,
+                                    double min_parallax_rad) {
+  CheiralityChoice choice;
+  if (candidates.empty()) return choice;
+  std::vector<internal::CheiralityCount> counts;
+  for (const Rigid3& c : candidates) counts.push_back(internal::CountCheirality(c, n1, n2, indices, min_parallax_rad));
+  for (size_t c = 0; c < candidates.size(); ++c) {
+    if (choice.best < 0 || counts[c].in_front > counts[choice.best].in_front) choice.best = static_cast<int>(c);
+  }
+  const double n = static_cast<double>(indices.size());
+  const internal::CheiralityCount& best = counts[choice.best];
+  choice.best_in_front = best.in_front;
+  choice.best_behind = best.behind;
+  choice.clear = best.in_front >= kMinInFrontFraction * n && best.behind <= kMaxBehindFraction * n;
+  for (size_t c = 0; c < candidates.size(); ++c) {
+    const Rigid3& a = candidates[c];
+    const Rigid3& b = candidates[choice.best];
+    const bool same =
+        RotationAngle(a.rotation.transpose() * b.rotation) < 1e-9 && (a.translation - b.translation).norm() < 1e-9;
+    if (same) continue;
+    const double refuting = std::max<double>(kRefutingBehindMin, kRefutingBehindFraction * n);
+    const bool ruled_out =
+        counts[c].in_front < kSecondBestRatio * best.in_front || counts[c].behind - best.behind >= refuting;
+    if (!ruled_out) {
+      choice.clear = false;
+      if (counts[c].in_front > choice.runner_up_in_front) {
+        choice.runner_up_in_front = counts[c].in_front;
+        choice.runner_up_behind = counts[c].behind;
+      }
+    }
+  }
+  return choice;
 }
 
 Eigen::Matrix3d FundamentalFromPose(double fx_px, const Rigid3& cam2_from_cam1) {

@@ -75,20 +75,6 @@ namespace {
 
 using internal::Correspondences;
 
-// G5: the winner must hold more than half of the inliers in front of both cameras and leave at most 10 %
-// confidently behind (ORB-SLAM2 asks 90 % in front; the slack is for outliers that slipped under the
-// threshold). Every other candidate must be out of the running: either it holds clearly fewer points in
-// front (below 0.7 of the winner, ORB-SLAM2's rule), or it puts clearly more points confidently behind a
-// camera than the winner does: at least max(3, 5 % of the inliers) more. "Confidently" means a
-// triangulation angle of at least two threshold-sized pixel errors, where noise flips a depth sign with
-// probability well under 1 %. The second test matters for planes: the dual decomposition of a lateral
-// motion typically keeps two thirds of the points in front, too many for the ratio, yet puts several
-// clearly behind, which no single plane seen by both cameras can do.
-constexpr double kSecondBestRatio = 0.7;
-constexpr double kMinInFrontFraction = 0.5;
-constexpr double kMaxBehindFraction = 0.1;
-constexpr double kRefutingBehindFraction = 0.05;
-constexpr int kRefutingBehindMin = 3;
 // A focal this far from the prior is a symptom of near-degenerate geometry, not a lens: a linear one is
 // replaced by the prior as the refinement's start, a refined one counts as a diverged refinement (G9).
 constexpr double kMaxFocalRatio = 10.0;
@@ -102,8 +88,8 @@ constexpr double kWarnInlierRatio = 0.8;
 // points, which carry most of a distortion's signature, are the first the RANSAC gate drops, while 3x
 // still keeps out gross mismatches. A warning needs
 //  - |z| > kRadialTestMinZ (two-sided p = 5e-4 for a Gaussian z). Measured at 0.5 px over 1000 seeded
-//    scenes per layout (two_view_test.cc, DISABLED_G10RadialWarningStudy), the 80 points within
-//    r < 260 px / filling the image (r < 400 px): clean 0 / 1 warnings, with 10 % random mismatches
+//    scenes per layout (two_view_diagnostics_test.cc, DISABLED_G10RadialWarningStudy), the 80 points
+//    within r < 260 px / filling the image (r < 400 px): clean 0 / 1 warnings, with 10 % random mismatches
 //    0 / 2, with 40 % 7 / 1. With k1 = -0.15 left uncorrected: 117 / 299 of 300 warned. Near the
 //    centre the distortion moves a point at most 2.6 px and f_x and the pose absorb most of it, so
 //    the test has little power there; over the whole image it is reliable;
@@ -126,15 +112,23 @@ void WarnIfFewInliers(int num_inliers, int n, TwoViewReport* report) {
   report->warnings.push_back(m.str());
 }
 
-void WarnIfRadialDistortion(const TwoViewOptions& options, const CameraIntrinsics& camera, double fx_px,
-                            const Rigid3& cam2_from_cam1, const Correspondences& data, TwoViewReport* report) {
+// Correspondences whose Sampson distance (px) to the epipolar geometry of (f_x, pose) is within the gate.
+std::vector<int> SampsonInliers(const CameraIntrinsics& camera, double fx_px, const Rigid3& cam2_from_cam1,
+                                const Correspondences& data, double threshold_px) {
   const Eigen::Matrix3d f_px =
       internal::FundamentalToPixels(camera, internal::FundamentalFromPose(fx_px, cam2_from_cam1));
-  const double gate_px = kRadialTestGate * options.ransac_threshold_px;
-  std::vector<int> tested;
+  std::vector<int> out;
   for (int i = 0; i < data.size(); ++i) {
-    if (internal::SampsonSquared(f_px, data.pixels1[i], data.pixels2[i]) <= gate_px * gate_px) tested.push_back(i);
+    if (internal::SampsonSquared(f_px, data.pixels1[i], data.pixels2[i]) <= threshold_px * threshold_px)
+      out.push_back(i);
   }
+  return out;
+}
+
+void WarnIfRadialDistortion(const TwoViewOptions& options, const CameraIntrinsics& camera, double fx_px,
+                            const Rigid3& cam2_from_cam1, const Correspondences& data, TwoViewReport* report) {
+  const double gate_px = kRadialTestGate * options.ransac_threshold_px;
+  const std::vector<int> tested = SampsonInliers(camera, fx_px, cam2_from_cam1, data, gate_px);
   if (static_cast<int>(tested.size()) < kRadialTestMinPoints) return;
   const internal::RadialDistortionScore score =
       internal::ScoreRadialDistortion(camera, fx_px, cam2_from_cam1, data, tested);
@@ -217,65 +211,213 @@ double MedianRotationTransferPx(const CameraIntrinsics& camera, const Eigen::Mat
   return *mid;
 }
 
-// Correspondences whose Sampson distance (px) to the epipolar geometry of (f_x, pose) is within the gate.
-std::vector<int> SampsonInliers(const CameraIntrinsics& camera, double fx_px, const Rigid3& cam2_from_cam1,
-                                const Correspondences& data, double threshold_px) {
-  const Eigen::Matrix3d f_px =
-      internal::FundamentalToPixels(camera, internal::FundamentalFromPose(fx_px, cam2_from_cam1));
-  std::vector<int> out;
-  for (int i = 0; i < data.size(); ++i) {
-    if (internal::SampsonSquared(f_px, data.pixels1[i], data.pixels2[i]) <= threshold_px * threshold_px)
-      out.push_back(i);
-  }
-  return out;
-}
-
-struct CheiralityChoice {
-  int best = -1;
-  bool clear = false;
-  int best_in_front = 0;
-  int best_behind = 0;
-  int runner_up_in_front = 0;  // the strongest rival not ruled out, 0 if none
-  int runner_up_behind = 0;
+// Both models by RANSAC (G7, G8), then model selection (G4).
+struct ModelSelection {
+  internal::RansacResult fundamental, homography;
+  bool use_homography = false;
+  const internal::RansacResult& chosen() const { return use_homography ? homography : fundamental; }
 };
 
-// Candidates that coincide (Faugeras' solutions repeat when two singular values of H are equal) are one
-// hypothesis and must not compete. min_parallax_rad: below it the sign of a depth may be noise.
-CheiralityChoice ChooseByCheirality(const std::vector<Rigid3>& candidates, const std::vector<Eigen::Vector2d>& n1,
-                                    const std::vector<Eigen::Vector2d>& n2, const std::vector<int>& indices,
-                                    double min_parallax_rad) {
-  CheiralityChoice choice;
-  if (candidates.empty()) return choice;
-  std::vector<internal::CheiralityCount> counts;
-  for (const Rigid3& c : candidates) counts.push_back(internal::CountCheirality(c, n1, n2, indices, min_parallax_rad));
-  for (size_t c = 0; c < candidates.size(); ++c) {
-    if (choice.best < 0 || counts[c].in_front > counts[choice.best].in_front) choice.best = static_cast<int>(c);
+// False, with `report` finished, when neither model explains enough of the n correspondences.
+bool SelectModel(const TwoViewOptions& options, const CameraIntrinsics& camera, const Correspondences& data, int n,
+                 ModelSelection* selection, TwoViewReport* report) {
+  std::mt19937_64 rng(options.seed);
+  internal::RansacResult& fundamental = selection->fundamental;
+  internal::RansacResult& homography = selection->homography;
+  fundamental = internal::RansacFundamental(options, camera, data, &rng);
+  // The homography only matters if it can win the model selection: with own-gate scores R_H stays below
+  // 0.45 unless H explains more than about half of the fundamental inliers (0.52 without noise, more
+  // with), so H-RANSAC may stop once it is confident no such plane was missed. On a 3D scene this is
+  // ~130 iterations instead of the cap.
+  const double useful_h_ratio = fundamental.found ? 0.5 * fundamental.num_inliers / n : 0.0;
+  homography = internal::RansacHomography(options, camera, data, useful_h_ratio, &rng);
+  if (!fundamental.found && !homography.found) {
+    *report = Finish(*report, Outcome::kDegenerate,
+                     "every 8-point and 4-point sample is rank-deficient (collinear or coincident points)");
+    return false;
   }
-  const double n = static_cast<double>(indices.size());
-  const internal::CheiralityCount& best = counts[choice.best];
-  choice.best_in_front = best.in_front;
-  choice.best_behind = best.behind;
-  choice.clear = best.in_front >= kMinInFrontFraction * n && best.behind <= kMaxBehindFraction * n;
-  for (size_t c = 0; c < candidates.size(); ++c) {
-    const Rigid3& a = candidates[c];
-    const Rigid3& b = candidates[choice.best];
-    const bool same =
-        RotationAngle(a.rotation.transpose() * b.rotation) < 1e-9 && (a.translation - b.translation).norm() < 1e-9;
-    if (same) continue;
-    const double refuting = std::max<double>(kRefutingBehindMin, kRefutingBehindFraction * n);
-    const bool ruled_out =
-        counts[c].in_front < kSecondBestRatio * best.in_front || counts[c].behind - best.behind >= refuting;
-    if (!ruled_out) {
-      choice.clear = false;
-      if (counts[c].in_front > choice.runner_up_in_front) {
-        choice.runner_up_in_front = counts[c].in_front;
-        choice.runner_up_behind = counts[c].behind;
-      }
-    }
+  const double score_f = fundamental.found ? internal::FundamentalScore(options, camera, fundamental.model, data) : 0;
+  const double score_h = homography.found ? internal::HomographyScore(options, camera, homography.model, data) : 0;
+  report->homography_ratio = score_f + score_h > 0 ? score_h / (score_f + score_h) : 0;
+
+  const int most_inliers = std::max(fundamental.num_inliers, homography.num_inliers);
+  if (most_inliers < options.min_inlier_ratio * n) {
+    std::ostringstream m;
+    m << "best model explains " << most_inliers << " of " << n << " correspondences, below the floor "
+      << options.min_inlier_ratio << " (G7; fundamental " << fundamental.num_inliers << " inliers after "
+      << fundamental.iterations << " iterations, homography " << homography.num_inliers << ")";
+    *report = Finish(*report, Outcome::kTooManyOutliers, m.str());
+    return false;
   }
-  return choice;
+  // Without a fundamental matrix (its 8-point design was rank-deficient everywhere) only H remains.
+  selection->use_homography =
+      !fundamental.found || (homography.found && report->homography_ratio > options.planar_homography_ratio);
+  return true;
 }
 
+struct FocalChoice {
+  double fx_px = 0;
+  bool refine = false;  // the refinement estimates f_x
+  std::string note;
+};
+
+// f_x: Bougnoux from Q when the geometry observes it, else the prior. Sets report->fx_linear_px when
+// Bougnoux's value is used.
+FocalChoice ChooseFocal(const TwoViewOptions& options, const CameraIntrinsics& camera, const ModelSelection& selection,
+                        TwoViewReport* report) {
+  FocalChoice focal;
+  focal.fx_px = camera.fx_px;
+  std::ostringstream note;
+  if (selection.use_homography) {
+    note << "f_x = prior (a single planar pair does not determine it)";
+  } else if (!options.estimate_focal) {
+    note << "f_x given";
+  } else {
+    const Eigen::Matrix3d& q = selection.fundamental.model;
+    double f_linear = 0, observability = 0;
+    const bool ok = FocalFromFundamental(q, options.focal_observability_min, &f_linear, &observability);
+    const bool plausible = ok && f_linear < kMaxFocalRatio * camera.fx_px && f_linear > camera.fx_px / kMaxFocalRatio;
+    // The observability of the geometry, judged with the prior focal: noise can make Bougnoux's f^2
+    // negative for a pair that does determine f, and then the refinement still should estimate it.
+    const double geometric = internal::AxisCoplanaritySine(q, camera.fx_px);
+    if (plausible) {
+      focal.fx_px = f_linear;
+      report->fx_linear_px = f_linear;
+      focal.refine = true;
+      note << "f_x linear " << f_linear << " px (axis coplanarity sine " << observability << ")";
+    } else if (geometric >= options.focal_observability_min) {
+      focal.refine = true;
+      note << "linear f_x failed (" << (ok ? "implausible" : "f^2 <= 0") << "), refined from the prior "
+           << "(axis coplanarity sine " << geometric << ")";
+    } else {
+      note << "f_x unobservable: optical axes (nearly) intersect, axis coplanarity sine " << geometric << " < "
+           << options.focal_observability_min << "; prior used";
+    }
+  }
+  focal.note = note.str();
+  return focal;
+}
+
+// The pose hypotheses at focal fx: Theorem 1's factors of E = A^T Q A, or the homography decomposition.
+std::vector<Rigid3> PoseCandidates(const ModelSelection& selection, double fx) {
+  if (selection.use_homography) {
+    const Eigen::Matrix3d k = Eigen::Vector3d(fx, fx, 1).asDiagonal();
+    return internal::DecomposeHomography(k.inverse() * selection.homography.model * k);
+  }
+  const Eigen::Matrix3d a = Eigen::Vector3d(fx, fx, 1).asDiagonal();
+  return FactorEssential(a.transpose() * selection.fundamental.model * a);
+}
+
+// G3 (a): the rotation-only model, a Wahba fit of the rays with the prior focal (Bougnoux's f means
+// nothing for a rotation), and its median transfer error over the inliers (px). If it is within the
+// homography gate, a translation is not needed to explain the data, so it is not observable: this
+// catches pure rotations, where t is noise and cheirality a coin toss. The residual is compared with the
+// noise gate, not with min_parallax_deg: it is what is left after a rotation has absorbed most of a real
+// translation's flow (about 1 deg in the 17 deg test scene, 0.3 deg for a lateral motion over a plane),
+// small in angle yet far above the noise. (G3 (b), the parallax of the refined pose, comes later.)
+struct RotationOnlyFit {
+  Eigen::Matrix3d rotation;
+  double residual_px = 0;
+};
+
+RotationOnlyFit FitRotationOnly(const CameraIntrinsics& camera, const Correspondences& data,
+                                const std::vector<int>& inliers) {
+  std::vector<Eigen::Vector2d> p1, p2;
+  Normalise(data, camera.fx_px, &p1, &p2);
+  RotationOnlyFit fit;
+  fit.rotation = BestRotation(p1, p2, inliers);
+  fit.residual_px = MedianRotationTransferPx(camera, fit.rotation, data, inliers);
+  return fit;
+}
+
+struct RefinementResult {
+  Outcome outcome = Outcome::kSuccess;  // kNoConvergence when the first round failed (G9)
+  std::string note;
+};
+
+// Refinement of eq. (13) (G9) of (fx, pose) on `inliers`, which it updates, as it does the report's
+// inlier set and refinement fields, and n1, n2 (normalised with the final focal).
+RefinementResult RefinePose(const TwoViewOptions& options, const CameraIntrinsics& camera, const Correspondences& data,
+                            bool use_homography, bool refine_focal, double* fx, Rigid3* pose,
+                            std::vector<int>* inliers, std::vector<Eigen::Vector2d>* n1,
+                            std::vector<Eigen::Vector2d>* n2, TwoViewReport* report) {
+  RefinementResult result;
+  result.note = options.refine ? "" : "not refined";
+  if (!options.refine) return result;
+  if (use_homography) {
+    // Eq. (13) ignores the plane and is poorly conditioned on planar points: in tests it doubled the
+    // error of the homography decomposition, so the planar path keeps the decomposition.
+    report->refinement_termination = "skipped";
+    result.note = "not refined (homography path: eq. (13) would discard the plane)";
+    return result;
+  }
+  // Up to two rounds, the second on the inliers of the refined model (local optimisation): the RANSAC
+  // gate was applied with an 8-point model, which loses some inliers and keeps an occasional outlier. Huber's
+  // quadratic zone covers the gate (for a true inlier sqrt(d1^2 + d2^2) is about twice its Sampson distance).
+  const double huber_px = 2 * options.ransac_threshold_px;
+  for (int round = 0; round < 2; ++round) {
+    const internal::RefineResult refined =
+        internal::RefineEpipolar(camera, data, *inliers, *fx, *pose, refine_focal, options.max_refine_iterations,
+                                 huber_px, camera.fx_px / kMaxFocalRatio, camera.fx_px * kMaxFocalRatio);
+    report->refinement_termination = refined.termination;
+    report->refinement_iterations += refined.iterations;
+    result.note += (round == 0 ? "refinement " : "; on the updated inliers ") + refined.detail;
+    if (!refined.accepted) {
+      // G9: a failure of the first round keeps the linear estimate, flagged; of the second, the first
+      // round's result.
+      if (refined.failed && round == 0) result.outcome = Outcome::kNoConvergence;
+      result.note += refined.failed ? " (rejected)" : " (no decrease)";
+      break;
+    }
+    report->refinement_accepted = true;
+    *fx = refined.fx_px;
+    *pose = refined.cam2_from_cam1;
+    const std::vector<int> updated = SampsonInliers(camera, *fx, *pose, data, options.ransac_threshold_px);
+    if (updated == *inliers || static_cast<int>(updated.size()) < options.min_points) break;
+    *inliers = updated;
+  }
+  if (result.outcome == Outcome::kNoConvergence) result.note += ": linear estimate kept";
+  // Eq. (13) is even in t; the sign is fixed by cheirality again.
+  Normalise(data, *fx, n1, n2);
+  const Rigid3 flipped(pose->rotation, -pose->translation);
+  if (internal::CountInFront(flipped, *n1, *n2, *inliers) > internal::CountInFront(*pose, *n1, *n2, *inliers)) {
+    *pose = flipped;
+  }
+  report->inliers.assign(data.size(), false);
+  for (int i : *inliers) report->inliers[i] = true;
+  report->num_inliers = static_cast<int>(inliers->size());
+  return result;
+}
+
+// G3 (b) before G6: pure-rotation detection has priority. A point farther than 50 baselines has a
+// triangulation angle below 1/50 rad (1.15 deg), so when more than half of the inliers are far the
+// median parallax is below 1.15 deg too: with the default min_parallax_deg of 1, G6 is left the pairs
+// in the 1-1.15 deg band (near points and noise can put them there), and everything once
+// min_parallax_deg is lowered. In both the rotation stands and the direction of t is too weakly
+// determined to hand out. `outcome` is the refinement's: only a success is judged. Returns the final
+// outcome, its message in *message.
+Outcome JudgeParallaxAndDepth(const TwoViewOptions& options, Outcome outcome, double parallax_deg,
+                              const std::string& summary, TwoViewReport* report, std::string* message) {
+  if (outcome == Outcome::kSuccess && parallax_deg < options.min_parallax_deg) {
+    report->translation_observable = false;
+    report->translation_direction.setZero();
+    *message = "rotation only: median parallax below " + std::to_string(options.min_parallax_deg) +
+               " deg, translation unobservable (G3); " + summary;
+    return Outcome::kPureRotation;
+  }
+  if (outcome == Outcome::kSuccess && report->far_point_fraction > options.max_far_point_fraction) {
+    report->translation_observable = false;
+    report->translation_direction.setZero();
+    std::ostringstream m;
+    m << "low depth variation: " << 100 * report->far_point_fraction << " % of the inliers lie farther than "
+      << internal::kFarDepthBaselines << " baselines (limit " << 100 * options.max_far_point_fraction
+      << " %), translation direction unreliable (G6); " << summary;
+    *message = m.str();
+    return Outcome::kLowDepthVariation;
+  }
+  *message = summary;
+  return outcome;
+}
 
 }  // namespace
 
@@ -318,36 +460,11 @@ TwoViewReport EstimateTwoView(const TwoViewOptions& options, const CameraIntrins
   if (!internal::ScreenInput(options, camera, pixels1, pixels2, &report)) return report;
   const int n = static_cast<int>(pixels1.size());
 
-  // ---- Both models by RANSAC (G7, G8), then model selection (G4) ----
   const Correspondences data = internal::MakeCorrespondences(camera, pixels1, pixels2);
-  std::mt19937_64 rng(options.seed);
-  const internal::RansacResult fundamental = internal::RansacFundamental(options, camera, data, &rng);
-  // The homography only matters if it can win the model selection: with own-gate scores R_H stays below
-  // 0.45 unless H explains more than about half of the fundamental inliers (0.52 without noise, more
-  // with), so H-RANSAC may stop once it is confident no such plane was missed. On a 3D scene this is
-  // ~130 iterations instead of the cap.
-  const double useful_h_ratio = fundamental.found ? 0.5 * fundamental.num_inliers / n : 0.0;
-  const internal::RansacResult homography = internal::RansacHomography(options, camera, data, useful_h_ratio, &rng);
-  if (!fundamental.found && !homography.found) {
-    return Finish(report, Outcome::kDegenerate,
-                  "every 8-point and 4-point sample is rank-deficient (collinear or coincident points)");
-  }
-  const double score_f = fundamental.found ? internal::FundamentalScore(options, camera, fundamental.model, data) : 0;
-  const double score_h = homography.found ? internal::HomographyScore(options, camera, homography.model, data) : 0;
-  report.homography_ratio = score_f + score_h > 0 ? score_h / (score_f + score_h) : 0;
-
-  const int most_inliers = std::max(fundamental.num_inliers, homography.num_inliers);
-  if (most_inliers < options.min_inlier_ratio * n) {
-    std::ostringstream m;
-    m << "best model explains " << most_inliers << " of " << n << " correspondences, below the floor "
-      << options.min_inlier_ratio << " (G7; fundamental " << fundamental.num_inliers << " inliers after "
-      << fundamental.iterations << " iterations, homography " << homography.num_inliers << ")";
-    return Finish(report, Outcome::kTooManyOutliers, m.str());
-  }
-  // Without a fundamental matrix (its 8-point design was rank-deficient everywhere) only H remains.
-  const bool use_homography =
-      !fundamental.found || (homography.found && report.homography_ratio > options.planar_homography_ratio);
-  const internal::RansacResult& chosen = use_homography ? homography : fundamental;
+  ModelSelection selection;
+  if (!SelectModel(options, camera, data, n, &selection, &report)) return report;
+  const bool use_homography = selection.use_homography;
+  const internal::RansacResult& chosen = selection.chosen();
   report.inliers = chosen.inliers;
   report.num_inliers = chosen.num_inliers;
   std::vector<int> inliers = IndicesOf(chosen.inliers);
@@ -362,78 +479,34 @@ TwoViewReport EstimateTwoView(const TwoViewOptions& options, const CameraIntrins
     return finish(Outcome::kTooFewPoints, m.str());
   }
 
-  // ---- f_x: Bougnoux from Q when the geometry observes it, else the prior ----
-  double fx = camera.fx_px;
-  bool refine_focal = false;
-  std::ostringstream focal_note;
-  if (use_homography) {
-    focal_note << "f_x = prior (a single planar pair does not determine it)";
-  } else if (!options.estimate_focal) {
-    focal_note << "f_x given";
-  } else {
-    double f_linear = 0, observability = 0;
-    const bool ok = FocalFromFundamental(fundamental.model, options.focal_observability_min, &f_linear, &observability);
-    const bool plausible = ok && f_linear < kMaxFocalRatio * camera.fx_px && f_linear > camera.fx_px / kMaxFocalRatio;
-    // The observability of the geometry, judged with the prior focal: noise can make Bougnoux's f^2
-    // negative for a pair that does determine f, and then the refinement still should estimate it.
-    const double geometric = internal::AxisCoplanaritySine(fundamental.model, camera.fx_px);
-    if (plausible) {
-      fx = f_linear;
-      report.fx_linear_px = f_linear;
-      refine_focal = true;
-      focal_note << "f_x linear " << f_linear << " px (axis coplanarity sine " << observability << ")";
-    } else if (geometric >= options.focal_observability_min) {
-      refine_focal = true;
-      focal_note << "linear f_x failed (" << (ok ? "implausible" : "f^2 <= 0") << "), refined from the prior "
-                 << "(axis coplanarity sine " << geometric << ")";
-    } else {
-      focal_note << "f_x unobservable: optical axes (nearly) intersect, axis coplanarity sine " << geometric << " < "
-                 << options.focal_observability_min << "; prior used";
-    }
-  }
+  const FocalChoice focal = ChooseFocal(options, camera, selection, &report);
+  double fx = focal.fx_px;
   report.fx_px = fx;
   report.planar = use_homography;
 
   // ---- Candidates (Theorem 1, or the homography decomposition) and cheirality (G5) ----
   std::vector<Eigen::Vector2d> n1, n2;
   Normalise(data, fx, &n1, &n2);
-  std::vector<Rigid3> candidates;
-  if (use_homography) {
-    const Eigen::Matrix3d k = Eigen::Vector3d(fx, fx, 1).asDiagonal();
-    candidates = internal::DecomposeHomography(k.inverse() * homography.model * k);
-  } else {
-    const Eigen::Matrix3d a = Eigen::Vector3d(fx, fx, 1).asDiagonal();
-    candidates = FactorEssential(a.transpose() * fundamental.model * a);  // E = A^T Q A
-  }
+  const std::vector<Rigid3> candidates = PoseCandidates(selection, fx);
   // Depth signs count only for points whose triangulation angle exceeds what two threshold-sized pixel
   // errors can produce.
   const double sign_parallax_rad = 2 * options.ransac_threshold_px / fx;
-  const CheiralityChoice choice = ChooseByCheirality(candidates, n1, n2, inliers, sign_parallax_rad);
-  const bool clear_winner = choice.clear;
+  const internal::CheiralityChoice choice =
+      internal::ChooseByCheirality(candidates, n1, n2, inliers, sign_parallax_rad);
 
   // ---- G3: pure rotation or tiny baseline ----
-  // Two signs, either suffices:
-  //  (a) the rotation-only model (Wahba fit of the rays, prior focal: Bougnoux's f means nothing for a
-  //      rotation) transfers the inliers within the homography gate (median): a translation is then not
-  //      needed to explain the data, so it is not observable. This catches pure rotations, where t is
-  //      noise and cheirality a coin toss. R is the Wahba fit, exact for a rotation.
-  //  (b) the cheirality winner's median triangulation angle (the angle between the ray of view 2 and the
-  //      rotated ray of view 1, ORB-SLAM2's parallax) is below min_parallax_deg, checked after the
-  //      refinement. R is the refined pose's: a best-fit rotation would absorb the translation's flow,
-  //      an error as large as the parallax itself.
-  // The Wahba residual is compared with the noise gate, not with min_parallax_deg: it is what is left
-  // after a rotation has absorbed most of a real translation's flow (about 1 deg in the 17 deg test
-  // scene, 0.3 deg for a lateral motion over a plane), small in angle yet far above the noise.
-  std::vector<Eigen::Vector2d> p1, p2;
-  Normalise(data, camera.fx_px, &p1, &p2);
-  const Eigen::Matrix3d rotation_only = BestRotation(p1, p2, inliers);
-  const double rotation_residual_px = MedianRotationTransferPx(camera, rotation_only, data, inliers);
+  // Two signs, either suffices: (a) the rotation-only model explains the inliers (FitRotationOnly);
+  // (b) the cheirality winner's median triangulation angle (the angle between the ray of view 2 and the
+  // rotated ray of view 1, ORB-SLAM2's parallax) is below min_parallax_deg, checked after the
+  // refinement. R is the refined pose's there: a best-fit rotation would absorb the translation's flow,
+  // an error as large as the parallax itself.
+  const RotationOnlyFit rotation_only = FitRotationOnly(camera, data, inliers);
   std::ostringstream summary;
   summary << (use_homography ? "homography" : "fundamental") << " path, " << report.num_inliers << "/" << n
-          << " inliers, R_H " << report.homography_ratio << ", rotation-only residual " << rotation_residual_px
-          << " px; " << focal_note.str();
-  if (rotation_residual_px <= internal::HomographyThresholdPx(options)) {
-    report.rotation = rotation_only;
+          << " inliers, R_H " << report.homography_ratio << ", rotation-only residual " << rotation_only.residual_px
+          << " px; " << focal.note;
+  if (rotation_only.residual_px <= internal::HomographyThresholdPx(options)) {
+    report.rotation = rotation_only.rotation;
     report.translation_observable = false;
     report.translation_direction.setZero();
     report.fx_observable = false;  // f_x is not estimated when a rotation explains the pair
@@ -452,7 +525,7 @@ TwoViewReport EstimateTwoView(const TwoViewOptions& options, const CameraIntrins
   Rigid3 pose = candidates[choice.best];
   report.rotation = pose.rotation;
   report.translation_direction = pose.translation;
-  if (!clear_winner) {
+  if (!choice.clear) {
     std::ostringstream m;
     m << "no clear cheirality winner: best candidate has " << choice.best_in_front << " points in front ("
       << choice.best_behind << " clearly behind), strongest rival " << choice.runner_up_in_front << " ("
@@ -461,53 +534,11 @@ TwoViewReport EstimateTwoView(const TwoViewOptions& options, const CameraIntrins
   }
   report.translation_observable = true;
 
-  // ---- Refinement of eq. (13) (G9) ----
-  Outcome outcome = Outcome::kSuccess;
-  std::string refinement_note = options.refine ? "" : "not refined";
-  if (options.refine && use_homography) {
-    // Eq. (13) ignores the plane and is poorly conditioned on planar points: in tests it doubled the
-    // error of the homography decomposition, so the planar path keeps the decomposition.
-    report.refinement_termination = "skipped";
-    refinement_note = "not refined (homography path: eq. (13) would discard the plane)";
-  } else if (options.refine) {
-    // Up to two rounds, the second on the inliers of the refined model (local optimisation): the RANSAC
-    // gate was applied with an 8-point model, which loses some inliers and keeps an occasional outlier. Huber's
-    // quadratic zone covers the gate (for a true inlier sqrt(d1^2 + d2^2) is about twice its Sampson distance).
-    const double huber_px = 2 * options.ransac_threshold_px;
-    for (int round = 0; round < 2; ++round) {
-      const internal::RefineResult refined =
-          internal::RefineEpipolar(camera, data, inliers, fx, pose, refine_focal, options.max_refine_iterations,
-                                   huber_px, camera.fx_px / kMaxFocalRatio, camera.fx_px * kMaxFocalRatio);
-      report.refinement_termination = refined.termination;
-      report.refinement_iterations += refined.iterations;
-      refinement_note += (round == 0 ? "refinement " : "; on the updated inliers ") + refined.detail;
-      if (!refined.accepted) {
-        // G9: a failure of the first round keeps the linear estimate, flagged; of the second, the first
-        // round's result.
-        if (refined.failed && round == 0) outcome = Outcome::kNoConvergence;
-        refinement_note += refined.failed ? " (rejected)" : " (no decrease)";
-        break;
-      }
-      report.refinement_accepted = true;
-      fx = refined.fx_px;
-      pose = refined.cam2_from_cam1;
-      const std::vector<int> updated = SampsonInliers(camera, fx, pose, data, options.ransac_threshold_px);
-      if (updated == inliers || static_cast<int>(updated.size()) < options.min_points) break;
-      inliers = updated;
-    }
-    if (outcome == Outcome::kNoConvergence) refinement_note += ": linear estimate kept";
-    // Eq. (13) is even in t; the sign is fixed by cheirality again.
-    Normalise(data, fx, &n1, &n2);
-    const Rigid3 flipped(pose.rotation, -pose.translation);
-    if (internal::CountInFront(flipped, n1, n2, inliers) > internal::CountInFront(pose, n1, n2, inliers)) {
-      pose = flipped;
-    }
-    report.inliers.assign(n, false);
-    for (int i : inliers) report.inliers[i] = true;
-    report.num_inliers = static_cast<int>(inliers.size());
-  }
+  const RefinementResult refinement = RefinePose(options, camera, data, use_homography, focal.refine, &fx, &pose,
+                                                 &inliers, &n1, &n2, &report);
+  const Outcome outcome = refinement.outcome;
   // Observable means estimated from this pair (by Bougnoux and/or an accepted refinement), not the prior.
-  report.fx_observable = refine_focal && (report.refinement_accepted || report.fx_linear_px > 0);
+  report.fx_observable = focal.refine && (report.refinement_accepted || report.fx_linear_px > 0);
   report.fx_px = fx;
   report.rotation = pose.rotation;
   report.translation_direction = pose.translation.normalized();
@@ -516,30 +547,10 @@ TwoViewReport EstimateTwoView(const TwoViewOptions& options, const CameraIntrins
   report.far_point_fraction = internal::FarPointFraction(pose, n1, n2, inliers);
   WarnIfRadialDistortion(options, camera, fx, pose, data, &report);
   summary << "; median parallax " << parallax_deg << " deg, " << 100 * report.far_point_fraction
-          << " % of inliers farther than " << internal::kFarDepthBaselines << " baselines; " << refinement_note;
-  // G3 (b) before G6: pure-rotation detection has priority. A point farther than 50 baselines has a
-  // triangulation angle below 1/50 rad (1.15 deg), so when more than half of the inliers are far the
-  // median parallax is below 1.15 deg too: with the default min_parallax_deg of 1, G6 is left the pairs
-  // in the 1-1.15 deg band (near points and noise can put them there), and everything once
-  // min_parallax_deg is lowered. In both the rotation stands and the direction of t is too weakly
-  // determined to hand out.
-  if (outcome == Outcome::kSuccess && parallax_deg < options.min_parallax_deg) {
-    report.translation_observable = false;
-    report.translation_direction.setZero();
-    return finish(Outcome::kPureRotation, "rotation only: median parallax below " +
-                                              std::to_string(options.min_parallax_deg) +
-                                              " deg, translation unobservable (G3); " + summary.str());
-  }
-  if (outcome == Outcome::kSuccess && report.far_point_fraction > options.max_far_point_fraction) {
-    report.translation_observable = false;
-    report.translation_direction.setZero();
-    std::ostringstream m;
-    m << "low depth variation: " << 100 * report.far_point_fraction << " % of the inliers lie farther than "
-      << internal::kFarDepthBaselines << " baselines (limit " << 100 * options.max_far_point_fraction
-      << " %), translation direction unreliable (G6); " << summary.str();
-    return finish(Outcome::kLowDepthVariation, m.str());
-  }
-  return finish(outcome, summary.str());
+          << " % of inliers farther than " << internal::kFarDepthBaselines << " baselines; " << refinement.note;
+  std::string message;
+  const Outcome final_outcome = JudgeParallaxAndDepth(options, outcome, parallax_deg, summary.str(), &report, &message);
+  return finish(final_outcome, message);
 }
 
 }  // namespace selfcal::twoview

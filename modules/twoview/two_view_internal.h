@@ -124,6 +124,20 @@ inline int CountInFront(const Rigid3& cam2_from_cam1, const std::vector<Eigen::V
   return CountCheirality(cam2_from_cam1, n1, n2, indices, 0.0).in_front;
 }
 
+// G5: the candidate with the most correspondences in front of both cameras, and whether it is a clear
+// winner (the rules are in fundamental.cc). best < 0 when there is no candidate.
+struct CheiralityChoice {
+  int best = -1;
+  bool clear = false;
+  int best_in_front = 0;
+  int best_behind = 0;
+  int runner_up_in_front = 0;  // the strongest rival not ruled out, 0 if none
+  int runner_up_behind = 0;
+};
+CheiralityChoice ChooseByCheirality(const std::vector<Rigid3>& candidates, const std::vector<Eigen::Vector2d>& n1,
+                                    const std::vector<Eigen::Vector2d>& n2, const std::vector<int>& indices,
+                                    double min_parallax_rad);
+
 // Eq. (12) over the listed correspondences for E = [t]x R and focal fx: RMS (px) of the symmetric
 // epipolar distance sqrt(d1^2 + d2^2).
 double RmsSymmetricEpipolarPx(const CameraIntrinsics& camera, double fx_px, const Rigid3& cam2_from_cam1,
