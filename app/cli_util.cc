@@ -9,9 +9,10 @@ namespace selfcal::app {
 
 std::string ResolveDataPath(const std::string& path) {
   namespace fs = std::filesystem;
-  if (fs::exists(path) || fs::path(path).is_absolute()) return path;
+  std::error_code ec;  // a symlink loop or an unreadable folder: not found here, the reader says why
+  if (fs::exists(path, ec) || fs::path(path).is_absolute()) return path;
   const fs::path in_source = fs::path(SELFCAL_SOURCE_DIR) / path;
-  return fs::exists(in_source) ? in_source.string() : path;
+  return fs::exists(in_source, ec) ? in_source.string() : path;
 }
 
 int Fail(const Status& status) {

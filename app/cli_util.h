@@ -8,6 +8,9 @@
 
 namespace selfcal::app {
 
+// An exception escaped a command: a bug, never the user's input (sysexits.h EX_SOFTWARE).
+inline constexpr int kInternalErrorExitCode = 70;
+
 // `path` as given if it exists, else relative to the source tree's root (so that the shipped defaults
 // under config/ work from any directory of a build tree).
 std::string ResolveDataPath(const std::string& path);

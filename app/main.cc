@@ -2,6 +2,7 @@
 #include <exception>
 #include <iostream>
 
+#include "app/cli_util.h"
 #include "app/commands.h"
 #include "base/status.h"
 
@@ -31,12 +32,13 @@ int main(int argc, char** argv) {
           {"run", run}}) {
       if (app.got_subcommand(name)) return command();
     }
-  } catch (const selfcal::InvalidArgument& e) {
-    std::cerr << "selfcal: internal error: " << e.what() << "\n";
-    return static_cast<int>(selfcal::ExitCode::kSolverFailure);
   } catch (const std::exception& e) {
-    std::cerr << "selfcal: unexpected error: " << e.what() << "\n";
-    return static_cast<int>(selfcal::ExitCode::kSolverFailure);
+    // Nothing the user did explains an exception escaping a command: every expected failure is a Status
+    // or an outcome. Say so, and exit with a code of its own rather than pretend the solver failed.
+    std::cerr << "selfcal: internal error: " << e.what()
+              << "\nThis is a bug in selfcal " << SELFCAL_VERSION
+              << ": please report it with the command line and this message.\n";
+    return selfcal::app::kInternalErrorExitCode;
   }
   return static_cast<int>(selfcal::ExitCode::kUsage);
 }
