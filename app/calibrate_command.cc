@@ -66,7 +66,7 @@ int CalibrateAndWrite(const ObservationSet& obs, const std::string& source_path,
   }
   json["method"] = method == Method::kBundle ? "bundle" : "paper";
   json["message"] = message;
-  json["input"] = {{"path", source_path}, {"fnv1a64", FileHash(source_path)}};
+  json["input"] = {{"path", source_path}, {"sha256", FileSha256(source_path)}};
   json["exit_code"] = static_cast<int>(code);
   json["accepted"] = code == ExitCode::kOk;
   const std::string report_path = (std::filesystem::path(out_dir) / "report.json").string();
@@ -86,7 +86,7 @@ int CalibrateAndWrite(const ObservationSet& obs, const std::string& source_path,
     }
     model.source = "selfcal calibrate " + source_path;
     model.provenance = {{"software_version", SELFCAL_VERSION},
-                        {"input_fnv1a64", FileHash(source_path)},
+                        {"sha256", FileSha256(source_path)},
                         {"method", method == Method::kBundle ? "kinematic bundle adjustment" : "paper pipeline"}};
     if (Status s = io::SaveCalibratedModel(model, model_path); !s.ok()) return Fail(s);
     std::cout << "calibrated model (" << json["method"].get<std::string>() << "): " << model_path << "\n";

@@ -20,8 +20,9 @@ ExitCode ExitCodeFor(pipeline::Outcome outcome);
 // kConverged 0; kScaleUnresolved, kDegenerate 3; kInvalidInput 2; anything else 5.
 ExitCode ExitCodeFor(bundle::Outcome outcome);
 
-// 64-bit FNV-1a of a file's bytes as 16 hex digits ("" if unreadable): provenance in reports (P7).
-std::string FileHash(const std::string& path);
+// SHA-256 of a file's bytes as 64 hex digits (base/sha256.h): provenance in reports (P7). "" when the path
+// is not a readable regular file (e.g. a session directory, whose provenance is its session.json).
+std::string FileSha256(const std::string& path);
 
 // Creates the directory (and parents). Refuses an existing non-directory.
 Status EnsureDirectory(const std::string& path);
