@@ -8,8 +8,6 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "app/calibrate_command.h"
 #include "base/status.h"
 #include "observations/observation_set.h"
@@ -46,14 +44,10 @@ int RunFromSettings(RunSettings settings, std::unique_ptr<sim::SimResult>* world
 // True when `path` is a session directory (it holds session.json).
 bool IsSessionDirectory(const std::string& path);
 
-// Builds the ObservationSet of a session: the setup input (camera, yardsticks, checks), the robot input,
-// and the accepted samples of the journal in plan order. Verifies every sample's image (P2). kUsage
-// naming the session and record on any inconsistency; kDegenerateData when too few samples were accepted.
-// *summary (optional) receives the journal's counts: samples, resumes, skips, faults and halts by kind.
-Result<ObservationSet> LoadSessionObservations(const std::string& session_path, nlohmann::json* summary = nullptr);
-
-// `selfcal calibrate SESSION`: LoadSessionObservations + CalibrateAndWrite into out_dir; writes
-// out_dir/observations.yaml (derived, for other tools) too.
+// `selfcal calibrate SESSION`: reads the session read-only (session::LoadSessionObservations: nothing in
+// it changes; a torn journal tail or unrecorded images are printed as warnings) and runs
+// CalibrateAndWrite into out_dir; writes out_dir/observations.yaml (derived, for other tools) too.
+// Refuses (exit 2, naming the path) an out_dir that is the session directory or inside it.
 int CalibrateSession(const std::string& session_path, const std::string& out_dir, uint64_t seed, Method method,
                      CalibrationResult* result, ObservationSet* observations);
 
