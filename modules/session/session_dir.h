@@ -133,7 +133,8 @@ class Session {
 Result<Session> CreateSession(const std::string& path, const SessionInputs& inputs, const std::string& software_version,
                               const CreateOptions& options);
 
-// Opens an existing session to resume or solve it (P2, P3, C9), in this order:
+// Opens an existing session for writing, to resume it (P2, P3, C9); offline readers such as calibrate use
+// ReadSession (session_snapshot.h), which changes nothing. In this order:
 //  1. reads session.json strictly (another format or major version, missing, unknown or ill-typed keys:
 //     kUsage naming the file and key); images/ and journal.log must exist;
 //  2. compares every `expected` input with the recorded SHA-256 (inputs recorded but not expected are
