@@ -1,6 +1,7 @@
 // selfcal calibrate INPUT --out DIR [--method bundle|paper]: parse, load, calibrate, write.
 #include "app/calibrate_command.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 
@@ -11,6 +12,7 @@
 #include "io/report_json.h"
 #include "io/robot_config.h"
 #include "report/calibration_report.h"
+#include "session/session_observations.h"
 
 namespace selfcal::app {
 
@@ -20,36 +22,81 @@ namespace {
 struct LoadedInput {
   ObservationSet observations;
   report::ReportInput input;
-  nlohmann::json session;  // the journal's counts, for a session
+  nlohmann::json session;           // the journal's counts and findings, for a session
+  session::JournalSummary summary;  // the same, for the terminal
 };
+
+// Refuses (kUsage, naming both paths) an output directory that is the session directory or inside it,
+// compared as weakly canonical absolute paths (symlinks of the existing part resolved), so that a
+// calibration never writes into the session it reads.
+Status CheckOutputOutsideSession(const std::string& out_dir, const std::string& session_path) {
+  namespace fs = std::filesystem;
+  auto resolve = [](const std::string& path) {
+    std::error_code error;
+    fs::path resolved = fs::weakly_canonical(fs::absolute(path), error);
+    if (error) resolved = fs::absolute(path).lexically_normal();
+    while (!resolved.empty() && resolved.filename().empty() && resolved != resolved.root_path()) {
+      resolved = resolved.parent_path();  // "a/b/" names b
+    }
+    return resolved;
+  };
+  const fs::path session = resolve(session_path);
+  const fs::path out = resolve(out_dir);
+  if (std::mismatch(session.begin(), session.end(), out.begin(), out.end()).first != session.end()) {
+    return Status::Ok();
+  }
+  return Status::Error(ExitCode::kUsage, "output directory " + out_dir + " is " +
+                                             (out == session ? "the session directory " : "inside the session ") +
+                                             session_path +
+                                             ": calibrate never writes into a session; choose --out outside it");
+}
+
+nlohmann::json SummaryJson(const std::string& session_path, const session::SessionObservations& loaded) {
+  const session::JournalSummary& s = loaded.summary;
+  return {{"path", session_path},
+          {"session_id", s.session_id},
+          {"session_json_sha256", loaded.manifest_sha256},
+          {"poses_planned", s.poses_planned},
+          {"samples_accepted", s.samples_accepted},
+          {"resumes", s.resumes},
+          {"finished", s.finished},
+          {"skips_by_reason", s.skips_by_reason},
+          {"faults_by_kind", s.faults_by_kind},
+          {"halts_by_reason", s.halts_by_reason},
+          {"warnings", loaded.findings}};
+}
+
+void PrintSummary(const session::JournalSummary& s) {
+  std::cout << "session: " << s.samples_accepted << " of " << s.poses_planned << " poses accepted, " << s.resumes
+            << " resumes";
+  for (const auto& [name, n] : s.skips_by_reason) std::cout << ", skipped " << name << " x" << n;
+  for (const auto& [name, n] : s.faults_by_kind) std::cout << ", fault " << name << " x" << n;
+  for (const auto& [name, n] : s.halts_by_reason) std::cout << ", halted " << name << " x" << n;
+  std::cout << "\n";
+}
 
 Result<LoadedInput> LoadInput(const CalibrateRequest& request) {
   LoadedInput loaded;
   if (IsSessionDirectory(request.input)) {
-    nlohmann::json summary;
-    Result<ObservationSet> obs = LoadSessionObservations(request.input, &summary);
-    if (!obs.ok()) return obs.status();
-    loaded.observations = std::move(obs).value();
-    loaded.session = std::move(summary);
-    const std::string manifest = (std::filesystem::path(request.input) / "session.json").string();
-    loaded.input = {"session", request.input, FileHash(manifest)};
+    if (Status s = CheckOutputOutsideSession(request.out_dir, request.input); !s.ok()) return s;
+    Result<session::SessionObservations> session = session::LoadSessionObservations(request.input);
+    if (!session.ok()) return session.status();
+    for (const std::string& finding : session->findings) std::cerr << "selfcal: warning: " << finding << "\n";
+    if (!session->findings.empty()) {
+      std::cerr << "selfcal: warning: calibrate changed nothing in session " << request.input
+                << " (a resume would repair it)\n";
+    }
+    loaded.session = SummaryJson(request.input, *session);
+    loaded.summary = session->summary;
+    loaded.input = {"session", request.input, session->manifest_sha256};
+    loaded.observations = std::move(session).value().observations;
     return loaded;
   }
   Result<ObservationSet> obs = io::LoadObservations(request.input);
   if (!obs.ok()) return obs.status();
   loaded.observations = std::move(obs).value();
-  loaded.input = {"observations", request.input, FileHash(request.input)};
+  loaded.input = {"observations", request.input, FileSha256(request.input)};
   return loaded;
-}
-
-void PrintSessionCounts(const nlohmann::json& summary) {
-  std::cout << "session: " << summary["samples_accepted"] << " of " << summary["poses_planned"] << " poses accepted, "
-            << summary["resumes"] << " resumes";
-  for (const char* key : {"skips_by_reason", "faults_by_kind", "halts_by_reason"}) {
-    const char* word = key[0] == 's' ? "skipped" : key[0] == 'f' ? "fault" : "halted";
-    for (const auto& [name, n] : summary[key].items()) std::cout << ", " << word << " " << name << " x" << n;
-  }
-  std::cout << "\n";
 }
 
 // Writes report.json, and calibrated_model.yaml when the verdict is "accepted" (K4).
@@ -108,7 +155,7 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   if (!report.accepted()) {
     std::cerr << "selfcal: " << ExitCodeName(code) << ": " << report.message << " (no calibrated model written)\n";
   }
-  if (from_session) PrintSessionCounts(loaded->session);
+  if (from_session) PrintSummary(loaded->summary);
   if (run != nullptr) *run = {std::move(loaded).value().observations, std::move(report)};
   return static_cast<int>(code);
 }

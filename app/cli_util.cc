@@ -1,9 +1,9 @@
 #include "app/cli_util.h"
 
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
+
+#include "base/sha256.h"
 
 namespace selfcal::app {
 
@@ -32,20 +32,9 @@ ExitCode ExitCodeFor(calibration::Verdict verdict) {
   return ExitCode::kSolverFailure;
 }
 
-std::string FileHash(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return "";
-  uint64_t hash = 1469598103934665603ULL;
-  char buffer[65536];
-  while (in.read(buffer, sizeof(buffer)) || in.gcount() > 0) {
-    for (std::streamsize i = 0; i < in.gcount(); ++i) {
-      hash ^= static_cast<unsigned char>(buffer[i]);
-      hash *= 1099511628211ULL;
-    }
-  }
-  char hex[17];
-  std::snprintf(hex, sizeof(hex), "%016llx", static_cast<unsigned long long>(hash));
-  return hex;
+std::string FileSha256(const std::string& path) {
+  Result<std::string> digest = Sha256OfFile(path);
+  return digest.ok() ? *digest : std::string();
 }
 
 Status EnsureDirectory(const std::string& path) {

@@ -22,8 +22,9 @@ int Fail(const Status& status);
 // solver failure 5.
 ExitCode ExitCodeFor(calibration::Verdict verdict);
 
-// 64-bit FNV-1a of a file's bytes as 16 hex digits ("" if unreadable): provenance in reports (P7).
-std::string FileHash(const std::string& path);
+// SHA-256 of a file's bytes as 64 hex digits (base/sha256.h): provenance in reports (P7). "" when the path
+// is not a readable regular file (e.g. a session directory, whose provenance is its session.json).
+std::string FileSha256(const std::string& path);
 
 // Creates the directory (and parents). Refuses an existing non-directory.
 Status EnsureDirectory(const std::string& path);

@@ -1,10 +1,11 @@
-// selfcal run: drives a robot through a plan and records a session (acquisition/session_runner.h).
+// selfcal run: drives a robot through a plan and records a session (pipeline/session_runner.h).
 // selfcal calibrate SESSION: the offline solve of a recorded session.
 #include "app/session_command.h"
 
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <ctime>
@@ -16,7 +17,6 @@
 
 #include "app/cli_util.h"
 #include "app/commands.h"
-#include "base/atomic_file.h"
 #include "capture/v4l2_camera.h"
 #include "io/observations_file.h"
 #include "io/report_json.h"
@@ -28,6 +28,8 @@
 #include "robot/network_robot.h"
 #include "session/samples.h"
 #include "session/session_dir.h"
+#include "session/session_observations.h"
+#include "session/setup_file.h"
 
 namespace selfcal::app {
 
@@ -53,62 +55,6 @@ std::string UtcNow() {
   char text[32];
   std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", &tm);
   return text;
-}
-
-Result<std::string> ReadWhole(const std::string& path) {
-  Result<std::string> bytes = ReadFileCapped(path, session::kMaxInputBytes);
-  if (!bytes.ok()) return Status::Error(ExitCode::kUsage, "cannot read " + path + ": " + bytes.status().message());
-  return bytes;
-}
-
-json KnownDistancesJson(const std::vector<KnownDistance>& distances) {
-  json a = json::array();
-  for (const KnownDistance& d : distances) a.push_back({{"dot_a", d.dot_a}, {"dot_b", d.dot_b}, {"length_m", d.length_m}});
-  return a;
-}
-
-// setup.json: what a calibration needs beside the robot and the samples (docs/session-format.md).
-json SetupJson(const ObservationSet& setup) {
-  const CameraIntrinsics& c = setup.camera;
-  return {{"format", "selfcal-session-setup"},
-          {"version", 1},
-          {"camera", {{"width_px", c.width_px}, {"height_px", c.height_px}, {"fx_px", c.fx_px}, {"mu", c.mu},
-                      {"cx_px", c.cx_px}, {"cy_px", c.cy_px}, {"k1", c.k1}}},
-          {"pixel_noise_px", setup.pixel_noise_px},
-          {"yardsticks", KnownDistancesJson(setup.yardsticks)},
-          {"check_distances", KnownDistancesJson(setup.check_distances)}};
-}
-
-Status ParseSetup(const std::string& text, const std::string& name, ObservationSet* set) {
-  auto bad = [&](const std::string& why) { return Status::Error(ExitCode::kUsage, name + ": " + why); };
-  json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (j.is_discarded() || !j.is_object()) return bad("not a JSON object");
-  if (j.value("format", "") != "selfcal-session-setup" || j.value("version", 0) != 1) {
-    return bad("format must be selfcal-session-setup version 1");
-  }
-  try {
-    const json& c = j.at("camera");
-    set->camera.width_px = c.at("width_px").get<int>();
-    set->camera.height_px = c.at("height_px").get<int>();
-    set->camera.fx_px = c.at("fx_px").get<double>();
-    set->camera.mu = c.at("mu").get<double>();
-    set->camera.cx_px = c.at("cx_px").get<double>();
-    set->camera.cy_px = c.at("cy_px").get<double>();
-    set->camera.k1 = c.at("k1").get<double>();
-    set->pixel_noise_px = j.at("pixel_noise_px").get<double>();
-    for (const char* key : {"yardsticks", "check_distances"}) {
-      std::vector<KnownDistance>& out = std::string(key) == "yardsticks" ? set->yardsticks : set->check_distances;
-      for (const json& d : j.at(key)) {
-        out.push_back({d.at("dot_a").get<int>(), d.at("dot_b").get<int>(), d.at("length_m").get<double>()});
-      }
-    }
-  } catch (const json::exception& e) {
-    return bad(std::string("missing or mistyped key: ") + e.what());
-  }
-  if (!(set->camera.fx_px > 0) || set->camera.width_px <= 0 || set->camera.height_px <= 0 || !(set->pixel_noise_px > 0)) {
-    return bad("camera size, fx_px and pixel_noise_px must be positive");
-  }
-  return Status::Ok();
 }
 
 std::vector<acquisition::PlannedPose> PlanPoses(const io::TrajectoryFile& plan) {
@@ -184,87 +130,17 @@ bool ConfirmOnTerminal(const std::string& preview, const robot::RobotIdentity& i
   return answer == identity.serial;
 }
 
-}  // namespace
-
-int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
-  const bool sim_robot = a.robot_backend == "sim";
-  const bool sim_camera = a.camera_backend == "sim";
-  if (sim_camera != sim_robot) {
-    return Fail(Status::Error(ExitCode::kUsage,
-                              "--camera sim renders what the simulated arm sees: it needs --robot sim, and --robot "
-                              "sim needs --camera sim (C9)"));
-  }
-  if (!sim_camera && a.setup.empty()) {
-    return Fail(Status::Error(ExitCode::kUsage, "--setup FILE (camera, yardstick; docs/session-format.md) is required "
-                                                "with a real camera (C2)"));
-  }
-  if (a.velocity_scaling < 0) a.velocity_scaling = sim_robot ? 1.0 : 0.1;
-  Result<std::string> robot_text = ReadWhole(ResolveDataPath(a.robot_config));
-  if (!robot_text.ok()) return Fail(robot_text.status());
-  Result<RobotModel> nominal = io::LoadRobotModel(ResolveDataPath(a.robot_config));
-  if (!nominal.ok()) return Fail(nominal.status());
-  Result<std::string> plan_text = ReadWhole(ResolveDataPath(a.plan));
-  if (!plan_text.ok()) return Fail(plan_text.status());
-  Result<io::TrajectoryFile> plan_file = io::LoadTrajectoryFile(ResolveDataPath(a.plan), *nominal);
-  if (!plan_file.ok()) return Fail(plan_file.status());
-  const std::vector<acquisition::PlannedPose> plan = PlanPoses(*plan_file);
-
-  // Resume: the simulated arm restarts where the last accepted sample left it (sim_session.h).
-  Eigen::VectorXd start_joints = plan.front().joints_rad;
-  double start_time_s = 0;
-  std::optional<session::Session> session;
-  session::SessionInputs inputs = {{"robot.yaml", *robot_text}, {"plan.yaml", *plan_text},
-                                   {"run.json", RunJson(a).dump(2) + "\n"}};
-  // The simulated cell (built before the session so that its setup can be recorded).
+// What the stages of a run share: the nominal robot, the plan, the session's inputs and, with the
+// simulated robot, the simulated cell.
+struct RunPlan {
+  RobotModel nominal;
+  std::vector<acquisition::PlannedPose> plan;
+  session::SessionInputs inputs;
   Result<simulation::SimCell> cell = Status::Error(ExitCode::kUsage, "no simulated cell");
-  std::string setup_text;
-  if (sim_robot) {
-    cell = simulation::MakeSimCell(*nominal, plan, SimCellOptionsFor(a), start_joints, start_time_s);
-    if (!cell.ok()) return Fail(cell.status());
-    setup_text = SetupJson(simulation::SimSetup(*cell)).dump(2) + "\n";
-  } else {
-    Result<std::string> text = ReadWhole(a.setup);
-    if (!text.ok()) return Fail(text.status());
-    ObservationSet probe;
-    if (Status s = ParseSetup(*text, a.setup, &probe); !s.ok()) return Fail(s);
-    setup_text = *text;
-  }
-  inputs.push_back({"setup.json", setup_text});
+};
 
-  if (a.resume) {
-    Result<session::Session> opened = session::OpenSession(a.session, inputs, a.force_changed_config);
-    if (!opened.ok()) return Fail(opened.status());
-    session.emplace(std::move(opened).value());
-    const session::OpenReport& r = session->open_report();
-    if (r.journal.truncated()) {
-      std::cout << "journal: dropped a torn tail of " << r.journal.dropped_bytes << " bytes (" << r.journal.reason
-                << ")\n";
-    }
-    for (const std::string& o : r.orphans) std::cout << "moved an unrecorded image aside: " << o << "\n";
-    if (!r.stale_lock_from.empty()) std::cout << "took over the lock of a dead process: " << r.stale_lock_from << "\n";
-    Result<session::SessionLog> log = session::ReadSessionLog(session->journal().records());
-    if (!log.ok()) return Fail(log.status());
-    if (sim_robot) {
-      if (const session::AcceptedSample* last = log->LastAcceptedSample()) {
-        start_joints = plan[last->pose].joints_rad;
-        start_time_s = last->sim_clock_s.value_or(0);
-        simulation::RestartSimCell(&cell.value(), SimCellOptionsFor(a), start_joints, start_time_s);
-      }
-    }
-  } else {
-    const std::filesystem::path parent = std::filesystem::path(a.session).parent_path();
-    if (!parent.empty()) {
-      if (Status s = EnsureDirectory(parent.string()); !s.ok()) return Fail(s);
-    }
-    session::CreateOptions create;
-    create.created_utc = UtcNow();
-    create.min_free_bytes = static_cast<std::uint64_t>(plan.size()) * 4 * 400 * 1024;
-    Result<session::Session> created = session::CreateSession(a.session, inputs, SELFCAL_VERSION, create);
-    if (!created.ok()) return Fail(created.status());
-    session.emplace(std::move(created).value());
-  }
-
-  // Backends (R12: the simulated ones are chosen explicitly and never talk to hardware).
+// The backends a run drives (R12: the simulated ones are chosen explicitly and never talk to hardware).
+struct Backends {
   std::unique_ptr<robot::Robot> owned_robot;
   std::unique_ptr<capture::FrameSource> owned_camera;
   std::unique_ptr<robot::Clock> owned_clock;
@@ -273,41 +149,136 @@ int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
   robot::Clock* clock = nullptr;
   acquisition::DetectionOrderIdentifier order_identifier;
   acquisition::DotIdentifier* identifier = &order_identifier;
-  if (sim_robot) {
-    arm = cell->robot.get();
-    camera = cell->camera.get();
-    clock = cell->clock.get();
-    identifier = cell->identifier.get();
-  } else {
-    owned_clock = std::make_unique<robot::MonotonicClock>();
-    clock = owned_clock.get();
-    if (a.robot_backend == "network") {
-      const size_t colon = a.address.rfind(':');
-      if (colon == std::string::npos) return Fail(Status::Error(ExitCode::kUsage, "--address must be HOST:PORT"));
-      robot::NetworkRobotOptions options;
-      owned_robot = std::make_unique<robot::NetworkRobot>(a.address.substr(0, colon),
-                                                          std::stoi(a.address.substr(colon + 1)), options);
-    } else if (a.robot_backend == "manual") {
-      robot::JointLimits limits;
-      const int n = nominal->num_joints();
-      limits.lower_rad.resize(n);
-      limits.upper_rad.resize(n);
-      for (int j = 0; j < n; ++j) {
-        limits.lower_rad[j] = nominal->limits[j].min_rad;
-        limits.upper_rad[j] = nominal->limits[j].max_rad;
-      }
-      limits.max_velocity_rad_s = Eigen::VectorXd::Constant(n, 0.5);  // the operator moves it; only for timing
-      owned_robot = std::make_unique<robot::ManualRobot>(std::cin, std::cout, limits, *clock);
-    } else {
-      return Fail(Status::Error(ExitCode::kUsage, "--robot must be sim, network or manual"));
-    }
-    arm = owned_robot.get();
-    capture::V4l2Options options;
-    options.device = a.device;
-    owned_camera = std::make_unique<capture::V4l2Camera>(options);
-    camera = owned_camera.get();
-  }
+};
 
+// Refuses backend combinations that cannot work and fills in the default velocity scaling.
+Status CheckRunSettings(RunSettings* a) {
+  const bool sim_robot = a->robot_backend == "sim";
+  if ((a->camera_backend == "sim") != sim_robot) {
+    return Status::Error(ExitCode::kUsage,
+                         "--camera sim renders what the simulated arm sees: it needs --robot sim, and --robot sim "
+                         "needs --camera sim (C9)");
+  }
+  if (!sim_robot && a->setup.empty()) {
+    return Status::Error(ExitCode::kUsage,
+                         "--setup FILE (camera, yardstick; docs/session-format.md) is required with a real camera (C2)");
+  }
+  if (a->velocity_scaling < 0) a->velocity_scaling = sim_robot ? 1.0 : 0.1;
+  return Status::Ok();
+}
+
+// Stage 1: the robot config, the plan and the setup (made by the simulated cell, or --setup), as the
+// session's inputs.
+Status LoadRunPlan(const RunSettings& a, RunPlan* run) {
+  Result<session::SessionInput> robot_input = session::ReadInputFile("robot.yaml", ResolveDataPath(a.robot_config));
+  if (!robot_input.ok()) return robot_input.status();
+  Result<RobotModel> nominal = io::LoadRobotModel(ResolveDataPath(a.robot_config));
+  if (!nominal.ok()) return nominal.status();
+  run->nominal = *nominal;
+  Result<session::SessionInput> plan_input = session::ReadInputFile("plan.yaml", ResolveDataPath(a.plan));
+  if (!plan_input.ok()) return plan_input.status();
+  Result<io::TrajectoryFile> plan_file = io::LoadTrajectoryFile(ResolveDataPath(a.plan), run->nominal);
+  if (!plan_file.ok()) return plan_file.status();
+  run->plan = PlanPoses(*plan_file);
+  run->inputs = {*robot_input, *plan_input, {"run.json", RunJson(a).dump(2) + "\n"}};
+  // The simulated cell is built before the session so that its setup can be recorded.
+  if (a.robot_backend == "sim") {
+    run->cell = simulation::MakeSimCell(run->nominal, run->plan, SimCellOptionsFor(a), run->plan.front().joints_rad, 0);
+    if (!run->cell.ok()) return run->cell.status();
+    run->inputs.push_back({session::kSetupFileName, session::SetupFileText(simulation::SimSetup(*run->cell))});
+    return Status::Ok();
+  }
+  Result<session::SessionInput> setup = session::ReadInputFile(session::kSetupFileName, a.setup);
+  if (!setup.ok()) return setup.status();
+  ObservationSet probe;
+  if (Status s = session::ParseSetupFile(setup->contents, a.setup, &probe); !s.ok()) return s;
+  run->inputs.push_back(*setup);
+  return Status::Ok();
+}
+
+// Stage 2, --resume: opens the session (inputs compared, journal recovered, orphans moved: reported) and
+// restarts the simulated arm where the last accepted sample left it (sim_session.h).
+Result<session::Session> ResumeSession(const RunSettings& a, RunPlan* run) {
+  Result<session::Session> opened = session::OpenSession(a.session, run->inputs, a.force_changed_config);
+  if (!opened.ok()) return opened.status();
+  const session::OpenReport& r = opened->open_report();
+  if (r.journal.truncated()) {
+    std::cout << "journal: dropped a torn tail of " << r.journal.dropped_bytes << " bytes (" << r.journal.reason
+              << ")\n";
+  }
+  for (const std::string& o : r.orphans) std::cout << "moved an unrecorded image aside: " << o << "\n";
+  if (!r.stale_lock_from.empty()) std::cout << "took over the lock of a dead process: " << r.stale_lock_from << "\n";
+  Result<session::SessionLog> log = session::ReadSessionLog(opened->journal().records());
+  if (!log.ok()) return log.status();
+  if (a.robot_backend == "sim") {
+    if (const session::AcceptedSample* last = log->LastAcceptedSample()) {
+      simulation::RestartSimCell(&run->cell.value(), SimCellOptionsFor(a), run->plan[last->pose].joints_rad,
+                               last->sim_clock_s.value_or(0));
+    }
+  }
+  return opened;
+}
+
+// Stage 2, a new session: created (with its parent folder) from the inputs; never overwrites (C10).
+Result<session::Session> CreateRunSession(const RunSettings& a, const RunPlan& run) {
+  const std::filesystem::path parent = std::filesystem::path(a.session).parent_path();
+  if (!parent.empty()) {
+    if (Status s = EnsureDirectory(parent.string()); !s.ok()) return s;
+  }
+  session::CreateOptions create;
+  create.created_utc = UtcNow();
+  create.min_free_bytes = static_cast<std::uint64_t>(run.plan.size()) * 4 * 400 * 1024;
+  return session::CreateSession(a.session, run.inputs, SELFCAL_VERSION, create);
+}
+
+// The joint limits the manual backend checks targets against: the nominal model's, with a nominal
+// velocity limit (the operator moves the arm; only used for timing).
+robot::JointLimits ManualJointLimits(const RobotModel& nominal) {
+  robot::JointLimits limits;
+  const int n = nominal.num_joints();
+  limits.lower_rad.resize(n);
+  limits.upper_rad.resize(n);
+  for (int j = 0; j < n; ++j) {
+    limits.lower_rad[j] = nominal.limits[j].min_rad;
+    limits.upper_rad[j] = nominal.limits[j].max_rad;
+  }
+  limits.max_velocity_rad_s = Eigen::VectorXd::Constant(n, 0.5);
+  return limits;
+}
+
+// Stage 3: the robot, camera, clock and dot identifier of the run.
+Status MakeBackends(const RunSettings& a, RunPlan* run, Backends* b) {
+  if (a.robot_backend == "sim") {
+    b->arm = run->cell->robot.get();
+    b->camera = run->cell->camera.get();
+    b->clock = run->cell->clock.get();
+    b->identifier = run->cell->identifier.get();
+    return Status::Ok();
+  }
+  b->owned_clock = std::make_unique<robot::MonotonicClock>();
+  b->clock = b->owned_clock.get();
+  if (a.robot_backend == "network") {
+    const size_t colon = a.address.rfind(':');
+    if (colon == std::string::npos) return Status::Error(ExitCode::kUsage, "--address must be HOST:PORT");
+    robot::NetworkRobotOptions options;
+    b->owned_robot = std::make_unique<robot::NetworkRobot>(a.address.substr(0, colon),
+                                                           std::stoi(a.address.substr(colon + 1)), options);
+  } else if (a.robot_backend == "manual") {
+    b->owned_robot = std::make_unique<robot::ManualRobot>(std::cin, std::cout, ManualJointLimits(run->nominal), *b->clock);
+  } else {
+    return Status::Error(ExitCode::kUsage, "--robot must be sim, network or manual");
+  }
+  b->arm = b->owned_robot.get();
+  capture::V4l2Options options;
+  options.device = a.device;
+  b->owned_camera = std::make_unique<capture::V4l2Camera>(options);
+  b->camera = b->owned_camera.get();
+  return Status::Ok();
+}
+
+// Stage 4: the session loop (acquisition::RunSession) and what it did; returns the exit code.
+int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, session::Session* session) {
+  const bool sim_robot = a.robot_backend == "sim";
   InstallStopHandlers();
   acquisition::RunOptions options;
   options.safety.velocity_scaling = a.velocity_scaling;
@@ -315,18 +286,18 @@ int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
   options.mode = sim_robot ? "simulated" : a.robot_backend;
   if (sim_robot) options.settle.min_dwell_s = 0.6;  // > the simulated ring-down cutoff (resume determinism)
   acquisition::RunContext context;
-  context.robot = arm;
-  context.camera = camera;
-  context.clock = clock;
-  context.session = &*session;
-  context.identifier = identifier;
+  context.robot = b.arm;
+  context.camera = b.camera;
+  context.clock = b.clock;
+  context.session = session;
+  context.identifier = b.identifier;
   context.stop_requested = &g_stop_requested;
   const bool dry_run = a.dry_run;
   context.confirm = [dry_run](const std::string& preview, const robot::RobotIdentity& identity) {
     return ConfirmOnTerminal(preview, identity, dry_run);
   };
   context.log = [](const std::string& line) { std::cout << line << "\n" << std::flush; };
-  const acquisition::RunReport report = acquisition::RunSession(plan, context, options);
+  const acquisition::RunReport report = acquisition::RunSession(run.plan, context, options);
   if (a.dry_run && report.outcome == acquisition::RunOutcome::kRefused && report.preview.size() > 0 &&
       report.message.rfind("not confirmed", 0) == 0) {
     return 0;
@@ -342,60 +313,27 @@ int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
                  "--session "
               << a.session << " (same options)\n";
   }
-  if (world != nullptr && sim_robot) *world = std::move(cell.value().world);
   return static_cast<int>(report.exit_code);
+}
+
+}  // namespace
+
+int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
+  if (Status s = CheckRunSettings(&a); !s.ok()) return Fail(s);
+  RunPlan run;
+  if (Status s = LoadRunPlan(a, &run); !s.ok()) return Fail(s);
+  Result<session::Session> session = a.resume ? ResumeSession(a, &run) : CreateRunSession(a, run);
+  if (!session.ok()) return Fail(session.status());
+  Backends backends;
+  if (Status s = MakeBackends(a, &run, &backends); !s.ok()) return Fail(s);
+  const int code = DriveSession(a, run, backends, &session.value());
+  if (world != nullptr && a.robot_backend == "sim") *world = std::move(run.cell.value().world);
+  return code;
 }
 
 bool IsSessionDirectory(const std::string& path) {
   struct stat st {};
   return ::stat((std::filesystem::path(path) / session::kManifestFileName).c_str(), &st) == 0;
-}
-
-Result<ObservationSet> LoadSessionObservations(const std::string& session_path, nlohmann::json* summary) {
-  Result<session::Session> opened = session::OpenSession(session_path, {}, false);
-  if (!opened.ok()) return opened.status();
-  const session::Session& s = *opened;
-  Result<session::SessionLog> log = session::ReadSessionLog(s.journal().records());
-  if (!log.ok()) return log.status();
-  if (summary != nullptr) {
-    *summary = {{"path", session_path},
-                {"session_id", s.manifest().session_id},
-                {"poses_planned", log->num_poses},
-                {"samples_accepted", log->NumAccepted()},
-                {"resumes", log->resumes},
-                {"finished", log->finished},
-                {"skips_by_reason", log->skips_by_reason},
-                {"faults_by_kind", log->faults_by_kind},
-                {"halts_by_reason", log->halts_by_reason}};
-  }
-  if (Status v = session::VerifySampleImages(s, *log); !v.ok()) return v;
-  Result<std::string> setup_text = s.ReadInput("setup.json");
-  if (!setup_text.ok()) return setup_text.status();
-  ObservationSet set;
-  if (Status p = ParseSetup(*setup_text, session_path + "/inputs/setup.json", &set); !p.ok()) return p;
-  Result<RobotModel> robot =
-      io::LoadRobotModel((std::filesystem::path(session_path) / session::kInputsDirName / "robot.yaml").string());
-  if (!robot.ok()) return robot.status();
-  set.robot = *robot;
-  for (const std::optional<session::AcceptedSample>& sample : log->accepted) {
-    if (!sample) continue;
-    PoseObservation pose;
-    pose.id = sample->id;
-    pose.role = sample->role;
-    pose.joints_rad = Eigen::Map<const Eigen::VectorXd>(sample->joints_rad.data(),
-                                                        static_cast<Eigen::Index>(sample->joints_rad.size()));
-    for (const session::SampleDot& d : sample->dots) pose.dots_px[d.id] = {d.u_px, d.v_px};
-    set.poses.push_back(std::move(pose));
-  }
-  if (set.PosesWithRole(PoseRole::kIdentification).size() < 2) {
-    return Status::Error(ExitCode::kDegenerateData, "session " + session_path + " has " +
-                                                        std::to_string(set.poses.size()) +
-                                                        " accepted samples: too few to calibrate");
-  }
-  if (const std::string problems = set.Validate(); !problems.empty()) {
-    return Status::Error(ExitCode::kDegenerateData, "session " + session_path + ": " + problems);
-  }
-  return set;
 }
 
 Command AddRunCommand(CLI::App& app) {

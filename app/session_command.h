@@ -1,13 +1,12 @@
-// Sessions from the command line: `selfcal run` (robot + camera -> a session directory), the session half
-// of `selfcal simulate`, and the reading of a recorded session for `selfcal calibrate SESSION`.
+// Sessions from the command line (issue 6): `selfcal run` (robot + camera -> a session directory),
+// `selfcal calibrate SESSION` (offline solve of a recorded session; never touches a robot) and the session
+// half of `selfcal simulate`.
 #pragma once
 
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "base/status.h"
 #include "observations/observation_set.h"
@@ -43,11 +42,5 @@ int RunFromSettings(RunSettings settings, std::unique_ptr<sim::SimResult>* world
 
 // True when `path` is a session directory (it holds session.json).
 bool IsSessionDirectory(const std::string& path);
-
-// Builds the ObservationSet of a session: the setup input (camera, yardsticks, checks), the robot input,
-// and the accepted samples of the journal in plan order. Verifies every sample's image (P2). kUsage
-// naming the session and record on any inconsistency; kDegenerateData when too few samples were accepted.
-// *summary (optional) receives the journal's counts: samples, resumes, skips, faults and halts by kind.
-Result<ObservationSet> LoadSessionObservations(const std::string& session_path, nlohmann::json* summary = nullptr);
 
 }  // namespace selfcal::app

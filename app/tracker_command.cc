@@ -80,7 +80,7 @@ Command AddTrackerCommand(CLI::App& app) {
                       {"max_centre_off_axis_mm", a.max_centre_off_axis_m * 1e3}, {"angle_ratio", a.angle_ratio}});
     }
     nlohmann::json doc = {{"format", "selfcal-tracker-report"}, {"version", 1}, {"data", path},
-                          {"data_hash", FileHash(path)}, {"outcome", external::OutcomeName(r.outcome)},
+                          {"data_hash", FileSha256(path)}, {"outcome", external::OutcomeName(r.outcome)},
                           {"message", r.message}, {"holdout_every", args->holdout_every},
                           {"j3_coupling", args->j3_coupling},
                           {"smr_distances_mm", {{"mean", {d.mean_m[0] * 1e3, d.mean_m[1] * 1e3, d.mean_m[2] * 1e3}},

@@ -11,14 +11,12 @@
 
 #include "observations/observation_set.h"
 #include "robot/robot.h"
+#include "session/planned_pose.h"
 
 namespace selfcal::acquisition {
 
-struct PlannedPose {
-  std::string id;                 // e.g. "p00"
-  PoseRole role = PoseRole::kIdentification;
-  Eigen::VectorXd joints_rad;
-};
+// A pose of the plan: the session's type (session/planned_pose.h), the same for the loop and the journal.
+using session::PlannedPose;
 
 struct MotionSafetyOptions {
   double velocity_scaling = 0.1;                 // R1: real robots start slow; (0, 1]

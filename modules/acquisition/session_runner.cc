@@ -340,7 +340,8 @@ RunReport Runner::Run() {
     // The recorded plan (a prefix of it if a crash came while it was being journaled) must be this one.
     bool same = log->num_poses == num_poses && static_cast<int>(log->plan.size()) <= num_poses;
     for (int i = 0; same && i < static_cast<int>(log->plan.size()); ++i) {
-      same = log->plan[i].id == plan_[i].id && FromVector(log->plan[i].joints_rad) == plan_[i].joints_rad;
+      same = log->plan[i].id == plan_[i].id && log->plan[i].joints_rad.size() == plan_[i].joints_rad.size() &&
+             log->plan[i].joints_rad == plan_[i].joints_rad;
     }
     if (!same) {
       report_.message = "session " + c_.session->path() + " recorded another plan than the one given (C9)";

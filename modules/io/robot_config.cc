@@ -193,14 +193,23 @@ CalibratedModel ParseRobotModel(const yaml::YamlNode& node, const std::string& n
   return Parse(node, name, problems, &format);
 }
 
-Result<RobotModel> LoadRobotModel(const std::string& path) {
-  Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(path);
+namespace {
+
+Result<RobotModel> RobotModelOf(const Result<yaml::YamlDocument>& doc, const std::string& name) {
   if (!doc.ok()) return doc.status();
-  Problems problems(path);
+  Problems problems(name);
   std::string format;
   CalibratedModel parsed = Parse(doc->root, "", &problems, &format);
   if (!problems.empty()) return problems.ToStatus("robot model");
   return parsed.model;
+}
+
+}  // namespace
+
+Result<RobotModel> LoadRobotModel(const std::string& path) { return RobotModelOf(yaml::LoadYamlFile(path), path); }
+
+Result<RobotModel> ParseRobotModelText(const std::string& text, const std::string& name) {
+  return RobotModelOf(yaml::ParseYamlText(text, name), name);
 }
 
 Result<CalibratedModel> LoadCalibratedModel(const std::string& path) {

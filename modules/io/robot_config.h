@@ -51,6 +51,10 @@ struct CalibratedModel {
 // and value of every problem.
 Result<RobotModel> LoadRobotModel(const std::string& path);
 
+// Parses a robot config (or calibrated-model file) already in memory, e.g. a session's verified copy;
+// `name` stands for the file in messages. Same checks and errors as LoadRobotModel.
+Result<RobotModel> ParseRobotModelText(const std::string& text, const std::string& name);
+
 // Reads a calibrated-model file (`format: selfcal-calibrated-model` required).
 Result<CalibratedModel> LoadCalibratedModel(const std::string& path);
 

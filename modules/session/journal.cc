@@ -169,6 +169,39 @@ std::string DirectoryOf(const std::string& path) {
   return parent.empty() ? "." : parent;
 }
 
+// Parses the whole journal `data` into *records. A torn tail is only reported in *recovery (valid_bytes:
+// where it starts, dropped_bytes: its length); damage and faulty writers are refused (kUsage).
+Status ParseJournal(const std::string& data, const std::string& path, const JournalLimits& limits,
+                    std::vector<nlohmann::json>* records, JournalRecovery* recovery) {
+  std::size_t pos = 0;
+  while (pos < data.size()) {
+    ParseResult record = ParseRecordAt(data, pos, limits);
+    if (record.kind == Parsed::kValid) {
+      records->push_back(std::move(record.payload));
+      pos = record.end;
+      continue;
+    }
+    const std::string where = "journal " + path + ": " + RecordName(records->size(), pos);
+    if (record.kind == Parsed::kBadPayload) {
+      return Status::Error(ExitCode::kUsage, where + " has a correct CRC but a bad payload (" + record.reason +
+                                                 "): written by a faulty writer, not torn by a crash; refusing it");
+    }
+    const std::size_t later = FindLaterRecord(data, pos, limits);
+    if (later != std::string::npos) {
+      return Status::Error(ExitCode::kUsage, where + " is corrupt (" + record.reason +
+                                                 ") and a valid record follows it at byte offset " +
+                                                 std::to_string(later) +
+                                                 ": the journal is damaged, not torn by a crash; refusing to drop "
+                                                 "records (nothing was changed)");
+    }
+    recovery->dropped_bytes = data.size() - pos;
+    recovery->reason = record.reason + ": " + RecordName(records->size(), pos);
+    break;
+  }
+  recovery->valid_bytes = pos;
+  return Status::Ok();
+}
+
 }  // namespace
 
 std::string FrameJournalRecord(const std::string& payload) {
@@ -193,41 +226,28 @@ Result<Journal> Journal::Open(const std::string& path, const JournalLimits& limi
 
   Result<std::string> read = ReadAll(journal.fd_, path, limits.max_file_bytes);
   if (!read.ok()) return read.status();
-  const std::string& data = *read;
-
-  std::size_t pos = 0;
-  while (pos < data.size()) {
-    ParseResult record = ParseRecordAt(data, pos, limits);
-    if (record.kind == Parsed::kValid) {
-      journal.records_.push_back(std::move(record.payload));
-      pos = record.end;
-      continue;
-    }
-    const std::string where = "journal " + path + ": " + RecordName(journal.records_.size(), pos);
-    if (record.kind == Parsed::kBadPayload) {
-      return Status::Error(ExitCode::kUsage, where + " has a correct CRC but a bad payload (" + record.reason +
-                                                 "): written by a faulty writer, not torn by a crash; refusing it");
-    }
-    const std::size_t later = FindLaterRecord(data, pos, limits);
-    if (later != std::string::npos) {
-      return Status::Error(ExitCode::kUsage, where + " is corrupt (" + record.reason +
-                                                 ") and a valid record follows it at byte offset " +
-                                                 std::to_string(later) +
-                                                 ": the journal is damaged, not torn by a crash; refusing to drop "
-                                                 "records (nothing was changed)");
-    }
+  if (Status s = ParseJournal(*read, path, limits, &journal.records_, &journal.recovery_); !s.ok()) return s;
+  const std::uint64_t pos = journal.recovery_.valid_bytes;
+  if (journal.recovery_.truncated()) {
     // A torn tail: cut it off so that the next Append starts on a record boundary.
     if (::ftruncate(journal.fd_, static_cast<off_t>(pos)) != 0) {
       return SystemError("cannot truncate the torn tail of journal", path, errno);
     }
     if (!FsyncRetrying(journal.fd_)) return SystemError("cannot fsync journal", path, errno);
-    journal.recovery_.dropped_bytes = data.size() - pos;
-    journal.recovery_.reason = record.reason + ": " + RecordName(journal.records_.size(), pos);
-    break;
   }
-  journal.recovery_.valid_bytes = pos;
   journal.size_bytes_ = pos;
   return journal;
+}
+
+Result<JournalContents> ReadJournal(const std::string& path, const JournalLimits& limits) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
+  if (fd < 0) return SystemError("cannot open journal", path, errno);
+  Result<std::string> read = ReadAll(fd, path, limits.max_file_bytes);
+  ::close(fd);
+  if (!read.ok()) return read.status();
+  JournalContents contents;
+  if (Status s = ParseJournal(*read, path, limits, &contents.records, &contents.recovery); !s.ok()) return s;
+  return contents;
 }
 
 Journal::Journal(Journal&& other) noexcept { *this = std::move(other); }

@@ -39,9 +39,9 @@ struct JournalLimits {
   int max_json_depth = 64;                                // nesting depth of a payload
 };
 
-// What Open found and did.
+// What Open found and did (ReadJournal: what Open would do; nothing is dropped there).
 struct JournalRecovery {
-  std::uint64_t valid_bytes = 0;    // length of the valid records, kept
+  std::uint64_t valid_bytes = 0;    // length of the valid records, kept; the byte offset of a torn tail
   std::uint64_t dropped_bytes = 0;  // length of the torn tail truncated away (0: nothing dropped)
   std::string reason;               // why the tail was dropped, e.g. "incomplete record (41 of 97 bytes)"
   bool created = false;             // the file did not exist and was created empty
@@ -88,6 +88,20 @@ class Journal {
   std::uint64_t size_bytes_ = 0;
   std::string failure_;  // set after an I/O error in Append: later appends are refused
 };
+
+// The valid records of a journal read without changing it (ReadJournal).
+struct JournalContents {
+  std::vector<nlohmann::json> records;
+  // recovery.truncated(): the journal ends in a torn tail of recovery.dropped_bytes bytes at byte offset
+  // recovery.valid_bytes, which Journal::Open (a resume) would truncate. It is left in place.
+  JournalRecovery recovery;
+};
+
+// Reads and validates every record of the journal at `path` read-only, for an offline reader (calibrate):
+// opens it O_RDONLY, takes no lock, creates nothing and truncates nothing. Damage and faulty writers are
+// refused as in Open (kUsage naming the record and byte offset); a torn tail is reported, not cut off.
+// kUsage for a missing file, one that is not a regular file or over the limits; kHardware for an I/O error.
+Result<JournalContents> ReadJournal(const std::string& path, const JournalLimits& limits = JournalLimits());
 
 // One framed journal line for `payload` (exposed for tests that build damaged journals).
 std::string FrameJournalRecord(const std::string& payload);

@@ -143,7 +143,8 @@ std::vector<SampleDot> ReadDots(const Fields& f) {
 }
 
 bool SamePlan(const PlannedPose& a, const PlannedPose& b) {
-  return a.id == b.id && a.role == b.role && a.joints_rad == b.joints_rad;
+  return a.id == b.id && a.role == b.role && a.joints_rad.size() == b.joints_rad.size() &&
+         a.joints_rad == b.joints_rad;
 }
 
 // The log being built, one record at a time.
@@ -172,7 +173,7 @@ class LogBuilder {
     } else if (type == "move_started") {
       const int pose = Pose(f);
       f.Number("time_s");
-      f.Joints("from_rad", log_.plan[pose].joints_rad.size());
+      f.Joints("from_rad", static_cast<std::size_t>(log_.plan[pose].joints_rad.size()));
     } else if (type == "move_done" || type == "settled") {
       Pose(f);
       f.Number("time_s");
@@ -220,21 +221,22 @@ class LogBuilder {
   void AddPlanned(const Fields& f) {
     PlannedPose planned;
     if (log_.num_poses == 0) f.Fail("pose", "the session has no poses");
-    planned.pose = static_cast<int>(f.Integer("pose", 0, log_.num_poses - 1));
+    const std::size_t pose = static_cast<std::size_t>(f.Integer("pose", 0, log_.num_poses - 1));
     planned.id = f.String("id");
     planned.role = f.Role();
-    planned.joints_rad = f.Joints("joints_rad", log_.plan.empty() ? 0 : log_.plan[0].joints_rad.size());
+    const std::vector<double> joints =
+        f.Joints("joints_rad", log_.plan.empty() ? 0 : static_cast<std::size_t>(log_.plan[0].joints_rad.size()));
+    planned.joints_rad = Eigen::Map<const Eigen::VectorXd>(joints.data(), static_cast<Eigen::Index>(joints.size()));
     const std::size_t next = log_.plan.size();
-    if (static_cast<std::size_t>(planned.pose) < next) {
-      if (!SamePlan(planned, log_.plan[planned.pose])) f.Fail("pose", "planned again with other values");
+    if (pose < next) {
+      if (!SamePlan(planned, log_.plan[pose])) f.Fail("pose", "planned again with other values");
       return;
     }
-    if (static_cast<std::size_t>(planned.pose) != next) {
-      f.Fail("pose", "pose " + std::to_string(planned.pose) + " planned before pose " + std::to_string(next));
-    }
-    for (const PlannedPose& other : log_.plan) {
-      if (other.id == planned.id)
-        f.Fail("id", "\"" + planned.id + "\" is the id of pose " + std::to_string(other.pose));
+    if (pose != next) f.Fail("pose", "pose " + std::to_string(pose) + " planned before pose " + std::to_string(next));
+    for (std::size_t other = 0; other < next; ++other) {
+      if (log_.plan[other].id == planned.id) {
+        f.Fail("id", "\"" + planned.id + "\" is the id of pose " + std::to_string(other));
+      }
     }
     log_.plan.push_back(std::move(planned));
     log_.accepted.emplace_back();
@@ -271,7 +273,7 @@ class LogBuilder {
       f.Fail("role",
              std::string(PoseRoleName(sample.role)) + " but the pose was planned as " + PoseRoleName(planned.role));
     }
-    sample.joints_rad = f.Joints("joints_rad", planned.joints_rad.size());
+    sample.joints_rad = f.Joints("joints_rad", static_cast<std::size_t>(planned.joints_rad.size()));
     sample.joint_time_s = f.Number("joint_time_s");
     sample.settle_time_s = f.Number("settle_time_s");
     sample.exposure_time_s = f.Number("exposure_time_s");
@@ -338,14 +340,14 @@ Result<SessionLog> ReadSessionLog(const std::vector<nlohmann::json>& records) {
   return builder.Take();
 }
 
-Status VerifySampleImages(const Session& session, const SessionLog& log) {
+Status VerifySampleImages(const std::string& session_path, const SessionLog& log) {
   std::vector<std::string> problems;
   for (const auto& sample : log.accepted) {
     if (!sample) continue;
     const FrameWritten& frame = log.frames.at(sample->image);
     const std::string where = sample->image + " (pose " + std::to_string(sample->pose) + ")";
     bool missing = false;
-    Result<std::string> bytes = ReadFileCapped(internal::Join(session.path(), sample->image), frame.bytes, &missing);
+    Result<std::string> bytes = ReadFileCapped(internal::Join(session_path, sample->image), frame.bytes, &missing);
     if (!bytes.ok()) {
       problems.push_back(where + (missing ? ": missing" : ": " + bytes.status().message()));
     } else if (bytes->size() != frame.bytes) {
@@ -357,7 +359,7 @@ Status VerifySampleImages(const Session& session, const SessionLog& log) {
     }
   }
   if (problems.empty()) return Status::Ok();
-  std::string message = "session " + session.path() + ": images of accepted samples do not match the journal: ";
+  std::string message = "session " + session_path + ": images of accepted samples do not match the journal: ";
   for (std::size_t i = 0; i < problems.size(); ++i) message += (i ? "; " : "") + problems[i];
   return Status::Error(ExitCode::kUsage, message);
 }

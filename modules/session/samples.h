@@ -21,6 +21,7 @@
 
 #include "base/status.h"
 #include "observations/observation_set.h"
+#include "session/planned_pose.h"
 #include "session/session_dir.h"
 
 namespace selfcal::session {
@@ -29,13 +30,7 @@ namespace selfcal::session {
 using selfcal::PoseRole;
 using selfcal::PoseRoleName;
 
-// pose_planned.
-struct PlannedPose {
-  int pose = 0;
-  std::string id;  // e.g. "p00"
-  PoseRole role = PoseRole::kIdentification;
-  std::vector<double> joints_rad;
-};
+// pose_planned: PlannedPose (session/planned_pose.h); its index in SessionLog::plan is its pose.
 
 // One dot of an accepted sample ("dots": [{"id", "u", "v", "area", "w", "h"}]).
 struct SampleDot {
@@ -125,8 +120,12 @@ struct SessionLog {
 // duplicate_accepts. kUsage naming the record, its type and field.
 Result<SessionLog> ReadSessionLog(const std::vector<nlohmann::json>& records);
 
-// Checks that the image of every accepted sample exists in `session` and has the size and CRC-32 its
-// frame_written record gives (P2). kUsage listing every missing or differing image.
-Status VerifySampleImages(const Session& session, const SessionLog& log);
+// Checks that the image of every accepted sample exists in the session directory `session_path` and has
+// the size and CRC-32 its frame_written record gives (P2); reads only. kUsage listing every missing or
+// differing image.
+Status VerifySampleImages(const std::string& session_path, const SessionLog& log);
+inline Status VerifySampleImages(const Session& session, const SessionLog& log) {
+  return VerifySampleImages(session.path(), log);
+}
 
 }  // namespace selfcal::session

@@ -99,7 +99,8 @@ TEST(SamplesTest, ReadsASyntheticJournal) {
   ASSERT_EQ(log.plan.size(), 4u);
   EXPECT_EQ(log.plan[2].id, "p02");
   EXPECT_EQ(log.plan[2].role, PoseRole::kVerification);
-  EXPECT_EQ(log.plan[3].joints_rad, kJoints);
+  EXPECT_EQ(std::vector<double>(log.plan[3].joints_rad.data(), log.plan[3].joints_rad.data() + log.plan[3].joints_rad.size()),
+            kJoints);
 
   ASSERT_TRUE(log.accepted[0].has_value());
   EXPECT_FALSE(log.accepted[1].has_value());

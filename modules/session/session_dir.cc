@@ -7,14 +7,12 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <cstdio>
 #include <filesystem>
 #include <regex>
 #include <set>
 
-#include <openssl/evp.h>
-
 #include "base/atomic_file.h"
+#include "base/sha256.h"
 #include "session/file_util.h"
 
 namespace selfcal::session {
@@ -204,20 +202,11 @@ Result<std::string> MoveToOrphans(const std::string& session_path, const std::st
 // Moves the files of images/ that no record names to orphans/ (P2).
 Result<std::vector<std::string>> MoveOrphans(const std::string& session_path,
                                              const std::vector<nlohmann::json>& records) {
-  std::set<std::string> referenced;
-  const std::string prefix = std::string(kImagesDirName) + "/";
-  for (const nlohmann::json& record : records) {
-    const auto image = record.find("image");
-    if (image == record.end() || !image->is_string()) continue;
-    const std::string& value = image->get_ref<const std::string&>();
-    if (value.compare(0, prefix.size(), prefix) == 0) referenced.insert(value.substr(prefix.size()));
-  }
   const std::string images = Join(session_path, kImagesDirName);
-  Result<std::vector<std::string>> names = ListNonDirectories(images);
+  Result<std::vector<std::string>> names = UnrecordedImages(session_path, records);
   if (!names.ok()) return names.status();
   std::vector<std::string> moved;
   for (const std::string& name : *names) {
-    if (referenced.count(name) > 0) continue;
     const std::string orphans = Join(session_path, kOrphansDirName);
     if (moved.empty() && ::mkdir(orphans.c_str(), 0755) != 0 && errno != EEXIST) {
       return SystemError("cannot create directory", orphans, errno);
@@ -236,25 +225,64 @@ Result<std::vector<std::string>> MoveOrphans(const std::string& session_path,
 
 }  // namespace
 
+Result<SessionInput> ReadInputFile(const std::string& name, const std::string& path) {
+  Result<std::string> bytes = ReadFileCapped(path, kMaxInputBytes);
+  if (!bytes.ok()) return Usage("cannot read " + path + ": " + bytes.status().message());
+  return SessionInput{name, std::move(bytes).value()};
+}
+
+Status CheckSessionLayout(const std::string& path) {
+  std::error_code error;
+  if (!std::filesystem::is_directory(Join(path, kImagesDirName), error)) {
+    return Usage("session " + path + " has no " + kImagesDirName + "/ directory");
+  }
+  // Created with the session: a missing journal is lost data, never silently started afresh.
+  if (!std::filesystem::exists(std::filesystem::symlink_status(Join(path, kJournalFileName), error))) {
+    return Usage("session " + path + " has no " + kJournalFileName + ": its records are lost");
+  }
+  return Status::Ok();
+}
+
+Result<std::vector<std::string>> UnrecordedImages(const std::string& session_path,
+                                                  const std::vector<nlohmann::json>& records) {
+  std::set<std::string> referenced;
+  const std::string prefix = std::string(kImagesDirName) + "/";
+  for (const nlohmann::json& record : records) {
+    const auto image = record.find("image");
+    if (image == record.end() || !image->is_string()) continue;
+    const std::string& value = image->get_ref<const std::string&>();
+    if (value.compare(0, prefix.size(), prefix) == 0) referenced.insert(value.substr(prefix.size()));
+  }
+  Result<std::vector<std::string>> names = ListNonDirectories(Join(session_path, kImagesDirName));
+  if (!names.ok()) return names.status();
+  std::vector<std::string> unrecorded;
+  for (const std::string& name : *names) {
+    if (referenced.count(name) == 0) unrecorded.push_back(name);
+  }
+  return unrecorded;
+}
+
+Result<std::string> ReadRecordedInput(const std::string& session_path, const InputDigest& digest) {
+  const std::string file = Join(Join(session_path, kInputsDirName), digest.name);
+  const std::string recorded = "recorded " + std::to_string(digest.bytes) + " bytes, sha256 " + digest.sha256_hex;
+  bool missing = false;
+  Result<std::string> text = ReadFileCapped(file, kMaxInputBytes, &missing);
+  if (missing) return Usage(file + ": missing, but recorded in " + kManifestFileName + " (" + recorded + ")");
+  if (!text.ok()) return WithErrnoExitCode(text.status());
+  const std::string sha256 = Sha256Hex(*text);
+  if (text->size() != digest.bytes || sha256 != digest.sha256_hex) {
+    return Usage(file + ": differs from the size or SHA-256 recorded in " + kManifestFileName + " (" + recorded +
+                 "; found " + std::to_string(text->size()) + " bytes, sha256 " + sha256 +
+                 "): the session's stored input was modified");
+  }
+  return text;
+}
+
 const InputDigest* SessionManifest::FindInput(const std::string& name) const {
   for (const InputDigest& input : inputs) {
     if (input.name == name) return &input;
   }
   return nullptr;
-}
-
-std::string Sha256Hex(const std::string& bytes) {
-  unsigned char digest[EVP_MAX_MD_SIZE];
-  unsigned int length = 0;
-  SELFCAL_CHECK(EVP_Digest(bytes.data(), bytes.size(), digest, &length, EVP_sha256(), nullptr) == 1,
-                "OpenSSL SHA-256 failed");
-  std::string hex;
-  char byte[3];
-  for (unsigned int i = 0; i < length; ++i) {
-    std::snprintf(byte, sizeof(byte), "%02x", digest[i]);
-    hex += byte;
-  }
-  return hex;
 }
 
 std::string ImageRecordPath(const std::string& name) { return std::string(kImagesDirName) + "/" + name; }
@@ -268,7 +296,7 @@ std::string DeriveSessionId(const std::string& path, const std::string& created_
   return stamp + "-" + Sha256Hex(absolute).substr(0, 8);
 }
 
-Result<SessionManifest> ReadManifest(const std::string& session_path) {
+Result<SessionManifest> ReadManifest(const std::string& session_path, std::string* sha256) {
   const std::string file = Join(session_path, kManifestFileName);
   bool missing = false;
   Result<std::string> text = ReadFileCapped(file, kMaxManifestBytes, &missing);
@@ -277,6 +305,7 @@ Result<SessionManifest> ReadManifest(const std::string& session_path) {
                  " (or its creation was interrupted)");
   }
   if (!text.ok()) return WithErrnoExitCode(text.status());
+  if (sha256 != nullptr) *sha256 = Sha256Hex(*text);
   return ParseManifest(*text, file);
 }
 
@@ -395,14 +424,7 @@ Result<Session> OpenSession(const std::string& path, const SessionInputs& expect
     return Usage("session " + path + " was recorded with other inputs: " + JoinProblems(report.changed_inputs) +
                  "; resume with the same files, or allow changed inputs explicitly (C9)");
   }
-  std::error_code error;
-  if (!std::filesystem::is_directory(Join(path, kImagesDirName), error)) {
-    return Usage("session " + path + " has no " + kImagesDirName + "/ directory");
-  }
-  // Created with the session: a missing journal is lost data, never silently started afresh.
-  if (!std::filesystem::exists(std::filesystem::symlink_status(Join(path, kJournalFileName), error))) {
-    return Usage("session " + path + " has no " + kJournalFileName + ": its records are lost");
-  }
+  if (Status s = CheckSessionLayout(path); !s.ok()) return s;
 
   Result<SessionLock> lock = SessionLock::Acquire(path);
   if (!lock.ok()) return lock.status();
@@ -447,14 +469,7 @@ Status Session::CheckFreeSpace(std::uint64_t bytes_needed) const {
 Result<std::string> Session::ReadInput(const std::string& name) const {
   const InputDigest* digest = manifest_.FindInput(name);
   if (digest == nullptr) return Usage("session " + path_ + " has no input \"" + name + "\"");
-  const std::string file = Join(Join(path_, kInputsDirName), name);
-  Result<std::string> text = ReadFileCapped(file, kMaxInputBytes);
-  if (!text.ok()) return WithErrnoExitCode(text.status());
-  if (text->size() != digest->bytes || Sha256Hex(*text) != digest->sha256_hex) {
-    return Usage("stored input " + file + " does not match its size and SHA-256 in " + kManifestFileName +
-                 ": it was modified");
-  }
-  return text;
+  return ReadRecordedInput(path_, *digest);
 }
 
 }  // namespace selfcal::session

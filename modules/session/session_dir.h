@@ -40,6 +40,10 @@ struct SessionInput {
 };
 using SessionInputs = std::vector<SessionInput>;  // in the order they are recorded
 
+// Input `name` with the bytes of the file `path` (at most kMaxInputBytes), for CreateSession and
+// OpenSession. kUsage naming the path when it is missing, unreadable, not a regular file or too large.
+Result<SessionInput> ReadInputFile(const std::string& name, const std::string& path);
+
 struct InputDigest {
   std::string name;
   std::uint64_t bytes = 0;
@@ -129,7 +133,8 @@ class Session {
 Result<Session> CreateSession(const std::string& path, const SessionInputs& inputs, const std::string& software_version,
                               const CreateOptions& options);
 
-// Opens an existing session to resume or solve it (P2, P3, C9), in this order:
+// Opens an existing session for writing, to resume it (P2, P3, C9); offline readers such as calibrate use
+// ReadSession (session_snapshot.h), which changes nothing. In this order:
 //  1. reads session.json strictly (another format or major version, missing, unknown or ill-typed keys:
 //     kUsage naming the file and key); images/ and journal.log must exist;
 //  2. compares every `expected` input with the recorded SHA-256 (inputs recorded but not expected are
@@ -144,14 +149,27 @@ Result<Session> CreateSession(const std::string& path, const SessionInputs& inpu
 Result<Session> OpenSession(const std::string& path, const SessionInputs& expected, bool allow_changed_inputs,
                             const JournalLimits& journal_limits = JournalLimits());
 
-// Reads and validates `<session>/session.json` without locking or changing anything.
-Result<SessionManifest> ReadManifest(const std::string& session_path);
+// Reads and validates `<session>/session.json` without locking or changing anything; *sha256 (optional)
+// receives the SHA-256 of the bytes read.
+Result<SessionManifest> ReadManifest(const std::string& session_path, std::string* sha256 = nullptr);
+
+// kUsage unless `session_path` has its images/ directory and its journal.log (a missing journal is lost
+// data, never started afresh).
+Status CheckSessionLayout(const std::string& session_path);
+
+// The stored copy inputs/<digest.name> of a session, checked against the size and SHA-256 its manifest
+// recorded. kUsage naming the file when it is missing ("<session>/inputs/<name>: missing, but recorded in
+// session.json ...") or differs ("<session>/inputs/<name>: differs from the size or SHA-256 recorded in
+// session.json (recorded ...; found ...)").
+Result<std::string> ReadRecordedInput(const std::string& session_path, const InputDigest& digest);
+
+// The names of the non-directory entries of <session>/images/ that no record names (the "image" field
+// of any record, "images/<name>"), sorted: what OpenSession would move to orphans/. Changes nothing.
+Result<std::vector<std::string>> UnrecordedImages(const std::string& session_path,
+                                                  const std::vector<nlohmann::json>& records);
 
 // "images/<name>": how journal records name an image file.
 std::string ImageRecordPath(const std::string& name);
-
-// SHA-256 of `bytes` (OpenSSL), 64 lower-case hex digits.
-std::string Sha256Hex(const std::string& bytes);
 
 // "<created_utc without '-', ':' and '.'>-<first 8 hex digits of the SHA-256 of the absolute, normalised
 // path>", e.g. "20250301T120000Z-1a2b3c4d": deterministic, distinct for sessions created at different
