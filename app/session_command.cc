@@ -1,5 +1,4 @@
-// selfcal run: drives a robot through a plan and records a session (pipeline/session_runner.h).
-// selfcal calibrate SESSION: the offline solve of a recorded session.
+// selfcal run: drives a robot through a plan and records a session (acquisition/session_runner.h).
 #include "app/session_command.h"
 
 #include <sys/stat.h>

@@ -1,6 +1,5 @@
-// Sessions from the command line (issue 6): `selfcal run` (robot + camera -> a session directory),
-// `selfcal calibrate SESSION` (offline solve of a recorded session; never touches a robot) and the session
-// half of `selfcal simulate`.
+// Sessions from the command line: `selfcal run` (robot + camera -> a session directory) and the session
+// half of `selfcal simulate`. (`selfcal calibrate SESSION` reads a session through the session module.)
 #pragma once
 
 #include <cstdint>

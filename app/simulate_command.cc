@@ -7,6 +7,8 @@
 #include <iomanip>
 #include <iostream>
 
+#include <nlohmann/json.hpp>
+
 #include "app/calibrate_command.h"
 #include "app/session_command.h"
 #include "app/cli_util.h"

@@ -1,5 +1,5 @@
-// One pose of a measurement plan: what the session loop drives the robot to (pipeline/session_runner.h,
-// its preflight in pipeline/motion_safety.h) and what a session's pose_planned record holds
+// One pose of a measurement plan: what the session loop drives the robot to (acquisition/session_runner.h,
+// its preflight in acquisition/motion_safety.h) and what a session's pose_planned record holds
 // (docs/session-format.md). The one type for both, in the lowest module that needs it.
 #pragma once
 
