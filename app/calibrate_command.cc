@@ -45,7 +45,7 @@ Status CheckOutputOutsideSession(const std::string& out_dir, const std::string& 
   if (std::mismatch(session.begin(), session.end(), out.begin(), out.end()).first != session.end()) {
     return Status::Ok();
   }
-  return Status::Error(ExitCode::kUsage, "output directory " + out_dir + " is " +
+  return Status::Error(ErrorCode::kInvalidInput, "output directory " + out_dir + " is " +
                                              (out == session ? "the session directory " : "inside the session ") +
                                              session_path +
                                              ": calibrate never writes into a session; choose --out outside it");

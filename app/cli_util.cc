@@ -17,7 +17,7 @@ std::string ResolveDataPath(const std::string& path) {
 
 int Fail(const Status& status) {
   std::cerr << "selfcal: " << status.ToString() << "\n";
-  return static_cast<int>(status.code());
+  return static_cast<int>(ExitCodeFor(status.code()));
 }
 
 ExitCode ExitCodeFor(calibration::Verdict verdict) {
@@ -41,10 +41,10 @@ Status EnsureDirectory(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (fs::exists(path, ec) && !fs::is_directory(path, ec)) {
-    return Status::Error(ExitCode::kUsage, "output `" + path + "` exists and is not a directory");
+    return Status::Error(ErrorCode::kInvalidInput, "output `" + path + "` exists and is not a directory");
   }
   fs::create_directories(path, ec);
-  if (ec) return Status::Error(ExitCode::kUsage, "cannot create output directory `" + path + "`: " + ec.message());
+  if (ec) return Status::Error(ErrorCode::kInvalidInput, "cannot create output directory `" + path + "`: " + ec.message());
   return Status::Ok();
 }
 

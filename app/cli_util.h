@@ -3,13 +3,11 @@
 
 #include <string>
 
+#include "app/exit_codes.h"
 #include "base/status.h"
 #include "calibration/calibrate.h"
 
 namespace selfcal::app {
-
-// An exception escaped a command: a bug, never the user's input (sysexits.h EX_SOFTWARE).
-inline constexpr int kInternalErrorExitCode = 70;
 
 // `path` as given if it exists, else relative to the source tree's root (so that the shipped defaults
 // under config/ work from any directory of a build tree).

@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     // CLI11 exits 0 for --help and --version; every real usage error maps to exit code 2 (C9).
     const int code = app.exit(e);
-    return code == 0 ? 0 : static_cast<int>(selfcal::ExitCode::kUsage);
+    return code == 0 ? 0 : static_cast<int>(selfcal::app::ExitCode::kUsage);
   }
   try {
     for (const auto& [name, command] :
@@ -38,7 +38,7 @@ int main(int argc, char** argv) {
     std::cerr << "selfcal: internal error: " << e.what()
               << "\nThis is a bug in selfcal " << SELFCAL_VERSION
               << ": please report it with the command line and this message.\n";
-    return selfcal::app::kInternalErrorExitCode;
+    return static_cast<int>(selfcal::app::ExitCode::kInternal);
   }
-  return static_cast<int>(selfcal::ExitCode::kUsage);
+  return static_cast<int>(selfcal::app::ExitCode::kUsage);
 }

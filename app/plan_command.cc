@@ -118,7 +118,7 @@ Command AddPlanCommand(CLI::App& app) {
     if (!robot.ok()) return Fail(robot.status());
     planning::Criterion criterion;
     if (!planning::ParseCriterion(args->criterion, &criterion)) {
-      return Fail(Status::Error(ExitCode::kUsage, "--criterion `" + args->criterion + "`: expected eq39, d-optimal or a-optimal"));
+      return Fail(Status::Error(ErrorCode::kInvalidInput, "--criterion `" + args->criterion + "`: expected eq39, d-optimal or a-optimal"));
     }
     const std::string plan_path = args->check.empty() ? args->start : args->check;
     Result<io::TrajectoryFile> file = io::LoadTrajectoryFile(ResolveDataPath(plan_path), robot->num_joints());
@@ -147,7 +147,7 @@ Command AddPlanCommand(CLI::App& app) {
       problem.scene = planning::Scene::FromBox(centre * 1e-3, size * 1e-3, args->box_dots, args->seed);
       std::cout << "scene: box centre " << centre.transpose() << " mm, size " << size.transpose() << " mm\n";
     } else if (!args->box_center_mm.empty() || !args->box_size_mm.empty()) {
-      return Fail(Status::Error(ExitCode::kUsage, "--box-center-mm and --box-size-mm go together (3 values each)"));
+      return Fail(Status::Error(ErrorCode::kInvalidInput, "--box-center-mm and --box-size-mm go together (3 values each)"));
     } else {
       sim::SimOptions sim_options;
       sim_options.world_seed = args->sim_world_seed;
@@ -156,14 +156,14 @@ Command AddPlanCommand(CLI::App& app) {
       if (!scene_poses.ok()) return Fail(scene_poses.status());
       const sim::SimResult world = sim::Simulate(*robot, *scene_poses, sim_options);
       if (!world.ok) {
-        return Fail(Status::Error(ExitCode::kDegenerateData, "no simulated scene for " + args->scene_from + ": " + world.message));
+        return Fail(Status::Error(ErrorCode::kDegenerateData, "no simulated scene for " + args->scene_from + ": " + world.message));
       }
       problem.scene = planning::Scene::FromDots(world.truth.dots_in_base);
       std::cout << "scene: the simulator's " << world.truth.dots_in_base.size() << " dots (world seed "
                 << args->sim_world_seed << ", placed for " << args->scene_from << ")\n";
     }
     if (const std::string invalid = problem.Validate(); !invalid.empty()) {
-      return Fail(Status::Error(ExitCode::kUsage, "plan options: " + invalid));
+      return Fail(Status::Error(ErrorCode::kInvalidInput, "plan options: " + invalid));
     }
 
     if (!args->check.empty()) {
@@ -186,7 +186,7 @@ Command AddPlanCommand(CLI::App& app) {
     std::cout << "start " << plan_path << ":\n";
     PrintCheck(r.check_start, std::cout);
     if (r.repaired_poses > 0) std::cout << "  repaired: " << r.repaired_poses << " poses replaced from the pool\n";
-    if (!r.ok) return Fail(Status::Error(ExitCode::kDegenerateData, r.message));
+    if (!r.ok) return Fail(Status::Error(ErrorCode::kDegenerateData, r.message));
     std::cout << "planned (" << planning::CriterionName(criterion) << ", " << Fixed(r.seconds * 1e3, 1) << " ms, "
               << r.iterations << " iterations, " << r.evaluations << " evaluations"
               << (r.solver_message.empty() ? "" : "; " + r.solver_message) << "):\n";

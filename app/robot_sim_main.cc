@@ -15,6 +15,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/exit_codes.h"
 #include "base/status.h"
 #include "io/robot_config.h"
 #include "robot/clock.h"
@@ -53,7 +54,7 @@ std::string ResolveConfigPath(const std::string& path) {
 
 int Fail(const selfcal::Status& status) {
   std::cerr << "selfcal-robot-sim: " << status.ToString() << "\n";
-  return static_cast<int>(status.code());
+  return static_cast<int>(selfcal::app::ExitCodeFor(status.code()));
 }
 
 std::set<int> AsSet(const std::vector<int>& indices) { return std::set<int>(indices.begin(), indices.end()); }
@@ -98,7 +99,7 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
-    return code == 0 ? 0 : static_cast<int>(ExitCode::kUsage);
+    return code == 0 ? 0 : static_cast<int>(selfcal::app::ExitCode::kUsage);
   }
 
   const Result<RobotModel> model = io::LoadRobotModel(ResolveConfigPath(args.robot));
@@ -121,7 +122,7 @@ int main(int argc, char** argv) {
   }
   if (!args.initial_joints_deg.empty()) {
     if (static_cast<int>(args.initial_joints_deg.size()) != n) {
-      return Fail(Status::Error(ExitCode::kUsage, "--initial-joints-deg: " + std::to_string(args.initial_joints_deg.size()) +
+      return Fail(Status::Error(ErrorCode::kInvalidInput, "--initial-joints-deg: " + std::to_string(args.initial_joints_deg.size()) +
                                                       " values for " + std::to_string(n) + " joints"));
     }
     for (int j = 0; j < n; ++j) options.initial_joints_rad[j] = args.initial_joints_deg[j] * kRadPerDeg;

@@ -135,7 +135,7 @@ struct RunPlan {
   RobotModel nominal;
   std::vector<acquisition::PlannedPose> plan;
   session::SessionInputs inputs;
-  Result<simulation::SimCell> cell = Status::Error(ExitCode::kUsage, "no simulated cell");
+  Result<simulation::SimCell> cell = Status::Error(ErrorCode::kInvalidInput, "no simulated cell");
 };
 
 // The backends a run drives (R12: the simulated ones are chosen explicitly and never talk to hardware).
@@ -154,12 +154,12 @@ struct Backends {
 Status CheckRunSettings(RunSettings* a) {
   const bool sim_robot = a->robot_backend == "sim";
   if ((a->camera_backend == "sim") != sim_robot) {
-    return Status::Error(ExitCode::kUsage,
+    return Status::Error(ErrorCode::kInvalidInput,
                          "--camera sim renders what the simulated arm sees: it needs --robot sim, and --robot sim "
                          "needs --camera sim (C9)");
   }
   if (!sim_robot && a->setup.empty()) {
-    return Status::Error(ExitCode::kUsage,
+    return Status::Error(ErrorCode::kInvalidInput,
                          "--setup FILE (camera, yardstick; docs/session-format.md) is required with a real camera (C2)");
   }
   if (a->velocity_scaling < 0) a->velocity_scaling = sim_robot ? 1.0 : 0.1;
@@ -258,14 +258,14 @@ Status MakeBackends(const RunSettings& a, RunPlan* run, Backends* b) {
   b->clock = b->owned_clock.get();
   if (a.robot_backend == "network") {
     const size_t colon = a.address.rfind(':');
-    if (colon == std::string::npos) return Status::Error(ExitCode::kUsage, "--address must be HOST:PORT");
+    if (colon == std::string::npos) return Status::Error(ErrorCode::kInvalidInput, "--address must be HOST:PORT");
     robot::NetworkRobotOptions options;
     b->owned_robot = std::make_unique<robot::NetworkRobot>(a.address.substr(0, colon),
                                                            std::stoi(a.address.substr(colon + 1)), options);
   } else if (a.robot_backend == "manual") {
     b->owned_robot = std::make_unique<robot::ManualRobot>(std::cin, std::cout, ManualJointLimits(run->nominal), *b->clock);
   } else {
-    return Status::Error(ExitCode::kUsage, "--robot must be sim, network or manual");
+    return Status::Error(ErrorCode::kInvalidInput, "--robot must be sim, network or manual");
   }
   b->arm = b->owned_robot.get();
   capture::V4l2Options options;
@@ -312,7 +312,7 @@ int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, se
                  "--session "
               << a.session << " (same options)\n";
   }
-  return static_cast<int>(report.exit_code);
+  return static_cast<int>(ExitCodeFor(report.error));
 }
 
 }  // namespace

@@ -280,7 +280,7 @@ Command AddSimulateCommand(CLI::App& app) {
   return [args]() {
     if (!args->points) {
       if (args->flat_sheet || args->perturb_gauge) {
-        return Fail(Status::Error(ExitCode::kUsage, "--flat-sheet and --perturb-gauge need --points"));
+        return Fail(Status::Error(ErrorCode::kInvalidInput, "--flat-sheet and --perturb-gauge need --points"));
       }
       return SimulateSession(*args);
     }
@@ -295,7 +295,7 @@ Command AddSimulateCommand(CLI::App& app) {
     options.perturb_gauge_parameters = args->perturb_gauge;
     options.flat_sheet = args->flat_sheet;
     const sim::SimResult world = sim::Simulate(*robot, *joints, options);
-    if (!world.ok) return Fail(Status::Error(ExitCode::kDegenerateData, "simulation: " + world.message));
+    if (!world.ok) return Fail(Status::Error(ErrorCode::kDegenerateData, "simulation: " + world.message));
     std::cout << "simulated " << world.observations.poses.size() << " poses x " << world.truth.dots_in_base.size()
               << " dots, pixel noise " << args->noise_px << " px (std), hidden errors: lengths N(0, "
               << options.length_error_std_m * 1e3 << " mm), angles N(0, " << RadToDeg(options.angle_error_std_rad)
@@ -347,7 +347,7 @@ Command AddMakeTrajectoryCommand(CLI::App& app) {
     options.num_poses = *poses;
     options.home_joints_deg = *home_deg;
     const sim::GeneratedTrajectory t = sim::MakeArcTrajectory(*robot, options);
-    if (!t.ok) return Fail(Status::Error(ExitCode::kDegenerateData, t.message));
+    if (!t.ok) return Fail(Status::Error(ErrorCode::kDegenerateData, t.message));
     const std::string description =
         "smooth arc around the simulated scene (sim::MakeArcTrajectory defaults): the paper's 'initial' trajectory";
     if (Status s = io::SaveTrajectory(t.joints, *out_path, robot->name, description); !s.ok()) return Fail(s);

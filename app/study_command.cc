@@ -54,7 +54,7 @@ Command AddStudyCommand(CLI::App& app) {
     for (const std::string& spec : args->trajectories) {
       const size_t eq = spec.find('=');
       if (eq == std::string::npos || eq == 0) {
-        return Fail(Status::Error(ExitCode::kUsage, "--trajectory `" + spec + "`: expected NAME=FILE"));
+        return Fail(Status::Error(ErrorCode::kInvalidInput, "--trajectory `" + spec + "`: expected NAME=FILE"));
       }
       Result<std::vector<Eigen::VectorXd>> joints =
           io::LoadTrajectory(ResolveDataPath(spec.substr(eq + 1)), robot->num_joints());
@@ -62,7 +62,7 @@ Command AddStudyCommand(CLI::App& app) {
       trajectories.push_back({spec.substr(0, eq), *joints});
     }
     for (double n : args->noise) {
-      if (!(n >= 0 && n < 10)) return Fail(Status::Error(ExitCode::kUsage, "--noise-px: " + std::to_string(n) + " is not in [0, 10)"));
+      if (!(n >= 0 && n < 10)) return Fail(Status::Error(ErrorCode::kInvalidInput, "--noise-px: " + std::to_string(n) + " is not in [0, 10)"));
     }
     simulation::StudyOptions options;
     options.runs = args->runs;

@@ -50,7 +50,7 @@ class Runner {
   // Appends a record; a failure ends the run (kSessionError, P5) after stopping the robot.
   bool Record(json record);
   // Ends the run in `outcome` after telling the robot to stop and journaling why (never resumes, R9).
-  Step Halt(RunOutcome outcome, ExitCode code, const std::string& reason, const std::string& detail, int pose);
+  Step Halt(RunOutcome outcome, ErrorCode code, const std::string& reason, const std::string& detail, int pose);
   Step Fault(const std::string& kind, int pose, const std::string& detail);
   void Skip(int pose, const std::string& reason, const std::string& detail);
   Step HaltOnRobotError(const Status& status, int pose, const std::string& what);
@@ -83,7 +83,7 @@ bool Runner::Record(json record) {
   if (Status s = c_.session->journal().Append(record); !s.ok()) {
     if (c_.robot != nullptr) c_.robot->Stop();
     report_.outcome = RunOutcome::kSessionError;
-    report_.exit_code = s.code();
+    report_.error = s.code();
     report_.message = "session journal: " + s.message();
     report_.halt_reason = "journal_write_failed";
     return false;
@@ -91,11 +91,11 @@ bool Runner::Record(json record) {
   return true;
 }
 
-Runner::Step Runner::Halt(RunOutcome outcome, ExitCode code, const std::string& reason, const std::string& detail,
+Runner::Step Runner::Halt(RunOutcome outcome, ErrorCode code, const std::string& reason, const std::string& detail,
                           int pose) {
   const Status stop = c_.robot->Stop();
   report_.outcome = outcome;
-  report_.exit_code = code;
+  report_.error = code;
   report_.halt_reason = reason;
   report_.message = "halted at pose " + (pose >= 0 ? plan_[pose].id : std::string("-")) + ": " + reason + ": " +
                     detail + (stop.ok() ? "" : " (stop command failed: " + stop.message() + ")");
@@ -118,7 +118,7 @@ void Runner::Skip(int pose, const std::string& reason, const std::string& detail
 
 Runner::Step Runner::HaltOnRobotError(const Status& status, int pose, const std::string& what) {
   const robot::RobotError e = robot::RobotErrorOf(status);
-  return Halt(RunOutcome::kHalted, ExitCode::kHardware, std::string("robot_") + robot::RobotErrorName(e),
+  return Halt(RunOutcome::kHalted, ErrorCode::kHardware, std::string("robot_") + robot::RobotErrorName(e),
               what + ": " + status.message(), pose);
 }
 
@@ -184,12 +184,12 @@ Runner::Step Runner::Grab(int pose, double not_before_s, bool during_move, captu
       const bool timeout = e == capture::CaptureError::kTimeout;
       if (Fault(timeout ? "frame_timeout" : "bad_frame", pose, f.status().message()) == Step::kEnd) return Step::kEnd;
       if (timeout && !during_move && attempt + 1 == attempts) {  // V3: the camera is silent; stop here
-        return Halt(RunOutcome::kHalted, ExitCode::kHardware, "camera_timeout",
+        return Halt(RunOutcome::kHalted, ErrorCode::kHardware, "camera_timeout",
                     "no frame after " + std::to_string(attempts) + " attempts: " + f.status().message(), pose);
       }
       continue;
     }
-    return Halt(RunOutcome::kHalted, ExitCode::kHardware,
+    return Halt(RunOutcome::kHalted, ErrorCode::kHardware,
                 std::string("camera_") + (e == capture::CaptureError::kNone ? "error" : capture::CaptureErrorName(e)),
                 f.status().message(), pose);
   }
@@ -259,20 +259,20 @@ Runner::Step Runner::Move(int pose, const robot::JointReading& from, const Eigen
   const double deadline = start + o_.watchdog_factor * planned + o_.watchdog_slack_s;
   while (true) {
     if (StopRequested()) {
-      return Halt(RunOutcome::kInterrupted, ExitCode::kInterrupted, "interrupted", "stop requested during the move",
+      return Halt(RunOutcome::kInterrupted, ErrorCode::kInterrupted, "interrupted", "stop requested during the move",
                   pose);
     }
     Result<robot::RobotStatus> status = c_.robot->GetStatus();
     if (!status.ok()) return HaltOnRobotError(status.status(), pose, "during the move");
     if (status->state == robot::MotionState::kIdle) break;
     if (status->state != robot::MotionState::kMoving) {
-      return Halt(RunOutcome::kHalted, ExitCode::kHardware, robot::MotionStateName(status->state),
+      return Halt(RunOutcome::kHalted, ErrorCode::kHardware, robot::MotionStateName(status->state),
                   "the controller stopped the arm: " + status->message, pose);
     }
     if (Now() > deadline) {  // R6: the move never finished
       std::ostringstream d;
       d << "the move did not finish within " << (deadline - start) << " s (planned " << planned << " s)";
-      return Halt(RunOutcome::kHalted, ExitCode::kHardware, "move_timeout", d.str(), pose);
+      return Halt(RunOutcome::kHalted, ErrorCode::kHardware, "move_timeout", d.str(), pose);
     }
     if (tracked_.empty()) {
       c_.clock->SleepFor(o_.settle.reading_period_s);
@@ -284,7 +284,7 @@ Runner::Step Runner::Move(int pose, const robot::JointReading& from, const Eigen
     if (grabbed == Step::kOk) {
       if (Step s = Identify(pose, frame); s == Step::kEnd) return s;
       if (tracked_.empty()) {
-        return Halt(RunOutcome::kHalted, ExitCode::kDegenerateData, "lost_track",
+        return Halt(RunOutcome::kHalted, ErrorCode::kDegenerateData, "lost_track",
                     "every dot was lost during the move: identities cannot be carried on", pose);
       }
     }
@@ -297,7 +297,7 @@ Runner::Step Runner::Settle(int pose, double arrival_s, double* settle_s, robot:
   int calm = 0;
   while (true) {
     if (StopRequested()) {
-      return Halt(RunOutcome::kInterrupted, ExitCode::kInterrupted, "interrupted", "stop requested while settling",
+      return Halt(RunOutcome::kInterrupted, ErrorCode::kInterrupted, "interrupted", "stop requested while settling",
                   pose);
     }
     if (Step s = ReadJoints(pose, arrival_s, reading); s != Step::kOk) return s;
@@ -322,7 +322,7 @@ RunReport Runner::Run() {
   SELFCAL_CHECK(c_.robot && c_.camera && c_.clock && c_.session && c_.identifier && c_.confirm,
                 "RunContext needs a robot, camera, clock, session, identifier and confirm callback");
   report_.outcome = RunOutcome::kRefused;
-  report_.exit_code = ExitCode::kUsage;
+  report_.error = ErrorCode::kInvalidInput;
   if (const std::string bad = o_.Validate(); !bad.empty()) {
     report_.message = "run options: " + bad;
     return report_;
@@ -331,7 +331,7 @@ RunReport Runner::Run() {
   Result<session::SessionLog> log = session::ReadSessionLog(c_.session->journal().records());
   if (!log.ok()) {
     report_.outcome = RunOutcome::kSessionError;
-    report_.exit_code = log.status().code();
+    report_.error = log.status().code();
     report_.message = log.status().message();
     return report_;
   }
@@ -353,7 +353,7 @@ RunReport Runner::Run() {
   if (first >= num_poses) {
     if (!log->finished && !Record({{"type", "finished"}, {"time_s", Now()}})) return report_;
     report_.outcome = RunOutcome::kCompleted;
-    report_.exit_code = ExitCode::kOk;
+    report_.error = ErrorCode::kOk;
     report_.message = "every pose of the session is done";
     return report_;
   }
@@ -361,7 +361,7 @@ RunReport Runner::Run() {
   // The robot: identity, limits, where it is.
   if (Status s = c_.robot->Connect(); !s.ok()) {
     report_.outcome = RunOutcome::kHalted;
-    report_.exit_code = ExitCode::kHardware;
+    report_.error = ErrorCode::kHardware;
     report_.message = "connecting to the robot: " + s.message();
     return report_;
   }
@@ -369,7 +369,7 @@ RunReport Runner::Run() {
   Result<robot::JointLimits> limits = identity.ok() ? c_.robot->Limits() : Result<robot::JointLimits>(identity.status());
   if (!limits.ok()) {
     report_.outcome = RunOutcome::kHalted;
-    report_.exit_code = ExitCode::kHardware;
+    report_.error = ErrorCode::kHardware;
     report_.message = "asking the robot for its identity and limits: " + limits.status().message();
     return report_;
   }
@@ -386,7 +386,7 @@ RunReport Runner::Run() {
   Result<robot::JointReading> now_joints = c_.robot->ReadJoints();
   if (!now_joints.ok()) {
     report_.outcome = RunOutcome::kHalted;
-    report_.exit_code = ExitCode::kHardware;
+    report_.error = ErrorCode::kHardware;
     report_.message = "reading the robot's joints: " + now_joints.status().message();
     return report_;
   }
@@ -422,7 +422,7 @@ RunReport Runner::Run() {
   // V1: the camera must work before anything moves (its Open grabs a test frame where it can).
   if (Status s = c_.camera->Open(); !s.ok()) {
     report_.outcome = RunOutcome::kHalted;
-    report_.exit_code = ExitCode::kHardware;
+    report_.error = ErrorCode::kHardware;
     report_.message = "opening the camera " + c_.camera->Describe() + ": " + s.message();
     return report_;
   }
@@ -437,7 +437,7 @@ RunReport Runner::Run() {
     return report_;
   }
   if (!c_.confirm(report_.preview, *identity)) {
-    report_.exit_code = ExitCode::kInterrupted;
+    report_.error = ErrorCode::kInterrupted;
     report_.message = "not confirmed: nothing moved";
     return report_;
   }
@@ -468,7 +468,7 @@ RunReport Runner::Run() {
     const bool is_return = returning && r == 0;
     const PlannedPose& target = route[r];
     if (StopRequested()) {
-      Halt(RunOutcome::kInterrupted, ExitCode::kInterrupted, "interrupted", "stop requested between poses", pose);
+      Halt(RunOutcome::kInterrupted, ErrorCode::kInterrupted, "interrupted", "stop requested between poses", pose);
       return report_;
     }
     if (Status s = c_.session->CheckFreeSpace(o_.frame_bytes_estimate * 4); !s.ok()) {
@@ -479,7 +479,7 @@ RunReport Runner::Run() {
     Step step = ReadJoints(pose, -std::numeric_limits<double>::infinity(), &before);
     if (step == Step::kEnd) return report_;
     if (step == Step::kSkip) {
-      Halt(RunOutcome::kHalted, ExitCode::kHardware, "bad_reading", "no valid joint reading before the move", pose);
+      Halt(RunOutcome::kHalted, ErrorCode::kHardware, "bad_reading", "no valid joint reading before the move", pose);
       return report_;
     }
     const double deviation = (before.position_rad - expected).cwiseAbs().maxCoeff();
@@ -488,7 +488,7 @@ RunReport Runner::Run() {
       d << "the arm is " << deviation << " rad away from where it should be (tolerance "
         << o_.safety.start_tolerance_rad << " rad): check the cell, then resume";
       Fault("start_state_mismatch", pose, d.str());
-      Halt(RunOutcome::kHalted, ExitCode::kHardware, "start_state_mismatch", d.str(), pose);
+      Halt(RunOutcome::kHalted, ErrorCode::kHardware, "start_state_mismatch", d.str(), pose);
       return report_;
     }
     Log("pose " + target.id + ": moving");
@@ -502,7 +502,7 @@ RunReport Runner::Run() {
     if (step == Step::kEnd) return report_;
     if (step == Step::kSkip) {
       if (is_return) {
-        Halt(RunOutcome::kHalted, ExitCode::kHardware, "return_failed", "could not return to the last sample's pose",
+        Halt(RunOutcome::kHalted, ErrorCode::kHardware, "return_failed", "could not return to the last sample's pose",
              pose);
         return report_;
       }
@@ -516,7 +516,7 @@ RunReport Runner::Run() {
     if (step == Step::kEnd) return report_;
     if (step == Step::kSkip) {
       if (is_return) {
-        Halt(RunOutcome::kHalted, ExitCode::kHardware, "return_failed", "no frame or reading at the last sample's pose",
+        Halt(RunOutcome::kHalted, ErrorCode::kHardware, "return_failed", "no frame or reading at the last sample's pose",
              pose);
         return report_;
       }
@@ -528,7 +528,7 @@ RunReport Runner::Run() {
     if (step == Step::kSkip) continue;
     FindMarkedAgain(frame);
     if (tracked_.empty()) {
-      Halt(RunOutcome::kHalted, ExitCode::kDegenerateData, "lost_track", "no dot is tracked any more", pose);
+      Halt(RunOutcome::kHalted, ErrorCode::kDegenerateData, "lost_track", "no dot is tracked any more", pose);
       return report_;
     }
     if (is_return) continue;  // the dots are found again; nothing is recorded for the return
@@ -570,7 +570,7 @@ RunReport Runner::Run() {
   }
   if (!Record({{"type", "finished"}, {"time_s", Now()}})) return report_;
   report_.outcome = RunOutcome::kCompleted;
-  report_.exit_code = ExitCode::kOk;
+  report_.error = ErrorCode::kOk;
   report_.message = "session complete: " + std::to_string(report_.accepted) + " samples accepted by this run";
   return report_;
 }
@@ -613,7 +613,7 @@ const char* RunOutcomeName(RunOutcome outcome) {
 
 Result<std::vector<tracking::PreviousDot>> DetectionOrderIdentifier::Identify(
     const capture::Frame& /*frame*/, const tracking::DetectionReport& detections) {
-  if (detections.dots.empty()) return Status::Error(ExitCode::kDegenerateData, "no dot detected in the first frame");
+  if (detections.dots.empty()) return Status::Error(ErrorCode::kDegenerateData, "no dot detected in the first frame");
   std::vector<tracking::PreviousDot> named;
   for (size_t k = 0; k < detections.dots.size(); ++k) {
     named.push_back(tracking::MakePreviousDot(static_cast<int>(k), detections.dots[k]));

@@ -103,7 +103,7 @@ const char* RunOutcomeName(RunOutcome outcome);
 
 struct RunReport {
   RunOutcome outcome = RunOutcome::kRefused;
-  ExitCode exit_code = ExitCode::kUsage;
+  ErrorCode error = ErrorCode::kInvalidInput;
   std::string message;
   std::string preview;          // the dry-run preview shown to confirm
   int first_pose = 0;           // where this invocation started (resume point)

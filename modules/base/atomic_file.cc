@@ -15,7 +15,7 @@ namespace selfcal {
 namespace {
 
 Status Failure(const std::string& what, const std::string& path, int error) {
-  return Status::Error(ExitCode::kUsage, "cannot write " + path + ": " + what + ": " + std::strerror(error))
+  return Status::Error(ErrorCode::kInvalidInput, "cannot write " + path + ": " + what + ": " + std::strerror(error))
       .WithDetail(kErrnoDomain, error);
 }
 
@@ -66,7 +66,7 @@ bool FsyncDirectory(const std::string& directory) {
 Status WriteFileAtomically(const std::string& path, const std::string& contents, Publish publish) {
   const std::string base = BaseNameOf(path);
   if (path.empty() || base.empty() || base == "." || base == "..") {
-    return Status::Error(ExitCode::kUsage, "cannot write `" + path + "`: not a file name");
+    return Status::Error(ErrorCode::kInvalidInput, "cannot write `" + path + "`: not a file name");
   }
   const std::string directory = DirectoryOf(path);
   std::string temp_name = directory + "/." + base + ".tmp.XXXXXX";
@@ -106,7 +106,7 @@ Result<std::string> ReadFileCapped(const std::string& path, std::size_t max_byte
   if (fd < 0) {
     const int error = errno;
     if (missing != nullptr) *missing = error == ENOENT;
-    return Status::Error(ExitCode::kUsage, "cannot open " + path + ": " + std::strerror(error))
+    return Status::Error(ErrorCode::kInvalidInput, "cannot open " + path + ": " + std::strerror(error))
         .WithDetail(kErrnoDomain, error);
   }
   struct stat info {};
@@ -140,8 +140,8 @@ Result<std::string> ReadFileCapped(const std::string& path, std::size_t max_byte
     if (error.empty() && used > max_bytes) error = path + " is larger than " + std::to_string(max_bytes) + " bytes";
   }
   ::close(fd);
-  if (error_number != 0) return Status::Error(ExitCode::kUsage, error).WithDetail(kErrnoDomain, error_number);
-  if (!error.empty()) return Status::Error(ExitCode::kUsage, error);
+  if (error_number != 0) return Status::Error(ErrorCode::kInvalidInput, error).WithDetail(kErrnoDomain, error_number);
+  if (!error.empty()) return Status::Error(ErrorCode::kInvalidInput, error);
   return text;
 }
 

@@ -22,13 +22,13 @@ enum class Publish {
 
 // Writes `contents` to a temporary file in the directory of `path` (".<name>.tmp.XXXXXX"), fsyncs it,
 // publishes it as `path` and fsyncs the directory. Permissions of a new file are 0644. On failure the
-// temporary file is removed, `path` is untouched, and the Status (ExitCode::kUsage: the output location
+// temporary file is removed, `path` is untouched, and the Status (ErrorCode::kInvalidInput: the output location
 // is part of the configuration, C10) names the path and the system error (also as the kErrnoDomain detail).
 Status WriteFileAtomically(const std::string& path, const std::string& contents, Publish publish = Publish::kReplace);
 
 // Reads a whole regular file of at most `max_bytes`; the size is checked (fstat) before reading, and
 // reading stops one byte past the cap should the file grow meanwhile. FIFOs, devices and directories
-// are refused without blocking. ExitCode::kUsage, naming the path (with the kErrnoDomain detail when a
+// are refused without blocking. ErrorCode::kInvalidInput, naming the path (with the kErrnoDomain detail when a
 // system call failed); `missing` (optional) is set when the file does not exist.
 Result<std::string> ReadFileCapped(const std::string& path, std::size_t max_bytes, bool* missing = nullptr);
 

@@ -33,7 +33,7 @@ struct ScopedFd {
 };
 
 Status FileError(const std::string& what, const std::string& path, int error) {
-  return Status::Error(ExitCode::kUsage, what + " " + path + ": " + std::strerror(error)).WithDetail(kErrnoDomain, error);
+  return Status::Error(ErrorCode::kInvalidInput, what + " " + path + ": " + std::strerror(error)).WithDetail(kErrnoDomain, error);
 }
 
 }  // namespace
@@ -54,7 +54,7 @@ Result<std::string> Sha256OfFile(const std::string& path) {
   struct stat info {};
   if (::fstat(fd, &info) != 0) return FileError("cannot stat", path, errno);
   if (!S_ISREG(info.st_mode)) {
-    return Status::Error(ExitCode::kUsage, path + " is not a regular file: cannot compute its SHA-256");
+    return Status::Error(ErrorCode::kInvalidInput, path + " is not a regular file: cannot compute its SHA-256");
   }
   const std::unique_ptr<EVP_MD_CTX, void (*)(EVP_MD_CTX*)> context(EVP_MD_CTX_new(), EVP_MD_CTX_free);
   SELFCAL_CHECK(context != nullptr && EVP_DigestInit_ex(context.get(), EVP_sha256(), nullptr) == 1,

@@ -13,7 +13,7 @@ namespace selfcal {
 std::string Sha256Hex(std::string_view bytes);
 
 // SHA-256 of the contents of the regular file `path` (read in chunks, no size cap), 64 lower-case hex
-// digits. ExitCode::kUsage naming the path when it cannot be opened or read, or is not a regular file
+// digits. ErrorCode::kInvalidInput naming the path when it cannot be opened or read, or is not a regular file
 // (a directory, FIFO or device is refused without blocking).
 Result<std::string> Sha256OfFile(const std::string& path);
 

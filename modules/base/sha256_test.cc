@@ -29,11 +29,11 @@ TEST(Sha256, OfFileMatchesTheDigestOfItsBytesAndRefusesWhatIsNoFile) {
 
   const Result<std::string> directory = Sha256OfFile(dir);
   ASSERT_FALSE(directory.ok());
-  EXPECT_EQ(directory.status().code(), ExitCode::kUsage);
+  EXPECT_EQ(directory.status().code(), ErrorCode::kInvalidInput);
   EXPECT_NE(directory.status().message().find(dir + " is not a regular file"), std::string::npos);
   const Result<std::string> missing = Sha256OfFile(dir + "/missing");
   ASSERT_FALSE(missing.ok());
-  EXPECT_EQ(missing.status().code(), ExitCode::kUsage);
+  EXPECT_EQ(missing.status().code(), ErrorCode::kInvalidInput);
   EXPECT_NE(missing.status().message().find(dir + "/missing"), std::string::npos);
   ::unlink(file.c_str());
   ::rmdir(dir.c_str());

@@ -2,21 +2,22 @@
 
 namespace selfcal {
 
-const char* ExitCodeName(ExitCode code) {
+const char* ErrorCodeName(ErrorCode code) {
   switch (code) {
-    case ExitCode::kOk: return "ok";
-    case ExitCode::kUsage: return "usage_or_config";
-    case ExitCode::kDegenerateData: return "degenerate_data";
-    case ExitCode::kHardware: return "hardware_fault";
-    case ExitCode::kSolverFailure: return "solver_failure";
-    case ExitCode::kInterrupted: return "interrupted";
+    case ErrorCode::kOk: return "ok";
+    case ErrorCode::kInvalidInput: return "invalid_input";
+    case ErrorCode::kDegenerateData: return "degenerate_data";
+    case ErrorCode::kHardware: return "hardware_fault";
+    case ErrorCode::kSolverFailure: return "solver_failure";
+    case ErrorCode::kInterrupted: return "interrupted";
+    case ErrorCode::kInternal: return "internal_error";
   }
   return "unknown";
 }
 
 std::string Status::ToString() const {
   if (ok()) return "ok";
-  return std::string(ExitCodeName(code_)) + ": " + message_;
+  return std::string(ErrorCodeName(code_)) + ": " + message_;
 }
 
 namespace internal {

@@ -5,8 +5,8 @@
 //    each estimator's report, never exceptions;
 //  - caller or programmer errors (size mismatch, NaN input) throw selfcal::InvalidArgument through
 //    SELFCAL_CHECK;
-//  - environment, file and configuration problems travel as a Status (or Result<T>) carrying an ExitCode
-//    so that the CLI maps them to the documented exit codes (RELIABILITY.md, design rule 2).
+//  - environment, file and configuration problems travel as a Status (or Result<T>) carrying an
+//    ErrorCode; the CLI alone maps it to the documented exit codes (RELIABILITY.md, design rule 2).
 #pragma once
 
 #include <optional>
@@ -17,17 +17,19 @@
 
 namespace selfcal {
 
-// Process exit codes (RELIABILITY.md, design rule 2).
-enum class ExitCode : int {
+// What went wrong, in the library's words. The application maps each to a process exit code
+// (app/exit_codes.h; RELIABILITY.md design rule 2); no library chooses exit codes.
+enum class ErrorCode : int {
   kOk = 0,
-  kUsage = 2,          // usage or configuration error (C1-C11)
-  kDegenerateData = 3, // insufficient or degenerate data
-  kHardware = 4,       // robot or camera fault
-  kSolverFailure = 5,  // the solver did not produce a usable result
-  kInterrupted = 130,
+  kInvalidInput,    // usage, configuration or file content the user can fix (names file, key, line, value)
+  kDegenerateData,  // insufficient or degenerate data
+  kHardware,        // robot or camera fault
+  kSolverFailure,   // the solver did not produce a usable result
+  kInterrupted,     // a stop request (Ctrl-C)
+  kInternal,        // a broken invariant inside selfcal: a bug, never the user's input
 };
 
-const char* ExitCodeName(ExitCode code);
+const char* ErrorCodeName(ErrorCode code);
 
 // Thrown by SELFCAL_CHECK for caller errors. Never thrown inside Ceres functors.
 class InvalidArgument : public std::invalid_argument {
@@ -39,14 +41,14 @@ class Status {
  public:
   Status() = default;  // OK
   static Status Ok() { return Status(); }
-  static Status Error(ExitCode code, std::string message) { return Status(code, std::move(message)); }
+  static Status Error(ErrorCode code, std::string message) { return Status(code, std::move(message)); }
 
-  bool ok() const { return code_ == ExitCode::kOk; }
-  ExitCode code() const { return code_; }
+  bool ok() const { return code_ == ErrorCode::kOk; }
+  ErrorCode code() const { return code_; }
   const std::string& message() const { return message_; }
   std::string ToString() const;
 
-  // An optional machine-readable detail finer than the ExitCode, for callers that must tell failures
+  // An optional machine-readable detail finer than the ErrorCode, for callers that must tell failures
   // apart (e.g. capture::CaptureError: a camera that timed out is retried, a missing one is not).
   // `domain` names the enum the value belongs to (a string literal, e.g. "capture"); an error without
   // a detail has detail_domain() == "" and detail() == 0. Ignored on an OK status.
@@ -62,8 +64,8 @@ class Status {
   int detail() const { return detail_; }
 
  private:
-  Status(ExitCode code, std::string message) : code_(code), message_(std::move(message)) {}
-  ExitCode code_ = ExitCode::kOk;
+  Status(ErrorCode code, std::string message) : code_(code), message_(std::move(message)) {}
+  ErrorCode code_ = ErrorCode::kOk;
   std::string message_;
   const char* detail_domain_ = "";
   int detail_ = 0;

@@ -12,20 +12,20 @@ TEST(Status, DefaultIsOk) {
 }
 
 TEST(Status, ErrorCarriesCodeAndMessage) {
-  Status s = Status::Error(ExitCode::kUsage, "unknown key `max_velocty`");
+  Status s = Status::Error(ErrorCode::kInvalidInput, "unknown key `max_velocty`");
   EXPECT_FALSE(s.ok());
   EXPECT_EQ(static_cast<int>(s.code()), 2);
-  EXPECT_EQ(s.ToString(), "usage_or_config: unknown key `max_velocty`");
+  EXPECT_EQ(s.ToString(), "invalid_input: unknown key `max_velocty`");
 }
 
 TEST(Status, DetailTravelsWithTheErrorOnly) {
-  const Status plain = Status::Error(ExitCode::kHardware, "camera gone");
+  const Status plain = Status::Error(ErrorCode::kHardware, "camera gone");
   EXPECT_STREQ(plain.detail_domain(), "");
   EXPECT_EQ(plain.detail(), 0);
   const Status detailed = plain.WithDetail("capture", 7);
   EXPECT_STREQ(detailed.detail_domain(), "capture");
   EXPECT_EQ(detailed.detail(), 7);
-  EXPECT_EQ(detailed.code(), ExitCode::kHardware);
+  EXPECT_EQ(detailed.code(), ErrorCode::kHardware);
   EXPECT_EQ(detailed.message(), "camera gone");
   const Result<int> carried(detailed);
   EXPECT_EQ(carried.status().detail(), 7);
@@ -36,9 +36,9 @@ TEST(Result, ValueAndErrorAccess) {
   Result<int> good(42);
   ASSERT_TRUE(good.ok());
   EXPECT_EQ(*good, 42);
-  Result<int> bad(Status::Error(ExitCode::kDegenerateData, "planar"));
+  Result<int> bad(Status::Error(ErrorCode::kDegenerateData, "planar"));
   EXPECT_FALSE(bad.ok());
-  EXPECT_EQ(bad.status().code(), ExitCode::kDegenerateData);
+  EXPECT_EQ(bad.status().code(), ErrorCode::kDegenerateData);
   EXPECT_THROW(bad.value(), InvalidArgument);
   EXPECT_THROW(Result<int>(Status::Ok()), InvalidArgument);
 }

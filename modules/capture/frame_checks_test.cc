@@ -14,11 +14,11 @@ using testing::Uniform;
 TEST(CaptureError, TravelsInTheStatusWithItsExitCode) {
   const Status s = CaptureFailure(CaptureError::kTimeout, "camera /dev/video0: no frame");
   EXPECT_EQ(CaptureErrorOf(s), CaptureError::kTimeout);
-  EXPECT_EQ(s.code(), ExitCode::kHardware);
-  EXPECT_EQ(CaptureFailure(CaptureError::kSequenceCorrupt, "x").code(), ExitCode::kUsage);
-  EXPECT_EQ(CaptureFailure(CaptureError::kSequenceEnd, "x").code(), ExitCode::kDegenerateData);
+  EXPECT_EQ(s.code(), ErrorCode::kHardware);
+  EXPECT_EQ(CaptureFailure(CaptureError::kSequenceCorrupt, "x").code(), ErrorCode::kInvalidInput);
+  EXPECT_EQ(CaptureFailure(CaptureError::kSequenceEnd, "x").code(), ErrorCode::kDegenerateData);
   EXPECT_EQ(CaptureErrorOf(Status::Ok()), CaptureError::kNone);
-  EXPECT_EQ(CaptureErrorOf(Status::Error(ExitCode::kUsage, "not from capture").WithDetail("io", 6)),
+  EXPECT_EQ(CaptureErrorOf(Status::Error(ErrorCode::kInvalidInput, "not from capture").WithDetail("io", 6)),
             CaptureError::kNone);
   EXPECT_STREQ(CaptureErrorName(CaptureError::kDeviceBusy), "device_busy");
   EXPECT_THROW(CaptureFailure(CaptureError::kNone, "x"), InvalidArgument);

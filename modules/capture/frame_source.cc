@@ -36,22 +36,22 @@ const char* CaptureErrorName(CaptureError error) {
   return "unknown";
 }
 
-ExitCode ExitCodeFor(CaptureError error) {
+ErrorCode ErrorCodeFor(CaptureError error) {
   switch (error) {
     case CaptureError::kNone:
-      return ExitCode::kOk;
+      return ErrorCode::kOk;
     case CaptureError::kSequenceCorrupt:
-      return ExitCode::kUsage;
+      return ErrorCode::kInvalidInput;
     case CaptureError::kSequenceEnd:
-      return ExitCode::kDegenerateData;
+      return ErrorCode::kDegenerateData;
     default:
-      return ExitCode::kHardware;
+      return ErrorCode::kHardware;
   }
 }
 
 Status CaptureFailure(CaptureError error, const std::string& message) {
   if (error == CaptureError::kNone) throw InvalidArgument("CaptureFailure needs an error, not kNone: " + message);
-  return Status::Error(ExitCodeFor(error), message).WithDetail(kCaptureErrorDomain, static_cast<int>(error));
+  return Status::Error(ErrorCodeFor(error), message).WithDetail(kCaptureErrorDomain, static_cast<int>(error));
 }
 
 CaptureError CaptureErrorOf(const Status& status) {

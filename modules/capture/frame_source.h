@@ -46,10 +46,10 @@ inline constexpr const char* kCaptureErrorDomain = "capture";
 // "device_missing", "timeout", ...: stable names for journals and reports.
 const char* CaptureErrorName(CaptureError error);
 
-// The ExitCode a capture error maps to: kHardware for device and frame faults, kUsage for a corrupt
+// The ErrorCode a capture error maps to: kHardware for device and frame faults, kInvalidInput for a corrupt
 // recorded sequence (a malformed input file, like io's files), kDegenerateData for the end of a sequence
 // (ran out of data).
-ExitCode ExitCodeFor(CaptureError error);
+ErrorCode ErrorCodeFor(CaptureError error);
 
 // A Status carrying `error` (kNone is not allowed) and `message`.
 Status CaptureFailure(CaptureError error, const std::string& message);

@@ -10,7 +10,7 @@ namespace selfcal::capture {
 
 Result<std::string> EncodeGreyPng(const vpImage<unsigned char>& image, int compression) {
   if (image.getWidth() == 0 || image.getHeight() == 0) {
-    return Status::Error(ExitCode::kUsage, "PNG encoding: empty image");
+    return Status::Error(ErrorCode::kInvalidInput, "PNG encoding: empty image");
   }
   // The image's pixels without a copy (vpImage is row-major, contiguous).
   const cv::Mat view(static_cast<int>(image.getHeight()), static_cast<int>(image.getWidth()), CV_8UC1,
@@ -18,10 +18,10 @@ Result<std::string> EncodeGreyPng(const vpImage<unsigned char>& image, int compr
   std::vector<unsigned char> png;
   try {
     if (!cv::imencode(".png", view, png, {cv::IMWRITE_PNG_COMPRESSION, compression})) {
-      return Status::Error(ExitCode::kUsage, "PNG encoding failed");
+      return Status::Error(ErrorCode::kInvalidInput, "PNG encoding failed");
     }
   } catch (const cv::Exception& e) {
-    return Status::Error(ExitCode::kUsage, std::string("PNG encoding failed: ") + e.what());
+    return Status::Error(ErrorCode::kInvalidInput, std::string("PNG encoding failed: ") + e.what());
   }
   return std::string(png.begin(), png.end());
 }
@@ -32,13 +32,13 @@ Result<vpImage<unsigned char>> DecodeGreyPng(const std::string& bytes, const std
     const cv::Mat raw(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data()));
     decoded = cv::imdecode(raw, cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& ex) {
-    return Status::Error(ExitCode::kUsage, "cannot decode " + what + ": " + ex.what());
+    return Status::Error(ErrorCode::kInvalidInput, "cannot decode " + what + ": " + ex.what());
   }
   if (decoded.empty()) {
-    return Status::Error(ExitCode::kUsage, "cannot decode " + what + ": truncated or corrupted PNG data");
+    return Status::Error(ErrorCode::kInvalidInput, "cannot decode " + what + ": truncated or corrupted PNG data");
   }
   if (decoded.type() != CV_8UC1) {
-    return Status::Error(ExitCode::kUsage, "cannot decode " + what + ": " + std::to_string(decoded.channels()) +
+    return Status::Error(ErrorCode::kInvalidInput, "cannot decode " + what + ": " + std::to_string(decoded.channels()) +
                                                " channel(s) or not 8 bit; expected 8-bit grey");
   }
   vpImage<unsigned char> image(static_cast<unsigned>(decoded.rows), static_cast<unsigned>(decoded.cols));

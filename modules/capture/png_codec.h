@@ -10,11 +10,11 @@
 
 namespace selfcal::capture {
 
-// The PNG bytes of `image` at zlib `compression` 0..9. ExitCode::kUsage on an empty image or an
+// The PNG bytes of `image` at zlib `compression` 0..9. ErrorCode::kInvalidInput on an empty image or an
 // encoder failure.
 Result<std::string> EncodeGreyPng(const vpImage<unsigned char>& image, int compression);
 
-// Decodes `bytes` (named `what` in messages) that must be an 8-bit single-channel image. ExitCode::kUsage
+// Decodes `bytes` (named `what` in messages) that must be an 8-bit single-channel image. ErrorCode::kInvalidInput
 // with "cannot decode <what>: ..." otherwise. The caller checks sizes and caps the input.
 Result<vpImage<unsigned char>> DecodeGreyPng(const std::string& bytes, const std::string& what);
 

@@ -317,26 +317,26 @@ std::string FormatSequenceIndex(const SequenceIndex& index) {
 Result<RecordedSequenceWriter> RecordedSequenceWriter::Create(const std::string& folder, int width_px, int height_px,
                                                               int png_compression) {
   if (width_px < 1 || height_px < 1) {
-    return Status::Error(ExitCode::kUsage, "cannot record " + folder + ": image size " + std::to_string(width_px) +
+    return Status::Error(ErrorCode::kInvalidInput, "cannot record " + folder + ": image size " + std::to_string(width_px) +
                                                "x" + std::to_string(height_px) + " must be positive");
   }
   if (png_compression < 0 || png_compression > 9) {
-    return Status::Error(ExitCode::kUsage,
+    return Status::Error(ErrorCode::kInvalidInput,
                          "png_compression = " + std::to_string(png_compression) + " must lie in [0, 9]");
   }
   if (::mkdir(folder.c_str(), 0755) != 0) {
     const int error = errno;
     if (error != EEXIST)
-      return Status::Error(ExitCode::kUsage, "cannot create " + folder + ": " + std::strerror(error));
+      return Status::Error(ErrorCode::kInvalidInput, "cannot create " + folder + ": " + std::strerror(error));
     DIR* dir = ::opendir(folder.c_str());
-    if (dir == nullptr) return Status::Error(ExitCode::kUsage, "cannot use " + folder + ": " + std::strerror(errno));
+    if (dir == nullptr) return Status::Error(ErrorCode::kInvalidInput, "cannot use " + folder + ": " + std::strerror(errno));
     bool empty = true;
     while (const dirent* d = ::readdir(dir)) {
       if (std::strcmp(d->d_name, ".") != 0 && std::strcmp(d->d_name, "..") != 0) empty = false;
     }
     ::closedir(dir);
     if (!empty) {
-      return Status::Error(ExitCode::kUsage, "cannot record into " + folder +
+      return Status::Error(ErrorCode::kInvalidInput, "cannot record into " + folder +
                                                  ": the folder is not empty (a recording is never overwritten)");
     }
   }
@@ -354,7 +354,7 @@ Result<RecordedSequenceWriter> RecordedSequenceWriter::Create(const std::string&
 Status RecordedSequenceWriter::Append(const Frame& frame, const std::string& pose_id) {
   const int w = static_cast<int>(frame.image.getWidth()), h = static_cast<int>(frame.image.getHeight());
   auto refuse = [&](const std::string& what) {
-    return Status::Error(ExitCode::kUsage,
+    return Status::Error(ErrorCode::kInvalidInput,
                          "cannot append frame " + std::to_string(frame.sequence) + " to " + folder_ + ": " + what);
   };
   if (w != index_.width_px || h != index_.height_px) {
@@ -404,7 +404,7 @@ Status RecordedSequenceWriter::Append(const Frame& frame, const std::string& pos
 
 Status RecordedSequenceWriter::WriteAuxiliaryFile(const std::string& name, const std::string& contents) {
   if (!SafeFileName(name) || name == kSequenceIndexName) {
-    return Status::Error(ExitCode::kUsage, "`" + name + "` is not a plain file name for " + folder_);
+    return Status::Error(ErrorCode::kInvalidInput, "`" + name + "` is not a plain file name for " + folder_);
   }
   return WriteFileAtomically(Join(folder_, name), contents, Publish::kNoReplace);
 }
@@ -426,7 +426,7 @@ std::string RecordedSequence::Describe() const {
 Status RecordedSequence::Open() {
   Close();
   if (const std::string problems = options_.checks.Validate(); options_.check_frames && !problems.empty()) {
-    return Status::Error(ExitCode::kUsage, "invalid frame check options for " + folder_ + ":\n" + problems);
+    return Status::Error(ErrorCode::kInvalidInput, "invalid frame check options for " + folder_ + ":\n" + problems);
   }
   Result<SequenceIndex> index = ReadSequenceIndex(folder_, options_.limits);
   if (!index.ok()) return index.status();
@@ -495,7 +495,7 @@ Result<Frame> RecordedSequence::Load(const SequenceEntry& e) const {
 }
 
 Result<Frame> RecordedSequence::Grab(double not_before_s, double /*timeout_s*/) {
-  if (!open_) return Status::Error(ExitCode::kUsage, "Grab on " + folder_ + " before Open");
+  if (!open_) return Status::Error(ErrorCode::kInvalidInput, "Grab on " + folder_ + " before Open");
   const int n = static_cast<int>(index_.frames.size());
   while (next_ < n && index_.frames[next_].exposure_time_s < not_before_s) ++next_;
   if (next_ >= n) {

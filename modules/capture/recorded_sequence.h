@@ -91,12 +91,12 @@ class RecordedSequenceWriter {
  public:
   // Creates `folder` (its parent must exist), or uses it if it is an empty directory; refuses a folder
   // with anything in it (a recording is never overwritten). Writes an index with no frames.
-  // ExitCode::kUsage naming the folder.
+  // ErrorCode::kInvalidInput naming the folder.
   static Result<RecordedSequenceWriter> Create(const std::string& folder, int width_px, int height_px,
                                                int png_compression = 6);
 
   // Appends `frame` (its image must be width x height; exposure time and sequence number must increase
-  // strictly) as the next entry, with the image's size and CRC-32. ExitCode::kUsage naming the file or
+  // strictly) as the next entry, with the image's size and CRC-32. ErrorCode::kInvalidInput naming the file or
   // the offending value; on failure the index still describes the frames appended before.
   Status Append(const Frame& frame, const std::string& pose_id);
 

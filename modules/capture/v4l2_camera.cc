@@ -298,7 +298,7 @@ Status V4l2Camera::Open() {
   Impl& m = *impl_;
   m.Shutdown();
   if (const std::string problems = m.options.Validate(); !problems.empty()) {
-    return Status::Error(ExitCode::kUsage, "invalid V4L2 camera options for " + m.options.device + ":\n" + problems);
+    return Status::Error(ErrorCode::kInvalidInput, "invalid V4L2 camera options for " + m.options.device + ":\n" + problems);
   }
   m.info = V4l2DeviceInfo();
   Result<DeviceFd> fd = OpenNode(m.options.device, &m.info);
@@ -362,9 +362,9 @@ Status V4l2Camera::Open() {
 
 Result<Frame> V4l2Camera::Grab(double not_before_s, double timeout_s) {
   Impl& m = *impl_;
-  if (!m.open) return Status::Error(ExitCode::kUsage, "Grab on camera " + m.options.device + " before Open");
+  if (!m.open) return Status::Error(ErrorCode::kInvalidInput, "Grab on camera " + m.options.device + " before Open");
   if (!(timeout_s >= 0) || !std::isfinite(timeout_s)) {
-    return Status::Error(ExitCode::kUsage,
+    return Status::Error(ErrorCode::kInvalidInput,
                          "Grab on camera " + m.options.device + ": timeout_s must be finite and >= 0");
   }
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);

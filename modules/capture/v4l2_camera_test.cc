@@ -18,7 +18,7 @@ TEST(V4l2V1, MissingDeviceNamesTheNodeAndErrno) {
   const Result<V4l2DeviceInfo> probe = ProbeV4l2Device("/dev/video99");
   ASSERT_FALSE(probe.ok());
   EXPECT_EQ(CaptureErrorOf(probe.status()), CaptureError::kDeviceMissing);
-  EXPECT_EQ(probe.status().code(), ExitCode::kHardware);
+  EXPECT_EQ(probe.status().code(), ErrorCode::kHardware);
   EXPECT_TRUE(Contains(probe.status().message(), "/dev/video99")) << probe.status().message();
   EXPECT_TRUE(Contains(probe.status().message(), "ENOENT")) << probe.status().message();
   EXPECT_TRUE(Contains(probe.status().message(), "video nodes present:")) << probe.status().message();
@@ -33,7 +33,7 @@ TEST(V4l2V1, MissingDeviceNamesTheNodeAndErrno) {
   // Grab without a successful Open is a caller error, not a hang.
   const Result<Frame> grab = camera.Grab(0.0, 0.1);
   EXPECT_FALSE(grab.ok());
-  EXPECT_EQ(grab.status().code(), ExitCode::kUsage);
+  EXPECT_EQ(grab.status().code(), ErrorCode::kInvalidInput);
   camera.Close();
   camera.Close();
 }
@@ -80,7 +80,7 @@ TEST(V4l2Options, ValidateListsEveryProblemAndOpenRefusesBeforeTouchingTheDevice
   EXPECT_TRUE(Contains(problems, "open_timeout_s = -1"));
   V4l2Camera camera(options);
   const Status open = camera.Open();
-  EXPECT_EQ(open.code(), ExitCode::kUsage);  // configuration, not hardware: the device was not probed
+  EXPECT_EQ(open.code(), ErrorCode::kInvalidInput);  // configuration, not hardware: the device was not probed
   EXPECT_TRUE(Contains(open.message(), "num_buffers")) << open.message();
 }
 

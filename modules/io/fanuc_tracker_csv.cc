@@ -24,7 +24,7 @@ bool ParseDouble(const std::string& token, double* value) {
 
 Result<std::vector<FanucTrackerRow>> LoadFanucTrackerCsv(const std::string& path) {
   std::ifstream in(path);
-  if (!in) return Status::Error(ExitCode::kUsage, path + ": cannot open");
+  if (!in) return Status::Error(ErrorCode::kInvalidInput, path + ": cannot open");
   std::vector<FanucTrackerRow> rows;
   std::string text, problems;
   int line = 0;
@@ -69,9 +69,9 @@ Result<std::vector<FanucTrackerRow>> LoadFanucTrackerCsv(const std::string& path
   }
   if (!problems.empty()) {
     problems.pop_back();
-    return Status::Error(ExitCode::kUsage, problems);
+    return Status::Error(ErrorCode::kInvalidInput, problems);
   }
-  if (rows.empty()) return Status::Error(ExitCode::kUsage, path + ": no data rows");
+  if (rows.empty()) return Status::Error(ErrorCode::kInvalidInput, path + ": no data rows");
   return rows;
 }
 

@@ -22,7 +22,7 @@ struct FanucTrackerRow {
   int line = 0;                                     // 1-based line in the file
 };
 
-// Reads every row. The whole file is refused (ExitCode::kUsage, naming file:line) if a row does not have
+// Reads every row. The whole file is refused (ErrorCode::kInvalidInput, naming file:line) if a row does not have
 // exactly 21 numbers, a number does not parse or is not finite, a joint lies outside [-720, 720] deg, or
 // the file holds no row. Blank lines and lines starting with '#' are skipped.
 Result<std::vector<FanucTrackerRow>> LoadFanucTrackerCsv(const std::string& path);

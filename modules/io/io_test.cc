@@ -24,7 +24,7 @@ using testing::WriteFile;
 // A refusal must be a Status with the config exit code that names the file (and, when given, says why).
 ::testing::AssertionResult CleanRefusal(const Status& status, const std::string& path, const std::string& why = "") {
   if (status.ok()) return ::testing::AssertionFailure() << "accepted";
-  if (status.code() != ExitCode::kUsage) return ::testing::AssertionFailure() << "code " << status.ToString();
+  if (status.code() != ErrorCode::kInvalidInput) return ::testing::AssertionFailure() << "code " << status.ToString();
   if (status.message().find(path) == std::string::npos) {
     return ::testing::AssertionFailure() << "message does not name " << path << ": " << status.message();
   }
@@ -65,7 +65,7 @@ TEST(YamlSchema, C1UnknownKeyNamesLineAndSuggestsTheClosestKey) {
   }
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_EQ(problems.messages()[0], "unknown key `max_velocty` at " + path + ":3; did you mean `max_velocity`?");
-  EXPECT_EQ(problems.ToStatus("motion limits").code(), ExitCode::kUsage);
+  EXPECT_EQ(problems.ToStatus("motion limits").code(), ErrorCode::kInvalidInput);
 }
 
 TEST(YamlSchema, C1UnknownKeyInARobotJointRow) {
@@ -160,7 +160,7 @@ TEST(YamlSchema, EditDistanceCountsTranspositionsOnce) {
   EXPECT_EQ(EditDistance("kitten", "sitting"), 3);
 }
 
-// ---- C8: malformed files. Every case is a clean kUsage Status naming the file. ----
+// ---- C8: malformed files. Every case is a clean kInvalidInput Status naming the file. ----
 
 TEST(MalformedFiles, C8EmptyAndCommentOnlyFiles) {
   TempDir dir;

@@ -261,7 +261,7 @@ Status SaveObservations(const ObservationSet& set, const std::string& path) {
     }
   }
   if (!problems.empty()) {
-    return Status::Error(ExitCode::kUsage, "refusing to write invalid observations to " + path + ":\n" + problems);
+    return Status::Error(ErrorCode::kInvalidInput, "refusing to write invalid observations to " + path + ":\n" + problems);
   }
   const CameraIntrinsics& c = set.camera;
   std::ostringstream out;

@@ -30,7 +30,7 @@ inline constexpr int kObservationsVersion = 1;
 
 // Reads and validates an observations file: schema (C1-C3), versions (P8), ObservationSet::Validate(),
 // joint values inside the robot's limits and dots inside the image. Every problem is reported together
-// (ExitCode::kUsage), naming the file, line and key.
+// (ErrorCode::kInvalidInput), naming the file, line and key.
 Result<ObservationSet> LoadObservations(const std::string& path);
 
 // The same for a document already parsed; robot_file is resolved relative to doc.path's directory.

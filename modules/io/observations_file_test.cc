@@ -163,7 +163,7 @@ class ObservationsEdits : public ::testing::Test {
   }
   ::testing::AssertionResult Refused(const Status& status, const std::string& why) {
     if (status.ok()) return ::testing::AssertionFailure() << "accepted";
-    if (status.code() != ExitCode::kUsage || status.message().find(why) == std::string::npos ||
+    if (status.code() != ErrorCode::kInvalidInput || status.message().find(why) == std::string::npos ||
         status.message().find(path_) == std::string::npos) {
       return ::testing::AssertionFailure() << "expected \"" << why << "\" in: " << status.ToString();
     }
@@ -267,7 +267,7 @@ TEST(ObservationsFile, C8MutatedFilesAreRefusedCleanlyOrLoad) {
     WriteFile(path, mutated);
     Result<ObservationSet> loaded = LoadObservations(path);
     if (!loaded.ok()) {
-      EXPECT_EQ(loaded.status().code(), ExitCode::kUsage);
+      EXPECT_EQ(loaded.status().code(), ErrorCode::kInvalidInput);
       EXPECT_NE(loaded.status().message().find(path), std::string::npos) << loaded.status().message();
     }
   }
@@ -299,7 +299,7 @@ TEST(TrajectoryFile, C5WrongJointCountNamesEveryBadPose) {
                   "  - [0, -30, 120, 0, 45, 0]\n  - [0, -30, 120, 0, 45, 0]\n  - [0, -30, 120, 0, 45]\n"
                   "  - [0, -30, 120, 0, 45, 0]\n  - [0, -30, 120, 0, 45, 0, 7]\n");
   const Status status = LoadTrajectory(path, 6).status();
-  EXPECT_EQ(status.code(), ExitCode::kUsage);
+  EXPECT_EQ(status.code(), ErrorCode::kInvalidInput);
   EXPECT_NE(status.message().find("pose 2 (`poses_deg[2]` at " + path + ":8) has 5 joint values, the robot has 6"),
             std::string::npos) << status.message();
   EXPECT_NE(status.message().find("pose 4 (`poses_deg[4]` at " + path + ":10) has 7 joint values"), std::string::npos);
@@ -335,13 +335,13 @@ TEST(AtomicFile, ReplacesTheTargetAndLeavesNoTemporaryFile) {
 TEST(AtomicFile, FailureLeavesTheTargetUntouchedAndNoTemporaryFile) {
   TempDir dir;
   const Status missing_dir = WriteFileAtomically(dir.File("no/such/dir/result.yaml"), "x");
-  EXPECT_EQ(missing_dir.code(), ExitCode::kUsage);
+  EXPECT_EQ(missing_dir.code(), ErrorCode::kInvalidInput);
   EXPECT_NE(missing_dir.message().find(dir.File("no/such/dir/result.yaml")), std::string::npos);
   // The target is a non-empty directory: rename fails after the temporary file was written.
   ASSERT_EQ(::mkdir(dir.File("taken").c_str(), 0755), 0);
   WriteFile(dir.File("taken/inner"), "keep");
   const Status taken = WriteFileAtomically(dir.File("taken"), "x");
-  EXPECT_EQ(taken.code(), ExitCode::kUsage);
+  EXPECT_EQ(taken.code(), ErrorCode::kInvalidInput);
   EXPECT_NE(taken.message().find("rename failed"), std::string::npos) << taken.message();
   EXPECT_EQ(dir.List(), std::vector<std::string>{"taken"});
   EXPECT_EQ(ReadFile(dir.File("taken/inner")), "keep");
@@ -357,7 +357,7 @@ TEST(JsonFile, WriteReadRoundTripAndGuards) {
   EXPECT_EQ((*read)["rms_px"].get<double>(), 0.1 + 0.2);
   EXPECT_TRUE((*read)["sigma"].is_null());
   EXPECT_EQ(dir.List(), std::vector<std::string>{"report.json"});
-  EXPECT_EQ(WriteJsonFile(nlohmann::json{{"bad", "\xC3\x28"}}, dir.File("bad.json")).code(), ExitCode::kUsage);
+  EXPECT_EQ(WriteJsonFile(nlohmann::json{{"bad", "\xC3\x28"}}, dir.File("bad.json")).code(), ErrorCode::kInvalidInput);
   WriteFile(path, std::string(10000, '[') + std::string(10000, ']'));
   EXPECT_NE(ReadJsonFile(path).status().message().find("nested deeper than 64"), std::string::npos);
   WriteFile(path, "{\"a\": [1, 2,");

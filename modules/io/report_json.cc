@@ -43,7 +43,7 @@ Status WriteJsonFile(const nlohmann::json& document, const std::string& path) {
   try {
     text = document.dump(2, ' ', false, nlohmann::json::error_handler_t::strict) + "\n";
   } catch (const std::exception& e) {
-    return Status::Error(ExitCode::kUsage, "cannot write " + path + ": " + e.what());
+    return Status::Error(ErrorCode::kInvalidInput, "cannot write " + path + ": " + e.what());
   }
   return WriteFileAtomically(path, text);
 }
@@ -53,15 +53,15 @@ Result<nlohmann::json> ReadJsonFile(const std::string& path) {
   if (!text.ok()) return text.status();
   size_t offset = 0;
   if (JsonDepth(*text, &offset) > yaml::kMaxYamlDepth) {
-    return Status::Error(ExitCode::kUsage, path + ": JSON nested deeper than " + std::to_string(yaml::kMaxYamlDepth) +
+    return Status::Error(ErrorCode::kInvalidInput, path + ": JSON nested deeper than " + std::to_string(yaml::kMaxYamlDepth) +
                                                " levels at byte " + std::to_string(offset));
   }
   try {
     return nlohmann::json::parse(*text);
   } catch (const nlohmann::json::parse_error& e) {
-    return Status::Error(ExitCode::kUsage, "malformed JSON in " + path + " at byte " + std::to_string(e.byte) + ": " + e.what());
+    return Status::Error(ErrorCode::kInvalidInput, "malformed JSON in " + path + " at byte " + std::to_string(e.byte) + ": " + e.what());
   } catch (const std::exception& e) {
-    return Status::Error(ExitCode::kUsage, "cannot read JSON " + path + ": " + e.what());
+    return Status::Error(ErrorCode::kInvalidInput, "cannot read JSON " + path + ": " + e.what());
   }
 }
 

@@ -11,7 +11,7 @@
 namespace selfcal::io {
 
 // Pretty-printed (2-space indent) with a final newline, written atomically (P4). Non-finite numbers
-// become null (JSON has no NaN); invalid UTF-8 in a string is refused. ExitCode::kUsage on failure.
+// become null (JSON has no NaN); invalid UTF-8 in a string is refused. ErrorCode::kInvalidInput on failure.
 Status WriteJsonFile(const nlohmann::json& document, const std::string& path);
 
 // Reads a JSON file with the same guards as YAML files: size cap (yaml/yaml_reader.h kMaxYamlBytes),

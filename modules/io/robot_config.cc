@@ -263,7 +263,7 @@ Status SaveCalibratedModel(const CalibratedModel& calibrated, const std::string&
     if (key.empty()) problems += "empty provenance key\n";
   }
   if (!problems.empty()) {
-    return Status::Error(ExitCode::kUsage, "refusing to write an invalid calibrated model to " + path + ":\n" + problems);
+    return Status::Error(ErrorCode::kInvalidInput, "refusing to write an invalid calibrated model to " + path + ":\n" + problems);
   }
   std::ostringstream out;
   out << "# selfcal calibrated robot model (docs/calibrated-model-format.md). Lengths in mm, angles in degrees.\n"

@@ -47,7 +47,7 @@ struct CalibratedModel {
   std::vector<std::pair<std::string, std::string>> provenance;  // P7: software, hashes, session id ...
 };
 
-// Reads a robot config or a calibrated-model file. Errors: ExitCode::kUsage, naming file, line, key
+// Reads a robot config or a calibrated-model file. Errors: ErrorCode::kInvalidInput, naming file, line, key
 // and value of every problem.
 Result<RobotModel> LoadRobotModel(const std::string& path);
 

@@ -190,11 +190,11 @@ TEST(CalibratedModel, UnknownMajorVersionIsRefused) {
   text.replace(text.find("version: 1\n"), 11, "version: 2\n");
   WriteFile(path, text);
   const Status status = LoadCalibratedModel(path).status();
-  EXPECT_EQ(status.code(), ExitCode::kUsage);
+  EXPECT_EQ(status.code(), ErrorCode::kInvalidInput);
   EXPECT_NE(status.message().find("`version` = `2` at " + path + ":4: this selfcal reads selfcal-calibrated-model version 1.x only"),
             std::string::npos)
       << status.message();
-  EXPECT_EQ(LoadRobotModel(path).status().code(), ExitCode::kUsage);
+  EXPECT_EQ(LoadRobotModel(path).status().code(), ErrorCode::kInvalidInput);
   // A minor version only adds optional keys: accepted.
   text.replace(text.find("version: 2\n"), 11, "version: 1.4\n");
   WriteFile(path, text);
@@ -214,7 +214,7 @@ TEST(CalibratedModel, InvalidModelIsNotWritten) {
   calibrated.model.links[1].a = std::nan("");
   TempDir dir;
   const Status status = SaveCalibratedModel(calibrated, dir.File("bad.yaml"));
-  EXPECT_EQ(status.code(), ExitCode::kUsage);
+  EXPECT_EQ(status.code(), ErrorCode::kInvalidInput);
   EXPECT_TRUE(dir.List().empty());
 }
 

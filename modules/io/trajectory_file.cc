@@ -95,13 +95,13 @@ Result<TrajectoryFile> Load(const std::string& path, int num_joints, const Robot
 }  // namespace
 
 Result<TrajectoryFile> LoadTrajectoryFile(const std::string& path, int num_joints) {
-  if (num_joints <= 0) return Status::Error(ExitCode::kUsage, "LoadTrajectory(" + path + "): num_joints must be > 0");
+  if (num_joints <= 0) return Status::Error(ErrorCode::kInvalidInput, "LoadTrajectory(" + path + "): num_joints must be > 0");
   return Load(path, num_joints, nullptr);
 }
 
 Result<TrajectoryFile> LoadTrajectoryFile(const std::string& path, const RobotModel& robot) {
   if (robot.num_joints() <= 0 || robot.limits.size() != robot.links.size()) {
-    return Status::Error(ExitCode::kUsage, "LoadTrajectory(" + path + "): the robot model has no joints or no limits");
+    return Status::Error(ErrorCode::kInvalidInput, "LoadTrajectory(" + path + "): the robot model has no joints or no limits");
   }
   return Load(path, robot.num_joints(), &robot);
 }
@@ -133,7 +133,7 @@ Status SaveTrajectoryFile(const TrajectoryFile& file, const std::string& path) {
   const std::string& description = file.description;
   for (size_t i = 0; i < poses_rad.size(); ++i) {
     if (!poses_rad[i].allFinite() || poses_rad[i].size() != poses_rad.front().size() || poses_rad[i].size() == 0) {
-      return Status::Error(ExitCode::kUsage, "refusing to write trajectory " + path + ": pose " + std::to_string(i) +
+      return Status::Error(ErrorCode::kInvalidInput, "refusing to write trajectory " + path + ": pose " + std::to_string(i) +
                                                  " is empty, not finite, or has a different joint count");
     }
   }

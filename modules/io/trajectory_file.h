@@ -41,7 +41,7 @@ Status SaveTrajectoryFile(const TrajectoryFile& file, const std::string& path);
 
 // Joint angles in radians, one vector per pose. The whole file is refused (C5) if any pose has a joint
 // count other than `num_joints` (every such pose is named by index and line) or a non-finite value or
-// one outside [-720, 720] deg. ExitCode::kUsage.
+// one outside [-720, 720] deg. ErrorCode::kInvalidInput.
 Result<std::vector<Eigen::VectorXd>> LoadTrajectory(const std::string& path, int num_joints);
 // The same, also refusing poses outside the robot's joint limits (C6).
 Result<std::vector<Eigen::VectorXd>> LoadTrajectory(const std::string& path, const RobotModel& robot);

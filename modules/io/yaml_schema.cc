@@ -82,7 +82,7 @@ Status Problems::ToStatus(const std::string& what) const {
                      (count_ == 1 ? " problem):" : " problems):");
   for (const std::string& m : messages_) text += "\n  - " + m;
   if (count_ > messages_.size()) text += "\n  ... and " + std::to_string(count_ - messages_.size()) + " more";
-  return Status::Error(ExitCode::kUsage, text);
+  return Status::Error(ErrorCode::kInvalidInput, text);
 }
 
 bool Range::Contains(double v) const {

@@ -34,7 +34,7 @@ class Problems {
   bool empty() const { return count_ == 0; }
   size_t size() const { return count_; }
   const std::vector<std::string>& messages() const { return messages_; }
-  // ExitCode::kUsage: "cannot load <what> from FILE (N problems):" then one problem per line.
+  // ErrorCode::kInvalidInput: "cannot load <what> from FILE (N problems):" then one problem per line.
   Status ToStatus(const std::string& what) const;
 
   static constexpr size_t kMaxKept = 100;

@@ -77,18 +77,23 @@ json PoseMeasurementsJson(const calibration::PaperPipelineReport& r) {
   return measurements;
 }
 
-json PaperParametersJson(const ObservationSet& obs, const identification::IdentificationReport& ident) {
+// One row per kinematic parameter, SI with the unit in the key: name, free, nominal_*, `value_key`_* (the
+// estimate), correction_* (estimate - nominal, when `with_correction`), stddev_* (null when unknown).
+json ParametersJson(const ObservationSet& obs, const Eigen::VectorXd& rho, const Eigen::VectorXd& stddev,
+                    const std::vector<int>& free_indices, const std::string& value_key, bool with_correction) {
   json parameters = json::array();
-  if (ident.rho.size() != obs.robot.num_parameters()) return parameters;
+  if (rho.size() != obs.robot.num_parameters()) return parameters;
   const KinematicParameters params(obs.robot.num_joints());
   const Eigen::VectorXd nominal = KinematicParameters::Nominal(obs.robot);
   for (int i = 0; i < params.size(); ++i) {
     const std::string unit = SiSuffix(params, i);
-    parameters.push_back({{"name", params.name(i)},
-                          {"free", Contains(ident.free_indices, i)},
-                          {"nominal" + unit, nominal[i]},
-                          {"identified_before_yardstick" + unit, ident.rho[i]},
-                          {"stddev" + unit, Finite(ident.stddev.size() > i ? ident.stddev[i] : NAN)}});
+    json row = {{"name", params.name(i)},
+                {"free", Contains(free_indices, i)},
+                {"nominal" + unit, nominal[i]},
+                {value_key + unit, rho[i]},
+                {"stddev" + unit, Finite(stddev.size() > i ? stddev[i] : NAN)}};
+    if (with_correction) row["correction" + unit] = rho[i] - nominal[i];
+    parameters.push_back(std::move(row));
   }
   return parameters;
 }
@@ -121,7 +126,8 @@ json PaperSectionJson(const ObservationSet& obs, const calibration::PaperPipelin
                           {"rms_rotation_rad", ident.rms_rotation_rad},
                           {"covariance_available", ident.covariance_available},
                           {"covariance_message", ident.covariance_message}}},
-      {"parameters", PaperParametersJson(obs, ident)},
+      {"parameters",
+       ParametersJson(obs, ident.rho, ident.stddev, ident.free_indices, "identified_before_yardstick", false)},
       {"yardstick", {{"ok", r.yardstick.ok},
                      {"message", r.yardstick.message},
                      {"scale", r.yardstick.scale},
@@ -129,23 +135,6 @@ json PaperSectionJson(const ObservationSet& obs, const calibration::PaperPipelin
                      {"measured_lengths_before_scale_m", lengths}}},
       {"verification", VerificationJson(obs, r.verification_nominal, r.verification_calibrated)},
       {"predicted_3d_error", nullptr}};
-}
-
-json BundleParametersJson(const ObservationSet& obs, const bundle::BundleReport& b) {
-  json parameters = json::array();
-  if (b.rho.size() != obs.robot.num_parameters()) return parameters;
-  const KinematicParameters params(obs.robot.num_joints());
-  const Eigen::VectorXd nominal = KinematicParameters::Nominal(obs.robot);
-  for (int i = 0; i < params.size(); ++i) {
-    const std::string unit = SiSuffix(params, i);
-    parameters.push_back({{"name", params.name(i)},
-                          {"free", Contains(b.free_indices, i)},
-                          {"nominal" + unit, nominal[i]},
-                          {"value" + unit, b.rho[i]},
-                          {"correction" + unit, b.rho[i] - nominal[i]},
-                          {"stddev" + unit, Finite(b.stddev.size() > i ? b.stddev[i] : NAN)}});
-  }
-  return parameters;
 }
 
 json BundleSectionJson(const ObservationSet& obs, const calibration::BundleStageReport& stage) {
@@ -180,7 +169,7 @@ json BundleSectionJson(const ObservationSet& obs, const calibration::BundleStage
           {"condition_number", Finite(b.condition_number)},
           {"covariance_available", b.covariance_available},
           {"covariance_message", b.covariance_message},
-          {"parameters", BundleParametersJson(obs, b)},
+          {"parameters", ParametersJson(obs, b.rho, b.stddev, b.free_indices, "value", true)},
           {"verification", VerificationJson(obs, stage.verification_nominal, stage.verification)},
           {"predicted_3d_error", PredictedErrorJson(stage.predicted_error)}};
 }

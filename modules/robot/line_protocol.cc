@@ -178,7 +178,7 @@ std::string MoveRequest(const Eigen::VectorXd& target_rad, double velocity_scali
 
 Result<Request> ParseRequest(std::string_view line) {
   const std::vector<std::string_view> tokens = SplitTokens(line);
-  if (tokens.empty()) return Status::Error(ExitCode::kUsage, "empty request");
+  if (tokens.empty()) return Status::Error(ErrorCode::kInvalidInput, "empty request");
   Request request;
   bool known = false;
   for (const RequestKind kind : {RequestKind::kHello, RequestKind::kLimits, RequestKind::kJoints, RequestKind::kMove,
@@ -189,10 +189,10 @@ Result<Request> ParseRequest(std::string_view line) {
     }
   }
   const std::string word(tokens[0].substr(0, 40));
-  if (!known) return Status::Error(ExitCode::kUsage, "unknown request \"" + word + "\"");
+  if (!known) return Status::Error(ErrorCode::kInvalidInput, "unknown request \"" + word + "\"");
   if (request.kind == RequestKind::kHello) {
     if (tokens.size() != 3 || tokens[1] != kName || tokens[2] != std::to_string(kVersion)) {
-      return Status::Error(ExitCode::kUsage, std::string("unsupported protocol: this server speaks \"") +
+      return Status::Error(ErrorCode::kInvalidInput, std::string("unsupported protocol: this server speaks \"") +
                                                  HelloRequest() + "\"");
     }
     return request;
@@ -200,15 +200,15 @@ Result<Request> ParseRequest(std::string_view line) {
   if (request.kind == RequestKind::kMove) {
     std::string bad;
     Eigen::VectorXd values;
-    if (tokens.size() < 3) return Status::Error(ExitCode::kUsage, "MOVE needs a scaling and the joint targets");
+    if (tokens.size() < 3) return Status::Error(ErrorCode::kInvalidInput, "MOVE needs a scaling and the joint targets");
     if (!ParseNumbers(tokens, 1, &values, &bad)) {
-      return Status::Error(ExitCode::kUsage, "MOVE: \"" + bad.substr(0, 40) + "\" is not a number");
+      return Status::Error(ErrorCode::kInvalidInput, "MOVE: \"" + bad.substr(0, 40) + "\" is not a number");
     }
     request.velocity_scaling = values[0];
     request.target_rad = values.tail(values.size() - 1);
     return request;
   }
-  if (tokens.size() != 1) return Status::Error(ExitCode::kUsage, word + " takes no arguments");
+  if (tokens.size() != 1) return Status::Error(ErrorCode::kInvalidInput, word + " takes no arguments");
   return request;
 }
 

@@ -212,16 +212,16 @@ Result<TcpListener> TcpListener::Listen(const std::string& address, int port) {
   bind_address.sin_family = AF_INET;
   bind_address.sin_port = htons(static_cast<uint16_t>(port));
   if (port < 0 || port > 65535 || ::inet_pton(AF_INET, address.c_str(), &bind_address.sin_addr) != 1) {
-    return Status::Error(ExitCode::kUsage, "cannot listen on " + where + ": not an IPv4 address and port");
+    return Status::Error(ErrorCode::kInvalidInput, "cannot listen on " + where + ": not an IPv4 address and port");
   }
   TcpListener listener;
   listener.fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-  if (listener.fd_ < 0) return Status::Error(ExitCode::kUsage, "socket: " + ErrnoText(errno));
+  if (listener.fd_ < 0) return Status::Error(ErrorCode::kInvalidInput, "socket: " + ErrnoText(errno));
   const int one = 1;
   ::setsockopt(listener.fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one));
   if (::bind(listener.fd_, reinterpret_cast<const sockaddr*>(&bind_address), sizeof(bind_address)) != 0 ||
       ::listen(listener.fd_, 4) != 0) {
-    return Status::Error(ExitCode::kUsage, "cannot listen on " + where + ": " + ErrnoText(errno));
+    return Status::Error(ErrorCode::kInvalidInput, "cannot listen on " + where + ": " + ErrnoText(errno));
   }
   sockaddr_in bound{};
   socklen_t size = sizeof(bound);

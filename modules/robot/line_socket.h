@@ -71,7 +71,7 @@ class TcpListener {
   TcpListener& operator=(const TcpListener&) = delete;
 
   // Binds `address`:`port` (numeric IPv4; port 0: an ephemeral port) with SO_REUSEADDR and listens.
-  // Errors: ExitCode::kUsage naming the address and errno (a busy port is the user's to change).
+  // Errors: ErrorCode::kInvalidInput naming the address and errno (a busy port is the user's to change).
   static Result<TcpListener> Listen(const std::string& address, int port);
 
   bool is_open() const { return fd_ >= 0; }

@@ -39,7 +39,7 @@ Status NetworkRobotOptions::Validate() const {
   }
   if (max_line_bytes < 256) problems << " max_line_bytes = " << max_line_bytes << " must be at least 256;";
   if (problems.str().empty()) return Status::Ok();
-  return Status::Error(ExitCode::kUsage, "network robot options:" + problems.str());
+  return Status::Error(ErrorCode::kInvalidInput, "network robot options:" + problems.str());
 }
 
 NetworkRobot::NetworkRobot(std::string host, int port, NetworkRobotOptions options)

@@ -37,7 +37,7 @@ struct NetworkRobotOptions {
   // the non-empty fields here (R12, R13).
   std::optional<RobotIdentity> expected_identity;
   size_t max_line_bytes = protocol::kMaxLineBytes;
-  // OK, or ExitCode::kUsage naming the bad field.
+  // OK, or ErrorCode::kInvalidInput naming the bad field.
   Status Validate() const;
 };
 

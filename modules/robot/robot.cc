@@ -34,7 +34,7 @@ const char* RobotErrorName(RobotError error) {
 
 Status RobotFailure(RobotError error, const std::string& message) {
   if (error == RobotError::kNone) throw InvalidArgument("RobotFailure needs an error, not kNone: " + message);
-  return Status::Error(ExitCode::kHardware, message).WithDetail(kRobotErrorDomain, static_cast<int>(error));
+  return Status::Error(ErrorCode::kHardware, message).WithDetail(kRobotErrorDomain, static_cast<int>(error));
 }
 
 RobotError RobotErrorOf(const Status& status) {

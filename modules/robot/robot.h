@@ -11,7 +11,7 @@
 // the monotonic clock when they arrive (the clock V4L2 stamps frames with), the simulated robot with the
 // simulated clock it shares with the simulated camera.
 //
-// Errors: every failure is a Status with ExitCode kHardware whose detail (domain kRobotErrorDomain)
+// Errors: every failure is a Status with ErrorCode kHardware whose detail (domain kRobotErrorDomain)
 // carries a RobotError; RobotErrorOf() reads it back. Messages name the backend and the pose or joint.
 #pragma once
 
@@ -41,7 +41,7 @@ inline constexpr const char* kRobotErrorDomain = "robot";
 // "rejected", "protective_stop", ...: stable names for journals and reports.
 const char* RobotErrorName(RobotError error);
 
-// A Status with ExitCode::kHardware carrying `error` (kNone is not allowed) and `message`.
+// A Status with ErrorCode::kHardware carrying `error` (kNone is not allowed) and `message`.
 Status RobotFailure(RobotError error, const std::string& message);
 
 // The RobotError of a Status: kNone for OK and for errors without a robot detail.

@@ -33,7 +33,7 @@ void RobotServer::EndClient(LineSocket& client, const std::string& why) {
 }
 
 Status RobotServer::Serve(const std::atomic<bool>& stop) {
-  if (!listener_.is_open()) return Status::Error(ExitCode::kUsage, "robot server: Serve() before Listen()");
+  if (!listener_.is_open()) return Status::Error(ErrorCode::kInvalidInput, "robot server: Serve() before Listen()");
   std::optional<LineSocket> client;
   while (!stop.load()) {
     if (!client) {

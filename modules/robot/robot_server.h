@@ -42,7 +42,7 @@ class RobotServer {
   // `robot` must outlive the server and must not be used by anyone else while Serve() runs.
   RobotServer(Robot& robot, RobotServerOptions options = {});
 
-  // Binds and listens. Errors: ExitCode::kUsage naming the address (e.g. the port is in use).
+  // Binds and listens. Errors: ErrorCode::kInvalidInput naming the address (e.g. the port is in use).
   Status Listen();
   // The bound port (after Listen()).
   int port() const { return listener_.port(); }

@@ -14,12 +14,12 @@ using ::testing::HasSubstr;
 
 TEST(RobotErrorTest, FailureCarriesTheErrorAsDetail) {
   const Status status = RobotFailure(RobotError::kProtectiveStop, "stopped");
-  EXPECT_EQ(status.code(), ExitCode::kHardware);
+  EXPECT_EQ(status.code(), ErrorCode::kHardware);
   EXPECT_EQ(status.message(), "stopped");
   EXPECT_EQ(RobotErrorOf(status), RobotError::kProtectiveStop);
   EXPECT_STREQ(RobotErrorName(RobotErrorOf(status)), "protective_stop");
   EXPECT_EQ(RobotErrorOf(Status::Ok()), RobotError::kNone);
-  EXPECT_EQ(RobotErrorOf(Status::Error(ExitCode::kHardware, "x").WithDetail("capture", 2)), RobotError::kNone);
+  EXPECT_EQ(RobotErrorOf(Status::Error(ErrorCode::kHardware, "x").WithDetail("capture", 2)), RobotError::kNone);
   EXPECT_THROW(RobotFailure(RobotError::kNone, "no"), InvalidArgument);
   EXPECT_STREQ(RobotErrorName(RobotError::kOperatorAbort), "operator_abort");
   EXPECT_STREQ(MotionStateName(MotionState::kEmergencyStop), "emergency_stop");

@@ -75,7 +75,7 @@ Status SimulatedRobotOptions::Validate() const {
   if (problems.empty()) return Status::Ok();
   std::string message = "simulated robot options:";
   for (const std::string& problem : problems) message += "\n  " + problem;
-  return Status::Error(ExitCode::kUsage, message);
+  return Status::Error(ErrorCode::kInvalidInput, message);
 }
 
 SimulatedRobot::SimulatedRobot(const SimulatedRobotOptions& options, Clock& clock)

@@ -80,7 +80,7 @@ struct SimulatedRobotOptions {
   SimulatedRobotFaults faults;
 
   int num_joints() const { return static_cast<int>(limits.lower_rad.size()); }
-  // OK, or ExitCode::kUsage listing every bad field by name and value.
+  // OK, or ErrorCode::kInvalidInput listing every bad field by name and value.
   Status Validate() const;
 };
 

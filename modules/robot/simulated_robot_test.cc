@@ -48,7 +48,7 @@ TEST(SimulatedRobotOptionsTest, ValidateNamesEveryBadField) {
   options.initial_joints_rad[2] = 5;
   options.faults.jog_offset_rad = Eigen::VectorXd::Zero(2);
   const Status status = options.Validate();
-  EXPECT_EQ(status.code(), ExitCode::kUsage);
+  EXPECT_EQ(status.code(), ErrorCode::kInvalidInput);
   EXPECT_THAT(status.message(), HasSubstr("latency_s = -1"));
   EXPECT_THAT(status.message(), HasSubstr("settle_tau_s = 0"));
   EXPECT_THAT(status.message(), HasSubstr("initial_joints_rad: joint 3: target 5 rad is outside"));
@@ -67,7 +67,7 @@ TEST_F(SimulatedRobotTest, IdentityLimitsAndNotConnected) {
   SimulatedRobot robot(options_, clock_);
   EXPECT_EQ(RobotErrorOf(robot.ReadJoints().status()), RobotError::kNotConnected);
   EXPECT_EQ(RobotErrorOf(robot.StartMove(options_.initial_joints_rad, 1.0)), RobotError::kNotConnected);
-  EXPECT_EQ(robot.StartMove(options_.initial_joints_rad, 1.0).code(), ExitCode::kHardware);
+  EXPECT_EQ(robot.StartMove(options_.initial_joints_rad, 1.0).code(), ErrorCode::kHardware);
   ASSERT_TRUE(robot.Connect().ok());
   const Result<RobotIdentity> identity = robot.Identity();
   ASSERT_TRUE(identity.ok());

@@ -8,18 +8,18 @@
 
 namespace selfcal::session::internal {
 
-ExitCode ExitCodeForErrno(int error) {
-  return error == ENOSPC || error == EDQUOT || error == EIO ? ExitCode::kHardware : ExitCode::kUsage;
+ErrorCode ErrorCodeForErrno(int error) {
+  return error == ENOSPC || error == EDQUOT || error == EIO ? ErrorCode::kHardware : ErrorCode::kInvalidInput;
 }
 
 Status SystemError(const std::string& what, const std::string& path, int error) {
-  return Status::Error(ExitCodeForErrno(error), what + " " + path + ": " + std::strerror(error))
+  return Status::Error(ErrorCodeForErrno(error), what + " " + path + ": " + std::strerror(error))
       .WithDetail(kErrnoDomain, error);
 }
 
-Status WithErrnoExitCode(const Status& status) {
+Status WithErrnoErrorCode(const Status& status) {
   if (status.ok() || std::strcmp(status.detail_domain(), kErrnoDomain) != 0) return status;
-  return Status::Error(ExitCodeForErrno(status.detail()), status.message()).WithDetail(kErrnoDomain, status.detail());
+  return Status::Error(ErrorCodeForErrno(status.detail()), status.message()).WithDetail(kErrnoDomain, status.detail());
 }
 
 bool SafeFileName(const std::string& name) {

@@ -8,16 +8,16 @@
 
 namespace selfcal::session::internal {
 
-// kHardware for a full or failing disk (ENOSPC, EDQUOT, EIO), kUsage for everything else (a missing,
+// kHardware for a full or failing disk (ENOSPC, EDQUOT, EIO), kInvalidInput for everything else (a missing,
 // read-only or foreign path is part of the configuration, C10).
-ExitCode ExitCodeForErrno(int error);
+ErrorCode ErrorCodeForErrno(int error);
 
-// "<what> <path>: <strerror(error)>" with the code of ExitCodeForErrno.
+// "<what> <path>: <strerror(error)>" with the code of ErrorCodeForErrno.
 Status SystemError(const std::string& what, const std::string& path, int error);
 
 // A Status from base/atomic_file.h whose code is re-derived from its errno detail (a WriteFileAtomically
 // that ran out of space becomes kHardware); other statuses unchanged.
-Status WithErrnoExitCode(const Status& status);
+Status WithErrnoErrorCode(const Status& status);
 
 // A plain file name: 1-255 printable ASCII characters, no '/' or '\', not hidden (no leading '.').
 bool SafeFileName(const std::string& name);

@@ -146,9 +146,9 @@ std::string RecordName(std::size_t index, std::size_t offset) {
 Result<std::string> ReadAll(int fd, const std::string& path, std::uint64_t max_bytes) {
   struct stat info {};
   if (::fstat(fd, &info) != 0) return SystemError("cannot stat journal", path, errno);
-  if (!S_ISREG(info.st_mode)) return Status::Error(ExitCode::kUsage, "journal " + path + " is not a regular file");
+  if (!S_ISREG(info.st_mode)) return Status::Error(ErrorCode::kInvalidInput, "journal " + path + " is not a regular file");
   if (static_cast<std::uint64_t>(info.st_size) > max_bytes) {
-    return Status::Error(ExitCode::kUsage, "journal " + path + " is " + std::to_string(info.st_size) +
+    return Status::Error(ErrorCode::kInvalidInput, "journal " + path + " is " + std::to_string(info.st_size) +
                                                " bytes, more than the limit of " + std::to_string(max_bytes));
   }
   std::string data(static_cast<std::size_t>(info.st_size), '\0');
@@ -170,7 +170,7 @@ std::string DirectoryOf(const std::string& path) {
 }
 
 // Parses the whole journal `data` into *records. A torn tail is only reported in *recovery (valid_bytes:
-// where it starts, dropped_bytes: its length); damage and faulty writers are refused (kUsage).
+// where it starts, dropped_bytes: its length); damage and faulty writers are refused (kInvalidInput).
 Status ParseJournal(const std::string& data, const std::string& path, const JournalLimits& limits,
                     std::vector<nlohmann::json>* records, JournalRecovery* recovery) {
   std::size_t pos = 0;
@@ -183,12 +183,12 @@ Status ParseJournal(const std::string& data, const std::string& path, const Jour
     }
     const std::string where = "journal " + path + ": " + RecordName(records->size(), pos);
     if (record.kind == Parsed::kBadPayload) {
-      return Status::Error(ExitCode::kUsage, where + " has a correct CRC but a bad payload (" + record.reason +
+      return Status::Error(ErrorCode::kInvalidInput, where + " has a correct CRC but a bad payload (" + record.reason +
                                                  "): written by a faulty writer, not torn by a crash; refusing it");
     }
     const std::size_t later = FindLaterRecord(data, pos, limits);
     if (later != std::string::npos) {
-      return Status::Error(ExitCode::kUsage, where + " is corrupt (" + record.reason +
+      return Status::Error(ErrorCode::kInvalidInput, where + " is corrupt (" + record.reason +
                                                  ") and a valid record follows it at byte offset " +
                                                  std::to_string(later) +
                                                  ": the journal is damaged, not torn by a crash; refusing to drop "
@@ -278,12 +278,12 @@ Status Journal::Append(const nlohmann::json& record) {
                 "a journal record is a JSON object with a \"type\" string, got " << record.dump());
   SELFCAL_CHECK(fd_ >= 0, "Append on a moved-from journal");
   if (!failure_.empty()) {
-    return Status::Error(ExitCode::kHardware, "journal " + path_ + " is unusable after an earlier error (" + failure_ +
+    return Status::Error(ErrorCode::kHardware, "journal " + path_ + " is unusable after an earlier error (" + failure_ +
                                                   "); reopen the session to recover it");
   }
   const std::string payload = record.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   if (payload.size() > limits_.max_record_bytes) {
-    return Status::Error(ExitCode::kUsage, "journal " + path_ + ": a " + record["type"].get<std::string>() +
+    return Status::Error(ErrorCode::kInvalidInput, "journal " + path_ + ": a " + record["type"].get<std::string>() +
                                                " record of " + std::to_string(payload.size()) +
                                                " bytes exceeds the limit of " +
                                                std::to_string(limits_.max_record_bytes) + " bytes");
@@ -292,12 +292,12 @@ Status Journal::Append(const nlohmann::json& record) {
   nlohmann::json stored;
   std::string why;
   if (!ParsePayload(payload, limits_.max_json_depth, &stored, &why)) {
-    return Status::Error(ExitCode::kUsage, "journal " + path_ + ": cannot append a " +
+    return Status::Error(ErrorCode::kInvalidInput, "journal " + path_ + ": cannot append a " +
                                                record["type"].get<std::string>() + " record: " + why);
   }
   const std::string line = FrameJournalRecord(payload);
   if (size_bytes_ + line.size() > limits_.max_file_bytes) {
-    return Status::Error(ExitCode::kUsage, "journal " + path_ + " would exceed its limit of " +
+    return Status::Error(ErrorCode::kInvalidInput, "journal " + path_ + " would exceed its limit of " +
                                                std::to_string(limits_.max_file_bytes) + " bytes");
   }
   const bool written = WriteAllToFd(fd_, line);

@@ -14,7 +14,7 @@
 //  - if no valid record starts at any line after it, what follows the last valid record is a torn tail
 //    (a write cut short by a crash or power loss, or the zeros a file system may leave): it is truncated
 //    away (ftruncate + fsync) and reported in JournalRecovery;
-//  - if a valid record follows, the file was damaged, not torn: Open refuses (ExitCode::kUsage) naming
+//  - if a valid record follows, the file was damaged, not torn: Open refuses (ErrorCode::kInvalidInput) naming
 //    the byte offset and the record number (counted from 1) of the bad record, and changes nothing;
 //  - a complete record whose CRC matches but whose payload is not a JSON object with a "type" string was
 //    written by a faulty writer, not torn by a crash: refused in the same way, even at the end.
@@ -51,7 +51,7 @@ struct JournalRecovery {
 class Journal {
  public:
   // Opens `path` for appending, creating it (0644, with a directory fsync) when absent; reads and
-  // validates every record and truncates a torn tail as described above. Errors: kUsage for a file that
+  // validates every record and truncates a torn tail as described above. Errors: kInvalidInput for a file that
   // is damaged, not a regular file, over the limits or not accessible; kHardware for an I/O error
   // (read, ftruncate or fsync failing).
   static Result<Journal> Open(const std::string& path, const JournalLimits& limits = JournalLimits());
@@ -64,7 +64,7 @@ class Journal {
 
   // Appends `record` (a JSON object with a "type" string: SELFCAL_CHECK) as one framed line, with one
   // write() loop followed by fdatasync(): when this returns OK the record is durable (P1). Invalid UTF-8
-  // in strings is replaced by U+FFFD. Errors: kUsage for a record over max_record_bytes or a journal that
+  // in strings is replaced by U+FFFD. Errors: kInvalidInput for a record over max_record_bytes or a journal that
   // would exceed max_file_bytes (nothing written); kHardware naming the file for an I/O error (ENOSPC,
   // EIO, ...). After an I/O error the partial line is cut off again when possible, the record does not
   // count, and every later Append fails: reopen the session (Open recovers the journal).
@@ -99,8 +99,8 @@ struct JournalContents {
 
 // Reads and validates every record of the journal at `path` read-only, for an offline reader (calibrate):
 // opens it O_RDONLY, takes no lock, creates nothing and truncates nothing. Damage and faulty writers are
-// refused as in Open (kUsage naming the record and byte offset); a torn tail is reported, not cut off.
-// kUsage for a missing file, one that is not a regular file or over the limits; kHardware for an I/O error.
+// refused as in Open (kInvalidInput naming the record and byte offset); a torn tail is reported, not cut off.
+// kInvalidInput for a missing file, one that is not a regular file or over the limits; kHardware for an I/O error.
 Result<JournalContents> ReadJournal(const std::string& path, const JournalLimits& limits = JournalLimits());
 
 // One framed journal line for `payload` (exposed for tests that build damaged journals).

@@ -146,7 +146,7 @@ TEST(JournalTest, FlippedByteInAMiddleRecordIsRefusedWithItsOffset) {
     WriteFile(path, damaged);
     Result<Journal> journal = Journal::Open(path);
     ASSERT_FALSE(journal.ok());
-    EXPECT_EQ(journal.status().code(), ExitCode::kUsage);
+    EXPECT_EQ(journal.status().code(), ErrorCode::kInvalidInput);
     EXPECT_TRUE(Contains(journal.status().message(), "record 2 at byte offset " + std::to_string(one.size())))
         << journal.status().message();
     EXPECT_TRUE(Contains(journal.status().message(), path));
@@ -162,7 +162,7 @@ TEST(JournalTest, ARecordWithAValidCrcButABadPayloadIsRefusedEvenAtTheEnd) {
     WriteFile(path, two + FrameJournalRecord(payload));
     Result<Journal> journal = Journal::Open(path);
     ASSERT_FALSE(journal.ok()) << payload;
-    EXPECT_EQ(journal.status().code(), ExitCode::kUsage);
+    EXPECT_EQ(journal.status().code(), ErrorCode::kInvalidInput);
     EXPECT_TRUE(Contains(journal.status().message(), "record 3 at byte offset " + std::to_string(two.size())))
         << journal.status().message();
   }
@@ -178,7 +178,7 @@ TEST(JournalTest, OversizeRecordsAreRefused) {
   ASSERT_TRUE(journal.value().Append(Record(0)).ok());
   const auto size = FileSize(path);
   const Status refused = journal.value().Append({{"type", "big"}, {"text", std::string(200, 'x')}});
-  EXPECT_EQ(refused.code(), ExitCode::kUsage);
+  EXPECT_EQ(refused.code(), ErrorCode::kInvalidInput);
   EXPECT_TRUE(Contains(refused.message(), "exceeds the limit of 100 bytes")) << refused.message();
   EXPECT_EQ(FileSize(path), size);                      // nothing written
   EXPECT_TRUE(journal.value().Append(Record(1)).ok());  // and the journal stays usable
@@ -201,7 +201,7 @@ TEST(JournalTest, FileSizeLimit) {
   Result<Journal> journal = Journal::Open(path, limits);
   ASSERT_TRUE(journal.ok());
   const Status refused = journal.value().Append(Record(2));
-  EXPECT_EQ(refused.code(), ExitCode::kUsage);
+  EXPECT_EQ(refused.code(), ErrorCode::kInvalidInput);
   EXPECT_TRUE(Contains(refused.message(), "would exceed")) << refused.message();
   limits.max_file_bytes = two.size() - 1;
   Result<Journal> too_big = Journal::Open(path, limits);
@@ -229,7 +229,7 @@ TEST(JournalTest, DeeplyNestedPayloadsAreRefused) {
   Result<Journal> journal = Journal::Open(path, limits);
   nlohmann::json deep = 1;
   for (int i = 0; i < 10; ++i) deep = nlohmann::json::array({deep});
-  EXPECT_EQ(journal.value().Append({{"type", "deep"}, {"value", deep}}).code(), ExitCode::kUsage);
+  EXPECT_EQ(journal.value().Append({{"type", "deep"}, {"value", deep}}).code(), ErrorCode::kInvalidInput);
   EXPECT_EQ(FileSize(path), 0u);
   WriteFile(path, FrameJournalRecord(R"({"type":"deep","v":[[[[[[[[[[1]]]]]]]]]]})"));
   Result<Journal> reread = Journal::Open(path, limits);
@@ -241,26 +241,26 @@ TEST(JournalTest, NotARegularFileIsRefused) {
   TempDir dir;
   Result<Journal> journal = Journal::Open(dir.path());
   ASSERT_FALSE(journal.ok());
-  EXPECT_EQ(journal.status().code(), ExitCode::kUsage);
+  EXPECT_EQ(journal.status().code(), ErrorCode::kInvalidInput);
   Result<Journal> missing_dir = Journal::Open(dir.File("no/such/journal.log"));
   ASSERT_FALSE(missing_dir.ok());
   EXPECT_TRUE(Contains(missing_dir.status().message(), "no/such/journal.log"));
 }
 
 TEST(JournalTest, FullDiskAndIoErrorsAreHardwareFaults) {
-  EXPECT_EQ(internal::ExitCodeForErrno(ENOSPC), ExitCode::kHardware);
-  EXPECT_EQ(internal::ExitCodeForErrno(EDQUOT), ExitCode::kHardware);
-  EXPECT_EQ(internal::ExitCodeForErrno(EIO), ExitCode::kHardware);
-  EXPECT_EQ(internal::ExitCodeForErrno(EACCES), ExitCode::kUsage);
+  EXPECT_EQ(internal::ErrorCodeForErrno(ENOSPC), ErrorCode::kHardware);
+  EXPECT_EQ(internal::ErrorCodeForErrno(EDQUOT), ErrorCode::kHardware);
+  EXPECT_EQ(internal::ErrorCodeForErrno(EIO), ErrorCode::kHardware);
+  EXPECT_EQ(internal::ErrorCodeForErrno(EACCES), ErrorCode::kInvalidInput);
   const Status from_atomic_write =
-      Status::Error(ExitCode::kUsage, "cannot write x: write failed").WithDetail(kErrnoDomain, ENOSPC);
-  EXPECT_EQ(internal::WithErrnoExitCode(from_atomic_write).code(), ExitCode::kHardware);
+      Status::Error(ErrorCode::kInvalidInput, "cannot write x: write failed").WithDetail(kErrnoDomain, ENOSPC);
+  EXPECT_EQ(internal::WithErrnoErrorCode(from_atomic_write).code(), ErrorCode::kHardware);
   // base/atomic_file.h carries the errno of a failed system call.
   const Status missing = ReadFileCapped("/nonexistent/selfcal/file", 10).status();
   EXPECT_STREQ(missing.detail_domain(), kErrnoDomain);
   EXPECT_EQ(missing.detail(), ENOENT);
-  const Status no_errno = Status::Error(ExitCode::kUsage, "bad");
-  EXPECT_EQ(internal::WithErrnoExitCode(no_errno).code(), ExitCode::kUsage);
+  const Status no_errno = Status::Error(ErrorCode::kInvalidInput, "bad");
+  EXPECT_EQ(internal::WithErrnoErrorCode(no_errno).code(), ErrorCode::kInvalidInput);
 }
 
 // A write that fails half-way (here: the file size limit of the process, EFBIG) leaves the journal a

@@ -333,9 +333,9 @@ Result<SessionLog> ReadSessionLog(const std::vector<nlohmann::json>& records) {
   try {
     for (std::size_t i = 0; i < records.size(); ++i) builder.Add(records[i], i);
   } catch (const RecordError& error) {
-    return Status::Error(ExitCode::kUsage, error.what());
+    return Status::Error(ErrorCode::kInvalidInput, error.what());
   } catch (const nlohmann::json::exception& error) {  // a value outside its type's range
-    return Status::Error(ExitCode::kUsage, std::string("journal: ") + error.what());
+    return Status::Error(ErrorCode::kInvalidInput, std::string("journal: ") + error.what());
   }
   return builder.Take();
 }
@@ -361,7 +361,7 @@ Status VerifySampleImages(const std::string& session_path, const SessionLog& log
   if (problems.empty()) return Status::Ok();
   std::string message = "session " + session_path + ": images of accepted samples do not match the journal: ";
   for (std::size_t i = 0; i < problems.size(); ++i) message += (i ? "; " : "") + problems[i];
-  return Status::Error(ExitCode::kUsage, message);
+  return Status::Error(ErrorCode::kInvalidInput, message);
 }
 
 }  // namespace selfcal::session

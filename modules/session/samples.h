@@ -117,11 +117,11 @@ struct SessionLog {
 // sample_accepted repeats its pose's id and role and names an image an earlier frame_written of the same
 // pose recorded; a second frame_written of an image must agree with the first; dot ids within a sample
 // are distinct. A second sample_accepted of an accepted pose is kept out (the first counts) and listed in
-// duplicate_accepts. kUsage naming the record, its type and field.
+// duplicate_accepts. kInvalidInput naming the record, its type and field.
 Result<SessionLog> ReadSessionLog(const std::vector<nlohmann::json>& records);
 
 // Checks that the image of every accepted sample exists in the session directory `session_path` and has
-// the size and CRC-32 its frame_written record gives (P2); reads only. kUsage listing every missing or
+// the size and CRC-32 its frame_written record gives (P2); reads only. kInvalidInput listing every missing or
 // differing image.
 Status VerifySampleImages(const std::string& session_path, const SessionLog& log);
 inline Status VerifySampleImages(const Session& session, const SessionLog& log) {

@@ -251,7 +251,7 @@ TEST(SamplesTest, BadRecordsAreNamedWithTheirField) {
     c.edit(records);
     Result<SessionLog> log = ReadSessionLog(records);
     ASSERT_FALSE(log.ok()) << c.expected;
-    EXPECT_EQ(log.status().code(), ExitCode::kUsage);
+    EXPECT_EQ(log.status().code(), ErrorCode::kInvalidInput);
     EXPECT_TRUE(Contains(log.status().message(), c.expected)) << log.status().message();
   }
   // Planning a pose again identically is harmless.
@@ -283,7 +283,7 @@ TEST(SamplesTest, VerifySampleImages) {
 
   WriteFile(path + "/images/p00.png", "PNG bytes of pose zer0");  // same size, other bytes
   Status bad = VerifySampleImages(session, *log);
-  EXPECT_EQ(bad.code(), ExitCode::kUsage);
+  EXPECT_EQ(bad.code(), ErrorCode::kInvalidInput);
   EXPECT_TRUE(Contains(bad.message(), "images/p00.png (pose 0): CRC-32")) << bad.message();
   WriteFile(path + "/images/p00.png", "short");
   EXPECT_TRUE(Contains(VerifySampleImages(session, *log).message(), "5 bytes, the journal recorded 22"));

@@ -22,11 +22,11 @@ namespace {
 using internal::Join;
 using internal::SafeFileName;
 using internal::SystemError;
-using internal::WithErrnoExitCode;
+using internal::WithErrnoErrorCode;
 
 constexpr std::size_t kMaxManifestBytes = std::size_t{1} << 20;
 
-Status Usage(const std::string& message) { return Status::Error(ExitCode::kUsage, message); }
+Status Usage(const std::string& message) { return Status::Error(ErrorCode::kInvalidInput, message); }
 
 bool ValidUtcTime(const std::string& text) {
   static const std::regex pattern(R"(^(\d{4})-(\d{2})-(\d{2})T(\d{2}):(\d{2}):(\d{2})(\.\d{1,9})?Z$)");
@@ -157,7 +157,7 @@ Result<SessionManifest> ParseManifest(const std::string& text, const std::string
   return manifest;
 }
 
-// Whether `path` is an empty directory; kUsage when it exists but is not a directory.
+// Whether `path` is an empty directory; kInvalidInput when it exists but is not a directory.
 Result<bool> IsEmptyDirectory(const std::string& path) {
   std::error_code error;
   if (!std::filesystem::is_directory(path, error)) return Usage(path + " exists and is not a directory");
@@ -268,7 +268,7 @@ Result<std::string> ReadRecordedInput(const std::string& session_path, const Inp
   bool missing = false;
   Result<std::string> text = ReadFileCapped(file, kMaxInputBytes, &missing);
   if (missing) return Usage(file + ": missing, but recorded in " + kManifestFileName + " (" + recorded + ")");
-  if (!text.ok()) return WithErrnoExitCode(text.status());
+  if (!text.ok()) return WithErrnoErrorCode(text.status());
   const std::string sha256 = Sha256Hex(*text);
   if (text->size() != digest.bytes || sha256 != digest.sha256_hex) {
     return Usage(file + ": differs from the size or SHA-256 recorded in " + kManifestFileName + " (" + recorded +
@@ -304,7 +304,7 @@ Result<SessionManifest> ReadManifest(const std::string& session_path, std::strin
     return Usage(session_path + " is not a selfcal session: it has no " + kManifestFileName +
                  " (or its creation was interrupted)");
   }
-  if (!text.ok()) return WithErrnoExitCode(text.status());
+  if (!text.ok()) return WithErrnoErrorCode(text.status());
   if (sha256 != nullptr) *sha256 = Sha256Hex(*text);
   return ParseManifest(*text, file);
 }
@@ -383,7 +383,7 @@ Result<Session> CreateSession(const std::string& path, const SessionInputs& inpu
   for (const SessionInput& input : inputs) {
     const std::string file = Join(inputs_dir, input.name);
     if (Status status = WriteFileAtomically(file, input.contents, Publish::kNoReplace); !status.ok()) {
-      return WithErrnoExitCode(status);
+      return WithErrnoErrorCode(status);
     }
     if (::chmod(file.c_str(), 0444) != 0) return SystemError("cannot make read-only", file, errno);
     manifest.inputs.push_back({input.name, input.contents.size(), Sha256Hex(input.contents)});
@@ -395,7 +395,7 @@ Result<Session> CreateSession(const std::string& path, const SessionInputs& inpu
   if (Status status = WriteFileAtomically(Join(path, kManifestFileName), ManifestToJson(manifest).dump(2) + "\n",
                                           Publish::kNoReplace);
       !status.ok()) {
-    return WithErrnoExitCode(status);
+    return WithErrnoErrorCode(status);
   }
   return Session(path, std::move(manifest), std::move(journal).value(), std::move(lock).value(), OpenReport());
 }
@@ -452,14 +452,14 @@ Status Session::WriteImage(const std::string& name, const std::string& bytes) {
                  " exists already with other content: recorded images are never overwritten; give the new frame "
                  "a new name");
   }
-  return WithErrnoExitCode(WriteFileAtomically(file, bytes, Publish::kNoReplace));
+  return WithErrnoErrorCode(WriteFileAtomically(file, bytes, Publish::kNoReplace));
 }
 
 Status Session::CheckFreeSpace(std::uint64_t bytes_needed) const {
   Result<std::uint64_t> available = AvailableBytes(path_);
   if (!available.ok()) return available.status();
   if (*available < bytes_needed) {
-    return Status::Error(ExitCode::kHardware, "only " + std::to_string(*available) +
+    return Status::Error(ErrorCode::kHardware, "only " + std::to_string(*available) +
                                                   " bytes are free on the file system of session " + path_ + ", " +
                                                   std::to_string(bytes_needed) + " are needed (P5)");
   }

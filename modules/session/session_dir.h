@@ -41,7 +41,7 @@ struct SessionInput {
 using SessionInputs = std::vector<SessionInput>;  // in the order they are recorded
 
 // Input `name` with the bytes of the file `path` (at most kMaxInputBytes), for CreateSession and
-// OpenSession. kUsage naming the path when it is missing, unreadable, not a regular file or too large.
+// OpenSession. kInvalidInput naming the path when it is missing, unreadable, not a regular file or too large.
 Result<SessionInput> ReadInputFile(const std::string& name, const std::string& path);
 
 struct InputDigest {
@@ -91,8 +91,8 @@ class Session {
 
   // Writes images/<name> atomically without replacing (base/atomic_file.h, Publish::kNoReplace). Call it
   // before appending the record that names ImageRecordPath(name). A file of that name that exists already
-  // is accepted only when its content is identical (a retried write); otherwise kUsage: recorded images
-  // are never overwritten, so a retaken frame needs a new name (e.g. "<pose id>_<sequence>.png"). kUsage
+  // is accepted only when its content is identical (a retried write); otherwise kInvalidInput: recorded images
+  // are never overwritten, so a retaken frame needs a new name (e.g. "<pose id>_<sequence>.png"). kInvalidInput
   // for a name that is not a plain file name; kHardware naming the file for ENOSPC or EIO.
   Status WriteImage(const std::string& name, const std::string& bytes);
 
@@ -100,7 +100,7 @@ class Session {
   // (P5: check before each frame, then halt cleanly rather than run into ENOSPC).
   Status CheckFreeSpace(std::uint64_t bytes_needed) const;
 
-  // The stored copy of input `name`, checked against its recorded size and SHA-256. kUsage when the
+  // The stored copy of input `name`, checked against its recorded size and SHA-256. kInvalidInput when the
   // session has no such input or the copy was modified.
   Result<std::string> ReadInput(const std::string& name) const;
 
@@ -123,7 +123,7 @@ class Session {
 };
 
 // Creates a new session in `path` (created; its parent must exist) or in an existing empty directory.
-// Refused with kUsage, before anything is written, when: `path` exists and is not an empty directory
+// Refused with kInvalidInput, before anything is written, when: `path` exists and is not an empty directory
 // (C10: a session is never overwritten; the message names the path), the directory is not writable, its
 // file system has less than the inputs plus options.min_free_bytes available, an input name is not a
 // plain file name or repeats, an input exceeds kMaxInputBytes, or an option is invalid. Writes, in order:
@@ -136,11 +136,11 @@ Result<Session> CreateSession(const std::string& path, const SessionInputs& inpu
 // Opens an existing session for writing, to resume it (P2, P3, C9); offline readers such as calibrate use
 // ReadSession (session_snapshot.h), which changes nothing. In this order:
 //  1. reads session.json strictly (another format or major version, missing, unknown or ill-typed keys:
-//     kUsage naming the file and key); images/ and journal.log must exist;
+//     kInvalidInput naming the file and key); images/ and journal.log must exist;
 //  2. compares every `expected` input with the recorded SHA-256 (inputs recorded but not expected are
-//     not compared); differences are refused with kUsage listing every differing input, unless
+//     not compared); differences are refused with kInvalidInput listing every differing input, unless
 //     `allow_changed_inputs` (then listed in open_report().changed_inputs);
-//  3. takes the lock (kUsage when in use; a dead holder's lock is taken over and reported);
+//  3. takes the lock (kInvalidInput when in use; a dead holder's lock is taken over and reported);
 //  4. opens the journal with recovery (a torn tail truncated and reported; damage refused);
 //  5. moves every non-directory entry of images/ that no durable journal record names (the "image"
 //     field of any record, "images/<name>") to orphans/ (a name taken there gets ".1", ".2", ...),
@@ -153,12 +153,12 @@ Result<Session> OpenSession(const std::string& path, const SessionInputs& expect
 // receives the SHA-256 of the bytes read.
 Result<SessionManifest> ReadManifest(const std::string& session_path, std::string* sha256 = nullptr);
 
-// kUsage unless `session_path` has its images/ directory and its journal.log (a missing journal is lost
+// kInvalidInput unless `session_path` has its images/ directory and its journal.log (a missing journal is lost
 // data, never started afresh).
 Status CheckSessionLayout(const std::string& session_path);
 
 // The stored copy inputs/<digest.name> of a session, checked against the size and SHA-256 its manifest
-// recorded. kUsage naming the file when it is missing ("<session>/inputs/<name>: missing, but recorded in
+// recorded. kInvalidInput naming the file when it is missing ("<session>/inputs/<name>: missing, but recorded in
 // session.json ...") or differs ("<session>/inputs/<name>: differs from the size or SHA-256 recorded in
 // session.json (recorded ...; found ...)").
 Result<std::string> ReadRecordedInput(const std::string& session_path, const InputDigest& digest);

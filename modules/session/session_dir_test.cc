@@ -88,7 +88,7 @@ TEST(SessionDirTest, CreateRefusesANonEmptyDirectory) {
   WriteFile(path + "/notes.txt", "keep me");
   Result<Session> session = CreateSession(path, TestInputs(), "v", TestCreateOptions());
   ASSERT_FALSE(session.ok());
-  EXPECT_EQ(session.status().code(), ExitCode::kUsage);
+  EXPECT_EQ(session.status().code(), ErrorCode::kInvalidInput);
   EXPECT_TRUE(Contains(session.status().message(), path)) << session.status().message();
   EXPECT_TRUE(Contains(session.status().message(), "never overwritten")) << session.status().message();
   EXPECT_EQ(dir.List("session"), std::vector<std::string>{"notes.txt"});
@@ -126,7 +126,7 @@ TEST(SessionDirTest, CreateRefusesBadArgumentsBeforeWritingAnything) {
     options.created_utc = c.created_utc;
     Result<Session> session = CreateSession(path, c.inputs, "v", options);
     ASSERT_FALSE(session.ok()) << c.expected;
-    EXPECT_EQ(session.status().code(), ExitCode::kUsage);
+    EXPECT_EQ(session.status().code(), ErrorCode::kInvalidInput);
     EXPECT_TRUE(Contains(session.status().message(), c.expected)) << session.status().message();
     EXPECT_FALSE(Exists(path));
   }
@@ -141,7 +141,7 @@ TEST(SessionDirTest, CreateChecksFreeSpace) {
   options.min_free_bytes = std::uint64_t{1} << 62;  // 4 EiB
   Result<Session> session = CreateSession(dir.File("s"), TestInputs(), "v", options);
   ASSERT_FALSE(session.ok());
-  EXPECT_EQ(session.status().code(), ExitCode::kUsage);
+  EXPECT_EQ(session.status().code(), ErrorCode::kInvalidInput);
   EXPECT_TRUE(Contains(session.status().message(), "bytes are free")) << session.status().message();
   EXPECT_FALSE(Exists(dir.File("s")));
 }
@@ -166,7 +166,7 @@ TEST(SessionDirTest, LockRefusesASecondSessionAndIsReleasedOnDestruction) {
     ASSERT_TRUE(first.ok());
     Result<Session> second = OpenSession(path, TestInputs(), false);
     ASSERT_FALSE(second.ok());
-    EXPECT_EQ(second.status().code(), ExitCode::kUsage);
+    EXPECT_EQ(second.status().code(), ErrorCode::kInvalidInput);
     EXPECT_TRUE(Contains(second.status().message(),
                          "session " + path + " is in use by pid " + std::to_string(::getpid()) + " on host "))
         << second.status().message();
@@ -202,7 +202,7 @@ TEST(SessionDirTest, ResumeWithChangedInputsIsRefusedUnlessAllowed) {
   changed.push_back({"camera.yaml", "fx: 800\n"});  // not recorded
   Result<Session> refused = OpenSession(path, changed, false);
   ASSERT_FALSE(refused.ok());
-  EXPECT_EQ(refused.status().code(), ExitCode::kUsage);
+  EXPECT_EQ(refused.status().code(), ErrorCode::kInvalidInput);
   const std::string& message = refused.status().message();
   EXPECT_TRUE(Contains(message, "config.yaml (recorded 16 bytes")) << message;
   EXPECT_TRUE(Contains(message, "camera.yaml (not recorded")) << message;
@@ -255,7 +255,7 @@ TEST(SessionDirTest, TheManifestIsReadStrictly) {
     WriteFile(path + "/session.json", edited.dump(2));
     Result<Session> session = OpenSession(path, {}, false);
     ASSERT_FALSE(session.ok()) << c.expected;
-    EXPECT_EQ(session.status().code(), ExitCode::kUsage);
+    EXPECT_EQ(session.status().code(), ErrorCode::kInvalidInput);
     EXPECT_TRUE(Contains(session.status().message(), c.expected)) << session.status().message();
     EXPECT_TRUE(Contains(session.status().message(), "session.json")) << session.status().message();
   }
@@ -311,12 +311,12 @@ TEST(SessionDirTest, WriteImageIsAtomicAndNeverReplaces) {
   EXPECT_EQ(ReadFile(path + "/images/f.png"), "AAAA");
   EXPECT_TRUE(session.value().WriteImage("f.png", "AAAA").ok());  // identical retry
   const Status replaced = session.value().WriteImage("f.png", "BBBB");
-  EXPECT_EQ(replaced.code(), ExitCode::kUsage);
+  EXPECT_EQ(replaced.code(), ErrorCode::kInvalidInput);
   EXPECT_TRUE(Contains(replaced.message(), "never overwritten")) << replaced.message();
   EXPECT_EQ(ReadFile(path + "/images/f.png"), "AAAA");
   EXPECT_FALSE(session.value().WriteImage("f.png", "AAAAA").ok());  // a longer file is not identical
   for (const char* bad : {"", ".hidden", "../escape.png", "a/b.png"}) {
-    EXPECT_EQ(session.value().WriteImage(bad, "x").code(), ExitCode::kUsage) << bad;
+    EXPECT_EQ(session.value().WriteImage(bad, "x").code(), ErrorCode::kInvalidInput) << bad;
   }
   EXPECT_EQ(dir.List("s/images"), std::vector<std::string>{"f.png"});  // no temporary file left
   EXPECT_FALSE(Exists(dir.File("escape.png")));
@@ -329,7 +329,7 @@ TEST(SessionDirTest, CheckFreeSpace) {
   ASSERT_TRUE(session.ok());
   EXPECT_TRUE(session->CheckFreeSpace(0).ok());
   const Status full = session->CheckFreeSpace(std::uint64_t{1} << 62);
-  EXPECT_EQ(full.code(), ExitCode::kHardware);
+  EXPECT_EQ(full.code(), ErrorCode::kHardware);
   EXPECT_TRUE(Contains(full.message(), dir.File("s"))) << full.message();
 }
 

@@ -67,7 +67,7 @@ Result<SessionLock> SessionLock::Acquire(const std::string& session_path, bool m
   lock.fd_ = ::open(path.c_str(), flags, 0644);
   if (lock.fd_ < 0) {
     if (must_create && errno == EEXIST) {
-      return Status::Error(ExitCode::kUsage,
+      return Status::Error(ErrorCode::kInvalidInput,
                            "session " + session_path + " is being created by another process (its lock file exists)");
     }
     return SystemError("cannot open the lock file", path, errno);
@@ -79,7 +79,7 @@ Result<SessionLock> SessionLock::Acquire(const std::string& session_path, bool m
   if (rc != 0) {
     const int error = errno;
     if (error == EWOULDBLOCK) {
-      return Status::Error(ExitCode::kUsage,
+      return Status::Error(ErrorCode::kInvalidInput,
                            "session " + session_path + " is in use by " + DescribeHolder(ReadHolder(lock.fd_)));
     }
     return SystemError("cannot lock", path, error);

@@ -21,8 +21,8 @@ inline constexpr const char* kLockFileName = "lock";
 class SessionLock {
  public:
   // Locks `<session_path>/lock`. With `must_create` the lock file must not exist yet (a new session:
-  // two processes creating the same directory cannot both succeed). Errors: kUsage "session <path> is in
-  // use by pid N on host H (since T)" when another holder has it; kUsage or kHardware (full disk) naming
+  // two processes creating the same directory cannot both succeed). Errors: kInvalidInput "session <path> is in
+  // use by pid N on host H (since T)" when another holder has it; kInvalidInput or kHardware (full disk) naming
   // the file when it cannot be created, locked or written.
   static Result<SessionLock> Acquire(const std::string& session_path, bool must_create = false);
 

@@ -67,12 +67,12 @@ Result<SessionObservations> LoadSessionObservations(const std::string& session_p
     if (sample) set.poses.push_back(ObservationOf(*sample));
   }
   if (set.PosesWithRole(PoseRole::kIdentification).size() < 2) {
-    return Status::Error(ExitCode::kDegenerateData, "session " + session_path + " has " +
+    return Status::Error(ErrorCode::kDegenerateData, "session " + session_path + " has " +
                                                         std::to_string(set.poses.size()) +
                                                         " accepted samples: too few to calibrate");
   }
   if (const std::string problems = set.Validate(); !problems.empty()) {
-    return Status::Error(ExitCode::kDegenerateData, "session " + session_path + ": " + problems);
+    return Status::Error(ErrorCode::kDegenerateData, "session " + session_path + ": " + problems);
   }
   return result;
 }

@@ -36,7 +36,7 @@ struct SessionObservations {
 // Builds the ObservationSet of the session at `session_path` from ReadSession (every recorded input
 // checked against its size and SHA-256; nothing locked or changed): the setup.json input (camera,
 // yardsticks, checks), the robot.yaml input and the accepted samples of the journal in plan order, after
-// checking every sample's image against its frame_written record (P2). kUsage naming the session, file
+// checking every sample's image against its frame_written record (P2). kInvalidInput naming the session, file
 // or record on any inconsistency; kDegenerateData when fewer than two identification samples were
 // accepted or the set is invalid.
 Result<SessionObservations> LoadSessionObservations(const std::string& session_path);

@@ -7,7 +7,7 @@ namespace selfcal::session {
 Result<std::string> SessionSnapshot::Input(const std::string& name) const {
   const auto it = inputs.find(name);
   if (it == inputs.end()) {
-    return Status::Error(ExitCode::kUsage, "session " + path + " has no input \"" + name + "\" in " +
+    return Status::Error(ErrorCode::kInvalidInput, "session " + path + " has no input \"" + name + "\" in " +
                                                kManifestFileName);
   }
   return it->second;
@@ -48,7 +48,7 @@ Result<SessionSnapshot> ReadSession(const std::string& path, const JournalLimits
   if (!problems.empty()) {
     std::string message;
     for (const std::string& problem : problems) message += (message.empty() ? "" : "; ") + problem;
-    return Status::Error(ExitCode::kUsage, message + "; refusing to read session " + path);
+    return Status::Error(ErrorCode::kInvalidInput, message + "; refusing to read session " + path);
   }
 
   Result<JournalContents> journal = ReadJournal(internal::Join(path, kJournalFileName), journal_limits);

@@ -31,7 +31,7 @@ struct SessionSnapshot {
   // Files of images/ no record names ("images/<name>"), which a resume would move to orphans/; left in place.
   std::vector<std::string> unrecorded_images;
 
-  // The checked bytes of input `name`; kUsage naming the session when the manifest does not record it.
+  // The checked bytes of input `name`; kInvalidInput naming the session when the manifest does not record it.
   Result<std::string> Input(const std::string& name) const;
   // One line per finding above, each saying what a resume would do and that nothing was changed; empty
   // when the session is clean.
@@ -41,7 +41,7 @@ struct SessionSnapshot {
 // Reads the session at `path` without changing anything, in this order:
 //  1. session.json, strictly (as ReadManifest); images/ and journal.log must exist;
 //  2. every input the manifest records, against its recorded size and SHA-256: a missing or differing
-//     one is refused (kUsage listing every such file, e.g. "<path>/inputs/robot.yaml: differs from the
+//     one is refused (kInvalidInput listing every such file, e.g. "<path>/inputs/robot.yaml: differs from the
 //     size or SHA-256 recorded in session.json (...)");
 //  3. the journal, read-only (ReadJournal): damage is refused, a torn tail reported;
 //  4. the unrecorded images, listed.

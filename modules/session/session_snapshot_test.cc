@@ -106,7 +106,7 @@ TEST(SessionSnapshotTest, EveryRecordedInputIsCheckedAgainstTheManifest) {
 
   Result<SessionSnapshot> snapshot = ReadSession(path);
   ASSERT_FALSE(snapshot.ok());
-  EXPECT_EQ(snapshot.status().code(), ExitCode::kUsage);
+  EXPECT_EQ(snapshot.status().code(), ErrorCode::kInvalidInput);
   const std::string& message = snapshot.status().message();
   EXPECT_TRUE(Contains(message, path + "/inputs/robot.yaml: differs from the size or SHA-256 recorded in session.json"))
       << message;

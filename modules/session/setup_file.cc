@@ -29,7 +29,7 @@ std::string SetupFileText(const ObservationSet& setup) {
 }
 
 Status ParseSetupFile(const std::string& text, const std::string& name, ObservationSet* set) {
-  auto bad = [&](const std::string& why) { return Status::Error(ExitCode::kUsage, name + ": " + why); };
+  auto bad = [&](const std::string& why) { return Status::Error(ErrorCode::kInvalidInput, name + ": " + why); };
   json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (j.is_discarded() || !j.is_object()) return bad("not a JSON object");
   if (j.value("format", "") != kSetupFormatName || j.value("version", 0) != kSetupFormatVersion) {

@@ -20,7 +20,7 @@ inline constexpr int kSetupFormatVersion = 1;
 std::string SetupFileText(const ObservationSet& setup);
 
 // Parses setup.json text into the camera, pixel_noise_px, yardsticks and check_distances of *set (its
-// robot and poses are left alone). kUsage naming `name` for another format or version, a missing or
+// robot and poses are left alone). kInvalidInput naming `name` for another format or version, a missing or
 // mistyped key, or a non-positive camera size, fx_px or pixel noise.
 Status ParseSetupFile(const std::string& text, const std::string& name, ObservationSet* set);
 

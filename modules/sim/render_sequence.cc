@@ -121,9 +121,9 @@ std::string SequenceRenderOptions::Validate() const {
 Status RenderSequenceFolder(const SimResult& world, const SequenceRenderOptions& options, const std::string& folder,
                             SequenceTruth* truth_out) {
   if (const std::string problems = options.Validate(); !problems.empty()) {
-    return Status::Error(ExitCode::kUsage, "invalid sequence rendering options:\n" + problems);
+    return Status::Error(ErrorCode::kInvalidInput, "invalid sequence rendering options:\n" + problems);
   }
-  if (!world.ok) return Status::Error(ExitCode::kUsage, "cannot render a failed simulation: " + world.message);
+  if (!world.ok) return Status::Error(ErrorCode::kInvalidInput, "cannot render a failed simulation: " + world.message);
   const SimTruth& truth = world.truth;
   std::vector<int> poses = options.pose_indices;
   if (poses.empty()) {
@@ -131,7 +131,7 @@ Status RenderSequenceFolder(const SimResult& world, const SequenceRenderOptions&
   }
   for (const int i : poses) {
     if (i < 0 || i >= static_cast<int>(truth.base_from_cam.size())) {
-      return Status::Error(ExitCode::kUsage, "pose index " + std::to_string(i) + " outside the world's " +
+      return Status::Error(ErrorCode::kInvalidInput, "pose index " + std::to_string(i) + " outside the world's " +
                                                  std::to_string(truth.base_from_cam.size()) + " poses");
     }
   }
@@ -189,9 +189,9 @@ Status RenderSequenceFolder(const SimResult& world, const SequenceRenderOptions&
 Result<SequenceTruth> ReadSequenceTruth(const std::string& path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0)
-    return Status::Error(ExitCode::kUsage, "cannot read truth file " + path + ": no such file");
+    return Status::Error(ErrorCode::kInvalidInput, "cannot read truth file " + path + ": no such file");
   if (!S_ISREG(st.st_mode) || st.st_size > kMaxTruthBytes) {
-    return Status::Error(ExitCode::kUsage,
+    return Status::Error(ErrorCode::kInvalidInput,
                          path + " is not a regular file of at most " + std::to_string(kMaxTruthBytes) + " bytes");
   }
   SequenceTruth t;
@@ -257,9 +257,9 @@ Result<SequenceTruth> ReadSequenceTruth(const std::string& path) {
       t.frames.push_back(std::move(frame));
     }
   } catch (const YAML::Exception& e) {
-    return Status::Error(ExitCode::kUsage, "malformed truth file " + path + ": " + e.what());
+    return Status::Error(ErrorCode::kInvalidInput, "malformed truth file " + path + ": " + e.what());
   } catch (const std::exception& e) {
-    return Status::Error(ExitCode::kUsage, "truth file " + path + ": " + e.what());
+    return Status::Error(ErrorCode::kInvalidInput, "truth file " + path + ": " + e.what());
   }
   return t;
 }

@@ -71,7 +71,7 @@ Status RenderSequenceFolder(const SimResult& world, const SequenceRenderOptions&
                             SequenceTruth* truth = nullptr);
 
 // Reads a truth file written by RenderSequenceFolder (test and tool use; size-capped, every yaml-cpp
-// error turned into a Status naming the file). ExitCode::kUsage.
+// error turned into a Status naming the file). ErrorCode::kInvalidInput.
 Result<SequenceTruth> ReadSequenceTruth(const std::string& path);
 
 }  // namespace selfcal::sim

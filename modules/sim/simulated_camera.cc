@@ -57,10 +57,10 @@ std::string SimulatedCamera::Describe() const {
 
 Status SimulatedCamera::Open() {
   if (const std::string problems = options_.Validate() + camera_.Validate(); !problems.empty()) {
-    return Status::Error(ExitCode::kUsage, "invalid simulated camera options:\n" + problems);
+    return Status::Error(ErrorCode::kInvalidInput, "invalid simulated camera options:\n" + problems);
   }
   if (scene_.normals_in_base.size() != scene_.centres_in_base.size() || !(scene_.radius_m > 0)) {
-    return Status::Error(ExitCode::kUsage,
+    return Status::Error(ErrorCode::kInvalidInput,
                          "invalid simulated scene: one normal per dot and a positive radius are needed");
   }
   grid_origin_s_ = options_.real_time ? capture::MonotonicNowS() : options_.first_exposure_s;
@@ -77,7 +77,7 @@ double SimulatedCamera::Now() const {
 }
 
 Result<capture::Frame> SimulatedCamera::Grab(double not_before_s, double timeout_s) {
-  if (!open_) return Status::Error(ExitCode::kUsage, "Grab on the simulated camera before Open");
+  if (!open_) return Status::Error(ErrorCode::kInvalidInput, "Grab on the simulated camera before Open");
   const double period = options_.frame_period_s;
   // First grid frame after the previous one, at or after not_before_s (and, in real time, not yet
   // exposed before this call: frames nobody grabbed are gone, as in a live camera).
@@ -114,7 +114,7 @@ Result<capture::Frame> SimulatedCamera::Grab(double not_before_s, double timeout
       why.precision(6);
       why << std::fixed << "simulated camera: no pose at exposure time " << exposure
           << " s: SetPose must place the camera before frames are grabbed";
-      return Status::Error(ExitCode::kUsage, why.str());
+      return Status::Error(ErrorCode::kInvalidInput, why.str());
     }
     base_from_cam = std::prev(after)->second;
   }

@@ -71,7 +71,7 @@ TEST(SimulatedCamera, NoPoseIsACallerErrorAndBadFramesAreRefused) {
   SimulatedCamera camera(CameraIntrinsics(), TwoDots());
   ASSERT_TRUE(camera.Open().ok());
   const Result<Frame> none = camera.Grab(0.0, 0.0);
-  EXPECT_EQ(none.status().code(), ExitCode::kUsage);
+  EXPECT_EQ(none.status().code(), ErrorCode::kInvalidInput);
   EXPECT_TRUE(none.status().message().find("SetPose") != std::string::npos);
 
   SimulatedCameraOptions dark;
@@ -84,7 +84,7 @@ TEST(SimulatedCamera, NoPoseIsACallerErrorAndBadFramesAreRefused) {
 
   SimulatedCameraOptions invalid;
   invalid.render.supersampling = 9;
-  EXPECT_EQ(SimulatedCamera(CameraIntrinsics(), TwoDots(), invalid).Open().code(), ExitCode::kUsage);
+  EXPECT_EQ(SimulatedCamera(CameraIntrinsics(), TwoDots(), invalid).Open().code(), ErrorCode::kInvalidInput);
 }
 
 TEST(SimulatedCamera, RealTimeWaitsForTheExposureAndTimesOut) {

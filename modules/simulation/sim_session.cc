@@ -21,7 +21,7 @@ std::vector<tracking::PreviousDot> TruthIdentifier::Name(const tracking::Detecti
 Result<std::vector<tracking::PreviousDot>> TruthIdentifier::Identify(const capture::Frame& /*frame*/,
                                                                      const tracking::DetectionReport& detections) {
   std::vector<tracking::PreviousDot> named = Name(detections, {});
-  if (named.empty()) return Status::Error(ExitCode::kDegenerateData, "no detection matches a rendered dot");
+  if (named.empty()) return Status::Error(ErrorCode::kDegenerateData, "no detection matches a rendered dot");
   return named;
 }
 
@@ -45,7 +45,7 @@ Result<SimCell> MakeSimCell(const RobotModel& nominal, const std::vector<acquisi
   world_options.num_identification_poses = num_identification;
   if (world_options.separation_dot_radius_m <= 0) world_options.separation_dot_radius_m = sim::kDefaultDotRadiusM;
   cell.world = std::make_unique<sim::SimResult>(sim::Simulate(nominal, joints, world_options));
-  if (!cell.world->ok) return Status::Error(ExitCode::kDegenerateData, "simulation: " + cell.world->message);
+  if (!cell.world->ok) return Status::Error(ErrorCode::kDegenerateData, "simulation: " + cell.world->message);
 
   RestartSimCell(&cell, options, start_joints_rad, start_time_s);
   return cell;

@@ -102,7 +102,7 @@ TEST(SessionRunner, CleanSessionTracksEveryIdentityThroughTheMotion) {
   Harness h(25);
   const acquisition::RunReport report = h.Run();
   ASSERT_EQ(report.outcome, acquisition::RunOutcome::kCompleted) << report.message;
-  EXPECT_EQ(report.exit_code, ExitCode::kOk);
+  EXPECT_EQ(report.error, ErrorCode::kOk);
   EXPECT_EQ(report.accepted, 25);
   const session::SessionLog log = h.Log();
   EXPECT_TRUE(log.finished);
@@ -182,7 +182,7 @@ TEST(SessionRunner, HangingMoveTripsTheWatchdogAndHalts) {  // R6
   Harness h(5, WithFaults(f));
   const acquisition::RunReport report = h.Run();
   EXPECT_EQ(report.outcome, acquisition::RunOutcome::kHalted);
-  EXPECT_EQ(report.exit_code, ExitCode::kHardware);
+  EXPECT_EQ(report.error, ErrorCode::kHardware);
   EXPECT_EQ(report.halt_reason, "move_timeout");
   EXPECT_GE(h.cell.robot->counts().stop, 1);
   EXPECT_EQ(h.cell.robot->counts().start_move, 3);  // never re-sent
@@ -207,7 +207,7 @@ TEST(SessionRunner, LostConnectionHalts) {  // R10
   const acquisition::RunReport report = h.Run();
   EXPECT_EQ(report.outcome, acquisition::RunOutcome::kHalted);
   EXPECT_EQ(report.halt_reason, "robot_disconnected");
-  EXPECT_EQ(report.exit_code, ExitCode::kHardware);
+  EXPECT_EQ(report.error, ErrorCode::kHardware);
 }
 
 TEST(SessionRunner, JoggedArmIsCaughtBeforeTheNextMove) {  // R4
@@ -256,7 +256,7 @@ TEST(SessionRunner, StopRequestHaltsWithTheInterruptedCode) {  // R11
   };
   const acquisition::RunReport report = acquisition::RunSession(h.plan, c, h.options);
   EXPECT_EQ(report.outcome, acquisition::RunOutcome::kInterrupted);
-  EXPECT_EQ(report.exit_code, ExitCode::kInterrupted);
+  EXPECT_EQ(report.error, ErrorCode::kInterrupted);
   EXPECT_GE(h.cell.robot->counts().stop, 1);
   EXPECT_EQ(h.Log().halts_by_reason.at("interrupted"), 1);
 }

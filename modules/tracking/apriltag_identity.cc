@@ -35,7 +35,7 @@ Status AprilTagOptions::Validate() const {
   std::ostringstream s;
   if (!(quad_decimate >= 1.0)) s << "quad_decimate must be >= 1, got " << quad_decimate << "\n";
   if (threads < 1) s << "threads must be >= 1, got " << threads << "\n";
-  return s.str().empty() ? Status::Ok() : Status::Error(ExitCode::kUsage, s.str());
+  return s.str().empty() ? Status::Ok() : Status::Error(ErrorCode::kInvalidInput, s.str());
 }
 
 std::vector<AprilTagDetection> DetectAprilTags(const vpImage<unsigned char>& image, const AprilTagOptions& options) {

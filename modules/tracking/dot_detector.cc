@@ -192,7 +192,7 @@ Status DotAcceptanceOptions::Validate() const {
   AddProblem(&s, ring_width_px < 1, "ring_width_px must be >= 1, got " + std::to_string(ring_width_px));
   AddProblem(&s, refine_margin_px < 0, "refine_margin_px must be >= 0, got " + std::to_string(refine_margin_px));
   const std::string problems = s.str();
-  return problems.empty() ? Status::Ok() : Status::Error(ExitCode::kUsage, problems);
+  return problems.empty() ? Status::Ok() : Status::Error(ErrorCode::kInvalidInput, problems);
 }
 
 Status DotDetectorOptions::Validate() const {
@@ -206,7 +206,7 @@ Status DotDetectorOptions::Validate() const {
   const Status acceptance_status = acceptance.Validate();
   if (!acceptance_status.ok()) s << acceptance_status.message();
   const std::string problems = s.str();
-  return problems.empty() ? Status::Ok() : Status::Error(ExitCode::kUsage, problems);
+  return problems.empty() ? Status::Ok() : Status::Error(ErrorCode::kInvalidInput, problems);
 }
 
 int OtsuThreshold(const vpImage<unsigned char>& image) {

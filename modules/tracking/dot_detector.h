@@ -137,7 +137,7 @@ struct DotAcceptanceOptions {
   bool refine_centroid = true;
   int refine_margin_px = 2;             // the weighted window is the bbox dilated by this
 
-  // Every problem, one per line, in the Status message (kUsage); OK when valid.
+  // Every problem, one per line, in the Status message (kInvalidInput); OK when valid.
   Status Validate() const;
 };
 

@@ -68,7 +68,7 @@ TEST(DotDetector, ValidateNamesEveryProblem) {
   o.acceptance.ellipse_shape_precision = 1.5;
   const Status s = o.Validate();
   ASSERT_FALSE(s.ok());
-  EXPECT_EQ(s.code(), ExitCode::kUsage);
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidInput);
   for (const char* key : {"fixed_threshold", "duplicate_distance_px", "min_area_px2", "min_axis_ratio",
                           "ellipse_shape_precision", "max_edge_coverage"}) {
     EXPECT_NE(s.message().find(key), std::string::npos) << key << " missing from:\n" << s.message();

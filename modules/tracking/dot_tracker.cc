@@ -227,7 +227,7 @@ Status DotTrackerOptions::Validate() const {
   if (!a.ok()) s << a.message();
   const Status c = consistency.Validate();
   if (!c.ok()) s << c.message();
-  return s.str().empty() ? Status::Ok() : Status::Error(ExitCode::kUsage, s.str());
+  return s.str().empty() ? Status::Ok() : Status::Error(ErrorCode::kInvalidInput, s.str());
 }
 
 TrackReport TrackDots(const vpImage<unsigned char>& image, const std::vector<PreviousDot>& previous,

@@ -426,7 +426,7 @@ Status GridIdentityOptions::Validate() const {
     s << "a partial grid (require_complete = false) needs the origin marker\n";
   }
   if (max_seed_attempts < 1) s << "max_seed_attempts must be >= 1, got " << max_seed_attempts << "\n";
-  return s.str().empty() ? Status::Ok() : Status::Error(ExitCode::kUsage, s.str());
+  return s.str().empty() ? Status::Ok() : Status::Error(ErrorCode::kInvalidInput, s.str());
 }
 
 Eigen::Vector3d GridPointInTarget(int row, int col, double spacing_m) {

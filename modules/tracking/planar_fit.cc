@@ -121,7 +121,7 @@ Status RobustPlanarFitOptions::Validate() const {
   if (!(min_inlier_fraction >= 0 && min_inlier_fraction <= 1)) {
     s << "min_inlier_fraction must be in [0, 1], got " << min_inlier_fraction << "\n";
   }
-  return s.str().empty() ? Status::Ok() : Status::Error(ExitCode::kUsage, s.str());
+  return s.str().empty() ? Status::Ok() : Status::Error(ErrorCode::kInvalidInput, s.str());
 }
 
 RobustPlanarFit FitPlanarRobust(const RobustPlanarFitOptions& options, const std::vector<Eigen::Vector2d>& from,

@@ -35,7 +35,7 @@ const char* YamlNode::KindName() const {
 
 namespace {
 
-Status UsageError(const std::string& message) { return Status::Error(ExitCode::kUsage, message); }
+Status UsageError(const std::string& message) { return Status::Error(ErrorCode::kInvalidInput, message); }
 
 std::string At(const std::string& name, int line) { return name + ":" + std::to_string(line); }
 

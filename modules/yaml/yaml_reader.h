@@ -9,7 +9,7 @@
 //     the tree refuses deeper block nesting before yaml-cpp recurses further, anchors and aliases (no
 //     alias bombs), explicit tags, non-scalar or duplicate map keys, more than kMaxYamlNodes nodes, and
 //     more than one document. Every yaml-cpp exception becomes a Status; the code is always
-//     ExitCode::kUsage and the message names the file (and the line when known). YamlRules sets the
+//     ErrorCode::kInvalidInput and the message names the file (and the line when known). YamlRules sets the
 //     limits and the wording of the refusals.
 //  2. Problems and MapReader (io/yaml_schema.h) check a tree against a schema.
 #pragma once
@@ -65,7 +65,7 @@ struct YamlDocument {
   YamlNode root;     // kNull for a document without content
 };
 
-// Reads and parses one file. Errors (kUsage): missing or unreadable file, not a regular file, too large,
+// Reads and parses one file. Errors (kInvalidInput): missing or unreadable file, not a regular file, too large,
 // not UTF-8, empty, malformed YAML, limits above exceeded.
 Result<YamlDocument> LoadYamlFile(const std::string& path);
 

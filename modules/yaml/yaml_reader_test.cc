@@ -22,7 +22,7 @@ std::string Refusal(const std::string& text, const YamlRules& rules = {}) {
   Result<YamlDocument> doc = ParseYamlText(text, "f.yaml", rules);
   EXPECT_FALSE(doc.ok()) << text;
   if (doc.ok()) return "";
-  EXPECT_EQ(doc.status().code(), ExitCode::kUsage);
+  EXPECT_EQ(doc.status().code(), ErrorCode::kInvalidInput);
   return doc.status().message();
 }
 

@@ -123,10 +123,13 @@ TEST(KillResume, RandomKillsLoseNothingAndTheResultIsIdentical) {
   std::uniform_real_distribution<double> delay(0.15, 0.15 + 3.0 * full_s / 25.0);
   RecoveryCounts recovery;
   int kills_while_recording = 0;
-  // Identical but for the line naming the session it came from.
+  // Identical but for the lines naming the session it came from: its path, and the SHA-256 of its
+  // session.json (which holds the session's own id and creation time).
   auto without_source = [](std::string text) {
-    const size_t at = text.find("\nsource: ");
-    if (at != std::string::npos) text.erase(at, text.find('\n', at + 1) - at);
+    for (const char* key : {"\nsource: ", "\n  \"input_sha256\": "}) {
+      const size_t at = text.find(key);
+      if (at != std::string::npos) text.erase(at, text.find('\n', at + 1) - at);
+    }
     return text;
   };
   int done_kills = 0, completed_early = 0, sessions = 0;
