@@ -3,6 +3,7 @@
 // indices and the predicted standard deviation of every identifiable parameter.
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "app/cli_util.h"
@@ -79,11 +80,7 @@ void PrintObservability(const planning::ObservabilityReport& r, const RobotModel
   out << "    f_x " << Fixed(r.predicted_fx_stddev_px, 3) << " px\n";
 }
 
-}  // namespace
-
-Command AddPlanCommand(CLI::App& app) {
-  auto args = std::make_shared<PlanArgs>();
-  CLI::App* cmd = app.add_subcommand("plan", "Plan measurement configurations (eq. 39, D- or A-optimal), or check a plan");
+void AddPlanOptions(CLI::App* cmd, PlanArgs* args) {
   cmd->add_option("--robot", args->robot, "Nominal robot config");
   cmd->add_option("--start", args->start, "Start trajectory (feasible; offending poses are repaired from a pool)");
   cmd->add_option("--out", args->out, "Plan file to write");
@@ -113,110 +110,149 @@ Command AddPlanCommand(CLI::App& app) {
   cmd->add_option("--max-travel-deg", args->max_travel_deg, "Largest joint change between consecutive poses");
   cmd->add_option("--min-depth-mm", args->min_depth_mm, "Nearest scene depth");
   cmd->add_option("--max-depth-mm", args->max_depth_mm, "Farthest scene depth");
-  return [args]() {
-    Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(args->robot));
-    if (!robot.ok()) return Fail(robot.status());
-    planning::Criterion criterion;
-    if (!planning::ParseCriterion(args->criterion, &criterion)) {
-      return Fail(Status::Error(ErrorCode::kInvalidInput, "--criterion `" + args->criterion + "`: expected eq39, d-optimal or a-optimal"));
-    }
-    const std::string plan_path = args->check.empty() ? args->start : args->check;
-    Result<io::TrajectoryFile> file = io::LoadTrajectoryFile(ResolveDataPath(plan_path), robot->num_joints());
-    if (!file.ok()) return Fail(file.status());
+}
 
-    planning::PlanningProblem problem;
-    problem.robot = *robot;
-    problem.camera.width_px = args->width;
-    problem.camera.height_px = args->height;
-    problem.camera.cx_px = 0.5 * (args->width - 1);
-    problem.camera.cy_px = 0.5 * (args->height - 1);
-    problem.camera.fx_px = args->fx_px;
-    problem.num_identification_poses =
-        file->num_identification_poses > 0 && !args->check.empty() ? file->num_identification_poses : args->identification_poses;
-    planning::PlanConstraints& c = problem.constraints;
-    c.image_margin_px = args->image_margin_px;
-    c.joint_margin_rad = DegToRad(args->joint_margin_deg);
-    c.min_spread_m = args->min_spread_mm * 1e-3;
-    c.min_axis_sine = args->min_axis_sine;
-    c.max_joint_travel_rad = DegToRad(args->max_travel_deg);
-    c.min_depth_m = args->min_depth_mm * 1e-3;
-    c.max_depth_m = args->max_depth_mm * 1e-3;
-    if (args->box_center_mm.size() == 3 && args->box_size_mm.size() == 3) {
-      const Eigen::Vector3d centre(args->box_center_mm[0], args->box_center_mm[1], args->box_center_mm[2]);
-      const Eigen::Vector3d size(args->box_size_mm[0], args->box_size_mm[1], args->box_size_mm[2]);
-      problem.scene = planning::Scene::FromBox(centre * 1e-3, size * 1e-3, args->box_dots, args->seed);
-      std::cout << "scene: box centre " << centre.transpose() << " mm, size " << size.transpose() << " mm\n";
-    } else if (!args->box_center_mm.empty() || !args->box_size_mm.empty()) {
-      return Fail(Status::Error(ErrorCode::kInvalidInput, "--box-center-mm and --box-size-mm go together (3 values each)"));
-    } else {
-      sim::SimOptions sim_options;
-      sim_options.world_seed = args->sim_world_seed;
-      Result<std::vector<Eigen::VectorXd>> scene_poses =
-          io::LoadTrajectory(ResolveDataPath(args->scene_from), robot->num_joints());
-      if (!scene_poses.ok()) return Fail(scene_poses.status());
-      const sim::SimResult world = sim::Simulate(*robot, *scene_poses, sim_options);
-      if (!world.ok) {
-        return Fail(Status::Error(ErrorCode::kDegenerateData, "no simulated scene for " + args->scene_from + ": " + world.message));
-      }
-      problem.scene = planning::Scene::FromDots(world.truth.dots_in_base);
-      std::cout << "scene: the simulator's " << world.truth.dots_in_base.size() << " dots (world seed "
-                << args->sim_world_seed << ", placed for " << args->scene_from << ")\n";
-    }
-    if (const std::string invalid = problem.Validate(); !invalid.empty()) {
-      return Fail(Status::Error(ErrorCode::kInvalidInput, "plan options: " + invalid));
-    }
+planning::PlanningProblem MakeProblem(const PlanArgs& args, const RobotModel& robot, const io::TrajectoryFile& file) {
+  planning::PlanningProblem problem;
+  problem.robot = robot;
+  problem.camera.width_px = args.width;
+  problem.camera.height_px = args.height;
+  problem.camera.cx_px = 0.5 * (args.width - 1);
+  problem.camera.cy_px = 0.5 * (args.height - 1);
+  problem.camera.fx_px = args.fx_px;
+  problem.num_identification_poses =
+      file.num_identification_poses > 0 && !args.check.empty() ? file.num_identification_poses : args.identification_poses;
+  planning::PlanConstraints& c = problem.constraints;
+  c.image_margin_px = args.image_margin_px;
+  c.joint_margin_rad = DegToRad(args.joint_margin_deg);
+  c.min_spread_m = args.min_spread_mm * 1e-3;
+  c.min_axis_sine = args.min_axis_sine;
+  c.max_joint_travel_rad = DegToRad(args.max_travel_deg);
+  c.min_depth_m = args.min_depth_mm * 1e-3;
+  c.max_depth_m = args.max_depth_mm * 1e-3;
+  return problem;
+}
 
-    if (!args->check.empty()) {
-      std::cout << "plan " << plan_path << ": " << file->poses.size() << " poses, " << problem.num_identification_poses
-                << " identify\n";
-      const planning::PlanCheck check = planning::CheckPlan(problem, file->poses);
-      PrintCheck(check, std::cout);
-      PrintObservability(planning::AnalyzeObservability(problem, file->poses, args->noise_px), *robot, std::cout);
-      std::cout << (check.ok ? "plan ok\n" : "plan refused: " + std::to_string(check.problems.size()) + " problems\n");
-      return check.ok ? 0 : static_cast<int>(ExitCode::kDegenerateData);
+// The problem's scene: stand-in dots in the given box, or the simulator's dots. The exit code when the
+// command ends here.
+std::optional<int> SetScene(const PlanArgs& args, const RobotModel& robot, planning::PlanningProblem* problem) {
+  if (args.box_center_mm.size() == 3 && args.box_size_mm.size() == 3) {
+    const Eigen::Vector3d centre(args.box_center_mm[0], args.box_center_mm[1], args.box_center_mm[2]);
+    const Eigen::Vector3d size(args.box_size_mm[0], args.box_size_mm[1], args.box_size_mm[2]);
+    problem->scene = planning::Scene::FromBox(centre * 1e-3, size * 1e-3, args.box_dots, args.seed);
+    std::cout << "scene: box centre " << centre.transpose() << " mm, size " << size.transpose() << " mm\n";
+  } else if (!args.box_center_mm.empty() || !args.box_size_mm.empty()) {
+    return Fail(Status::Error(ErrorCode::kInvalidInput, "--box-center-mm and --box-size-mm go together (3 values each)"));
+  } else {
+    sim::SimOptions sim_options;
+    sim_options.world_seed = args.sim_world_seed;
+    Result<std::vector<Eigen::VectorXd>> scene_poses =
+        io::LoadTrajectory(ResolveDataPath(args.scene_from), robot.num_joints());
+    if (!scene_poses.ok()) return Fail(scene_poses.status());
+    const sim::SimResult world = sim::Simulate(robot, *scene_poses, sim_options);
+    if (!world.ok) {
+      return Fail(Status::Error(ErrorCode::kDegenerateData, "no simulated scene for " + args.scene_from + ": " + world.message));
     }
+    problem->scene = planning::Scene::FromDots(world.truth.dots_in_base);
+    std::cout << "scene: the simulator's " << world.truth.dots_in_base.size() << " dots (world seed "
+              << args.sim_world_seed << ", placed for " << args.scene_from << ")\n";
+  }
+  return std::nullopt;
+}
 
-    planning::PlannerOptions options;
-    options.criterion = criterion;
-    options.lambda = args->lambda;
-    options.seed = args->seed;
-    options.pool_size = args->pool;
-    options.fisher.pixel_noise_px = args->noise_px;
-    const planning::PlanResult r = planning::PlanMeasurements(problem, file->poses, options);
-    std::cout << "start " << plan_path << ":\n";
-    PrintCheck(r.check_start, std::cout);
-    if (r.repaired_poses > 0) std::cout << "  repaired: " << r.repaired_poses << " poses replaced from the pool\n";
-    if (!r.ok) return Fail(Status::Error(ErrorCode::kDegenerateData, r.message));
-    std::cout << "planned (" << planning::CriterionName(criterion) << ", " << Fixed(r.seconds * 1e3, 1) << " ms, "
-              << r.iterations << " iterations, " << r.evaluations << " evaluations"
-              << (r.solver_message.empty() ? "" : "; " + r.solver_message) << "):\n";
-    PrintCheck(r.check_final, std::cout);
-    std::cout << "criteria, start -> planned:\n  eq. (39) " << r.eq39_start.total << " -> " << r.eq39_final.total
-              << " (ratio term " << r.eq39_start.ratio_term << " -> " << r.eq39_final.ratio_term << ", Cond(J) "
-              << r.eq39_start.condition_number << " -> " << r.eq39_final.condition_number << ", lambda " << args->lambda
-              << ")\n  D (log det information) " << r.fisher_start.log_det << " -> " << r.fisher_final.log_det
-              << "\n  A (sum of variance / prior variance) " << r.fisher_start.a_value << " -> " << r.fisher_final.a_value
-              << "\n";
-    PrintObservability(planning::AnalyzeObservability(problem, r.poses, args->noise_px), *robot, std::cout);
-    io::TrajectoryFile plan;
-    plan.poses = r.poses;
-    plan.robot = robot->name;
-    plan.num_identification_poses = problem.num_identification_poses;
-    plan.description = "planned from " + plan_path + " by selfcal plan";
-    std::ostringstream provenance;
-    provenance << "criterion " << planning::CriterionName(criterion) << ", lambda " << args->lambda << ", seed " << args->seed
-               << ", pool " << args->pool << "; eq39 " << r.eq39_start.total << " -> " << r.eq39_final.total
-               << ", D " << r.fisher_start.log_det << " -> " << r.fisher_final.log_det << ", A " << r.fisher_start.a_value
-               << " -> " << r.fisher_final.a_value;
-    plan.planner = provenance.str();
-    const size_t slash = args->out.find_last_of('/');
-    if (slash != std::string::npos && slash > 0) {
-      if (Status s = EnsureDirectory(args->out.substr(0, slash)); !s.ok()) return Fail(s);
-    }
-    if (Status s = io::SaveTrajectoryFile(plan, args->out); !s.ok()) return Fail(s);
-    std::cout << "wrote " << args->out << "\n";
-    return 0;
-  };
+// --check: the plan's constraints and observability; exit 3 when it has problems.
+int CheckOnly(const PlanArgs& args, const planning::PlanningProblem& problem, const io::TrajectoryFile& file,
+              const std::string& plan_path) {
+  std::cout << "plan " << plan_path << ": " << file.poses.size() << " poses, " << problem.num_identification_poses
+            << " identify\n";
+  const planning::PlanCheck check = planning::CheckPlan(problem, file.poses);
+  PrintCheck(check, std::cout);
+  PrintObservability(planning::AnalyzeObservability(problem, file.poses, args.noise_px), problem.robot, std::cout);
+  std::cout << (check.ok ? "plan ok\n" : "plan refused: " + std::to_string(check.problems.size()) + " problems\n");
+  return check.ok ? 0 : static_cast<int>(ExitCode::kDegenerateData);
+}
+
+void PrintPlanned(const PlanArgs& args, planning::Criterion criterion, const planning::PlanResult& r) {
+  std::cout << "planned (" << planning::CriterionName(criterion) << ", " << Fixed(r.seconds * 1e3, 1) << " ms, "
+            << r.iterations << " iterations, " << r.evaluations << " evaluations"
+            << (r.solver_message.empty() ? "" : "; " + r.solver_message) << "):\n";
+  PrintCheck(r.check_final, std::cout);
+  std::cout << "criteria, start -> planned:\n  eq. (39) " << r.eq39_start.total << " -> " << r.eq39_final.total
+            << " (ratio term " << r.eq39_start.ratio_term << " -> " << r.eq39_final.ratio_term << ", Cond(J) "
+            << r.eq39_start.condition_number << " -> " << r.eq39_final.condition_number << ", lambda " << args.lambda
+            << ")\n  D (log det information) " << r.fisher_start.log_det << " -> " << r.fisher_final.log_det
+            << "\n  A (sum of variance / prior variance) " << r.fisher_start.a_value << " -> " << r.fisher_final.a_value
+            << "\n";
+}
+
+// The planned poses as a plan file at --out, with their provenance.
+int WritePlan(const PlanArgs& args, planning::Criterion criterion, const planning::PlanningProblem& problem,
+              const std::string& plan_path, const planning::PlanResult& r) {
+  io::TrajectoryFile plan;
+  plan.poses = r.poses;
+  plan.robot = problem.robot.name;
+  plan.num_identification_poses = problem.num_identification_poses;
+  plan.description = "planned from " + plan_path + " by selfcal plan";
+  std::ostringstream provenance;
+  provenance << "criterion " << planning::CriterionName(criterion) << ", lambda " << args.lambda << ", seed " << args.seed
+             << ", pool " << args.pool << "; eq39 " << r.eq39_start.total << " -> " << r.eq39_final.total
+             << ", D " << r.fisher_start.log_det << " -> " << r.fisher_final.log_det << ", A " << r.fisher_start.a_value
+             << " -> " << r.fisher_final.a_value;
+  plan.planner = provenance.str();
+  const size_t slash = args.out.find_last_of('/');
+  if (slash != std::string::npos && slash > 0) {
+    if (Status s = EnsureDirectory(args.out.substr(0, slash)); !s.ok()) return Fail(s);
+  }
+  if (Status s = io::SaveTrajectoryFile(plan, args.out); !s.ok()) return Fail(s);
+  std::cout << "wrote " << args.out << "\n";
+  return 0;
+}
+
+// Plans from the start trajectory, prints the figures before and after, and writes the plan.
+int PlanAndWrite(const PlanArgs& args, planning::Criterion criterion, const planning::PlanningProblem& problem,
+                 const io::TrajectoryFile& file, const std::string& plan_path) {
+  planning::PlannerOptions options;
+  options.criterion = criterion;
+  options.lambda = args.lambda;
+  options.seed = args.seed;
+  options.pool_size = args.pool;
+  options.fisher.pixel_noise_px = args.noise_px;
+  const planning::PlanResult r = planning::PlanMeasurements(problem, file.poses, options);
+  std::cout << "start " << plan_path << ":\n";
+  PrintCheck(r.check_start, std::cout);
+  if (r.repaired_poses > 0) std::cout << "  repaired: " << r.repaired_poses << " poses replaced from the pool\n";
+  if (!r.ok) return Fail(Status::Error(ErrorCode::kDegenerateData, r.message));
+  PrintPlanned(args, criterion, r);
+  PrintObservability(planning::AnalyzeObservability(problem, r.poses, args.noise_px), problem.robot, std::cout);
+  return WritePlan(args, criterion, problem, plan_path, r);
+}
+
+int RunPlanCommand(const PlanArgs& args) {
+  Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(args.robot));
+  if (!robot.ok()) return Fail(robot.status());
+  planning::Criterion criterion;
+  if (!planning::ParseCriterion(args.criterion, &criterion)) {
+    return Fail(Status::Error(ErrorCode::kInvalidInput, "--criterion `" + args.criterion + "`: expected eq39, d-optimal or a-optimal"));
+  }
+  const std::string plan_path = args.check.empty() ? args.start : args.check;
+  Result<io::TrajectoryFile> file = io::LoadTrajectoryFile(ResolveDataPath(plan_path), robot->num_joints());
+  if (!file.ok()) return Fail(file.status());
+  planning::PlanningProblem problem = MakeProblem(args, *robot, *file);
+  if (const std::optional<int> code = SetScene(args, *robot, &problem)) return *code;
+  if (const std::string invalid = problem.Validate(); !invalid.empty()) {
+    return Fail(Status::Error(ErrorCode::kInvalidInput, "plan options: " + invalid));
+  }
+  if (!args.check.empty()) return CheckOnly(args, problem, *file, plan_path);
+  return PlanAndWrite(args, criterion, problem, *file, plan_path);
+}
+
+}  // namespace
+
+Command AddPlanCommand(CLI::App& app) {
+  auto args = std::make_shared<PlanArgs>();
+  CLI::App* cmd = app.add_subcommand("plan", "Plan measurement configurations (eq. 39, D- or A-optimal), or check a plan");
+  AddPlanOptions(cmd, args.get());
+  return [args]() { return RunPlanCommand(*args); };
 }
 
 }  // namespace selfcal::app
