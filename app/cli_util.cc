@@ -3,6 +3,9 @@
 #include <filesystem>
 #include <iostream>
 
+#include "io/robot_config.h"
+#include "io/trajectory_file.h"
+
 #include "base/sha256.h"
 
 namespace selfcal::app {
@@ -35,6 +38,18 @@ ExitCode ExitCodeFor(calibration::Verdict verdict) {
 std::string FileSha256(const std::string& path) {
   Result<std::string> digest = Sha256OfFile(path);
   return digest.ok() ? *digest : std::string();
+}
+
+void AddRobotOption(CLI::App* cmd, std::string* robot_path) {
+  cmd->add_option("--robot", *robot_path, "Nominal robot config");
+}
+
+Result<RobotAndTrajectory> LoadRobotAndTrajectory(const std::string& robot_path, const std::string& trajectory_path) {
+  Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(robot_path));
+  if (!robot.ok()) return robot.status();
+  Result<std::vector<Eigen::VectorXd>> joints = io::LoadTrajectory(ResolveDataPath(trajectory_path), robot->num_joints());
+  if (!joints.ok()) return joints.status();
+  return RobotAndTrajectory{std::move(robot).value(), std::move(joints).value()};
 }
 
 Status EnsureDirectory(const std::string& path) {

@@ -3,7 +3,13 @@
 
 #include <string>
 
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <Eigen/Core>
+
 #include "app/exit_codes.h"
+#include "kinematics/robot_model.h"
 #include "base/status.h"
 #include "calibration/calibrate.h"
 
@@ -23,6 +29,16 @@ ExitCode ExitCodeFor(calibration::Verdict verdict);
 // SHA-256 of a file's bytes as 64 hex digits (base/sha256.h): provenance in reports (P7). "" when the path
 // is not a readable regular file (e.g. a session directory, whose provenance is its session.json).
 std::string FileSha256(const std::string& path);
+
+// `--robot PATH`: the nominal robot config (docs/frames-and-units.md), as every simulation command takes it.
+void AddRobotOption(CLI::App* cmd, std::string* robot_path);
+
+// The nominal robot of a config and a trajectory file for it, both paths resolved by ResolveDataPath.
+struct RobotAndTrajectory {
+  RobotModel robot;
+  std::vector<Eigen::VectorXd> joints;
+};
+Result<RobotAndTrajectory> LoadRobotAndTrajectory(const std::string& robot_path, const std::string& trajectory_path);
 
 // Creates the directory (and parents). Refuses an existing non-directory.
 Status EnsureDirectory(const std::string& path);

@@ -29,15 +29,14 @@ void Print(const char* title, const identification::IdentifiabilityReport& r) {
 Command AddIdentifiabilityCommand(CLI::App& app) {
   auto args = std::make_shared<IdentifiabilityArgs>();
   CLI::App* cmd = app.add_subcommand("identifiability", "Rank analysis of the identification Jacobian");
-  cmd->add_option("--robot", args->robot, "Robot config");
+  AddRobotOption(cmd, &args->robot);
   cmd->add_option("--trajectory", args->trajectory, "Trajectory file");
   cmd->add_option("--identification-poses", args->identification_poses, "Use the first N poses")->check(CLI::Range(2, 10000));
   return [args]() {
-    Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(args->robot));
-    if (!robot.ok()) return Fail(robot.status());
-    Result<std::vector<Eigen::VectorXd>> joints = io::LoadTrajectory(ResolveDataPath(args->trajectory), robot->num_joints());
-    if (!joints.ok()) return Fail(joints.status());
-    std::vector<Eigen::VectorXd> poses = *joints;
+    Result<RobotAndTrajectory> loaded = LoadRobotAndTrajectory(args->robot, args->trajectory);
+    if (!loaded.ok()) return Fail(loaded.status());
+    const RobotModel* robot = &loaded->robot;
+    std::vector<Eigen::VectorXd> poses = loaded->joints;
     if (static_cast<int>(poses.size()) > args->identification_poses) poses.resize(args->identification_poses);
     const Eigen::VectorXd rho = KinematicParameters::Nominal(*robot);
     std::cout << "robot " << robot->name << ", " << poses.size() << " poses, measurements cam_1_from_cam_i\n";

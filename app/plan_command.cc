@@ -81,7 +81,7 @@ void PrintObservability(const planning::ObservabilityReport& r, const RobotModel
 }
 
 void AddPlanOptions(CLI::App* cmd, PlanArgs* args) {
-  cmd->add_option("--robot", args->robot, "Nominal robot config");
+  AddRobotOption(cmd, &args->robot);
   cmd->add_option("--start", args->start, "Start trajectory (feasible; offending poses are repaired from a pool)");
   cmd->add_option("--out", args->out, "Plan file to write");
   cmd->add_option("--check", args->check, "Check this plan instead of planning (exit 3 when it has problems)");

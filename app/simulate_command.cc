@@ -261,7 +261,7 @@ int SimulateSession(const SimulateArgs& args) {
 Command AddSimulateCommand(CLI::App& app) {
   auto args = std::make_shared<SimulateArgs>();
   CLI::App* cmd = app.add_subcommand("simulate", "Simulated robot with hidden errors: observe, calibrate, compare");
-  cmd->add_option("--robot", args->robot, "Nominal robot config");
+  AddRobotOption(cmd, &args->robot);
   cmd->add_option("--trajectory", args->trajectory, "Trajectory file");
   cmd->add_option("--out", args->out, "Output directory");
   cmd->add_option("--noise-px", args->noise_px, "Pixel noise std (px)")->check(CLI::Range(0.0, 10.0));
@@ -284,10 +284,10 @@ Command AddSimulateCommand(CLI::App& app) {
       }
       return SimulateSession(*args);
     }
-    Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(args->robot));
-    if (!robot.ok()) return Fail(robot.status());
-    Result<std::vector<Eigen::VectorXd>> joints = io::LoadTrajectory(ResolveDataPath(args->trajectory), robot->num_joints());
-    if (!joints.ok()) return Fail(joints.status());
+    Result<RobotAndTrajectory> loaded = LoadRobotAndTrajectory(args->robot, args->trajectory);
+    if (!loaded.ok()) return Fail(loaded.status());
+    const RobotModel* robot = &loaded->robot;
+    const std::vector<Eigen::VectorXd>* joints = &loaded->joints;
     if (Status s = EnsureDirectory(args->out); !s.ok()) return Fail(s);
     sim::SimOptions options;
     options.world_seed = options.noise_seed = args->seed;

@@ -31,7 +31,7 @@ struct StudyArgs {
 Command AddStudyCommand(CLI::App& app) {
   auto args = std::make_shared<StudyArgs>();
   CLI::App* cmd = app.add_subcommand("study", "Monte Carlo: the paper's Table 2 and Fig. 6 on the simulator");
-  cmd->add_option("--robot", args->robot, "Nominal robot config");
+  AddRobotOption(cmd, &args->robot);
   cmd->add_option("--trajectory", args->trajectories, "NAME=FILE, repeatable");
   cmd->add_option("--runs", args->runs, "Runs per cell")->check(CLI::Range(1, 100000));
   cmd->add_option("--noise-px", args->noise, "Pixel noise levels (std, px)")->delimiter(',');

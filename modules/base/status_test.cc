@@ -14,7 +14,7 @@ TEST(Status, DefaultIsOk) {
 TEST(Status, ErrorCarriesCodeAndMessage) {
   Status s = Status::Error(ErrorCode::kInvalidInput, "unknown key `max_velocty`");
   EXPECT_FALSE(s.ok());
-  EXPECT_EQ(static_cast<int>(s.code()), 2);
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidInput);  // the library says what went wrong; app chooses exit 2
   EXPECT_EQ(s.ToString(), "invalid_input: unknown key `max_velocty`");
 }
 

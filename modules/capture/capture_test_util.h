@@ -12,12 +12,9 @@
 
 namespace selfcal::capture::testing {
 
-class TempDir : public selfcal::testing::TempDir {
- public:
-  TempDir() : selfcal::testing::TempDir("selfcal_capture_test") {}
-};
-using selfcal::testing::ReadFile;
-using selfcal::testing::WriteFile;
+inline constexpr char kTempDirPrefix[] = "selfcal_capture_test";
+using TempDir = selfcal::testing::NamedTempDir<kTempDirPrefix>;
+using namespace selfcal::testing;  // ReadFile, WriteFile and the other helpers of temp_files.h
 
 // A light background (level 190) with dark squares (level 40) on a grid shifted by `shift_px`, plus
 // uniform noise of +-3 grey levels from `seed`: passes the default frame checks, differs per seed.

@@ -16,10 +16,7 @@
 namespace selfcal::io {
 namespace {
 
-using testing::ReadFile;
-using testing::SourcePath;
-using testing::TempDir;
-using testing::WriteFile;
+using namespace testing;  // io::testing: TempDir, ReadFile, WriteFile, SourcePath
 
 // A refusal must be a Status with the config exit code that names the file (and, when given, says why).
 ::testing::AssertionResult CleanRefusal(const Status& status, const std::string& path, const std::string& why = "") {

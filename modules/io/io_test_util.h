@@ -8,12 +8,9 @@
 
 namespace selfcal::io::testing {
 
-class TempDir : public selfcal::testing::TempDir {
- public:
-  TempDir() : selfcal::testing::TempDir("selfcal_io_test") {}
-};
-using selfcal::testing::ReadFile;
-using selfcal::testing::WriteFile;
+inline constexpr char kTempDirPrefix[] = "selfcal_io_test";
+using TempDir = selfcal::testing::NamedTempDir<kTempDirPrefix>;
+using namespace selfcal::testing;  // ReadFile, WriteFile and the other helpers of temp_files.h
 
 inline std::string SourcePath(const std::string& relative) { return std::string(SELFCAL_SOURCE_DIR) + "/" + relative; }
 

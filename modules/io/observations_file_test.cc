@@ -17,10 +17,7 @@
 namespace selfcal::io {
 namespace {
 
-using testing::ReadFile;
-using testing::SourcePath;
-using testing::TempDir;
-using testing::WriteFile;
+using namespace testing;  // io::testing: TempDir, ReadFile, WriteFile, SourcePath
 
 bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof(double)) == 0; }
 

@@ -12,10 +12,7 @@
 namespace selfcal::io {
 namespace {
 
-using testing::ReadFile;
-using testing::SourcePath;
-using testing::TempDir;
-using testing::WriteFile;
+using namespace testing;  // io::testing: TempDir, ReadFile, WriteFile, SourcePath
 using selfcal::testing::RigidNear;
 
 Eigen::VectorXd RandomJoints(const RobotModel& model, std::mt19937_64* rng) {

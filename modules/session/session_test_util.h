@@ -11,12 +11,9 @@
 
 namespace selfcal::session::testing {
 
-class TempDir : public selfcal::testing::TempDir {
- public:
-  TempDir() : selfcal::testing::TempDir("selfcal_session_test") {}
-};
-using selfcal::testing::ReadFile;
-using selfcal::testing::WriteFile;
+inline constexpr char kTempDirPrefix[] = "selfcal_session_test";
+using TempDir = selfcal::testing::NamedTempDir<kTempDirPrefix>;
+using namespace selfcal::testing;  // ReadFile, WriteFile and the other helpers of temp_files.h
 
 inline bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 

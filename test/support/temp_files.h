@@ -61,4 +61,12 @@ inline std::string ReadFile(const std::string& path) {
   return s.str();
 }
 
+// A TempDir named after a module's tests: `inline constexpr char kPrefix[] = "selfcal_io_test";` then
+// `using TempDir = selfcal::testing::NamedTempDir<kPrefix>;`.
+template <const char* kPrefix>
+class NamedTempDir : public TempDir {
+ public:
+  NamedTempDir() : TempDir(kPrefix) {}
+};
+
 }  // namespace selfcal::testing
