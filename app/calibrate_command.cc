@@ -7,11 +7,12 @@
 
 #include "app/cli_util.h"
 #include "app/commands.h"
-#include "app/session_command.h"
 #include "io/observations_file.h"
 #include "io/report_json.h"
 #include "io/robot_config.h"
 #include "report/calibration_report.h"
+#include "session/session_dir.h"
+#include "session/session_dir.h"
 #include "session/session_observations.h"
 
 namespace selfcal::app {
@@ -22,8 +23,7 @@ namespace {
 struct LoadedInput {
   ObservationSet observations;
   report::ReportInput input;
-  nlohmann::json session;           // the journal's counts and findings, for a session
-  session::JournalSummary summary;  // the same, for the terminal
+  std::optional<report::SessionContext> session;  // for a session: its counts and findings
 };
 
 // Refuses (kUsage, naming both paths) an output directory that is the session directory or inside it,
@@ -51,21 +51,6 @@ Status CheckOutputOutsideSession(const std::string& out_dir, const std::string& 
                                              ": calibrate never writes into a session; choose --out outside it");
 }
 
-nlohmann::json SummaryJson(const std::string& session_path, const session::SessionObservations& loaded) {
-  const session::JournalSummary& s = loaded.summary;
-  return {{"path", session_path},
-          {"session_id", s.session_id},
-          {"session_json_sha256", loaded.manifest_sha256},
-          {"poses_planned", s.poses_planned},
-          {"samples_accepted", s.samples_accepted},
-          {"resumes", s.resumes},
-          {"finished", s.finished},
-          {"skips_by_reason", s.skips_by_reason},
-          {"faults_by_kind", s.faults_by_kind},
-          {"halts_by_reason", s.halts_by_reason},
-          {"warnings", loaded.findings}};
-}
-
 void PrintSummary(const session::JournalSummary& s) {
   std::cout << "session: " << s.samples_accepted << " of " << s.poses_planned << " poses accepted, " << s.resumes
             << " resumes";
@@ -77,7 +62,7 @@ void PrintSummary(const session::JournalSummary& s) {
 
 Result<LoadedInput> LoadInput(const CalibrateRequest& request) {
   LoadedInput loaded;
-  if (IsSessionDirectory(request.input)) {
+  if (session::IsSessionDirectory(request.input)) {
     if (Status s = CheckOutputOutsideSession(request.out_dir, request.input); !s.ok()) return s;
     Result<session::SessionObservations> session = session::LoadSessionObservations(request.input);
     if (!session.ok()) return session.status();
@@ -86,8 +71,7 @@ Result<LoadedInput> LoadInput(const CalibrateRequest& request) {
       std::cerr << "selfcal: warning: calibrate changed nothing in session " << request.input
                 << " (a resume would repair it)\n";
     }
-    loaded.session = SummaryJson(request.input, *session);
-    loaded.summary = session->summary;
+    loaded.session = report::SessionContext{session->summary, session->findings};
     loaded.input = {"session", request.input, session->manifest_sha256};
     loaded.observations = std::move(session).value().observations;
     return loaded;
@@ -138,7 +122,7 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   Result<LoadedInput> loaded = LoadInput(request);
   if (!loaded.ok()) return Fail(loaded.status());
   if (Status s = EnsureDirectory(request.out_dir); !s.ok()) return Fail(s);
-  const bool from_session = loaded->input.kind == "session";
+  const bool from_session = loaded->session.has_value();
   if (from_session) {
     // The session's observations as a file, for other tools and for re-solving without the images.
     const std::string derived = (std::filesystem::path(request.out_dir) / "observations.yaml").string();
@@ -155,7 +139,7 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   if (!report.accepted()) {
     std::cerr << "selfcal: " << ExitCodeName(code) << ": " << report.message << " (no calibrated model written)\n";
   }
-  if (from_session) PrintSummary(loaded->summary);
+  if (from_session) PrintSummary(loaded->session->summary);
   if (run != nullptr) *run = {std::move(loaded).value().observations, std::move(report)};
   return static_cast<int>(code);
 }

@@ -330,11 +330,6 @@ int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
   return code;
 }
 
-bool IsSessionDirectory(const std::string& path) {
-  struct stat st {};
-  return ::stat((std::filesystem::path(path) / session::kManifestFileName).c_str(), &st) == 0;
-}
-
 Command AddRunCommand(CLI::App& app) {
   auto a = std::make_shared<RunSettings>();
   CLI::App* cmd = app.add_subcommand("run", "Drive a robot through a plan and record a session directory");

@@ -39,7 +39,4 @@ struct RunSettings {
 // With the simulated robot, *world (optional) receives the simulated world after the run (its hidden truth).
 int RunFromSettings(RunSettings settings, std::unique_ptr<sim::SimResult>* world = nullptr);
 
-// True when `path` is a session directory (it holds session.json).
-bool IsSessionDirectory(const std::string& path);
-
 }  // namespace selfcal::app

@@ -174,6 +174,22 @@ json BundleSectionJson(const ObservationSet& obs, const calibration::BundleStage
           {"predicted_3d_error", PredictedErrorJson(stage.predicted_error)}};
 }
 
+// The session block: the input's path and manifest hash, the journal's counts, the findings.
+json SessionJson(const ReportInput& input, const SessionContext& session) {
+  const session::JournalSummary& s = session.summary;
+  return {{"path", input.path},
+          {"session_id", s.session_id},
+          {"session_json_sha256", input.sha256},
+          {"poses_planned", s.poses_planned},
+          {"samples_accepted", s.samples_accepted},
+          {"resumes", s.resumes},
+          {"finished", s.finished},
+          {"skips_by_reason", s.skips_by_reason},
+          {"faults_by_kind", s.faults_by_kind},
+          {"halts_by_reason", s.halts_by_reason},
+          {"warnings", session.findings}};
+}
+
 }  // namespace
 
 json CalibrationReportJson(const ObservationSet& obs, const calibration::CalibrationReport& report,
@@ -198,7 +214,7 @@ json CalibrationReportJson(const ObservationSet& obs, const calibration::Calibra
   j["verification"] = chosen["verification"];
   j["predicted_3d_error"] = chosen["predicted_3d_error"];
   j["methods"] = methods;
-  j["session"] = context.session;
+  j["session"] = context.session ? SessionJson(context.input, *context.session) : json();
   // Timing in one place, so that two reports of the same input compare equal without it.
   const calibration::PaperPipelineReport& p = report.paper;
   j["timing"] = {{"paper_two_view_s", p.seconds_two_view},

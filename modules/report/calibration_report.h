@@ -4,13 +4,16 @@
 // sections under "methods" have the same shape for every method that ran.
 #pragma once
 
+#include <optional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "calibration/calibrate.h"
 #include "observations/observation_set.h"
+#include "session/session_observations.h"
 
 namespace selfcal::report {
 
@@ -24,12 +27,18 @@ struct ReportInput {
   std::string sha256;  // of the observations file, or of the session's session.json
 };
 
+// What a session input adds to the report: the journal's counts and what a resume would repair.
+struct SessionContext {
+  session::JournalSummary summary;
+  std::vector<std::string> findings;  // one line per torn tail or unrecorded image, left unchanged
+};
+
 // The application's side of the report: the process exit code it maps the verdict to, and (for a
-// session) the journal's counts as the session module reports them.
+// session) the session's counts and findings.
 struct ReportContext {
   ReportInput input;
   int exit_code = 0;
-  nlohmann::json session;  // null when the input was not a session
+  std::optional<SessionContext> session;  // empty when the input was not a session
 };
 
 nlohmann::json CalibrationReportJson(const ObservationSet& observations, const calibration::CalibrationReport& report,

@@ -231,6 +231,11 @@ Result<SessionInput> ReadInputFile(const std::string& name, const std::string& p
   return SessionInput{name, std::move(bytes).value()};
 }
 
+bool IsSessionDirectory(const std::string& path) {
+  struct stat st {};
+  return ::stat((std::filesystem::path(path) / kManifestFileName).c_str(), &st) == 0;
+}
+
 Status CheckSessionLayout(const std::string& path) {
   std::error_code error;
   if (!std::filesystem::is_directory(Join(path, kImagesDirName), error)) {

@@ -149,6 +149,10 @@ Result<Session> CreateSession(const std::string& path, const SessionInputs& inpu
 Result<Session> OpenSession(const std::string& path, const SessionInputs& expected, bool allow_changed_inputs,
                             const JournalLimits& journal_limits = JournalLimits());
 
+// True when `path` holds a session.json: what `selfcal calibrate` reads as a session rather than as an
+// observations file (whether the session is whole is ReadSession's to say).
+bool IsSessionDirectory(const std::string& path);
+
 // Reads and validates `<session>/session.json` without locking or changing anything; *sha256 (optional)
 // receives the SHA-256 of the bytes read.
 Result<SessionManifest> ReadManifest(const std::string& session_path, std::string* sha256 = nullptr);
