@@ -151,7 +151,10 @@ TEST(Identifiability, NamesTheParallelPairCombination) {
   const IdentifiabilityReport report =
       AnalyzeIdentifiability(puma, KinematicParameters::Nominal(puma), poses, 0, IdentifiabilityOptions());
   const auto& c = report.null_combinations;
-  EXPECT_NE(std::find(c.begin(), c.end(), "0.71 j2.d - 0.71 j3.d"), c.end());
+  // A null direction has no sign: either wording names the same combination.
+  const bool named = std::find(c.begin(), c.end(), "0.71 j2.d - 0.71 j3.d") != c.end() ||
+                     std::find(c.begin(), c.end(), "0.71 j3.d - 0.71 j2.d") != c.end();
+  EXPECT_TRUE(named) << ::testing::PrintToString(c);
   EXPECT_NE(std::find(c.begin(), c.end(), "1.00 base.tx"), c.end());
   // Deterministic: the same input gives the same words.
   const IdentifiabilityReport again =

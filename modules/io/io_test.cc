@@ -107,7 +107,7 @@ TEST(YamlSchema, C3NonFiniteWrongTypeAndOutOfRangeValuesAreRefused) {
       {"a_mm: 431.8,", "a_mm: [431.8],", "is not a number (found a sequence)"},
       {"a_mm: 431.8,", "a_mm: 0x1AF,", "is not a number"},
       {"a_mm: 431.8,", "a_mm: 43180000,", "is out of range: must be in [-10000, 10000]"},
-      {"alpha_deg: 0.0,   d_mm: 0.0,    theta_offset_deg: 0.0, min_deg: -225", "alpha_deg: 900,   d_mm: 0.0,    theta_offset_deg: 0.0, min_deg: -225", "must be in [-360, 360]"},
+      {"alpha_deg: 0.0,   d_mm: 0.0,    theta_offset_deg: 0.0, min_deg: -45", "alpha_deg: 900,   d_mm: 0.0,    theta_offset_deg: 0.0, min_deg: -45", "must be in [-360, 360]"},
       {"min_deg: -225, max_deg: 45}", "min_deg: 45, max_deg: -225}", "is not below max"},
       {"min_deg: -266, max_deg: 266}", "min_deg: -266, max_deg: 9000}", "`joints[5].max_deg` = `9000`"},
       {"dh_convention: standard", "dh_convention: craig", "must be one of standard, modified, modified_hayati"},

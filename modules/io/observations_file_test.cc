@@ -132,7 +132,7 @@ TEST(ObservationsFile, TheDocumentedExampleLoads) {
   EXPECT_EQ(set->robot.name, "puma560");
   ASSERT_EQ(set->poses.size(), 2u);
   EXPECT_EQ(set->poses[1].role, PoseRole::kVerification);
-  EXPECT_EQ(set->poses[0].joints_rad[1], DegToRad(-30));
+  EXPECT_EQ(set->poses[0].joints_rad[1], DegToRad(30));
   EXPECT_EQ(set->poses[0].dots_px.at(2), Eigen::Vector2d(415.75, 300.0));
   EXPECT_EQ(set->yardsticks[0].length_m, 0.25);
   EXPECT_EQ(set->check_distances[0].length_m, 0.3125);
@@ -206,16 +206,16 @@ TEST_F(ObservationsEdits, C3CameraValues) {
 }
 
 TEST_F(ObservationsEdits, C3JointsOutsidePlausibleRanges) {
-  EXPECT_TRUE(Refused(Load("[0, -30, 120, 0, 45, 0]", "[0, -30, 12000, 0, 45, 0]"),
+  EXPECT_TRUE(Refused(Load("[0, 30, -150, 0, 45, 0]", "[0, 30, 12000, 0, 45, 0]"),
                       "`poses[0].joints_deg[2]` = `12000` at " + path_ + ":13 is out of range: must be in [-720, 720]"));
-  // Joint 2 of the PUMA stops at 45 deg.
-  EXPECT_TRUE(Refused(Load("[0, -30, 120, 0, 45, 0]", "[0, 60, 120, 0, 45, 0]"),
-                      "`poses[0].joints_deg[1]` = 60 at " + path_ + ":13 is outside joint 2's limits [-225, 45] deg"));
-  EXPECT_TRUE(Refused(Load("[0, -30, 120, 0, 45, 0]", "[0, -30, 120, 0, 45]"),
+  // Joint 2 of the PUMA stops at 225 deg.
+  EXPECT_TRUE(Refused(Load("[0, 30, -150, 0, 45, 0]", "[0, 230, -150, 0, 45, 0]"),
+                      "`poses[0].joints_deg[1]` = 230 at " + path_ + ":13 is outside joint 2's limits [-45, 225] deg"));
+  EXPECT_TRUE(Refused(Load("[0, 30, -150, 0, 45, 0]", "[0, 30, -150, 0, 45]"),
                       "`poses[0].joints_deg` at " + path_ + ":13 has 5 values, expected 6"));
-  EXPECT_TRUE(Refused(Load("joints_deg: [0, -30, 120, 0, 45, 0]", "joints_deg: [0, -30, 120, 0, 45, 0]\n    joints_rad: [0, 0, 0, 0, 0, 0]"),
+  EXPECT_TRUE(Refused(Load("joints_deg: [0, 30, -150, 0, 45, 0]", "joints_deg: [0, 30, -150, 0, 45, 0]\n    joints_rad: [0, 0, 0, 0, 0, 0]"),
                       "give the same quantity twice"));
-  EXPECT_TRUE(Refused(Load("joints_deg: [0, -30, 120, 0, 45, 0]", "joints: [0, -30, 120, 0, 45, 0]"),
+  EXPECT_TRUE(Refused(Load("joints_deg: [0, 30, -150, 0, 45, 0]", "joints: [0, 30, -150, 0, 45, 0]"),
                       "`poses[0].joints` at " + path_ + ":13 is not allowed here: the unit goes in the key: `joints_deg` or `joints_rad`"));
 }
 
@@ -293,8 +293,8 @@ TEST(TrajectoryFile, C5WrongJointCountNamesEveryBadPose) {
   TempDir dir;
   const std::string path = dir.File("plan.yaml");
   WriteFile(path, "format: selfcal-trajectory\nversion: 1\nrobot: puma560\ndescription: \"test\"\nposes_deg:\n"
-                  "  - [0, -30, 120, 0, 45, 0]\n  - [0, -30, 120, 0, 45, 0]\n  - [0, -30, 120, 0, 45]\n"
-                  "  - [0, -30, 120, 0, 45, 0]\n  - [0, -30, 120, 0, 45, 0, 7]\n");
+                  "  - [0, 30, -150, 0, 45, 0]\n  - [0, 30, -150, 0, 45, 0]\n  - [0, 30, -150, 0, 45]\n"
+                  "  - [0, 30, -150, 0, 45, 0]\n  - [0, 30, -150, 0, 45, 0, 7]\n");
   const Status status = LoadTrajectory(path, 6).status();
   EXPECT_EQ(status.code(), ErrorCode::kInvalidInput);
   EXPECT_NE(status.message().find("pose 2 (`poses_deg[2]` at " + path + ":8) has 5 joint values, the robot has 6"),
@@ -302,7 +302,7 @@ TEST(TrajectoryFile, C5WrongJointCountNamesEveryBadPose) {
   EXPECT_NE(status.message().find("pose 4 (`poses_deg[4]` at " + path + ":10) has 7 joint values"), std::string::npos);
   Result<std::vector<Eigen::VectorXd>> ok = LoadTrajectory(path, 5);
   EXPECT_FALSE(ok.ok());
-  WriteFile(path, "format: selfcal-trajectory\nversion: 1\nposes:\n  - [0, -30, 120, 0, 45, 0]\n");
+  WriteFile(path, "format: selfcal-trajectory\nversion: 1\nposes:\n  - [0, 30, -150, 0, 45, 0]\n");
   EXPECT_NE(LoadTrajectory(path, 6).status().message().find("`poses` at " + path + ":3 is not allowed here: the unit goes in the key"),
             std::string::npos) << LoadTrajectory(path, 6).status().message();
 }
@@ -310,10 +310,10 @@ TEST(TrajectoryFile, C5WrongJointCountNamesEveryBadPose) {
 TEST(TrajectoryFile, C6PosesOutsideTheLimitsAreRefused) {
   TempDir dir;
   const std::string path = dir.File("plan.yaml");
-  WriteFile(path, "format: selfcal-trajectory\nversion: 1\nposes_deg:\n  - [0, -30, 120, 0, 45, 0]\n  - [0, 50, 120, 0, 45, 0]\n");
+  WriteFile(path, "format: selfcal-trajectory\nversion: 1\nposes_deg:\n  - [0, 30, -150, 0, 45, 0]\n  - [0, 230, -150, 0, 45, 0]\n");
   EXPECT_TRUE(LoadTrajectory(path, 6).ok());
   const Status status = LoadTrajectory(path, selfcal::testing::Puma560()).status();
-  EXPECT_NE(status.message().find("pose 1 (`poses_deg[1]` at " + path + ":5): joint 2 = 50 deg is outside its limits [-225, 45] deg"),
+  EXPECT_NE(status.message().find("pose 1 (`poses_deg[1]` at " + path + ":5): joint 2 = 230 deg is outside its limits [-45, 225] deg"),
             std::string::npos) << status.message();
   WriteFile(path, "format: selfcal-trajectory\nversion: 1\nrobot: ur5e\nposes_deg: []\n");
   EXPECT_NE(LoadTrajectory(path, selfcal::testing::Puma560()).status().message().find("the robot model is `puma560`"),

@@ -48,6 +48,23 @@ TEST(RobotConfig, ShippedPuma560MatchesTestSupport) {
   ExpectSameKinematics(selfcal::testing::Puma560(), *loaded, &rng);
 }
 
+// The limits the config cites: Corke, Robotics Toolbox for MATLAB, mdl_puma560.m,
+// qlim = [-160 160; -45 225; -225 45; -110 170; -100 100; -266 266] deg (q2 is the shoulder, q3 the elbow:
+// with q2 and q3 swapped, every trajectory bends the elbow where a real PUMA cannot).
+TEST(RobotConfig, ShippedPuma560LimitsAreCorkesQlim) {
+  const double qlim_deg[6][2] = {{-160, 160}, {-45, 225}, {-225, 45}, {-110, 170}, {-100, 100}, {-266, 266}};
+  Result<RobotModel> loaded = LoadRobotModel(SourcePath("config/robots/puma560.yaml"));
+  ASSERT_TRUE(loaded.ok()) << loaded.status().ToString();
+  ASSERT_EQ(loaded->limits.size(), 6u);
+  const RobotModel support = selfcal::testing::Puma560();
+  for (int j = 0; j < 6; ++j) {
+    EXPECT_NEAR(loaded->limits[j].min_rad, DegToRad(qlim_deg[j][0]), 1e-12) << "joint " << j + 1;
+    EXPECT_NEAR(loaded->limits[j].max_rad, DegToRad(qlim_deg[j][1]), 1e-12) << "joint " << j + 1;
+    EXPECT_NEAR(support.limits[j].min_rad, DegToRad(qlim_deg[j][0]), 1e-12) << "test support, joint " << j + 1;
+    EXPECT_NEAR(support.limits[j].max_rad, DegToRad(qlim_deg[j][1]), 1e-12) << "test support, joint " << j + 1;
+  }
+}
+
 TEST(RobotConfig, ShippedUr5eMatchesTestSupport) {
   std::mt19937_64 rng(2);
   Result<RobotModel> loaded = LoadRobotModel(SourcePath("config/robots/ur5e.yaml"));
@@ -76,8 +93,8 @@ TEST(RobotConfig, ModifiedConventionMatchesItsStandardEquivalent) {
       "dh_convention: modified\n"
       "joints:\n"
       "  - {a_mm: 0, alpha_deg: 0, d_mm: 0, min_deg: -160, max_deg: 160}\n"
-      "  - {a_mm: 0, alpha_deg: 90, d_mm: 0, min_deg: -225, max_deg: 45}\n"
-      "  - {a_m: 0.4318, alpha_deg: 0, d_m: 0.15005, min_deg: -45, max_deg: 225}\n"
+      "  - {a_mm: 0, alpha_deg: 90, d_mm: 0, min_deg: -45, max_deg: 225}\n"
+      "  - {a_m: 0.4318, alpha_deg: 0, d_m: 0.15005, min_deg: -225, max_deg: 45}\n"
       "  - {a_mm: 20.3, alpha_rad: -1.5707963267948966, d_mm: 431.8, min_deg: -110, max_deg: 170}\n"
       "  - {a_mm: 0, alpha_deg: 90, d_mm: 0, min_deg: -100, max_deg: 100}\n"
       "  - {a_mm: 0, alpha_deg: -90, d_mm: 0, min_deg: -266, max_deg: 266}\n"
@@ -93,7 +110,7 @@ TEST(RobotConfig, ModifiedConventionMatchesItsStandardEquivalent) {
 TEST(RobotConfig, BetaNeedsTheHayatiConvention) {
   TempDir dir;
   std::string text = ReadFile(SourcePath("config/robots/puma560.yaml"));
-  text.replace(text.find("theta_offset_deg: 0.0, min_deg: -225"), 21, "beta_deg: 0.1");
+  text.replace(text.find("theta_offset_deg: 0.0, min_deg: -45"), 21, "beta_deg: 0.1");
   WriteFile(dir.File("beta.yaml"), text);
   const Status status = LoadRobotModel(dir.File("beta.yaml")).status();
   EXPECT_NE(status.message().find("`joints[1].beta_deg` at " + dir.File("beta.yaml") + ":13 is not allowed here: a Hayati "

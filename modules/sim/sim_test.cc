@@ -149,7 +149,7 @@ TEST(Sim, RefusesImpossibleSetups) {
   options.num_dots = 5;
   EXPECT_FALSE(Simulate(puma, joints, options).ok);
   options = SimOptions();
-  joints[4][1] = DegToRad(80);  // beyond joint 2's +45 deg limit
+  joints[4][1] = DegToRad(-80);  // beyond joint 2's -45 deg limit
   const SimResult r = Simulate(puma, joints, options);
   EXPECT_FALSE(r.ok);
   EXPECT_NE(r.message.find("pose 4"), std::string::npos) << r.message;

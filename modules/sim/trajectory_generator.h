@@ -18,7 +18,7 @@ struct ArcTrajectoryOptions {
   int num_poses = 25;
   // The camera looks at a target distance_m ahead of where it is at these joint angles (the PUMA 560's
   // forearm-down, wrist-tilted pose by default); the arc sweeps around that target.
-  std::vector<double> home_joints_deg = {0.0, 20.0, 160.0, 0.0, 45.0, 0.0};
+  std::vector<double> home_joints_deg = {0.0, 20.0, -200.0, 0.0, 45.0, 0.0};
   double distance_m = 0.65;          // camera centre to target, mean
   double distance_swing_m = 0.08;
   double azimuth_start_deg = -35.0;  // viewing direction about the vertical through the target, from home

@@ -326,7 +326,7 @@ class RecordingRealRobot : public robot::Robot {
   Result<robot::RobotIdentity> Identity() override { return robot::RobotIdentity{"network", "puma560", "SN-1", "", true}; }
   Result<robot::JointLimits> Limits() override {
     const int n = static_cast<int>(joints_.size());
-    return robot::JointLimits{Eigen::VectorXd::Constant(n, -3.1), Eigen::VectorXd::Constant(n, 3.1),
+    return robot::JointLimits{Eigen::VectorXd::Constant(n, -4.0), Eigen::VectorXd::Constant(n, 4.0),
                               Eigen::VectorXd::Constant(n, 1.0)};
   }
   Result<robot::JointReading> ReadJoints() override {

@@ -15,7 +15,7 @@ RobotModel Puma560() {
       {0.0, h, 0.0, 0.0}, {0.4318, 0.0, 0.0, 0.0}, {0.0203, -h, 0.15005, 0.0},
       {0.0, h, 0.4318, 0.0}, {0.0, -h, 0.0, 0.0},   {0.0, 0.0, 0.0, 0.0}};
   const std::vector<JointLimits> limits = {
-      {DegToRad(-160), DegToRad(160)}, {DegToRad(-225), DegToRad(45)},  {DegToRad(-45), DegToRad(225)},
+      {DegToRad(-160), DegToRad(160)}, {DegToRad(-45), DegToRad(225)},  {DegToRad(-225), DegToRad(45)},
       {DegToRad(-110), DegToRad(170)}, {DegToRad(-100), DegToRad(100)}, {DegToRad(-266), DegToRad(266)}};
   return RobotModel::FromDh("puma560", DhConvention::kStandard, rows, limits, Rigid3(), CameraOnFlange());
 }
