@@ -28,14 +28,15 @@ int RunSelfcal(const std::string& arguments, std::string* output) {
 
 bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
-// The first `n` poses of the shipped PUMA arc as a plan file.
-void WriteShortPlan(const fs::path& path, int n) {
+// The first `n` poses of the shipped PUMA arc as a plan file, the first `identify` of them identifying.
+void WriteShortPlan(const fs::path& path, int n, int identify) {
   std::istringstream in(ReadFile(std::string(SELFCAL_SOURCE_DIR) + "/config/trajectories/initial_puma560.yaml"));
   std::string text, line;
   int poses = 0;
   while (std::getline(in, line)) {
     const bool pose = line.rfind("  - [", 0) == 0;
     if (pose && poses++ >= n) continue;
+    if (line.rfind("poses_rad:", 0) == 0) text += "num_identification_poses: " + std::to_string(identify) + "\n";
     text += line + "\n";
   }
   WriteFile(path.string(), text);
@@ -62,13 +63,13 @@ class AuditSessionTest : public ::testing::Test {
     root_ = new fs::path(fs::temp_directory_path() / ("selfcal_audit_" + std::to_string(::getpid())));
     fs::remove_all(*root_);
     fs::create_directories(*root_);
-    WriteShortPlan(*root_ / "plan.yaml", 6);
-    std::string output;
-    const int code = RunSelfcal("run --robot sim --camera sim --seed 2 --plan " + (*root_ / "plan.yaml").string() +
-                                    " --session " + (*root_ / "s").string(),
-                                &output);
-    ASSERT_EQ(code, 0) << output;
+    WriteShortPlan(*root_ / "plan.yaml", 6, 4);
+    run_code_ = RunSelfcal("run --robot sim --camera sim --seed 2 --plan " + (*root_ / "plan.yaml").string() +
+                               " --session " + (*root_ / "s").string(),
+                           &run_output_);
   }
+  // Every test fails (not skips) when the session could not be recorded.
+  void SetUp() override { ASSERT_EQ(run_code_, 0) << run_output_; }
   static void TearDownTestSuite() {
     fs::remove_all(*root_);
     delete root_;
@@ -89,8 +90,12 @@ class AuditSessionTest : public ::testing::Test {
     return RunSelfcal("audit " + session.string(), output);
   }
   static fs::path* root_;
+  static int run_code_;
+  static std::string run_output_;
 };
 fs::path* AuditSessionTest::root_ = nullptr;
+int AuditSessionTest::run_code_ = -1;
+std::string AuditSessionTest::run_output_;
 
 TEST_F(AuditSessionTest, ScoresEveryNameRightAndChangesNothing) {
   const fs::path session = *root_ / "s";
