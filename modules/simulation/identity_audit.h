@@ -12,9 +12,10 @@
 // to its own. The gate: a right name's pixel differs from its dot's projected centre by the centroid
 // noise (0.01 px std measured at grey noise 2; 0.02 px assumed by the solvers) plus the perspective
 // ellipse-centre bias (< 0.02 px for 4 mm discs at 0.65 m, sim::EllipseCentrePx) plus k1's share (of the
-// same order), well under 0.1 px; two dots' projected centres are at least 1.5 projected diameters
-// (>= 15 px) apart in the planned views (the world's spacing rule). 3 px lies 30x above the first and 5x
-// below half the second, and is the radius the simulator's own TruthIdentifier names within.
+// same order), well under 0.1 px; two dots' projected centres are about 1.5 projected diameters or
+// more apart in the planned views (the world's spacing rule: rims 0.5 of the larger diameter apart; ~16 px
+// for the arc's 11 px discs). 3 px lies 30x above the first and well below half the second, and is the
+// radius the simulator's own TruthIdentifier names within.
 // max_right_error_px reports how far the right names really were, so that the gate can be checked.
 //
 // A sample whose recorded joints differ from the arm's true joints at exposure (a jog between settle
