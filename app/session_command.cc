@@ -22,6 +22,7 @@
 #include "io/robot_config.h"
 #include "io/trajectory_file.h"
 #include "acquisition/session_runner.h"
+#include "simulation/sim_run_settings.h"
 #include "simulation/sim_session.h"
 #include "robot/manual_robot.h"
 #include "robot/network_robot.h"
@@ -90,25 +91,9 @@ json RunJson(const RunSettings& a) {
             {"short_reads", a.fault_short_reads}}}};
 }
 
+// The simulated cell of these settings, through their run.json (the recorded form an audit rebuilds from).
 simulation::SimCellOptions SimCellOptionsFor(const RunSettings& a) {
-  simulation::SimCellOptions o;
-  o.world.world_seed = a.seed;
-  o.world.noise_seed = a.seed;
-  o.world.pixel_noise_px = 0.02;  // the centroid noise the solvers are told (measured 0.01 px at grey noise 2)
-  o.camera.render.noise_std_grey = a.grey_noise;
-  o.camera.render.blur_sigma_px = a.blur_px;
-  o.camera.render.supersampling = a.supersampling;
-  auto set = [](const std::vector<int>& v) { return std::set<int>(v.begin(), v.end()); };
-  o.faults.reject_moves = set(a.fault_reject_moves);
-  o.faults.protective_stop_moves = set(a.fault_pstop_moves);
-  o.faults.hang_moves = set(a.fault_hang_moves);
-  o.faults.disconnect_moves = set(a.fault_disconnect_moves);
-  o.faults.jog_after_moves = set(a.fault_jog_after_moves);
-  o.faults.slow_settle_moves = set(a.fault_slow_settle_moves);
-  o.faults.stale_reads = set(a.fault_stale_reads);
-  o.faults.nan_reads = set(a.fault_nan_reads);
-  o.faults.short_reads = set(a.fault_short_reads);
-  return o;
+  return simulation::SimCellOptionsFor(RunJson(a)).value();
 }
 
 // Typed confirmation before a real backend moves (R1): the operator types the robot's serial.
