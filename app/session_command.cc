@@ -133,6 +133,7 @@ struct Backends {
   robot::Clock* clock = nullptr;
   acquisition::DetectionOrderIdentifier order_identifier;
   acquisition::DotIdentifier* identifier = &order_identifier;
+  std::unique_ptr<acquisition::DotIdentifier> owned_identifier;  // --identify
 };
 
 // Refuses backend combinations that cannot work and fills in the default velocity scaling.
@@ -232,11 +233,20 @@ robot::JointLimits ManualJointLimits(const RobotModel& nominal) {
 
 // Stage 3: the robot, camera, clock and dot identifier of the run.
 Status MakeBackends(const RunSettings& a, RunPlan* run, Backends* b) {
+  if (!a.identify.method.empty()) {  // acquisition/identifiers.h; the reference dots come from setup.json
+    std::string setup_text;
+    for (const session::SessionInput& input : run->inputs) {
+      if (input.name == session::kSetupFileName) setup_text = input.contents;
+    }
+    auto chosen = MakeIdentifier(a.identify, "order", setup_text, a.setup.empty() ? "setup.json" : a.setup);
+    if (!chosen.ok()) return chosen.status();
+    b->owned_identifier = std::move(chosen).value();
+  }
   if (a.robot_backend == "sim") {
     b->arm = run->cell->robot.get();
     b->camera = run->cell->camera.get();
     b->clock = run->cell->clock.get();
-    b->identifier = run->cell->identifier.get();
+    b->identifier = b->owned_identifier ? b->owned_identifier.get() : run->cell->identifier.get();
     return Status::Ok();
   }
   b->owned_clock = std::make_unique<robot::MonotonicClock>();
@@ -257,6 +267,7 @@ Status MakeBackends(const RunSettings& a, RunPlan* run, Backends* b) {
   options.device = a.device;
   b->owned_camera = std::make_unique<capture::V4l2Camera>(options);
   b->camera = b->owned_camera.get();
+  if (b->owned_identifier) b->identifier = b->owned_identifier.get();
   return Status::Ok();
 }
 
@@ -337,6 +348,7 @@ Command AddRunCommand(CLI::App& app) {
   cmd->add_option("--grey-noise", a->grey_noise, "sim: pixel noise std, grey levels")->check(CLI::Range(0.0, 50.0));
   cmd->add_option("--blur-px", a->blur_px, "sim: Gaussian blur sigma, px")->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--supersampling", a->supersampling, "sim: samples per pixel side")->check(CLI::Range(1, 8));
+  AddIdentifyOptions(cmd, &a->identify, "default: the simulator's truth with sim, else order");
   auto fault = [&](const char* name, std::vector<int>* v, const char* what) {
     cmd->add_option(name, *v, what)->delimiter(',')->group("Simulated faults (sim robot, 0-based call counts)");
   };
