@@ -18,5 +18,6 @@ Command AddMakeTrajectoryCommand(CLI::App& app);
 Command AddTrackerCommand(CLI::App& app);
 Command AddPlanCommand(CLI::App& app);
 Command AddRunCommand(CLI::App& app);
+Command AddSessionCommand(CLI::App& app);
 
 }  // namespace selfcal::app
