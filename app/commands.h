@@ -20,5 +20,6 @@ Command AddPlanCommand(CLI::App& app);
 Command AddRunCommand(CLI::App& app);
 Command AddAuditCommand(CLI::App& app);
 Command AddNameDotsCommand(CLI::App& app);
+Command AddSessionCommand(CLI::App& app);
 
 }  // namespace selfcal::app

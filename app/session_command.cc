@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -27,6 +28,7 @@
 #include "robot/manual_robot.h"
 #include "robot/network_robot.h"
 #include "session/samples.h"
+#include "session/session_cleanup.h"
 #include "session/session_dir.h"
 #include "session/session_observations.h"
 #include "session/setup_file.h"
@@ -72,7 +74,7 @@ std::vector<acquisition::PlannedPose> PlanPoses(const io::TrajectoryFile& plan) 
 
 // The run settings that must not change on resume (run.json input).
 json RunJson(const RunSettings& a) {
-  return {{"format", "selfcal-run"},
+  json run = {{"format", "selfcal-run"},
           {"version", 1},
           {"robot", a.robot_backend},
           {"address", a.robot_backend == "network" ? a.address : ""},
@@ -89,6 +91,9 @@ json RunJson(const RunSettings& a) {
             {"jog_after_moves", a.fault_jog_after_moves}, {"slow_settle_moves", a.fault_slow_settle_moves},
             {"stale_reads", a.fault_stale_reads}, {"nan_reads", a.fault_nan_reads},
             {"short_reads", a.fault_short_reads}}}};
+  // The jog's delay only when not the default, so that the run.json of earlier sessions is unchanged.
+  if (a.fault_jog_delay_s != RunSettings().fault_jog_delay_s) run["faults"]["jog_delay_s"] = a.fault_jog_delay_s;
+  return run;
 }
 
 // The simulated cell of these settings, through their run.json (the recorded form an audit rebuilds from).
@@ -204,8 +209,13 @@ Result<session::Session> ResumeSession(const RunSettings& a, RunPlan* run) {
   return opened;
 }
 
-// Stage 2, a new session: created (with its parent folder) from the inputs; never overwrites (C10).
-Result<session::Session> CreateRunSession(const RunSettings& a, const RunPlan& run) {
+// Stage 2, a new session: created (with its parent folder) from the inputs once the run can start (the
+// callback of acquisition::RunContext); never overwrites (C10). `restart` removes an interrupted creation
+// with the same inputs first (nothing was recorded in it; session_cleanup.h).
+Result<session::Session> CreateRunSession(const RunSettings& a, const RunPlan& run, bool restart) {
+  if (restart) {
+    if (Status s = session::DiscardSession(a.session); !s.ok()) return s;
+  }
   const std::filesystem::path parent = std::filesystem::path(a.session).parent_path();
   if (!parent.empty()) {
     if (Status s = EnsureDirectory(parent.string()); !s.ok()) return s;
@@ -231,6 +241,13 @@ robot::JointLimits ManualJointLimits(const RobotModel& nominal) {
   return limits;
 }
 
+// The port of --address HOST:PORT: 1-65535, else -1.
+int PortNumber(const std::string& text) {
+  if (text.empty() || text.size() > 5 || !std::all_of(text.begin(), text.end(), ::isdigit)) return -1;
+  const int port = std::stoi(text);
+  return port >= 1 && port <= 65535 ? port : -1;
+}
+
 // Stage 3: the robot, camera, clock and dot identifier of the run.
 Status MakeBackends(const RunSettings& a, RunPlan* run, Backends* b) {
   if (!a.identify.method.empty()) {  // acquisition/identifiers.h; the reference dots come from setup.json
@@ -253,10 +270,10 @@ Status MakeBackends(const RunSettings& a, RunPlan* run, Backends* b) {
   b->clock = b->owned_clock.get();
   if (a.robot_backend == "network") {
     const size_t colon = a.address.rfind(':');
-    if (colon == std::string::npos) return Status::Error(ErrorCode::kInvalidInput, "--address must be HOST:PORT");
+    const int port = colon == std::string::npos ? -1 : PortNumber(a.address.substr(colon + 1));
+    if (port < 0) return Status::Error(ErrorCode::kInvalidInput, "--address must be HOST:PORT, not \"" + a.address + "\"");
     robot::NetworkRobotOptions options;
-    b->owned_robot = std::make_unique<robot::NetworkRobot>(a.address.substr(0, colon),
-                                                           std::stoi(a.address.substr(colon + 1)), options);
+    b->owned_robot = std::make_unique<robot::NetworkRobot>(a.address.substr(0, colon), port, options);
   } else if (a.robot_backend == "manual") {
     b->owned_robot = std::make_unique<robot::ManualRobot>(std::cin, std::cout, ManualJointLimits(run->nominal), *b->clock);
   } else {
@@ -271,20 +288,72 @@ Status MakeBackends(const RunSettings& a, RunPlan* run, Backends* b) {
   return Status::Ok();
 }
 
+// The session directory a run writes into, as found before anything is created.
+struct SessionTarget {
+  std::optional<session::Session> opened;  // --resume of a recorded session
+  bool restart_creation = false;           // --resume of an interrupted creation: made again (same inputs)
+};
+
+// Stage 2: a new run needs an absent or empty directory (C10; it is created once the run can start); a
+// resume opens the session (ResumeSession), or completes an interrupted creation made with the same
+// inputs (session_cleanup.h).
+Status PrepareSession(const RunSettings& a, RunPlan* run, Backends* backends, SessionTarget* out) {
+  Result<session::SessionDirInspection> dir = session::InspectSessionDir(a.session);
+  if (!dir.ok()) return dir.status();
+  const session::SessionDirState state = dir->state;
+  const bool unrecorded =
+      state == session::SessionDirState::kInterruptedCreation || state == session::SessionDirState::kNothingRecorded;
+  if (!a.resume) {
+    if (state == session::SessionDirState::kAbsent || state == session::SessionDirState::kEmpty) return Status::Ok();
+    return Status::Error(ErrorCode::kInvalidInput,
+                         "session directory " + a.session +
+                             " exists and is not empty: a session is never overwritten (C10); " +
+                             (unrecorded ? "it holds no recorded sample: `selfcal run --resume` with the same options "
+                                           "completes it, `selfcal session discard " + a.session + "` removes it"
+                                         : std::string("choose a new directory")));
+  }
+  if (state == session::SessionDirState::kInterruptedCreation) {
+    std::string differing;
+    for (const std::string& name : session::DifferingInputs(*dir, run->inputs)) {
+      differing += (differing.empty() ? "" : ", ") + name;
+    }
+    if (!differing.empty() && !a.force_changed_config) {
+      return Status::Error(ErrorCode::kInvalidInput,
+                           "session " + a.session + ": its creation was interrupted with other inputs (" + differing +
+                               "); run with the same files, or remove it with `selfcal session discard " + a.session +
+                               "` (C9)");
+    }
+    std::cout << "session " << a.session << ": its creation was interrupted (no session.json, nothing recorded); "
+              << "it is created again once the run can start\n";
+    out->restart_creation = true;
+    return Status::Ok();
+  }
+  Result<session::Session> opened = ResumeSession(a, run);
+  if (!opened.ok()) return opened.status();
+  out->opened.emplace(std::move(opened).value());
+  // The resumed simulated cell was restarted: its robot, camera and clock are new objects.
+  return a.robot_backend == "sim" ? MakeBackends(a, run, backends) : Status::Ok();
+}
+
 // Stage 4: the session loop (acquisition::RunSession) and what it did; returns the exit code.
-int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, session::Session* session) {
+// `session` is the session to continue, or null: then `create` makes it once the run can start.
+int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, session::Session* session,
+                 const std::function<Result<session::Session*>()>& create,
+                 const std::optional<session::Session>& created) {
   const bool sim_robot = a.robot_backend == "sim";
   InstallStopHandlers();
   acquisition::RunOptions options;
   options.safety.velocity_scaling = a.velocity_scaling;
   options.journal_sim_clock = sim_robot;
   options.mode = sim_robot ? "simulated" : a.robot_backend;
+  options.revisit_skipped = a.revisit_skipped;
   if (sim_robot) options.settle.min_dwell_s = 0.6;  // > the simulated ring-down cutoff (resume determinism)
   acquisition::RunContext context;
   context.robot = b.arm;
   context.camera = b.camera;
   context.clock = b.clock;
   context.session = session;
+  context.create_session = create;
   context.identifier = b.identifier;
   context.stop_requested = &g_stop_requested;
   const bool dry_run = a.dry_run;
@@ -303,7 +372,15 @@ int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, se
   for (const auto& [reason, n] : report.skips) std::cout << ", skipped " << reason << " x" << n;
   for (const auto& [kind, n] : report.faults) std::cout << ", fault " << kind << " x" << n;
   std::cout << "\n";
-  if (report.outcome == acquisition::RunOutcome::kHalted || report.outcome == acquisition::RunOutcome::kInterrupted) {
+  const bool halted =
+      report.outcome == acquisition::RunOutcome::kHalted || report.outcome == acquisition::RunOutcome::kInterrupted;
+  if (halted && report.halt_reason.empty()) {  // before the first motion command (connect, identity, camera)
+    std::cout << "HALTED before any motion command: nothing was sent to the arm. "
+              << (session == nullptr && !created ? "No session was created; run the same command again"
+                                                          : "Continue with: selfcal run --resume --session " +
+                                                                a.session + " (same options)")
+              << " once the cause is fixed\n";
+  } else if (halted) {
     std::cout << "HALTED. The robot was told to stop. Check the cell, then continue with: selfcal run --resume "
                  "--session "
               << a.session << " (same options)\n";
@@ -317,11 +394,18 @@ int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
   if (Status s = CheckRunSettings(&a); !s.ok()) return Fail(s);
   RunPlan run;
   if (Status s = LoadRunPlan(a, &run); !s.ok()) return Fail(s);
-  Result<session::Session> session = a.resume ? ResumeSession(a, &run) : CreateRunSession(a, run);
-  if (!session.ok()) return Fail(session.status());
-  Backends backends;
+  Backends backends;  // a bad --address is refused before any session is touched
   if (Status s = MakeBackends(a, &run, &backends); !s.ok()) return Fail(s);
-  const int code = DriveSession(a, run, backends, &session.value());
+  SessionTarget target;
+  if (Status s = PrepareSession(a, &run, &backends, &target); !s.ok()) return Fail(s);
+  std::optional<session::Session> created;
+  auto create = [&]() -> Result<session::Session*> {
+    Result<session::Session> made = CreateRunSession(a, run, target.restart_creation);
+    if (!made.ok()) return made.status();
+    created.emplace(std::move(made).value());
+    return &*created;
+  };
+  const int code = DriveSession(a, run, backends, target.opened ? &*target.opened : nullptr, create, created);
   if (world != nullptr && a.robot_backend == "sim") *world = std::move(run.cell.value().world);
   return code;
 }
@@ -333,7 +417,11 @@ Command AddRunCommand(CLI::App& app) {
   cmd->add_flag("--resume", a->resume, "Continue a session after a stop or crash (checks every input's hash)");
   cmd->add_flag("--force-resume-with-changed-config", a->force_changed_config,
                 "Resume although an input differs from the recorded one (C9)");
-  cmd->add_flag("--dry-run", a->dry_run, "Check the plan and print the preview; send no motion command");
+  cmd->add_flag("--dry-run", a->dry_run, "Check the plan and print the preview; send no motion command, create nothing");
+  cmd->add_option("--revisit-skipped", a->revisit_skipped,
+                  "--resume: visit poses skipped for too few dots, not settled, a bad frame or reading again, at "
+                  "most N more times each (0: never)")
+      ->check(CLI::Range(0, 100));
   cmd->add_option("--robot-config", a->robot_config, "Nominal robot config");
   cmd->add_option("--plan", a->plan, "Plan (trajectory file)");
   cmd->add_option("--setup", a->setup, "Camera, yardstick and checks (docs/session-format.md); not with sim");
@@ -357,6 +445,11 @@ Command AddRunCommand(CLI::App& app) {
   fault("--fault-hang-move", &a->fault_hang_moves, "R6: move #k never finishes");
   fault("--fault-disconnect-move", &a->fault_disconnect_moves, "R10: connection lost during move #k");
   fault("--fault-jog-after-move", &a->fault_jog_after_moves, "R4: someone jogs the arm after move #k");
+  cmd->add_option("--fault-jog-delay-s", a->fault_jog_delay_s,
+                  "R4: the jog comes this long after the move's arrival (0.5: while settling; the simulated session "
+                  "settles 0.6 s after arrival, so a little more jogs between settle and capture)")
+      ->check(CLI::Range(0.0, 10.0))
+      ->group("Simulated faults (sim robot, 0-based call counts)");
   fault("--fault-slow-settle-move", &a->fault_slow_settle_moves, "R7: move #k rings 20x longer");
   fault("--fault-stale-read", &a->fault_stale_reads, "R8: joint reading #n is stale");
   fault("--fault-nan-read", &a->fault_nan_reads, "R8: joint reading #n has a NaN");

@@ -20,6 +20,7 @@ struct RunSettings {
   bool resume = false;
   bool force_changed_config = false;
   bool dry_run = false;
+  int revisit_skipped = 1;  // --resume: further attempts per pose skipped for a revisitable reason
   std::string robot_config = "config/robots/puma560.yaml";
   std::string plan = "config/trajectories/initial_puma560.yaml";
   std::string setup;  // required unless --camera sim
@@ -35,6 +36,7 @@ struct RunSettings {
   IdentifySettings identify;  // --identify: empty is the simulator's truth, or the detection order
   std::vector<int> fault_reject_moves, fault_pstop_moves, fault_hang_moves, fault_disconnect_moves,
       fault_jog_after_moves, fault_slow_settle_moves, fault_stale_reads, fault_nan_reads, fault_short_reads;
+  double fault_jog_delay_s = 0.5;  // after the jogged move's arrival (SimulatedRobotFaults::jog_delay_s)
 };
 
 // `selfcal run` with these settings: creates or resumes the session, drives the robot, returns the exit code.

@@ -75,7 +75,7 @@ Runner::Step Runner::HaltOnRobotError(const Status& status, int pose, const std:
               what + ": " + status.message(), pose);
 }
 
-bool Runner::StartFromJournal(const session::SessionLog& log, int* first) {
+bool Runner::StartFromJournal(const session::SessionLog& log, std::vector<int>* todo) {
   const int num_poses = static_cast<int>(plan_.size());
   if (log.started) {
     // The recorded plan (a prefix of it if a crash came while it was being journaled) must be this one.
@@ -88,10 +88,16 @@ bool Runner::StartFromJournal(const session::SessionLog& log, int* first) {
       report_.message = "session " + c_.session->path() + " recorded another plan than the one given (C9)";
       return false;
     }
+    *todo = log.PosesToVisit(o_.revisit_skipped);
+  } else {
+    for (int i = 0; i < num_poses; ++i) todo->push_back(i);
   }
-  *first = log.started ? log.FirstPoseWithoutAcceptedSample() : 0;
-  report_.first_pose = *first;
-  if (*first < num_poses) return true;
+  report_.first_pose = todo->empty() ? num_poses : todo->front();
+  if (!todo->empty()) return true;
+  if (c_.session == nullptr) {
+    report_.message = "the plan has no pose: nothing to record";
+    return false;
+  }
   if (!log.finished && !Record({{"type", "finished"}, {"time_s", Now()}})) return false;
   report_.outcome = RunOutcome::kCompleted;
   report_.error = ErrorCode::kOk;
@@ -136,8 +142,13 @@ bool Runner::ConnectRobot(const session::SessionLog& log, RobotAtStart* robot) {
   return true;
 }
 
-Route Runner::PlanRoute(const session::SessionLog& log, int first, const Eigen::VectorXd& now_rad) {
-  const session::AcceptedSample* last = log.started ? log.LastAcceptedSample() : nullptr;
+Route Runner::PlanRoute(const session::SessionLog& log, const std::vector<int>& todo, const Eigen::VectorXd& now_rad) {
+  // The route starts from the accepted sample closest before the first pose to visit: the last one
+  // accepted when nothing is revisited (every accepted pose lies before the resume point).
+  const session::AcceptedSample* last = nullptr;
+  for (int p = todo.front() - 1; log.started && p >= 0 && last == nullptr; --p) {
+    if (p < static_cast<int>(log.accepted.size()) && log.accepted[p]) last = &*log.accepted[p];
+  }
   Route route;
   if (last != nullptr) {
     for (const session::SampleDot& d : last->dots) {
@@ -149,17 +160,22 @@ Route Runner::PlanRoute(const session::SessionLog& log, int first, const Eigen::
       p.height_px = d.height_px;
       tracked_.push_back(p);
     }
-    last_frame_s_ = last->exposure_time_s;
+    last_frame_s_ = std::max(last_frame_s_, log.LastAcceptedSample()->exposure_time_s);
     const Eigen::VectorXd there = FromVector(last->joints_rad);
     if (now_rad.size() != there.size() || (now_rad - there).cwiseAbs().maxCoeff() > o_.safety.start_tolerance_rad) {
       route.returning = true;
       route.poses.push_back({plan_[last->pose].id + "-return", plan_[last->pose].role, there});
       route.plan_index.push_back(last->pose);
+      route.pass.push_back(true);
     }
   }
-  for (int i = first; i < static_cast<int>(plan_.size()); ++i) {
+  // The plan from there: the poses to visit, and the accepted ones between them passed without recording.
+  for (int i = last != nullptr ? last->pose + 1 : todo.front(); i <= todo.back(); ++i) {
+    const bool visit = std::binary_search(todo.begin(), todo.end(), i);
+    if (!visit && !(i < static_cast<int>(log.accepted.size()) && log.accepted[i])) continue;
     route.poses.push_back(plan_[i]);
     route.plan_index.push_back(i);
+    route.pass.push_back(!visit);
   }
   return route;
 }
@@ -191,7 +207,21 @@ bool Runner::Arm(const Route& route, const RobotAtStart& robot) {
   return true;
 }
 
-bool Runner::JournalStart(const session::SessionLog& log, int first, const robot::RobotIdentity& identity) {
+bool Runner::CreateSession() {
+  Result<session::Session*> created = c_.create_session();
+  if (!created.ok() || *created == nullptr) {
+    report_.outcome = RunOutcome::kSessionError;
+    report_.error = created.ok() ? ErrorCode::kInternal : created.status().code();
+    report_.message = "creating the session (nothing moved): " +
+                      (created.ok() ? std::string("no session") : created.status().message());
+    return false;
+  }
+  c_.session = *created;
+  return true;
+}
+
+bool Runner::JournalStart(const session::SessionLog& log, const std::vector<int>& todo,
+                          const robot::RobotIdentity& identity) {
   const int num_poses = static_cast<int>(plan_.size());
   if (!log.started) {
     if (!Record({{"type", "session_started"}, {"time_s", Now()}, {"num_poses", num_poses}, {"mode", o_.mode},
@@ -200,8 +230,19 @@ bool Runner::JournalStart(const session::SessionLog& log, int first, const robot
                  {"camera", c_.camera->Describe()}})) {
       return false;
     }
-  } else if (!Record({{"type", "resumed"}, {"time_s", Now()}, {"first_pose", first}})) {
-    return false;
+  } else {
+    json revisit = json::array();  // poses skipped before that this run visits again
+    for (int p : todo) {
+      if (p < static_cast<int>(log.skips.size()) && !log.skips[p].empty()) revisit.push_back(p);
+    }
+    json resumed = {{"type", "resumed"}, {"time_s", Now()}, {"first_pose", todo.front()}};
+    if (!revisit.empty()) {
+      resumed["revisit"] = revisit;
+      resumed["revisit_skipped"] = o_.revisit_skipped;
+      Log("revisiting " + std::to_string(revisit.size()) + " skipped poses (at most " +
+          std::to_string(o_.revisit_skipped) + " further attempts each)");
+    }
+    if (!Record(resumed)) return false;
   }
   for (int i = log.started ? static_cast<int>(log.plan.size()) : 0; i < num_poses; ++i) {
     if (!Record({{"type", "pose_planned"}, {"pose", i}, {"id", plan_[i].id}, {"role", RoleName(plan_[i].role)},
@@ -213,36 +254,67 @@ bool Runner::JournalStart(const session::SessionLog& log, int first, const robot
   return true;
 }
 
+Runner::Step Runner::ReturnTo(const PlannedPose& target, int pose, Eigen::VectorXd* expected) {
+  // The dots of the sample are those of a frame at its joints: they are found again there, not tracked
+  // through a move that starts wherever the arm was left (a jog, a restart).
+  std::vector<tracking::PreviousDot> at_sample;
+  at_sample.swap(tracked_);
+  robot::JointReading before;
+  if (CheckBeforeMove(pose, *expected, &before) == Step::kEnd) return Step::kEnd;
+  Log("pose " + target.id + ": moving");
+  Arrival arrival;
+  Capture capture;
+  Step step = MoveAndSettle(pose, before, target, expected, &arrival);
+  if (step == Step::kOk) step = CaptureAtPose(pose, arrival.settle_s, &capture);
+  if (step == Step::kEnd) return step;
+  if (step == Step::kSkip) {
+    return Halt(RunOutcome::kHalted, ErrorCode::kHardware, "return_failed",
+                "could not return to the last sample's pose, or no frame or reading there", pose);
+  }
+  tracked_ = std::move(at_sample);
+  return NameDots(pose, capture.frame);
+}
+
 RunReport Runner::Run() {
-  SELFCAL_CHECK(c_.robot && c_.camera && c_.clock && c_.session && c_.identifier && c_.confirm,
-                "RunContext needs a robot, camera, clock, session, identifier and confirm callback");
+  SELFCAL_CHECK(c_.robot && c_.camera && c_.clock && (c_.session || c_.create_session) && c_.identifier &&
+                    c_.confirm,
+                "RunContext needs a robot, camera, clock, session (or create_session), identifier and confirm "
+                "callback");
   report_.outcome = RunOutcome::kRefused;
   report_.error = ErrorCode::kInvalidInput;
   if (const std::string bad = o_.Validate(); !bad.empty()) {
     report_.message = "run options: " + bad;
     return report_;
   }
-  // The journal decides where this invocation starts.
-  Result<session::SessionLog> log = session::ReadSessionLog(c_.session->journal().records());
-  if (!log.ok()) {
-    report_.outcome = RunOutcome::kSessionError;
-    report_.error = log.status().code();
-    report_.message = log.status().message();
-    return report_;
+  // The journal of a session to continue decides where this invocation starts; a new one starts at 0.
+  session::SessionLog log;
+  if (c_.session != nullptr) {
+    Result<session::SessionLog> read = session::ReadSessionLog(c_.session->journal().records());
+    if (!read.ok()) {
+      report_.outcome = RunOutcome::kSessionError;
+      report_.error = read.status().code();
+      report_.message = read.status().message();
+      return report_;
+    }
+    log = std::move(read).value();
   }
-  int first = 0;
-  if (!StartFromJournal(*log, &first)) return report_;
-  // The robot: identity, limits, where it is; the route; armed.
+  std::vector<int> todo;
+  if (!StartFromJournal(log, &todo)) return report_;
+  // The robot: identity, limits, where it is; the route; armed; only then a new session is created.
   RobotAtStart robot;
-  if (!ConnectRobot(*log, &robot)) return report_;
-  const Route route = PlanRoute(*log, first, robot.joints.position_rad);
-  if (!Arm(route, robot) || !JournalStart(*log, first, robot.identity)) return report_;
+  if (!ConnectRobot(log, &robot)) return report_;
+  const Route route = PlanRoute(log, todo, robot.joints.position_rad);
+  if (!Arm(route, robot)) return report_;
+  if (c_.session == nullptr && !CreateSession()) return report_;
+  if (!JournalStart(log, todo, robot.identity)) return report_;
 
   // R4: where the arm should be before each move: the previous move's target (the reading at the start).
   Eigen::VectorXd expected = robot.joints.position_rad;
   for (size_t r = 0; r < route.poses.size(); ++r) {
     const bool is_return = route.returning && r == 0;
-    if (VisitPose(route.poses[r], route.plan_index[r], is_return, &expected) == Step::kEnd) return report_;
+    const Step step = is_return ? ReturnTo(route.poses[r], route.plan_index[r], &expected)
+                                : VisitPose(route.poses[r], route.plan_index[r], route.pass[r], &expected);
+    if (step == Step::kEnd) return report_;
   }
   if (!Record({{"type", "finished"}, {"time_s", Now()}})) return report_;
   report_.outcome = RunOutcome::kCompleted;
@@ -272,6 +344,7 @@ std::string RunOptions::Validate() const {
   if (!(frame_timeout_s > 0)) out << "frame timeout must be > 0\n";
   if (!(tracking_interval_s >= 0)) out << "tracking interval must be >= 0\n";
   if (min_dots < 1) out << "min_dots must be >= 1\n";
+  if (revisit_skipped < 0) out << "revisit_skipped must be >= 0\n";
   if (png_compression < 0 || png_compression > 9) out << "png_compression must lie in [0, 9]\n";
   return out.str();
 }

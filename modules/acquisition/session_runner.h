@@ -12,10 +12,18 @@
 // and RunSession returns. Nothing here resumes by itself: continuing is a new RunSession on the same
 // session (`selfcal run --resume`), started by a person, which re-reads the robot and re-checks the plan.
 //
+// A new session is created only once the run can start: RunContext::create_session is called after the
+// robot answered, the preflight passed and the operator confirmed, so a dry run, a refusal or an
+// unreachable robot leave nothing behind.
+//
 // Resume: the journal decides. RunSession continues at the first pose with neither an accepted sample
 // nor a final skip (session/samples.h), with the dots of the last accepted sample as the tracker's state;
 // if the robot is no longer where that sample was taken (beyond the start tolerance) it first returns
-// there (a move of its own in the preview) and re-finds the dots in a frame at that pose.
+// there (a move of its own in the preview) and re-finds the dots in a frame at that pose. Poses skipped
+// for revisitable reasons (too_few_dots, not_settled, bad_frame, bad_reading) are visited again, at most
+// RunOptions::revisit_skipped times each over the session: the route then starts at the accepted pose
+// before the first of them and walks the plan, passing the accepted poses on the way without recording
+// them (their moves are the plan's, so the tracker keeps the identities).
 #pragma once
 
 #include <atomic>
@@ -89,6 +97,7 @@ struct RunOptions {
   std::uint64_t frame_bytes_estimate = 400 * 1024;  // P5: free space needed per frame
   bool journal_sim_clock = false;   // simulated sessions: journal the clock with each sample (resume)
   std::string mode = "simulated";   // session_started.mode
+  int revisit_skipped = 1;          // resume: further attempts per pose skipped for a revisitable reason
   std::string Validate() const;     // empty when valid
 };
 
@@ -119,7 +128,11 @@ struct RunContext {
   robot::Robot* robot = nullptr;
   capture::FrameSource* camera = nullptr;
   robot::Clock* clock = nullptr;
+  // The session to continue (a resume), or null with create_session: called once the operator confirmed,
+  // just before the first record; returns the new session (owned by the caller) or why it could not be
+  // made (the run then ends in kSessionError, nothing having moved).
   session::Session* session = nullptr;
+  std::function<Result<session::Session*>()> create_session;
   DotIdentifier* identifier = nullptr;
   // Polled between every step; set by a signal handler (the handler only sets it, R11).
   const std::atomic<bool>* stop_requested = nullptr;

@@ -26,10 +26,11 @@ struct RobotAtStart {
 };
 
 // The poses this invocation visits: back to the last accepted sample's pose if the arm left it (resume),
-// then the plan from the resume point.
+// then the plan from the resume point; accepted poses between revisited ones are passed, not recorded.
 struct Route {
   std::vector<PlannedPose> poses;
   std::vector<int> plan_index;  // plan index per route entry; the return move has the sample's pose
+  std::vector<bool> pass;       // per route entry: visited without recording (the return, an accepted pose)
   bool returning = false;       // poses[0] is the return move
 };
 
@@ -73,16 +74,22 @@ class Runner {
   Step HaltOnRobotError(const Status& status, int pose, const std::string& what);
 
   // Before the first move (session_runner.cc); each returns false when the run ends there, report_ set.
-  // C9 (the journal's plan is this one) and the resume point *first; also false when every pose is done.
-  bool StartFromJournal(const session::SessionLog& log, int* first);
+  // C9 (the journal's plan is this one) and the poses to visit *todo (in plan order: the resume point
+  // and the revisits); also false when every pose is done.
+  bool StartFromJournal(const session::SessionLog& log, std::vector<int>* todo);
   // Connect, identity and limits (limits_), R13 (the robot the session started with), where the arm is.
   bool ConnectRobot(const session::SessionLog& log, RobotAtStart* robot);
-  // Sets the tracker's state from the last accepted sample when resuming.
-  Route PlanRoute(const session::SessionLog& log, int first, const Eigen::VectorXd& now_rad);
+  // Sets the tracker's state from the accepted sample the route starts from when resuming.
+  Route PlanRoute(const session::SessionLog& log, const std::vector<int>& todo, const Eigen::VectorXd& now_rad);
   // V1 (the camera works), preflight of the whole route, the preview and the operator's confirmation.
   bool Arm(const Route& route, const RobotAtStart& robot);
+  // The return move to the route's starting sample (its dots found again at its joints; R4).
+  Step ReturnTo(const PlannedPose& target, int pose, Eigen::VectorXd* expected);
+  // A new session made through create_session (c_.session set), after the confirmation.
+  bool CreateSession();
   // The start (or the resumption) and the plan's poses, journaled before the first command.
-  bool JournalStart(const session::SessionLog& log, int first, const robot::RobotIdentity& identity);
+  bool JournalStart(const session::SessionLog& log, const std::vector<int>& todo,
+                    const robot::RobotIdentity& identity);
 
   // One pose of the route (session_pose.cc): kEnd when the run ends there, else the next pose follows
   // (the pose was recorded, skipped, or was the return move).
@@ -113,7 +120,7 @@ class Runner {
   void FindMarkedAgain(const capture::Frame& frame);
 
   const std::vector<PlannedPose>& plan_;
-  const RunContext& c_;
+  RunContext c_;  // a copy: c_.session is set when the run creates its session
   const RunOptions& o_;
   RunReport report_;
   robot::JointLimits limits_;

@@ -47,6 +47,9 @@ struct SimulatedRobotFaults {
   // comes earlier) the arm is displaced by jog_offset_rad, as if someone had jogged it.
   std::set<int> jog_after_moves;
   Eigen::VectorXd jog_offset_rad;  // one entry per joint; empty: 0.02 rad on joint 0
+  // Counted from the arm's true arrival (the end of the quintic), which precedes the moment a session
+  // polls the status as idle. 0.5 s falls inside a simulated session's 0.6 s settle dwell; a delay between
+  // its settle time and its next frame jogs between settle and capture (`selfcal run --fault-jog-delay-s`).
   double jog_delay_s = 0.5;
   // R7: the ring-down after move k decays 20 times slower (settle_tau_s * 20).
   std::set<int> slow_settle_moves;

@@ -306,18 +306,42 @@ bool IsFinalSkipReason(const std::string& reason) {
   return kFinal.count(reason) > 0;
 }
 
-bool SessionLog::PoseDone(int pose) const {
-  if (pose < 0 || pose >= static_cast<int>(plan.size())) return false;
-  if (accepted[pose]) return true;
-  return std::any_of(skips[pose].begin(), skips[pose].end(),
-                     [](const SkippedSample& skip) { return IsFinalSkipReason(skip.reason); });
+bool IsRevisitableSkipReason(const std::string& reason) {
+  static const std::set<std::string> kRevisitable = {"too_few_dots", "not_settled", "bad_frame", "bad_reading"};
+  return kRevisitable.count(reason) > 0;
 }
 
-int SessionLog::FirstPoseWithoutAcceptedSample() const {
+bool SessionLog::PoseDone(int pose, int max_revisits) const {
+  if (pose < 0 || pose >= static_cast<int>(plan.size())) return false;
+  if (accepted[pose]) return true;
+  int final_skips = 0;
+  for (const SkippedSample& skip : skips[pose]) {
+    if (!IsFinalSkipReason(skip.reason)) continue;
+    if (!IsRevisitableSkipReason(skip.reason)) return true;
+    ++final_skips;
+  }
+  return final_skips > std::max(0, max_revisits);
+}
+
+int SessionLog::FirstPoseWithoutAcceptedSample(int max_revisits) const {
   for (int pose = 0; pose < num_poses; ++pose) {
-    if (!PoseDone(pose)) return pose;
+    if (!PoseDone(pose, max_revisits)) return pose;
   }
   return num_poses;
+}
+
+std::vector<int> SessionLog::PosesToVisit(int max_revisits) const {
+  std::vector<int> poses;
+  for (int pose = 0; pose < num_poses; ++pose) {
+    if (!PoseDone(pose, max_revisits)) poses.push_back(pose);
+  }
+  return poses;
+}
+
+int SessionLog::SkippedThenAccepted() const {
+  int n = 0;
+  for (std::size_t pose = 0; pose < accepted.size(); ++pose) n += accepted[pose] && !skips[pose].empty() ? 1 : 0;
+  return n;
 }
 
 int SessionLog::NumAccepted() const {

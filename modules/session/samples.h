@@ -78,6 +78,11 @@ struct SkippedSample {
 // halt is not a skip.
 bool IsFinalSkipReason(const std::string& reason);
 
+// Whether a final skip reason may be retried by a resumed session (`selfcal run --resume
+// --revisit-skipped N`): too_few_dots (a fault such as a jog can lose the dots for a few poses),
+// not_settled, bad_frame and bad_reading (transient). move_failed and no_frame are not retried.
+bool IsRevisitableSkipReason(const std::string& reason);
+
 struct SessionLog {
   bool started = false;  // the journal has its session_started record (an empty journal has not)
   int num_poses = 0;
@@ -99,11 +104,18 @@ struct SessionLog {
 
   // Every pose of session_started has its pose_planned record.
   bool plan_complete() const { return static_cast<int>(plan.size()) == num_poses; }
-  // The pose has an accepted sample or a final skip (IsFinalSkipReason).
-  bool PoseDone(int pose) const;
+  // The pose has an accepted sample or a final skip (IsFinalSkipReason). With `max_revisits` > 0, a pose
+  // whose final skips all have revisitable reasons (IsRevisitableSkipReason) is done only once it was
+  // skipped more than max_revisits times: a resume retries it at most max_revisits times in all.
+  bool PoseDone(int pose, int max_revisits = 0) const;
   // The resume point: the first pose in [0, num_poses) that is not PoseDone (a pose not planned yet is
   // not done); num_poses when every pose is done.
-  int FirstPoseWithoutAcceptedSample() const;
+  int FirstPoseWithoutAcceptedSample(int max_revisits = 0) const;
+  // Every pose that is not PoseDone(pose, max_revisits), in plan order.
+  std::vector<int> PosesToVisit(int max_revisits) const;
+  // Skipped poses that a later sample_accepted took (a revisit): their skips stay in skips and
+  // skips_by_reason (every skip record counts), and the pose counts as accepted.
+  int SkippedThenAccepted() const;
   int NumAccepted() const;
   // The accepted sample appended last (journal order; duplicates ignored), for the tracker state on
   // resume; nullptr when there is none.

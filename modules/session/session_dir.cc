@@ -233,7 +233,10 @@ Result<SessionInput> ReadInputFile(const std::string& name, const std::string& p
 
 bool IsSessionDirectory(const std::string& path) {
   struct stat st {};
-  return ::stat((std::filesystem::path(path) / kManifestFileName).c_str(), &st) == 0;
+  for (const char* entry : {kManifestFileName, kLockFileName, kInputsDirName, kJournalFileName}) {
+    if (::stat((std::filesystem::path(path) / entry).c_str(), &st) == 0) return true;
+  }
+  return false;
 }
 
 Status CheckSessionLayout(const std::string& path) {
@@ -306,8 +309,15 @@ Result<SessionManifest> ReadManifest(const std::string& session_path, std::strin
   bool missing = false;
   Result<std::string> text = ReadFileCapped(file, kMaxManifestBytes, &missing);
   if (missing) {
-    return Usage(session_path + " is not a selfcal session: it has no " + kManifestFileName +
-                 " (or its creation was interrupted)");
+    struct stat st {};
+    if (::stat(Join(session_path, kLockFileName).c_str(), &st) == 0 ||
+        ::stat(Join(session_path, kInputsDirName).c_str(), &st) == 0) {
+      return Usage("session " + session_path + " was never completely created (its creation was interrupted: no " +
+                   kManifestFileName + "), so nothing was recorded in it: complete it with `selfcal run --resume "
+                   "--session " + session_path + "` (the same options) or remove it with `selfcal session discard " +
+                   session_path + "`");
+    }
+    return Usage(session_path + " is not a selfcal session: it has no " + kManifestFileName);
   }
   if (!text.ok()) return WithErrnoErrorCode(text.status());
   if (sha256 != nullptr) *sha256 = Sha256Hex(*text);

@@ -129,7 +129,7 @@ class Session {
 // plain file name or repeats, an input exceeds kMaxInputBytes, or an option is invalid. Writes, in order:
 // the directory, the lock (held by the returned Session), inputs/ (each file atomically, then 0444),
 // images/, an empty journal, and session.json last (atomically): a directory without session.json is an
-// interrupted creation, which OpenSession refuses. Errors after the directory exists leave it in place.
+// interrupted creation, which OpenSession refuses (session_cleanup.h completes or removes it). Errors after the directory exists leave it in place.
 Result<Session> CreateSession(const std::string& path, const SessionInputs& inputs, const std::string& software_version,
                               const CreateOptions& options);
 
@@ -149,8 +149,9 @@ Result<Session> CreateSession(const std::string& path, const SessionInputs& inpu
 Result<Session> OpenSession(const std::string& path, const SessionInputs& expected, bool allow_changed_inputs,
                             const JournalLimits& journal_limits = JournalLimits());
 
-// True when `path` holds a session.json: what `selfcal calibrate` reads as a session rather than as an
-// observations file (whether the session is whole is ReadSession's to say).
+// True when `path` holds a session.json, or the lock, inputs/ or journal.log of an interrupted creation:
+// what `selfcal calibrate` reads as a session rather than as an observations file (whether the session is
+// whole is ReadSession's to say; ReadManifest names an interrupted creation).
 bool IsSessionDirectory(const std::string& path);
 
 // Reads and validates `<session>/session.json` without locking or changing anything; *sha256 (optional)

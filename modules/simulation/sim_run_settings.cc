@@ -58,6 +58,11 @@ Result<SimCellOptions> SimCellOptionsFor(const nlohmann::json& run_json, const s
     if (!Get(faults, key, name + " faults", &v, &problem)) return Status::Error(ErrorCode::kInvalidInput, problem);
     set->insert(v.begin(), v.end());
   }
+  if (faults.contains("jog_delay_s")) {  // written only when not the default
+    if (!Get(faults, "jog_delay_s", name + " faults", &o.faults.jog_delay_s, &problem)) {
+      return Status::Error(ErrorCode::kInvalidInput, problem);
+    }
+  }
   return o;
 }
 

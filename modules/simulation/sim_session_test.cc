@@ -364,6 +364,45 @@ TEST(SessionRunner, DryRunOnARealBackendSendsItNoMotionCommand) {  // R12, F8 (a
   EXPECT_EQ(h.cell.robot->counts().start_move, 0);  // nor to the simulated one
 }
 
+// The times of `pose` (move #pose): the arm's true arrival (the robot's, before the loop sees it idle),
+// the journaled settle and the accepted frame's exposure.
+struct PoseTimes {
+  double arrival_s = 0, settle_s = 0, exposure_s = 0;
+};
+PoseTimes TimesOf(Harness& h, int pose) {
+  PoseTimes t;
+  double started_s = 0;
+  for (const nlohmann::json& r : h.session->journal().records()) {
+    if (r.value("pose", -1) != pose) continue;
+    if (r["type"] == "move_started") started_s = r["time_s"];
+    if (r["type"] == "settled") t.settle_s = r["time_s"];
+    if (r["type"] == "frame_written") t.exposure_s = r["exposure_time_s"];
+  }
+  for (const robot::AcceptedMove& move : h.cell.robot->accepted_moves()) {
+    if (move.command_time_s >= started_s) return t.arrival_s = move.start_time_s + move.duration_s, t;
+  }
+  return t;
+}
+
+// A person's --resume: a new cell at rest where the last accepted sample was taken, its clock at the
+// journaled time, with `faults` (counted afresh), revisiting skipped poses at most `revisit` times.
+acquisition::RunReport Resume(Harness& h, const robot::SimulatedRobotFaults& faults, int revisit) {
+  const session::SessionLog log = h.Log();
+  const session::AcceptedSample* last = log.LastAcceptedSample();
+  EXPECT_NE(last, nullptr);
+  SimCellOptions options;
+  options.camera.render.supersampling = 4;
+  options.camera.render.noise_std_grey = 2;
+  options.faults = faults;
+  Result<SimCell> restarted =
+      MakeSimCell(testing::Puma560(), h.plan, options, h.plan[last->pose].joints_rad, last->sim_clock_s.value());
+  EXPECT_TRUE(restarted.ok());
+  h.cell = std::move(restarted).value();
+  h.camera = std::make_unique<capture::FaultyFrameSource>(h.cell.camera.get(), capture::FrameFaults());
+  h.options.revisit_skipped = revisit;
+  return h.Run();
+}
+
 // A stopped session continued by a second RunSession (a person's --resume) on a cell rebuilt where the
 // last accepted sample left the arm gives the very samples an uninterrupted session gives (P3, F4).
 TEST(SessionRunner, ResumedSessionEqualsTheUninterruptedOne) {
@@ -380,19 +419,8 @@ TEST(SessionRunner, ResumedSessionEqualsTheUninterruptedOne) {
   const session::AcceptedSample* last = stopped.LastAcceptedSample();
   ASSERT_NE(last, nullptr);
   // The restart: a new cell at rest at the last sample's target, the clock at its journaled time.
-  SimCellOptions options;
-  options.camera.render.supersampling = 4;
-  options.camera.render.noise_std_grey = 2;
-  Result<SimCell> restarted =
-      MakeSimCell(testing::Puma560(), h.plan, options, h.plan[last->pose].joints_rad, last->sim_clock_s.value());
-  ASSERT_TRUE(restarted.ok());
   h.stop = false;
-  acquisition::RunContext c2 = h.Context();
-  c2.robot = restarted->robot.get();
-  c2.camera = restarted->camera.get();
-  c2.clock = restarted->clock.get();
-  c2.identifier = restarted->identifier.get();
-  const acquisition::RunReport resumed = acquisition::RunSession(h.plan, c2, h.options);
+  const acquisition::RunReport resumed = Resume(h, robot::SimulatedRobotFaults(), h.options.revisit_skipped);
   ASSERT_EQ(resumed.outcome, acquisition::RunOutcome::kCompleted) << resumed.message;
   EXPECT_EQ(resumed.first_pose, last->pose + 1);
   const session::SessionLog a = clean.Log(), b = h.Log();
@@ -407,6 +435,98 @@ TEST(SessionRunner, ResumedSessionEqualsTheUninterruptedOne) {
     }
     EXPECT_EQ(a.accepted[p]->joints_rad, b.accepted[p]->joints_rad);
   }
+}
+
+}  // namespace
+}  // namespace selfcal::simulation
+
+namespace selfcal::simulation {
+namespace {
+
+// R4 between settle and capture: pose 3 is jogged after the session saw it settle and before its frame,
+// so the frame no longer matches the tracked dots and the pose is skipped; the next move is refused.
+robot::SimulatedRobotFaults JogBetweenSettleAndCapture(int move, const PoseTimes& clean) {
+  robot::SimulatedRobotFaults f;
+  f.jog_after_moves = {move};
+  f.jog_delay_s = 0.5 * (clean.settle_s + clean.exposure_s) - clean.arrival_s;
+  f.jog_offset_rad = Eigen::VectorXd::Zero(6);
+  f.jog_offset_rad[0] = 0.15;  // enough to lose most tracked dots (0.1 rad is not, at this seed)
+  return f;
+}
+
+// A clean run of 8 poses (the times of pose 3) and the cell options that jog the arm at pose 3.
+struct JoggedAtPose3 {
+  JoggedAtPose3() {
+    EXPECT_EQ(clean.Run().outcome, acquisition::RunOutcome::kCompleted);
+    times = TimesOf(clean, 3);
+    options.faults = JogBetweenSettleAndCapture(3, times);
+  }
+  Harness clean{8};
+  PoseTimes times;
+  SimCellOptions options;
+};
+
+TEST(SessionRunner, JogBetweenSettleAndCaptureThenResumeRevisitsTheSkippedPose) {  // R4, issue 12 item 6
+  JoggedAtPose3 jog;
+  Harness& clean = jog.clean;
+  const PoseTimes& times = jog.times;
+  Harness h(8, jog.options);
+  const acquisition::RunReport first = h.Run();
+  EXPECT_EQ(first.halt_reason, "start_state_mismatch") << first.message;
+  // The jog came after the settle and before the exposure (the times are those of the clean run).
+  const PoseTimes seen = TimesOf(h, 3);
+  EXPECT_EQ(seen.settle_s, times.settle_s);
+  EXPECT_NEAR((h.cell.robot->JointsAt(seen.settle_s + 1e-3) - h.cell.robot->JointsAt(seen.settle_s - 1e-3)).norm(),
+              0, 1e-9);
+  EXPECT_NEAR((h.cell.robot->JointsAt(times.exposure_s) - h.cell.robot->JointsAt(times.settle_s)).norm(), 0.15, 1e-9);
+  session::SessionLog log = h.Log();
+  ASSERT_EQ(log.skips[3].size(), 1u);
+  EXPECT_EQ(log.skips[3][0].reason, "too_few_dots");
+
+  const acquisition::RunReport resumed = Resume(h, robot::SimulatedRobotFaults(), 1);
+  ASSERT_EQ(resumed.outcome, acquisition::RunOutcome::kCompleted) << resumed.message;
+  EXPECT_EQ(resumed.first_pose, 3);
+  log = h.Log();
+  EXPECT_EQ(log.NumAccepted(), 8);
+  EXPECT_EQ(log.SkippedThenAccepted(), 1);
+  EXPECT_EQ(log.skips_by_reason.at("too_few_dots"), 1);  // the skip record stays; the pose counts as accepted
+  ASSERT_TRUE(log.accepted[3]);
+  EXPECT_GE(log.accepted[3]->dots.size(), clean.Log().accepted[3]->dots.size() * 9 / 10);
+  // Every dot of the revisited sample against the truth, on the restarted arm's history (a swap: > 10 px).
+  const sim::SimTruth& truth = h.cell.world->truth;
+  const Rigid3 cam_from_base =
+      BaseFromCam(truth.nominal, truth.rho_true, h.cell.robot->JointsAt(log.accepted[3]->exposure_time_s)).Inverse();
+  for (const session::SampleDot& d : log.accepted[3]->dots) {
+    const auto uv = Project(truth.camera_true, cam_from_base * truth.dots_in_base[d.id]);
+    EXPECT_LT((*uv - Eigen::Vector2d(d.u_px, d.v_px)).norm(), 1.0) << "dot " << d.id;
+  }
+}
+
+TEST(SessionRunner, RevisitsOfSkippedPosesStayWithinTheOperatorsBound) {  // issue 12 item 6
+  JoggedAtPose3 jog;
+  const PoseTimes& times = jog.times;
+  Harness h(8, jog.options);
+  h.Run();
+  // 0: today's rule, the skip is final.
+  acquisition::RunReport r = Resume(h, robot::SimulatedRobotFaults(), 0);
+  ASSERT_EQ(r.outcome, acquisition::RunOutcome::kCompleted) << r.message;
+  EXPECT_EQ(r.first_pose, 4);
+  EXPECT_FALSE(h.Log().accepted[3]);
+  // 1: one more attempt; the arm returns to p02 and is jogged again at p03 (move #1 of this run).
+  robot::SimulatedRobotFaults again = JogBetweenSettleAndCapture(1, times);
+  r = Resume(h, again, 1);
+  EXPECT_EQ(r.first_pose, 3);
+  EXPECT_EQ(h.Log().skips[3].size(), 2u);
+  // The bound is spent: nothing is left to visit.
+  r = Resume(h, robot::SimulatedRobotFaults(), 1);
+  EXPECT_EQ(r.outcome, acquisition::RunOutcome::kCompleted);
+  EXPECT_EQ(r.message, "every pose of the session is done");
+  EXPECT_EQ(h.cell.robot->counts().start_move, 0);
+  // A larger bound allows a third attempt, which succeeds without the jog.
+  r = Resume(h, robot::SimulatedRobotFaults(), 2);
+  ASSERT_EQ(r.outcome, acquisition::RunOutcome::kCompleted) << r.message;
+  EXPECT_TRUE(h.Log().accepted[3]);
+  EXPECT_EQ(h.Log().NumAccepted(), 8);
 }
 
 }  // namespace

@@ -310,14 +310,17 @@ TEST(CliSession, HardwareFaultExitsFourAndResumeFinishesTheSession) {  // R9, ex
   ASSERT_EQ(RunSelfcal("calibrate " + session + " --out " + (dir / "cal").string(), &output), 3) << output;
 }
 
-TEST(CliSession, DryRunPrintsThePreviewAndRecordsNothing) {  // R1, F8
+TEST(CliSession, DryRunPrintsThePreviewAndCreatesNothing) {  // R1, F8
   const fs::path dir = FreshDir("run_dry");
-  const std::string session = (dir / "s").string();
+  const std::string session = (dir / "sessions" / "s").string();
   std::string output;
   ASSERT_EQ(RunSelfcal("run --dry-run --session " + session + " --seed 3", &output), 0) << output;
   EXPECT_NE(output.find("dry run: nothing moved"), std::string::npos) << output;
   EXPECT_NE(output.find("25 moves"), std::string::npos) << output;
-  EXPECT_EQ(fs::file_size(fs::path(session) / "journal.log"), 0u);
+  EXPECT_FALSE(fs::exists(dir / "sessions")) << output;  // neither the session nor its parent folder
+  // The real run that follows is not refused.
+  ASSERT_EQ(RunSelfcal("run --session " + session + " --seed 3", &output), 0) << output;
+  EXPECT_TRUE(fs::exists(fs::path(session) / "session.json"));
 }
 
 // selfcal name-dots on a recorded frame: the annotated PNG, a setup that `run --setup` accepts with the
