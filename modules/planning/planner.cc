@@ -220,6 +220,14 @@ bool PoseFits(const PlanningProblem& problem, const std::vector<Eigen::VectorXd>
   if (i > 0 && i < problem.num_identification_poses && AxisSine<double>(views[0], view) < c.min_axis_sine) return false;
   if (i > 0 && (q - poses[i - 1]).lpNorm<Eigen::Infinity>() > c.max_joint_travel_rad) return false;
   if (i + 1 < m && (q - poses[i + 1]).lpNorm<Eigen::Infinity>() > c.max_joint_travel_rad) return false;
+  // The moves into and out of pose i within the image-motion bound.
+  const std::vector<Eigen::Vector2d> here = DotImages(problem, q);
+  for (int k : {i - 1, i + 1}) {
+    if (k >= 0 && k < m &&
+        !(ImageMotionBetween(DotImages(problem, poses[k]), here).median_px <= c.max_image_motion_px)) {
+      return false;
+    }
+  }
   return true;
 }
 
@@ -320,16 +328,17 @@ void PlanExchange(const PlanningProblem& problem, const PlannerOptions& options,
       if (s == slot) continue;
       if (chosen[s] == cand) return false;
       if ((views[cand].translation - views[chosen[s]].translation).norm() < c.min_spread_m) return false;
-      // Pairwise joint travel and image motion within the bounds: any visit order then respects them.
+      // Pairwise joint travel within the bound: any visit order then respects it.
       if ((candidates[cand] - candidates[chosen[s]]).lpNorm<Eigen::Infinity>() > c.max_joint_travel_rad) return false;
-      if (!(ImageMotionBetween(images[cand], images[chosen[s]]).median_px <= c.max_image_motion_px)) return false;
     }
     if (m > m_id && (candidates[cand] - result->poses[m_id]).lpNorm<Eigen::Infinity>() > c.max_joint_travel_rad) {
       return false;
     }
-    if (m > m_id && !(ImageMotionBetween(images[cand], first_verification).median_px <= c.max_image_motion_px)) {
-      return false;
-    }
+    // Image motion of the moves into and out of the slot (the visit order is the slots'): every exchange
+    // keeps each move within the bound.
+    if (!(ImageMotionBetween(images[chosen[slot - 1]], images[cand]).median_px <= c.max_image_motion_px)) return false;
+    const std::vector<Eigen::Vector2d>& next = slot + 1 < m_id ? images[chosen[slot + 1]] : first_verification;
+    if (!next.empty() && !(ImageMotionBetween(images[cand], next).median_px <= c.max_image_motion_px)) return false;
     for (const Rigid3& v : verification) {
       if ((views[cand].translation - v.translation).norm() < c.min_spread_m) return false;
     }
