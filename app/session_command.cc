@@ -182,6 +182,12 @@ Status LoadRunPlan(const RunSettings& a, RunPlan* run) {
   if (!plan_file.ok()) return plan_file.status();
   run->plan = PlanPoses(*plan_file);
   run->plan_check = acquisition::PlanToCheck{run->nominal, io::PlanSubjectOf(*plan_file)};
+  // The plan check against the robot config before the simulated cell is built for the plan; the preflight
+  // repeats it with the controller's limits.
+  const planning::PlanCheck check = planning::CheckPlanFor(&run->nominal, run->plan_check->plan, nullptr);
+  if (!check.ok) {
+    return Status::Error(ErrorCode::kDegenerateData, acquisition::PreflightRefusal(acquisition::PreflightProblems(check)));
+  }
   run->inputs = {*robot_input, *plan_input, {"run.json", RunJson(a).dump(2) + "\n"}};
   // The simulated cell is built before the session so that its setup can be recorded.
   if (a.robot_backend == "sim") {

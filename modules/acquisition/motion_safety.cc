@@ -22,6 +22,20 @@ std::string MotionSafetyOptions::Validate() const {
   return out.str();
 }
 
+std::string PreflightRefusal(const std::vector<std::string>& problems) {
+  std::string text = "preflight refused the plan:\n";
+  for (const std::string& p : problems) text += "  " + p + "\n";
+  return text;
+}
+
+std::vector<std::string> PreflightProblems(const planning::PlanCheck& check) {
+  std::vector<std::string> lines;
+  for (const planning::PlanProblemItem& p : check.problems) {
+    lines.push_back(std::string(planning::PlanIssueName(p.issue)) + ": " + p.message);
+  }
+  return lines;
+}
+
 PreflightReport Preflight(const std::vector<PlannedPose>& plan, const robot::JointLimits& limits,
                           const Eigen::VectorXd& start_rad, const MotionSafetyOptions& options, int first_pose,
                           const PlanToCheck* whole_plan) {
@@ -56,9 +70,7 @@ PreflightReport Preflight(const std::vector<PlannedPose>& plan, const robot::Joi
     route.max_joint_travel_rad = options.max_joint_travel_rad;
     report.check = planning::CheckPlanFor(nullptr, route, &controller);
   }
-  for (const planning::PlanProblemItem& p : report.check.problems) {
-    problem(std::string(planning::PlanIssueName(p.issue)) + ": " + p.message);
-  }
+  for (const std::string& p : PreflightProblems(report.check)) problem(p);
   if (!report.problems.empty()) return report;
 
   char text[256];

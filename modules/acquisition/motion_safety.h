@@ -53,6 +53,11 @@ struct PreflightReport {
   std::string Preview(const std::vector<PlannedPose>& plan, double velocity_scaling) const;
 };
 
+// "preflight refused the plan:" and one line per problem: the words of every refusal of a plan by run.
+std::string PreflightRefusal(const std::vector<std::string>& problems);
+// The plan check's problems as the preflight lists them ("joint_limit: pose p03 joint 2 = ...").
+std::vector<std::string> PreflightProblems(const planning::PlanCheck& check);
+
 // With `whole_plan`: planning::CheckPlanFor of the whole plan against its robot config and the
 // controller's `limits`; without: the same check of the route `plan` (from `first_pose`, named by its
 // ids) against the controller's limits alone. Then the move from `start_rad` to the first pose (travel

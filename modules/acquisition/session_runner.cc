@@ -180,8 +180,7 @@ bool Runner::Arm(const Route& route, const RobotAtStart& robot) {
                     (route.returning ? "first returning to the pose of the last accepted sample, then\n" : "") +
                     preflight.Preview(route.poses, o_.safety.velocity_scaling);
   if (!preflight.ok()) {
-    report_.message = "preflight refused the plan:\n";
-    for (const std::string& p : preflight.problems) report_.message += "  " + p + "\n";
+    report_.message = PreflightRefusal(preflight.problems);
     return false;
   }
   if (!c_.confirm(report_.preview, identity)) {
