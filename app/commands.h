@@ -18,5 +18,7 @@ Command AddMakeTrajectoryCommand(CLI::App& app);
 Command AddTrackerCommand(CLI::App& app);
 Command AddPlanCommand(CLI::App& app);
 Command AddRunCommand(CLI::App& app);
+Command AddAuditCommand(CLI::App& app);
+Command AddNameDotsCommand(CLI::App& app);
 
 }  // namespace selfcal::app

@@ -18,6 +18,8 @@ int main(int argc, char** argv) {
   const selfcal::app::Command identify_tracker = selfcal::app::AddTrackerCommand(app);
   const selfcal::app::Command plan = selfcal::app::AddPlanCommand(app);
   const selfcal::app::Command run = selfcal::app::AddRunCommand(app);
+  const selfcal::app::Command audit = selfcal::app::AddAuditCommand(app);
+  const selfcal::app::Command name_dots = selfcal::app::AddNameDotsCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -29,7 +31,7 @@ int main(int argc, char** argv) {
     for (const auto& [name, command] :
          {std::pair{"calibrate", calibrate}, {"simulate", simulate}, {"study", study},
           {"identifiability", identifiability}, {"make-trajectory", make_trajectory}, {"identify-tracker", identify_tracker}, {"plan", plan},
-          {"run", run}}) {
+          {"run", run}, {"audit", audit}, {"name-dots", name_dots}}) {
       if (app.got_subcommand(name)) return command();
     }
   } catch (const std::exception& e) {

@@ -22,6 +22,7 @@
 #include "io/robot_config.h"
 #include "io/trajectory_file.h"
 #include "acquisition/session_runner.h"
+#include "simulation/sim_run_settings.h"
 #include "simulation/sim_session.h"
 #include "robot/manual_robot.h"
 #include "robot/network_robot.h"
@@ -90,25 +91,9 @@ json RunJson(const RunSettings& a) {
             {"short_reads", a.fault_short_reads}}}};
 }
 
+// The simulated cell of these settings, through their run.json (the recorded form an audit rebuilds from).
 simulation::SimCellOptions SimCellOptionsFor(const RunSettings& a) {
-  simulation::SimCellOptions o;
-  o.world.world_seed = a.seed;
-  o.world.noise_seed = a.seed;
-  o.world.pixel_noise_px = 0.02;  // the centroid noise the solvers are told (measured 0.01 px at grey noise 2)
-  o.camera.render.noise_std_grey = a.grey_noise;
-  o.camera.render.blur_sigma_px = a.blur_px;
-  o.camera.render.supersampling = a.supersampling;
-  auto set = [](const std::vector<int>& v) { return std::set<int>(v.begin(), v.end()); };
-  o.faults.reject_moves = set(a.fault_reject_moves);
-  o.faults.protective_stop_moves = set(a.fault_pstop_moves);
-  o.faults.hang_moves = set(a.fault_hang_moves);
-  o.faults.disconnect_moves = set(a.fault_disconnect_moves);
-  o.faults.jog_after_moves = set(a.fault_jog_after_moves);
-  o.faults.slow_settle_moves = set(a.fault_slow_settle_moves);
-  o.faults.stale_reads = set(a.fault_stale_reads);
-  o.faults.nan_reads = set(a.fault_nan_reads);
-  o.faults.short_reads = set(a.fault_short_reads);
-  return o;
+  return simulation::SimCellOptionsFor(RunJson(a)).value();
 }
 
 // Typed confirmation before a real backend moves (R1): the operator types the robot's serial.
@@ -149,6 +134,7 @@ struct Backends {
   robot::Clock* clock = nullptr;
   acquisition::DetectionOrderIdentifier order_identifier;
   acquisition::DotIdentifier* identifier = &order_identifier;
+  std::unique_ptr<acquisition::DotIdentifier> owned_identifier;  // --identify
 };
 
 // Refuses backend combinations that cannot work and fills in the default velocity scaling.
@@ -256,11 +242,20 @@ robot::JointLimits ManualJointLimits(const RobotModel& nominal) {
 
 // Stage 3: the robot, camera, clock and dot identifier of the run.
 Status MakeBackends(const RunSettings& a, RunPlan* run, Backends* b) {
+  if (!a.identify.method.empty()) {  // acquisition/identifiers.h; the reference dots come from setup.json
+    std::string setup_text;
+    for (const session::SessionInput& input : run->inputs) {
+      if (input.name == session::kSetupFileName) setup_text = input.contents;
+    }
+    auto chosen = MakeIdentifier(a.identify, "order", setup_text, a.setup.empty() ? "setup.json" : a.setup);
+    if (!chosen.ok()) return chosen.status();
+    b->owned_identifier = std::move(chosen).value();
+  }
   if (a.robot_backend == "sim") {
     b->arm = run->cell->robot.get();
     b->camera = run->cell->camera.get();
     b->clock = run->cell->clock.get();
-    b->identifier = run->cell->identifier.get();
+    b->identifier = b->owned_identifier ? b->owned_identifier.get() : run->cell->identifier.get();
     return Status::Ok();
   }
   b->owned_clock = std::make_unique<robot::MonotonicClock>();
@@ -281,6 +276,7 @@ Status MakeBackends(const RunSettings& a, RunPlan* run, Backends* b) {
   options.device = a.device;
   b->owned_camera = std::make_unique<capture::V4l2Camera>(options);
   b->camera = b->owned_camera.get();
+  if (b->owned_identifier) b->identifier = b->owned_identifier.get();
   return Status::Ok();
 }
 
@@ -362,6 +358,7 @@ Command AddRunCommand(CLI::App& app) {
   cmd->add_option("--grey-noise", a->grey_noise, "sim: pixel noise std, grey levels")->check(CLI::Range(0.0, 50.0));
   cmd->add_option("--blur-px", a->blur_px, "sim: Gaussian blur sigma, px")->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--supersampling", a->supersampling, "sim: samples per pixel side")->check(CLI::Range(1, 8));
+  AddIdentifyOptions(cmd, &a->identify, "default: the simulator's truth with sim, else order");
   auto fault = [&](const char* name, std::vector<int>* v, const char* what) {
     cmd->add_option(name, *v, what)->delimiter(',')->group("Simulated faults (sim robot, 0-based call counts)");
   };

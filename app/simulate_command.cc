@@ -19,6 +19,7 @@
 #include "io/trajectory_file.h"
 #include "sim/sim_world.h"
 #include "sim/trajectory_generator.h"
+#include "simulation/session_audit.h"
 
 namespace selfcal::app {
 
@@ -208,6 +209,24 @@ std::string FreshSessionPath(const std::string& out) {
   }
 }
 
+// The session's dot identities against the world it ran in, and what the calibration kept of the plan's
+// observations (poses x dots) and check distances: printed and added to the comparison.
+Status AddIdentityAudit(const sim::SimResult& world, const std::string& session, const CalibrationRun& calibrated,
+                        nlohmann::json* comparison) {
+  Result<simulation::IdentityAudit> audit = simulation::AuditRecordedIdentities(world, session);
+  if (!audit.ok()) return audit.status();
+  int observations = 0;
+  for (const PoseObservation& pose : calibrated.observations.poses) observations += static_cast<int>(pose.dots_px.size());
+  const int possible = audit->poses_planned * static_cast<int>(world.truth.dots_in_base.size());
+  const calibration::VerificationSummary& checks = calibrated.report.verification_calibrated();
+  std::cout << "dot identities: " << simulation::IdentityAuditSummary(*audit) << "\nkept " << observations << " of "
+            << possible << " observations, " << checks.num_ok << " of " << checks.checks.size() << " check distances\n";
+  (*comparison)["identities"] = simulation::IdentityAuditJson(*audit);
+  (*comparison)["identities"]["observations_kept"] = {{"kept", observations}, {"of", possible}};
+  (*comparison)["identities"]["check_distances_kept"] = {{"kept", checks.num_ok}, {"of", checks.checks.size()}};
+  return Status::Ok();
+}
+
 // selfcal simulate (default): the simulated arm and rendered camera through a real session directory, the
 // offline calibration of that session, and the comparison with the hidden truth.
 int SimulateSession(const SimulateArgs& args) {
@@ -245,6 +264,7 @@ int SimulateSession(const SimulateArgs& args) {
     comparison["bundle"] = CompareBundleWithTruth(world, obs, *result.bundle, false, std::cout);
   }
   comparison["seconds"] = {{"session", run_s}, {"session_and_calibration", total_s}};
+  if (Status s = AddIdentityAudit(world, run.session, calibrated, &comparison); !s.ok()) return Fail(s);
   if (Status s = io::WriteJsonFile(comparison, (std::filesystem::path(args.out) / "comparison_with_truth.json").string());
       !s.ok()) {
     return Fail(s);

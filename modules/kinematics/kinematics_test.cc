@@ -100,7 +100,7 @@ TEST(Kinematics, ApplyParametersRoundTrip) {
 TEST(Kinematics, InverseKinematicsReachesTarget) {
   const RobotModel puma = Puma560();
   const Eigen::VectorXd rho = KinematicParameters::Nominal(puma);
-  const Eigen::VectorXd q_true = (Eigen::VectorXd(6) << 0.2, -0.6, 0.8, 0.3, -0.6, 0.4).finished();
+  const Eigen::VectorXd q_true = (Eigen::VectorXd(6) << 0.2, -0.6, -0.8, 0.3, -0.6, 0.4).finished();
   const Rigid3 target = BaseFromCam(puma, rho, q_true);
   Eigen::VectorXd seed = q_true + Eigen::VectorXd::Constant(6, 0.1);
   Eigen::VectorXd q;

@@ -1,5 +1,8 @@
 #include "session/setup_file.h"
 
+#include <cmath>
+#include <set>
+
 #include <nlohmann/json.hpp>
 
 namespace selfcal::session {
@@ -14,21 +17,46 @@ json KnownDistancesJson(const std::vector<KnownDistance>& distances) {
   return a;
 }
 
+// The optional naming keys (setup_file.h) into *naming; an error message, or empty.
+std::string ParseNaming(const json& j, SetupNaming* naming) {
+  if (j.contains("reference_image")) naming->reference_image = j.at("reference_image").get<std::string>();
+  if (!j.contains("reference_dots")) return "";
+  std::set<int> ids;
+  for (const json& d : j.at("reference_dots")) {
+    const ReferenceDot r{d.at("id").get<int>(), d.at("u_px").get<double>(), d.at("v_px").get<double>(),
+                         d.at("area_px2").get<double>()};
+    if (r.id < 0 || !ids.insert(r.id).second) return "reference_dots: id " + std::to_string(r.id) + " is negative or repeated";
+    if (!std::isfinite(r.u_px) || !std::isfinite(r.v_px) || !(r.area_px2 >= 0)) {
+      return "reference_dots: id " + std::to_string(r.id) + " has a non-finite position or a negative area";
+    }
+    naming->reference_dots.push_back(r);
+  }
+  return "";
+}
+
 }  // namespace
 
-std::string SetupFileText(const ObservationSet& setup) {
+std::string SetupFileText(const ObservationSet& setup, const SetupNaming& naming) {
   const CameraIntrinsics& c = setup.camera;
-  const json j = {{"format", kSetupFormatName},
-                  {"version", kSetupFormatVersion},
-                  {"camera", {{"width_px", c.width_px}, {"height_px", c.height_px}, {"fx_px", c.fx_px}, {"mu", c.mu},
-                              {"cx_px", c.cx_px}, {"cy_px", c.cy_px}, {"k1", c.k1}}},
-                  {"pixel_noise_px", setup.pixel_noise_px},
-                  {"yardsticks", KnownDistancesJson(setup.yardsticks)},
-                  {"check_distances", KnownDistancesJson(setup.check_distances)}};
+  json j = {{"format", kSetupFormatName},
+            {"version", kSetupFormatVersion},
+            {"camera", {{"width_px", c.width_px}, {"height_px", c.height_px}, {"fx_px", c.fx_px}, {"mu", c.mu},
+                        {"cx_px", c.cx_px}, {"cy_px", c.cy_px}, {"k1", c.k1}}},
+            {"pixel_noise_px", setup.pixel_noise_px},
+            {"yardsticks", KnownDistancesJson(setup.yardsticks)},
+            {"check_distances", KnownDistancesJson(setup.check_distances)}};
+  if (!naming.reference_image.empty()) j["reference_image"] = naming.reference_image;
+  if (!naming.reference_dots.empty()) {
+    json dots = json::array();
+    for (const ReferenceDot& d : naming.reference_dots) {
+      dots.push_back({{"id", d.id}, {"u_px", d.u_px}, {"v_px", d.v_px}, {"area_px2", d.area_px2}});
+    }
+    j["reference_dots"] = dots;
+  }
   return j.dump(2) + "\n";
 }
 
-Status ParseSetupFile(const std::string& text, const std::string& name, ObservationSet* set) {
+Status ParseSetupFile(const std::string& text, const std::string& name, ObservationSet* set, SetupNaming* naming) {
   auto bad = [&](const std::string& why) { return Status::Error(ErrorCode::kInvalidInput, name + ": " + why); };
   json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (j.is_discarded() || !j.is_object()) return bad("not a JSON object");
@@ -50,6 +78,9 @@ Status ParseSetupFile(const std::string& text, const std::string& name, Observat
       for (const json& d : j.at(key)) {
         out.push_back({d.at("dot_a").get<int>(), d.at("dot_b").get<int>(), d.at("length_m").get<double>()});
       }
+    }
+    if (naming != nullptr) {
+      if (const std::string why = ParseNaming(j, naming); !why.empty()) return bad(why);
     }
   } catch (const json::exception& e) {
     return bad(std::string("missing or mistyped key: ") + e.what());

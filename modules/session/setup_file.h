@@ -1,10 +1,13 @@
 // setup.json, a session input (docs/session-format.md, "What selfcal run writes"): what a calibration
 // needs beside the robot and the samples. Format `selfcal-session-setup` version 1: camera {width_px,
 // height_px, fx_px (the nominal f_x), mu, cx_px, cy_px, k1}, pixel_noise_px, yardsticks and
-// check_distances as [{dot_a, dot_b, length_m}].
+// check_distances as [{dot_a, dot_b, length_m}]; optional (written by `selfcal name-dots`, ignored by
+// readers that do not need them): reference_dots [{id, u_px, v_px, area_px2}] (the named dots of the frame
+// the operator saw) and reference_image (where that frame came from).
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "base/status.h"
 #include "observations/observation_set.h"
@@ -15,13 +18,30 @@ inline constexpr const char* kSetupFileName = "setup.json";
 inline constexpr const char* kSetupFormatName = "selfcal-session-setup";
 inline constexpr int kSetupFormatVersion = 1;
 
+// A dot as the operator saw it named in one frame (pixels as tracking/dot_detector.h).
+struct ReferenceDot {
+  int id = -1;
+  double u_px = 0;
+  double v_px = 0;
+  double area_px2 = 0;
+};
+
+// The optional naming keys of setup.json. Empty: the keys are not written.
+struct SetupNaming {
+  std::vector<ReferenceDot> reference_dots;
+  std::string reference_image;
+};
+
 // The setup.json text (2-space indented JSON and a newline) of the camera, pixel noise, yardsticks and
-// check distances of `setup`; its robot and poses are not part of it.
-std::string SetupFileText(const ObservationSet& setup);
+// check distances of `setup`, and the naming keys of `naming` when it has any; the robot and poses of
+// `setup` are not part of it.
+std::string SetupFileText(const ObservationSet& setup, const SetupNaming& naming = {});
 
 // Parses setup.json text into the camera, pixel_noise_px, yardsticks and check_distances of *set (its
-// robot and poses are left alone). kInvalidInput naming `name` for another format or version, a missing or
-// mistyped key, or a non-positive camera size, fx_px or pixel noise.
-Status ParseSetupFile(const std::string& text, const std::string& name, ObservationSet* set);
+// robot and poses are left alone) and, when `naming` is given, the optional naming keys. kInvalidInput
+// naming `name` for another format or version, a missing or mistyped key, a non-positive camera size,
+// fx_px or pixel noise, or reference dots with a repeated id or a non-finite position.
+Status ParseSetupFile(const std::string& text, const std::string& name, ObservationSet* set,
+                      SetupNaming* naming = nullptr);
 
 }  // namespace selfcal::session

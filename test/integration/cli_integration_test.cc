@@ -369,5 +369,63 @@ TEST(CliSession, DryRunPrintsThePreviewAndRecordsNothing) {  // R1, F8
   EXPECT_EQ(fs::file_size(fs::path(session) / "journal.log"), 0u);
 }
 
+// selfcal name-dots on a recorded frame: the annotated PNG, a setup that `run --setup` accepts with the
+// reference identifier, and a yardstick id that was not detected refused naming it.
+TEST(CliNameDots, NamesARecordedFrameWritesThePngAndASetupThatRunAccepts) {
+  const fs::path dir = FreshDir("name_dots");
+  const std::string frame = std::string(SELFCAL_SOURCE_DIR) + "/test/data/sequences/puma_arc_clean/frame_000000.png";
+  const std::string setup = (dir / "setup.json").string();
+  const std::string png = (dir / "named.png").string();
+  std::string output;
+  // A yardstick end that is not a detected dot: refused, nothing written.
+  EXPECT_EQ(RunSelfcal("name-dots --image " + frame + " --setup " + setup + " --out " + png +
+                           " --fx-px 1000 --pixel-noise-px 0.02 --yardstick 3,9999 --length-mm 200", &output), 2)
+      << output;
+  EXPECT_NE(output.find("9999"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(setup));
+  EXPECT_EQ(RunSelfcal("name-dots --image " + frame + " --setup " + setup + " --out " + png +
+                           " --fx-px 1000 --pixel-noise-px 0.02 --yardstick 3,3 --length-mm 200", &output), 2)
+      << output;
+  ASSERT_EQ(RunSelfcal("name-dots --image " + frame + " --setup " + setup + " --out " + png +
+                           " --fx-px 1000 --pixel-noise-px 0.02 --yardstick 3,10 --length-mm 200", &output), 0)
+      << output;
+  std::ifstream png_in(png, std::ios::binary);
+  std::string magic(8, '\0');
+  png_in.read(&magic[0], 8);
+  EXPECT_EQ(magic, std::string("\x89PNG\r\n\x1a\n", 8));
+  const nlohmann::json written = ReadJson(setup);
+  EXPECT_EQ(written["version"], 1);
+  ASSERT_EQ(written["yardsticks"].size(), 1u);
+  EXPECT_EQ(written["yardsticks"][0]["dot_a"], 3);
+  EXPECT_EQ(written["yardsticks"][0]["dot_b"], 10);
+  EXPECT_DOUBLE_EQ(written["yardsticks"][0]["length_m"].get<double>(), 0.2);
+  // Every reference dot is a row of the printed table (id u v area).
+  ASSERT_GT(written["reference_dots"].size(), 10u);
+  for (const nlohmann::json& d : written["reference_dots"]) {
+    char row[64];
+    std::snprintf(row, sizeof(row), "%8d %10.2f %10.2f", d["id"].get<int>(), d["u_px"].get<double>(), d["v_px"].get<double>());
+    EXPECT_NE(output.find(row), std::string::npos) << row;
+  }
+  // An update keeps the yardstick unless a new one is given.
+  ASSERT_EQ(RunSelfcal("name-dots --image " + frame + " --setup " + setup + " --out " + png, &output), 0) << output;
+  EXPECT_EQ(ReadJson(setup)["yardsticks"], written["yardsticks"]);
+  // run takes it with the reference identifier; it only stops at the camera this machine does not have.
+  const fs::path joints = dir / "joints.txt";
+  std::ofstream(joints) << "0 0 0 0 0 0\n";
+  const std::string run = "run --robot manual --camera v4l2 --device " + (dir / "no-video").string() + " --setup " +
+                          setup + " --identify reference --session " + (dir / "s").string();
+  EXPECT_EQ(RunSelfcal(run + " < " + joints.string(), &output), 4) << output;
+  EXPECT_NE(output.find("opening the camera"), std::string::npos) << output;
+  // Without reference dots the reference identifier is refused before anything moves.
+  nlohmann::json bare = written;
+  bare.erase("reference_dots");
+  std::ofstream(dir / "bare.json") << bare.dump(2);
+  EXPECT_EQ(RunSelfcal("run --robot manual --camera v4l2 --setup " + (dir / "bare.json").string() +
+                           " --identify reference --session " + (dir / "s2").string() + " < " + joints.string(), &output),
+            2)
+      << output;
+  EXPECT_NE(output.find("name-dots"), std::string::npos) << output;
+}
+
 }  // namespace
 }  // namespace selfcal

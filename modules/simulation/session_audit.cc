@@ -1,0 +1,83 @@
+#include "simulation/session_audit.h"
+
+#include "io/robot_config.h"
+#include "session/samples.h"
+#include "session/session_snapshot.h"
+#include "session/setup_file.h"
+#include "simulation/sim_run_settings.h"
+#include "simulation/sim_session.h"
+
+namespace selfcal::simulation {
+
+namespace {
+
+Status Refuse(const std::string& message) { return Status::Error(ErrorCode::kInvalidInput, message); }
+
+// The recorded session's run settings, refused unless they are the simulated robot's and camera's.
+Result<SimCellOptions> SimulatedRunOptions(const session::SessionSnapshot& snapshot, const std::string& path) {
+  Result<std::string> text = snapshot.Input("run.json");
+  if (!text.ok()) return text.status();
+  const std::string name = path + "/inputs/run.json";
+  const nlohmann::json run = nlohmann::json::parse(*text, nullptr, /*allow_exceptions=*/false);
+  if (run.is_discarded()) return Refuse(name + ": not valid JSON");
+  if (!IsSimulatedRun(run)) {
+    return Refuse("session " + path + " was recorded with robot \"" + run.value("robot", "?") + "\" and camera \"" +
+                  run.value("camera", "?") + "\" (" + name +
+                  "): only a session recorded with the simulated robot and camera (run --robot sim --camera sim) "
+                  "has a hidden truth to audit against");
+  }
+  return SimCellOptionsFor(run, name);
+}
+
+// The world `selfcal run` built for this session, rebuilt from its inputs and checked against setup.json.
+Result<SimCell> RebuildWorld(const session::SessionSnapshot& snapshot, const session::SessionLog& log,
+                             const SimCellOptions& options, const std::string& path) {
+  Result<std::string> robot_text = snapshot.Input("robot.yaml");
+  if (!robot_text.ok()) return robot_text.status();
+  Result<RobotModel> nominal = io::ParseRobotModelText(*robot_text, path + "/inputs/robot.yaml");
+  if (!nominal.ok()) return nominal.status();
+  if (!log.plan_complete() || log.plan.empty()) {
+    return Refuse("session " + path + ": the journal holds " + std::to_string(log.plan.size()) + " of " +
+                  std::to_string(log.num_poses) + " planned poses; the world cannot be rebuilt without the plan");
+  }
+  Result<SimCell> cell = MakeSimCell(*nominal, log.plan, options, log.plan.front().joints_rad, 0);
+  if (!cell.ok()) return cell.status();
+  Result<std::string> setup = snapshot.Input(session::kSetupFileName);
+  if (!setup.ok()) return setup.status();
+  if (session::SetupFileText(SimSetup(*cell)) != *setup) {
+    return Refuse("session " + path + ": the simulated world rebuilt from robot.yaml, the journal's plan and run.json "
+                  "does not reproduce the recorded " + path + "/inputs/setup.json (recorded by another version?); "
+                  "its identities cannot be scored");
+  }
+  return cell;
+}
+
+}  // namespace
+
+Result<IdentityAudit> AuditRecordedIdentities(const sim::SimResult& world, const std::string& session_path,
+                                              const IdentityAuditOptions& options) {
+  Result<session::SessionSnapshot> snapshot = session::ReadSession(session_path);
+  if (!snapshot.ok()) return snapshot.status();
+  Result<session::SessionLog> log = session::ReadSessionLog(snapshot->records);
+  if (!log.ok()) return log.status();
+  return AuditIdentities(world, *log, options);
+}
+
+Result<SessionAudit> AuditSession(const std::string& session_path, const IdentityAuditOptions& options) {
+  Result<session::SessionSnapshot> snapshot = session::ReadSession(session_path);
+  if (!snapshot.ok()) return snapshot.status();
+  Result<SimCellOptions> cell_options = SimulatedRunOptions(*snapshot, session_path);
+  if (!cell_options.ok()) return cell_options.status();
+  Result<session::SessionLog> log = session::ReadSessionLog(snapshot->records);
+  if (!log.ok()) return log.status();
+  Result<SimCell> cell = RebuildWorld(*snapshot, *log, *cell_options, session_path);
+  if (!cell.ok()) return cell.status();
+  SessionAudit audit;
+  audit.session_path = session_path;
+  audit.robot_name = cell->world->truth.nominal.name;
+  audit.seed = cell_options->world.world_seed;
+  audit.identities = AuditIdentities(*cell->world, *log, options);
+  return audit;
+}
+
+}  // namespace selfcal::simulation
