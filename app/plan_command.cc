@@ -20,7 +20,7 @@ namespace {
 
 struct PlanArgs {
   std::string robot = "config/robots/puma560.yaml";
-  std::string start = "config/trajectories/initial_puma560.yaml";
+  std::string start;  // default: config/trajectories/initial_<robot name>.yaml
   std::string out = "out/plan.yaml";
   std::string check;
   std::string criterion = "eq39";
@@ -31,10 +31,12 @@ struct PlanArgs {
   std::vector<double> box_center_mm, box_size_mm;
   int box_dots = 80;
   uint64_t sim_world_seed = 1;
-  std::string scene_from = "config/trajectories/initial_puma560.yaml";
+  std::string scene_from;  // default: the start
   double fx_px = 1000, noise_px = 0.2;
   int width = 640, height = 480;
-  double image_margin_px = 5, joint_margin_deg = 5, min_spread_mm = 20, min_axis_sine = 0.08, max_travel_deg = 90;
+  double image_margin_px = 5, joint_margin_deg = 5, min_spread_mm = 20, min_axis_sine = 0, max_travel_deg = 90;
+  double max_image_motion_px = planning::PlanConstraints().max_image_motion_px;
+  double max_fx_stddev_rel = planning::PlanConstraints().max_fx_stddev_rel;
   double min_depth_mm = 250, max_depth_mm = 2000;
 };
 
@@ -45,10 +47,23 @@ std::string Fixed(double v, int digits) {
 }
 
 void PrintCheck(const planning::PlanCheck& check, std::ostream& out) {
+  if (check.image_motion.empty()) {  // the robot-level checks only
+    out << "  max joint travel " << Fixed(RadToDeg(check.max_joint_travel_rad), 1) << " deg\n";
+    std::istringstream lines(check.Summary());
+    for (std::string line; !check.ok && std::getline(lines, line);) out << "  PROBLEM " << line << "\n";
+    return;
+  }
   out << "  min camera spread " << Fixed(check.min_spread_m * 1e3, 1) << " mm, min axis sine "
-      << Fixed(check.min_axis_sine, 4) << ", min image margin " << Fixed(check.min_image_margin_px, 1)
-      << " px, max joint travel " << Fixed(RadToDeg(check.max_joint_travel_rad), 1) << " deg, identifiable "
-      << check.identifiable << "/" << check.generic_identifiable << "\n";
+      << Fixed(check.min_axis_sine, 4) << " (" << check.pairs_below_paper_axis_sine
+      << " pairs (reference, i) below 0.08: the paper method's f_x), f_x std " << Fixed(check.predicted_fx_stddev_px, 3)
+      << " px, min image margin " << Fixed(check.min_image_margin_px, 1) << " px, max joint travel "
+      << Fixed(RadToDeg(check.max_joint_travel_rad), 1) << " deg, identifiable " << check.identifiable << "/"
+      << check.generic_identifiable << "\n";
+  if (!check.image_motion.empty()) {
+    out << "  image motion per move (median px):";
+    for (const planning::MoveImageMotion& m : check.image_motion) out << " " << Fixed(m.median_px, 0);
+    out << "; largest " << Fixed(check.max_image_motion_px, 1) << " px\n";
+  }
   if (!check.ok) {
     std::istringstream lines(check.Summary());
     for (std::string line; std::getline(lines, line);) out << "  PROBLEM " << line << "\n";
@@ -82,7 +97,9 @@ void PrintObservability(const planning::ObservabilityReport& r, const RobotModel
 
 void AddPlanOptions(CLI::App* cmd, PlanArgs* args) {
   AddRobotOption(cmd, &args->robot);
-  cmd->add_option("--start", args->start, "Start trajectory (feasible; offending poses are repaired from a pool)");
+  cmd->add_option("--start", args->start,
+                  "Start trajectory (offending poses are repaired from a pool); default: "
+                  "config/trajectories/initial_<robot name>.yaml");
   cmd->add_option("--out", args->out, "Plan file to write");
   cmd->add_option("--check", args->check, "Check this plan instead of planning (exit 3 when it has problems)");
   cmd->add_option("--criterion", args->criterion, "eq39 (the paper's), d-optimal or a-optimal");
@@ -98,7 +115,7 @@ void AddPlanOptions(CLI::App* cmd, PlanArgs* args) {
   cmd->add_option("--sim-world-seed", args->sim_world_seed,
                   "Without a box: the simulator's scene of this world seed (dry runs)");
   cmd->add_option("--scene-from", args->scene_from,
-                  "Without a box: the trajectory the simulator's scene is placed for (the same for plan and --check)");
+                  "Without a box: the trajectory the simulator's scene is placed for (default: the start)");
   cmd->add_option("--fx-px", args->fx_px, "Nominal focal length (px)")->check(CLI::Range(1.0, 1e6));
   cmd->add_option("--width", args->width, "Image width (px)")->check(CLI::Range(16, 100000));
   cmd->add_option("--height", args->height, "Image height (px)")->check(CLI::Range(16, 100000));
@@ -106,7 +123,13 @@ void AddPlanOptions(CLI::App* cmd, PlanArgs* args) {
   cmd->add_option("--image-margin-px", args->image_margin_px, "Scene points this far inside every image");
   cmd->add_option("--joint-margin-deg", args->joint_margin_deg, "Inside the joint limits by this");
   cmd->add_option("--min-spread-mm", args->min_spread_mm, "Camera centres at least this far apart");
-  cmd->add_option("--min-axis-sine", args->min_axis_sine, "Optical axes of (reference, i) apart (f_x observable)");
+  cmd->add_option("--min-axis-sine", args->min_axis_sine,
+                  "The paper method's f_x per pair: optical axes of (reference, i) apart (0: no constraint; 0.08 for "
+                  "--method paper)");
+  cmd->add_option("--max-image-motion-px", args->max_image_motion_px,
+                  "Median image motion of the scene's dots per move (tracking keeps the dots' identities)");
+  cmd->add_option("--max-fx-stddev-rel", args->max_fx_stddev_rel,
+                  "f_x from the identification poses as a set: bundle Cramer-Rao std / f_x at --noise-px");
   cmd->add_option("--max-travel-deg", args->max_travel_deg, "Largest joint change between consecutive poses");
   cmd->add_option("--min-depth-mm", args->min_depth_mm, "Nearest scene depth");
   cmd->add_option("--max-depth-mm", args->max_depth_mm, "Farthest scene depth");
@@ -130,6 +153,9 @@ planning::PlanningProblem MakeProblem(const PlanArgs& args, const RobotModel& ro
   c.max_joint_travel_rad = DegToRad(args.max_travel_deg);
   c.min_depth_m = args.min_depth_mm * 1e-3;
   c.max_depth_m = args.max_depth_mm * 1e-3;
+  c.max_image_motion_px = args.max_image_motion_px;
+  c.max_fx_stddev_rel = args.max_fx_stddev_rel;
+  c.pixel_noise_px = args.noise_px;
   return problem;
 }
 
@@ -160,14 +186,26 @@ std::optional<int> SetScene(const PlanArgs& args, const RobotModel& robot, plann
   return std::nullopt;
 }
 
-// --check: the plan's constraints and observability; exit 3 when it has problems.
-int CheckOnly(const PlanArgs& args, const planning::PlanningProblem& problem, const io::TrajectoryFile& file,
-              const std::string& plan_path) {
-  std::cout << "plan " << plan_path << ": " << file.poses.size() << " poses, " << problem.num_identification_poses
-            << " identify\n";
-  const planning::PlanCheck check = planning::CheckPlan(problem, file.poses);
+// --check: the one check of the plan file against the robot config (planning::CheckPlanFor, the same as
+// run's preflight) and the observability of its planned_for scene; exit 3 when it has problems.
+int CheckOnly(const PlanArgs& args, const RobotModel& robot, const io::TrajectoryFile& file, const std::string& plan_path) {
+  const planning::PlanSubject subject = io::PlanSubjectOf(file);
+  std::cout << "plan " << plan_path << ": " << file.poses.size() << " poses, "
+            << (file.num_identification_poses > 0 ? std::to_string(file.num_identification_poses) : "default")
+            << " identify, robot " << (file.robot.empty() ? "not named" : file.robot) << "\n";
+  const planning::PlanCheck check = planning::CheckPlanFor(&robot, subject, nullptr);
+  for (const std::string& line : check.scope) std::cout << "  checked: " << line << "\n";
   PrintCheck(check, std::cout);
-  PrintObservability(planning::AnalyzeObservability(problem, file.poses, args.noise_px), problem.robot, std::cout);
+  if (file.planned_for && check.ok) {
+    planning::PlanningProblem problem;
+    problem.robot = robot;
+    problem.camera = file.planned_for->camera;
+    problem.scene = file.planned_for->scene;
+    problem.constraints = file.planned_for->constraints;
+    problem.num_identification_poses = file.num_identification_poses > 0 ? file.num_identification_poses
+                                                                         : std::min<int>(15, file.poses.size());
+    PrintObservability(planning::AnalyzeObservability(problem, file.poses, args.noise_px), robot, std::cout);
+  }
   std::cout << (check.ok ? "plan ok\n" : "plan refused: " + std::to_string(check.problems.size()) + " problems\n");
   return check.ok ? 0 : static_cast<int>(ExitCode::kDegenerateData);
 }
@@ -192,7 +230,9 @@ int WritePlan(const PlanArgs& args, planning::Criterion criterion, const plannin
   plan.poses = r.poses;
   plan.robot = problem.robot.name;
   plan.num_identification_poses = problem.num_identification_poses;
-  plan.description = "planned from " + plan_path + " by selfcal plan";
+  plan.description = "planned from " + plan_path + " by `selfcal plan --robot " + args.robot + " --criterion " +
+                     planning::CriterionName(criterion) + " --seed " + std::to_string(args.seed) + "` (docs/planning.md)";
+  plan.planned_for = planning::PlannedFor{problem.camera, problem.scene, problem.constraints};
   std::ostringstream provenance;
   provenance << "criterion " << planning::CriterionName(criterion) << ", lambda " << args.lambda << ", seed " << args.seed
              << ", pool " << args.pool << "; eq39 " << r.eq39_start.total << " -> " << r.eq39_final.total
@@ -234,16 +274,19 @@ int RunPlanCommand(const PlanArgs& args) {
   if (!planning::ParseCriterion(args.criterion, &criterion)) {
     return Fail(Status::Error(ErrorCode::kInvalidInput, "--criterion `" + args.criterion + "`: expected eq39, d-optimal or a-optimal"));
   }
-  const std::string plan_path = args.check.empty() ? args.start : args.check;
+  PlanArgs a = args;  // the defaults follow the robot
+  if (a.start.empty()) a.start = "config/trajectories/initial_" + robot->name + ".yaml";
+  if (a.scene_from.empty()) a.scene_from = a.start;
+  const std::string plan_path = a.check.empty() ? a.start : a.check;
   Result<io::TrajectoryFile> file = io::LoadTrajectoryFile(ResolveDataPath(plan_path), robot->num_joints());
   if (!file.ok()) return Fail(file.status());
-  planning::PlanningProblem problem = MakeProblem(args, *robot, *file);
-  if (const std::optional<int> code = SetScene(args, *robot, &problem)) return *code;
+  if (!a.check.empty()) return CheckOnly(a, *robot, *file, plan_path);
+  planning::PlanningProblem problem = MakeProblem(a, *robot, *file);
+  if (const std::optional<int> code = SetScene(a, *robot, &problem)) return *code;
   if (const std::string invalid = problem.Validate(); !invalid.empty()) {
     return Fail(Status::Error(ErrorCode::kInvalidInput, "plan options: " + invalid));
   }
-  if (!args.check.empty()) return CheckOnly(args, problem, *file, plan_path);
-  return PlanAndWrite(args, criterion, problem, *file, plan_path);
+  return PlanAndWrite(a, criterion, problem, *file, plan_path);
 }
 
 }  // namespace

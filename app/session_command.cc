@@ -124,6 +124,7 @@ bool ConfirmOnTerminal(const std::string& preview, const robot::RobotIdentity& i
 struct RunPlan {
   RobotModel nominal;
   std::vector<acquisition::PlannedPose> plan;
+  std::optional<acquisition::PlanToCheck> plan_check;  // the whole plan file, for the preflight
   session::SessionInputs inputs;
   Result<simulation::SimCell> cell = Status::Error(ErrorCode::kInvalidInput, "no simulated cell");
 };
@@ -167,9 +168,17 @@ Status LoadRunPlan(const RunSettings& a, RunPlan* run) {
   run->nominal = *nominal;
   Result<session::SessionInput> plan_input = session::ReadInputFile("plan.yaml", ResolveDataPath(a.plan));
   if (!plan_input.ok()) return plan_input.status();
-  Result<io::TrajectoryFile> plan_file = io::LoadTrajectoryFile(ResolveDataPath(a.plan), run->nominal);
+  // The robot name and limits are the plan check's (preflight), in the words of `plan --check`.
+  Result<io::TrajectoryFile> plan_file = io::LoadTrajectoryFile(ResolveDataPath(a.plan), run->nominal.num_joints());
   if (!plan_file.ok()) return plan_file.status();
   run->plan = PlanPoses(*plan_file);
+  run->plan_check = acquisition::PlanToCheck{run->nominal, io::PlanSubjectOf(*plan_file)};
+  // The plan check against the robot config before the simulated cell is built for the plan; the preflight
+  // repeats it with the controller's limits.
+  const planning::PlanCheck check = planning::CheckPlanFor(&run->nominal, run->plan_check->plan, nullptr);
+  if (!check.ok) {
+    return Status::Error(ErrorCode::kDegenerateData, acquisition::PreflightRefusal(acquisition::PreflightProblems(check)));
+  }
   run->inputs = {*robot_input, *plan_input, {"run.json", RunJson(a).dump(2) + "\n"}};
   // The simulated cell is built before the session so that its setup can be recorded.
   if (a.robot_backend == "sim") {
@@ -344,6 +353,7 @@ int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, se
   InstallStopHandlers();
   acquisition::RunOptions options;
   options.safety.velocity_scaling = a.velocity_scaling;
+  options.plan_check = run.plan_check;
   options.journal_sim_clock = sim_robot;
   options.mode = sim_robot ? "simulated" : a.robot_backend;
   options.revisit_skipped = a.revisit_skipped;

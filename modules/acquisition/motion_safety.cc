@@ -1,5 +1,6 @@
 #include "acquisition/motion_safety.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -21,8 +22,23 @@ std::string MotionSafetyOptions::Validate() const {
   return out.str();
 }
 
+std::string PreflightRefusal(const std::vector<std::string>& problems) {
+  std::string text = "preflight refused the plan:\n";
+  for (const std::string& p : problems) text += "  " + p + "\n";
+  return text;
+}
+
+std::vector<std::string> PreflightProblems(const planning::PlanCheck& check) {
+  std::vector<std::string> lines;
+  for (const planning::PlanProblemItem& p : check.problems) {
+    lines.push_back(std::string(planning::PlanIssueName(p.issue)) + ": " + p.message);
+  }
+  return lines;
+}
+
 PreflightReport Preflight(const std::vector<PlannedPose>& plan, const robot::JointLimits& limits,
-                          const Eigen::VectorXd& start_rad, const MotionSafetyOptions& options, int first_pose) {
+                          const Eigen::VectorXd& start_rad, const MotionSafetyOptions& options, int first_pose,
+                          const PlanToCheck* whole_plan) {
   PreflightReport report;
   auto problem = [&](const std::string& text) { report.problems.push_back(text); };
   const std::string invalid = options.Validate();
@@ -32,48 +48,32 @@ PreflightReport Preflight(const std::vector<PlannedPose>& plan, const robot::Joi
     problem("the robot reports no joint limits: refusing to move (R3)");
     return report;
   }
-  if (limits.max_velocity_rad_s.size() != n) {
-    problem("the robot reports no joint velocity limits: moves cannot be timed or bounded (R3)");
-    return report;
-  }
-  for (int j = 0; j < n; ++j) {
-    if (!(limits.max_velocity_rad_s[j] > 0 && std::isfinite(limits.max_velocity_rad_s[j]))) {
-      problem("joint " + std::to_string(j + 1) + ": velocity limit " + std::to_string(limits.max_velocity_rad_s[j]) +
-              " rad/s is not a positive number (R3)");
-    }
-  }
   if (plan.empty()) problem("the plan has no poses");
   if (start_rad.size() != n || !start_rad.allFinite()) {
     problem("the robot's current joint reading has " + std::to_string(start_rad.size()) +
             " values or non-finite ones; expected " + std::to_string(n) + " finite values (R8)");
   }
   if (!report.problems.empty()) return report;
-
-  char text[256];
-  for (size_t i = static_cast<size_t>(first_pose); i < plan.size(); ++i) {
-    const PlannedPose& p = plan[i];
-    if (p.joints_rad.size() != n) {
-      std::snprintf(text, sizeof(text), "pose %s: %d joint values, the robot has %d (C5)", p.id.c_str(),
-                    static_cast<int>(p.joints_rad.size()), n);
-      problem(text);
-      continue;
+  const planning::ControllerLimits controller{limits.lower_rad, limits.upper_rad, limits.max_velocity_rad_s};
+  if (whole_plan != nullptr) {
+    planning::PlanSubject subject = whole_plan->plan;
+    subject.joint_margin_rad = std::max(subject.joint_margin_rad, options.limit_margin_rad);
+    subject.max_joint_travel_rad = std::min(subject.max_joint_travel_rad, options.max_joint_travel_rad);
+    report.check = planning::CheckPlanFor(&whole_plan->robot, subject, &controller);
+  } else {
+    planning::PlanSubject route;
+    for (size_t i = static_cast<size_t>(first_pose); i < plan.size(); ++i) {
+      route.poses.push_back(plan[i].joints_rad);
+      route.pose_ids.push_back(plan[i].id);
     }
-    for (int j = 0; j < n; ++j) {
-      const double q = p.joints_rad[j];
-      if (!std::isfinite(q)) {
-        std::snprintf(text, sizeof(text), "pose %s joint %d: value is not finite (C5)", p.id.c_str(), j + 1);
-        problem(text);
-      } else if (q < limits.lower_rad[j] + options.limit_margin_rad || q > limits.upper_rad[j] - options.limit_margin_rad) {
-        std::snprintf(text, sizeof(text),
-                      "pose %s joint %d: %.3f deg is outside the limits [%.3f, %.3f] deg less a margin of %.3f deg (C6)",
-                      p.id.c_str(), j + 1, RadToDeg(q), RadToDeg(limits.lower_rad[j]), RadToDeg(limits.upper_rad[j]),
-                      RadToDeg(options.limit_margin_rad));
-        problem(text);
-      }
-    }
+    route.joint_margin_rad = options.limit_margin_rad;
+    route.max_joint_travel_rad = options.max_joint_travel_rad;
+    report.check = planning::CheckPlanFor(nullptr, route, &controller);
   }
+  for (const std::string& p : PreflightProblems(report.check)) problem(p);
   if (!report.problems.empty()) return report;
 
+  char text[256];
   Eigen::VectorXd from = start_rad;
   std::string from_name = "the current position";
   for (size_t i = static_cast<size_t>(first_pose); i < plan.size(); ++i) {
@@ -116,6 +116,7 @@ std::string PreflightReport::Preview(const std::vector<PlannedPose>& plan, doubl
   std::snprintf(line, sizeof(line), "%zu moves, %.1f s of motion at velocity scaling %.0f %%\n", moves.size(),
                 total_motion_s, 100 * velocity_scaling);
   out << line;
+  for (const std::string& line : check.scope) out << "checked: " << line << "\n";
   for (const std::string& p : problems) out << "REFUSED: " << p << "\n";
   return out.str();
 }

@@ -1,7 +1,9 @@
-// Motion safety before the first move (RELIABILITY.md C5, C6, R1-R3, design rule 3): the whole plan is
-// checked against the robot's limits and the per-move joint travel bound, the moves are timed within the
-// velocity limits times the scaling, and the operator gets a preview to confirm. Pure functions: no
-// robot is touched here.
+// Motion safety before the first move (RELIABILITY.md C5, C6, R1-R3, design rule 3): the plan is checked
+// by planning::CheckPlanFor, the same check and words as `selfcal plan --check` (robot name, limits of the
+// config and of the controller less the margin, per-move travel, velocity limits, and the plan's
+// geometry when its file records `planned_for`); the first move from where the arm is is bounded too, the
+// moves are timed within the velocity limits times the scaling, and the operator gets a preview to
+// confirm. Pure functions: no robot is touched here.
 #pragma once
 
 #include <string>
@@ -9,7 +11,9 @@
 
 #include <Eigen/Core>
 
+#include "kinematics/robot_model.h"
 #include "observations/observation_set.h"
+#include "planning/plan_check.h"
 #include "robot/robot.h"
 #include "session/planned_pose.h"
 
@@ -26,6 +30,12 @@ struct MotionSafetyOptions {
   std::string Validate() const;                  // empty when valid
 };
 
+// The whole plan as its file gave it and the robot config: what CheckPlanFor checks.
+struct PlanToCheck {
+  RobotModel robot;
+  planning::PlanSubject plan;
+};
+
 struct MoveSummary {
   int pose = -1;                  // the target pose (index in the plan)
   double max_travel_rad = 0;      // largest joint travel of the move
@@ -35,6 +45,7 @@ struct MoveSummary {
 
 struct PreflightReport {
   std::vector<std::string> problems;  // each names the pose, joint, value and bound; empty = go
+  planning::PlanCheck check;          // the plan check's verdict, figures and scope
   std::vector<MoveSummary> moves;     // start -> pose 0 -> pose 1 ...
   double total_motion_s = 0;
   bool ok() const { return problems.empty(); }
@@ -42,10 +53,17 @@ struct PreflightReport {
   std::string Preview(const std::vector<PlannedPose>& plan, double velocity_scaling) const;
 };
 
-// Checks every pose of `plan` (joint count and finiteness [C5], limits less the margin [C6]) and every
-// move from `start_rad` through the plan in order (travel bound [R2]); refuses absent or non-positive
-// velocity limits [R3]. `first_pose` skips the poses before it (a resumed session starts there).
+// "preflight refused the plan:" and one line per problem: the words of every refusal of a plan by run.
+std::string PreflightRefusal(const std::vector<std::string>& problems);
+// The plan check's problems as the preflight lists them ("joint_limit: pose p03 joint 2 = ...").
+std::vector<std::string> PreflightProblems(const planning::PlanCheck& check);
+
+// With `whole_plan`: planning::CheckPlanFor of the whole plan against its robot config and the
+// controller's `limits`; without: the same check of the route `plan` (from `first_pose`, named by its
+// ids) against the controller's limits alone. Then the move from `start_rad` to the first pose (travel
+// bound [R2]) and the timing of every move. `first_pose` skips the poses before it (a resumed session).
 PreflightReport Preflight(const std::vector<PlannedPose>& plan, const robot::JointLimits& limits,
-                          const Eigen::VectorXd& start_rad, const MotionSafetyOptions& options, int first_pose = 0);
+                          const Eigen::VectorXd& start_rad, const MotionSafetyOptions& options, int first_pose = 0,
+                          const PlanToCheck* whole_plan = nullptr);
 
 }  // namespace selfcal::acquisition

@@ -189,14 +189,14 @@ bool Runner::Arm(const Route& route, const RobotAtStart& robot) {
     return false;
   }
   const robot::RobotIdentity& identity = robot.identity;
-  const PreflightReport preflight = Preflight(route.poses, limits_, robot.joints.position_rad, o_.safety);
+  const PreflightReport preflight = Preflight(route.poses, limits_, robot.joints.position_rad, o_.safety, 0,
+                                              o_.plan_check ? &*o_.plan_check : nullptr);
   report_.preview = "robot " + identity.backend + " " + identity.model + " serial " + identity.serial +
                     (identity.real_hardware ? " (REAL HARDWARE)" : " (no hardware)") + "\n" +
                     (route.returning ? "first returning to the pose of the last accepted sample, then\n" : "") +
                     preflight.Preview(route.poses, o_.safety.velocity_scaling);
   if (!preflight.ok()) {
-    report_.message = "preflight refused the plan:\n";
-    for (const std::string& p : preflight.problems) report_.message += "  " + p + "\n";
+    report_.message = PreflightRefusal(preflight.problems);
     return false;
   }
   if (!c_.confirm(report_.preview, identity)) {

@@ -29,6 +29,7 @@
 #include <atomic>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -83,6 +84,9 @@ struct SettleOptions {
 
 struct RunOptions {
   MotionSafetyOptions safety;
+  // The plan file and robot config, checked whole by the preflight (planning::CheckPlanFor, the words of
+  // `selfcal plan --check`); unset: the route is checked against the controller's limits only.
+  std::optional<PlanToCheck> plan_check;
   SettleOptions settle;
   double watchdog_factor = 1.1;     // R6: a move may take factor x its planned duration + slack
   double watchdog_slack_s = 0.5;

@@ -44,6 +44,8 @@ std::string PixelProblem(const CameraIntrinsics& camera, const Eigen::Vector2d& 
          " image (u in [-0.5, " + Short(camera.width_px - 0.5) + "], v in [-0.5, " + Short(camera.height_px - 0.5) + "])";
 }
 
+}  // namespace
+
 bool ReadCamera(MapReader* root, Problems* problems, CameraIntrinsics* camera) {
   const yaml::YamlNode* node = root->Required("camera");
   if (!node) return false;
@@ -68,6 +70,8 @@ bool ReadCamera(MapReader* root, Problems* problems, CameraIntrinsics* camera) {
   }
   return ok;
 }
+
+namespace {
 
 bool ReadDistances(MapReader* root, const std::string& key, bool required, Problems* problems,
                    std::vector<KnownDistance>* out) {

@@ -20,6 +20,7 @@
 #include <string>
 
 #include "base/status.h"
+#include "io/yaml_schema.h"
 #include "yaml/yaml_reader.h"
 #include "observations/observation_set.h"
 
@@ -40,5 +41,9 @@ Result<ObservationSet> ParseObservations(const yaml::YamlDocument& doc);
 // shortest round-trip numbers, so that LoadObservations returns a bit-identical set. Refuses a set
 // that LoadObservations would refuse.
 Status SaveObservations(const ObservationSet& set, const std::string& path);
+
+// The required `camera` map of *root (width_px, height_px, fx_px, cx_px, cy_px, optional mu and k1), with
+// the intrinsics' cross-field checks; shared with the trajectory file's `planned_for` block.
+bool ReadCamera(MapReader* root, Problems* problems, CameraIntrinsics* camera);
 
 }  // namespace selfcal::io

@@ -289,6 +289,47 @@ TEST(TrajectoryFile, SaveLoadRoundTripIsExact) {
   for (size_t p = 0; p < poses.size(); ++p) EXPECT_TRUE(SameBits((*loaded)[p], poses[p])) << p;
 }
 
+// The planned_for block (camera, scene, constraints) comes back bit for bit; a bad value names its key.
+TEST(TrajectoryFile, PlannedForRoundTripsAndIsChecked) {
+  TrajectoryFile file;
+  file.robot = "puma560";
+  file.poses = {Eigen::VectorXd::Constant(6, 0.25), Eigen::VectorXd::Constant(6, -0.125)};
+  planning::PlannedFor p;
+  p.camera.width_px = 640;
+  p.camera.height_px = 480;
+  p.camera.fx_px = 1000.125;
+  p.camera.cx_px = 319.5;
+  p.camera.cy_px = 239.5;
+  p.camera.k1 = -0.01;
+  p.constraints.max_image_motion_px = 77.5;
+  p.constraints.min_axis_sine = 0.08;
+  for (int k = 0; k < 8; ++k) p.scene.dots_in_base.emplace_back(0.8 + 0.01 * k, -0.1 * k, -0.3);
+  p.scene.extent_in_base = p.scene.dots_in_base;
+  file.planned_for = p;
+  TempDir dir;
+  const std::string path = dir.File("plan.yaml");
+  ASSERT_TRUE(SaveTrajectoryFile(file, path).ok());
+  Result<TrajectoryFile> loaded = LoadTrajectoryFile(path, 6);
+  ASSERT_TRUE(loaded.ok()) << loaded.status().ToString();
+  ASSERT_TRUE(loaded->planned_for.has_value());
+  const planning::PlannedFor& q = *loaded->planned_for;
+  EXPECT_EQ(q.camera.fx_px, p.camera.fx_px);
+  EXPECT_EQ(q.camera.k1, p.camera.k1);
+  EXPECT_EQ(q.constraints.max_image_motion_px, 77.5);
+  EXPECT_EQ(q.constraints.min_axis_sine, 0.08);
+  EXPECT_EQ(q.constraints.joint_margin_rad, p.constraints.joint_margin_rad);
+  ASSERT_EQ(q.scene.dots_in_base.size(), 8u);
+  for (int k = 0; k < 8; ++k) EXPECT_NEAR((q.scene.dots_in_base[k] - p.scene.dots_in_base[k]).norm(), 0, 1e-15) << k;
+  std::string text = ReadFile(path);
+  const size_t at = text.find("max_image_motion_px: ");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, text.find('\n', at) - at, "max_image_motion_px: -3");
+  WriteFile(path, text);
+  Result<TrajectoryFile> bad = LoadTrajectoryFile(path, 6);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("planned_for.max_image_motion_px"), std::string::npos) << bad.status().message();
+}
+
 TEST(TrajectoryFile, C5WrongJointCountNamesEveryBadPose) {
   TempDir dir;
   const std::string path = dir.File("plan.yaml");

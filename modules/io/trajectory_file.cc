@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "io/atomic_file.h"
+#include "io/observations_file.h"
 #include "yaml/yaml_reader.h"
 #include "io/yaml_schema.h"
 #include "io/yaml_writer.h"
@@ -17,6 +18,96 @@ std::string Short(double v) {
   char buffer[32];
   std::snprintf(buffer, sizeof(buffer), "%.6g", v);
   return buffer;
+}
+
+// A list of points `key` ([x, y, z] in mm) of the map.
+bool ReadPointsMm(MapReader* map, const std::string& key, bool required, Problems* problems,
+                  std::vector<Eigen::Vector3d>* out) {
+  const yaml::YamlNode* list = required ? map->Required(key) : map->Optional(key);
+  if (list == nullptr) return !required;
+  if (!list->IsSequence()) {
+    problems->Add("`" + map->Path(key) + "` at " + problems->At(list->line) + " must be a sequence of [x, y, z] rows");
+    return false;
+  }
+  bool ok = true;
+  for (size_t i = 0; i < list->items.size(); ++i) {
+    std::vector<double> p;
+    if (ReadDoubleList(list->items[i], map->Path(key) + "[" + std::to_string(i) + "]", 3, Range::Closed(-100, 100),
+                       problems, &p, KeyUnit::kMillimetre)) {
+      out->emplace_back(p[0], p[1], p[2]);
+    } else {
+      ok = false;
+    }
+  }
+  return ok;
+}
+
+// The optional `planned_for` block (docs/trajectory-format.md).
+void ReadPlannedFor(MapReader* root, Problems* problems, std::optional<planning::PlannedFor>* out) {
+  const yaml::YamlNode* node = root->Optional("planned_for");
+  if (node == nullptr) return;
+  MapReader map(*node, "planned_for", problems);
+  if (!map.ok()) return;
+  planning::PlannedFor p;
+  planning::PlanConstraints& c = p.constraints;
+  bool ok = ReadCamera(&map, problems, &p.camera);
+  ok &= map.Quantity("joint_margin", Unit::kAngle, Range::Closed(0, kPi), &c.joint_margin_rad);
+  ok &= map.Double("image_margin_px", Range::Closed(0, 1e5), &c.image_margin_px);
+  ok &= map.Quantity("min_depth", Unit::kLength, Range::Positive(1e3), &c.min_depth_m);
+  ok &= map.Quantity("max_depth", Unit::kLength, Range::Positive(1e3), &c.max_depth_m);
+  ok &= map.Quantity("min_spread", Unit::kLength, Range::Closed(0, 1e3), &c.min_spread_m);
+  ok &= map.Double("min_axis_sine", Range::Closed(0, 0.999), &c.min_axis_sine);
+  ok &= map.Quantity("max_joint_travel", Unit::kAngle, Range::Positive(2 * kPi), &c.max_joint_travel_rad);
+  ok &= map.Double("max_image_motion_px", Range::Positive(1e5), &c.max_image_motion_px);
+  ok &= map.Double("max_fx_stddev_rel", Range::Positive(1), &c.max_fx_stddev_rel);
+  ok &= map.Double("pixel_noise_px", Range::Positive(100), &c.pixel_noise_px);
+  long long min_poses = 0;
+  ok &= map.Int("min_identification_poses", 3, 100000, &min_poses);
+  c.min_identification_poses = static_cast<int>(min_poses);
+  ok &= map.Double("max_condition_number", Range::Positive(1e300), &c.max_condition_number);
+  ok &= ReadPointsMm(&map, "scene_dots_mm", true, problems, &p.scene.dots_in_base);
+  ok &= ReadPointsMm(&map, "scene_extent_mm", false, problems, &p.scene.extent_in_base);
+  map.Finish();
+  if (p.scene.extent_in_base.empty()) p.scene.extent_in_base = p.scene.dots_in_base;
+  if (ok) {
+    std::istringstream invalid(c.Validate() + "\n" + p.scene.Validate());
+    for (std::string line; std::getline(invalid, line);) {
+      if (!line.empty()) problems->Add("`planned_for` at " + problems->At(node->line) + ": " + line);
+    }
+    *out = std::move(p);
+  }
+}
+
+std::string PointsMm(const std::vector<Eigen::Vector3d>& points) {
+  std::ostringstream out;
+  for (const Eigen::Vector3d& x : points) out << "    - " << YamlNumberList(Eigen::VectorXd(x * 1e3)) << "\n";
+  return out.str();
+}
+
+// The `planned_for` block as SaveTrajectoryFile writes it.
+std::string PlannedForYaml(const planning::PlannedFor& p) {
+  const CameraIntrinsics& k = p.camera;
+  const planning::PlanConstraints& c = p.constraints;
+  std::ostringstream out;
+  out << "planned_for:\n"
+      << "  camera: {width_px: " << k.width_px << ", height_px: " << k.height_px << ", fx_px: " << YamlNumber(k.fx_px)
+      << ", mu: " << YamlNumber(k.mu) << ", cx_px: " << YamlNumber(k.cx_px) << ", cy_px: " << YamlNumber(k.cy_px)
+      << ", k1: " << YamlNumber(k.k1) << "}\n"
+      << "  joint_margin_rad: " << YamlNumber(c.joint_margin_rad) << "\n"
+      << "  image_margin_px: " << YamlNumber(c.image_margin_px) << "\n"
+      << "  min_depth_m: " << YamlNumber(c.min_depth_m) << "\n"
+      << "  max_depth_m: " << YamlNumber(c.max_depth_m) << "\n"
+      << "  min_spread_m: " << YamlNumber(c.min_spread_m) << "\n"
+      << "  min_axis_sine: " << YamlNumber(c.min_axis_sine) << "\n"
+      << "  max_joint_travel_rad: " << YamlNumber(c.max_joint_travel_rad) << "\n"
+      << "  max_image_motion_px: " << YamlNumber(c.max_image_motion_px) << "\n"
+      << "  max_fx_stddev_rel: " << YamlNumber(c.max_fx_stddev_rel) << "\n"
+      << "  pixel_noise_px: " << YamlNumber(c.pixel_noise_px) << "\n"
+      << "  min_identification_poses: " << c.min_identification_poses << "\n"
+      << "  max_condition_number: " << YamlNumber(c.max_condition_number) << "\n";
+  if (p.scene.extent_in_base != p.scene.dots_in_base) out << "  scene_extent_mm:\n" << PointsMm(p.scene.extent_in_base);
+  out << "  scene_dots_mm:\n" << PointsMm(p.scene.dots_in_base);
+  return out.str();
 }
 
 Result<TrajectoryFile> Load(const std::string& path, int num_joints, const RobotModel* robot) {
@@ -37,6 +128,7 @@ Result<TrajectoryFile> Load(const std::string& path, int num_joints, const Robot
     long long count = 0;
     if (root.Int("num_identification_poses", 3, 100000, &count)) file.num_identification_poses = static_cast<int>(count);
   }
+  ReadPlannedFor(&root, &problems, &file.planned_for);
   if (robot && !robot_name.empty() && robot_name != robot->name) {
     problems.Add("`robot` = `" + robot_name + "` at " + problems.At(root.KeyLine("robot")) +
                  ", but the robot model is `" + robot->name + "`");
@@ -94,6 +186,15 @@ Result<TrajectoryFile> Load(const std::string& path, int num_joints, const Robot
 
 }  // namespace
 
+planning::PlanSubject PlanSubjectOf(const TrajectoryFile& file) {
+  planning::PlanSubject plan;
+  plan.robot = file.robot;
+  plan.poses = file.poses;
+  plan.num_identification_poses = file.num_identification_poses;
+  plan.planned_for = file.planned_for;
+  return plan;
+}
+
 Result<TrajectoryFile> LoadTrajectoryFile(const std::string& path, int num_joints) {
   if (num_joints <= 0) return Status::Error(ErrorCode::kInvalidInput, "LoadTrajectory(" + path + "): num_joints must be > 0");
   return Load(path, num_joints, nullptr);
@@ -145,6 +246,7 @@ Status SaveTrajectoryFile(const TrajectoryFile& file, const std::string& path) {
   if (!description.empty()) out << "description: " << YamlQuoted(description) << "\n";
   if (!file.planner.empty()) out << "planner: " << YamlQuoted(file.planner) << "\n";
   if (file.num_identification_poses > 0) out << "num_identification_poses: " << file.num_identification_poses << "\n";
+  if (file.planned_for) out << PlannedForYaml(*file.planned_for);
   out << "poses_rad:" << (poses_rad.empty() ? " []\n" : "\n");
   for (size_t i = 0; i < poses_rad.size(); ++i) {
     out << "  - " << YamlNumberList(poses_rad[i]) << "  # " << i << ": [";

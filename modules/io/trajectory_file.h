@@ -6,10 +6,12 @@
 //   description: "..."          # optional
 //   planner: "..."              # optional, provenance of a planned trajectory
 //   num_identification_poses: 15   # optional: the first 15 poses identify, the rest verify
+//   planned_for: {...}          # optional: the camera, scene and constraints the plan was made for
 //   poses_deg:                  # one row of joint angles per pose (or poses_rad)
 //     - [0, -30, 120, 0, 45, 0]
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +19,7 @@
 
 #include "base/status.h"
 #include "kinematics/robot_model.h"
+#include "planning/plan_check.h"
 
 namespace selfcal::io {
 
@@ -30,7 +33,13 @@ struct TrajectoryFile {
   std::string robot, description;
   int num_identification_poses = 0;    // 0: not given
   std::string planner;                 // free text: criterion, options, figures
+  // The camera, scene and constraints the plan was planned and checked with (`selfcal plan` writes it);
+  // `plan --check` and `run` check the plan's geometry against it. Absent: robot-level checks only.
+  std::optional<planning::PlannedFor> planned_for;
 };
+
+// The plan as the one check takes it (planning::CheckPlanFor).
+planning::PlanSubject PlanSubjectOf(const TrajectoryFile& file);
 
 // The whole file, with the same checks as LoadTrajectory; num_identification_poses must not exceed the pose
 // count.

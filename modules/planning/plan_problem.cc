@@ -25,24 +25,9 @@ Scene Scene::FromBox(const Eigen::Vector3d& center_m, const Eigen::Vector3d& siz
 Scene Scene::FromDots(const std::vector<Eigen::Vector3d>& dots_in_base) {
   Scene scene;
   scene.dots_in_base = dots_in_base;
-  // The extent: the dots extreme along 200 directions spread over the sphere (Fibonacci lattice), i.e. the
-  // vertices of the convex hull that matter; a dot inside the hull projects inside the hull's image. The
-  // plan check tests every dot all the same.
-  std::vector<bool> keep(dots_in_base.size(), false);
-  const int directions = 200;
-  const double golden = kPi * (3.0 - std::sqrt(5.0));
-  for (int k = 0; k < directions && !dots_in_base.empty(); ++k) {
-    const double z = 1.0 - 2.0 * (k + 0.5) / directions, r = std::sqrt(1.0 - z * z);
-    const Eigen::Vector3d dir(r * std::cos(golden * k), r * std::sin(golden * k), z);
-    size_t best = 0;
-    for (size_t j = 1; j < dots_in_base.size(); ++j) {
-      if (dots_in_base[j].dot(dir) > dots_in_base[best].dot(dir)) best = j;
-    }
-    keep[best] = true;
-  }
-  for (size_t j = 0; j < dots_in_base.size(); ++j) {
-    if (keep[j]) scene.extent_in_base.push_back(dots_in_base[j]);
-  }
+  // The extent is every dot: a subset (the dots extreme along a few hundred directions) misses hull
+  // vertices, and the planner then returned poses with a dot outside the image that the check refused.
+  scene.extent_in_base = dots_in_base;
   return scene;
 }
 
@@ -74,6 +59,9 @@ std::string PlanConstraints::Validate() const {
   positive("min_depth_m", min_depth_m);
   if (!(max_depth_m > min_depth_m)) out << "max_depth_m = " << max_depth_m << " must exceed min_depth_m\n";
   non_negative("min_spread_m", min_spread_m);
+  positive("max_image_motion_px", max_image_motion_px);
+  positive("max_fx_stddev_rel", max_fx_stddev_rel);
+  positive("pixel_noise_px", pixel_noise_px);
   if (!(min_axis_sine >= 0 && min_axis_sine < 1)) out << "min_axis_sine = " << min_axis_sine << " must lie in [0, 1)\n";
   positive("max_joint_travel_rad", max_joint_travel_rad);
   if (min_identification_poses < 3) out << "min_identification_poses = " << min_identification_poses << " must be >= 3\n";

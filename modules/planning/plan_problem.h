@@ -19,7 +19,7 @@ namespace selfcal::planning {
 
 // Where the dots are, roughly. Either a box (the planner spreads num_dots seeded points inside it to stand
 // for the dots, and requires the box's 8 corners in every image) or rough dot positions (every one of them
-// required in every image: the planner's barrier uses the ones on the convex hull, the check all of them).
+// required in every image, by the planner's barrier and by the check).
 struct Scene {
   std::vector<Eigen::Vector3d> dots_in_base;    // stand-ins for the dots (Fisher information, yardstick)
   std::vector<Eigen::Vector3d> extent_in_base;  // points every image must contain with the margin
@@ -38,11 +38,24 @@ struct PlanConstraints {
   // Camera centres of any two poses at least this far apart (duplicates and near-duplicates, C7; the factor
   // method also needs a baseline: pure rotation makes t unobservable, G3).
   double min_spread_m = 0.02;
-  // For every identification pose i and the reference pose: the sine of the angle between one optical axis
-  // and the plane through the other axis and the second camera centre, at least this. Near zero the
-  // axes (nearly) intersect and f_x is unobservable from the pair (DESIGN.md section 4); the two-view
-  // estimator's own threshold is 0.05 (twoview::TwoViewOptions::focal_observability_min).
-  double min_axis_sine = 0.08;
+  // f_x observable by the identification poses as a set, which is what the default method (the kinematic
+  // bundle adjustment over every image) needs: the Cramer-Rao standard deviation of f_x from the bundle's
+  // Fisher information (planning/fisher_design.h, dots unknown) at pixel_noise_px, relative to the
+  // nominal f_x, at most this. The shipped arc: 1.1 px of 1000 (0.0011); its bundle error over 5 seeds
+  // stays within 2 sigma (docs/planning.md).
+  double max_fx_stddev_rel = 0.005;
+  double pixel_noise_px = 0.2;  // the noise of that bound
+  // The paper method (Method::kPaper) recovers f_x from every pair (reference, i): for every
+  // identification pose i, the sine of the angle between one optical axis and the plane through the other
+  // axis and the second camera centre, at least this. Near zero the axes (nearly) intersect and f_x is
+  // unobservable from the pair (DESIGN.md section 4); the two-view estimator's own threshold is 0.05
+  // (twoview::TwoViewOptions::focal_observability_min), 0.08 keeps a margin. 0 (the default): not a
+  // constraint (the bundle does not need it); the check reports the pairs below 0.08 as a figure.
+  double min_axis_sine = 0.0;
+  // Image motion per move, what the session needs to keep the dots' identities by tracking through the
+  // move: the median displacement (px) of the scene's dots seen at both ends of each move between
+  // consecutive poses, at most this. The shipped PUMA arc's largest is 41 px (docs/planning.md).
+  double max_image_motion_px = 100.0;
   // Largest change of any joint between consecutive poses (the order the robot visits them).
   double max_joint_travel_rad = DegToRad(90.0);
   // Fewer identification poses are refused (the paper's 6m > n; the rank check decides the rest).
@@ -53,6 +66,14 @@ struct PlanConstraints {
   double max_condition_number = 1e4;
   // Empty when valid; otherwise every problem, one per line.
   std::string Validate() const;
+};
+
+// What a plan was planned and checked with: the plan file records it (docs/trajectory-format.md
+// `planned_for`), so that `selfcal plan --check` and `selfcal run` check the same scene and camera.
+struct PlannedFor {
+  CameraIntrinsics camera;
+  Scene scene;
+  PlanConstraints constraints;
 };
 
 struct PlanningProblem {

@@ -131,7 +131,7 @@ class BarrierObjective final : public ceres::FirstOrderFunction {
     }
     // Optical axes of (reference, i) apart: tau^2 - s^2 |d x z|^2 > 0 for both axes, over |d|^2.
     const double s2 = c.min_axis_sine * c.min_axis_sine;
-    for (int i = 1; i < m_id; ++i) {
+    for (int i = 1; c.min_axis_sine > 0 && i < m_id; ++i) {
       const Vec3T<Jet12> c0 = Promote(views[0].centre, kMaxJoints), z0 = Promote(views[0].axis, kMaxJoints);
       const Vec3T<Jet12> ci = Promote(views[i].centre, 0), zi = Promote(views[i].axis, 0);
       const Vec3T<Jet12> dd = ci - c0;
@@ -220,6 +220,14 @@ bool PoseFits(const PlanningProblem& problem, const std::vector<Eigen::VectorXd>
   if (i > 0 && i < problem.num_identification_poses && AxisSine<double>(views[0], view) < c.min_axis_sine) return false;
   if (i > 0 && (q - poses[i - 1]).lpNorm<Eigen::Infinity>() > c.max_joint_travel_rad) return false;
   if (i + 1 < m && (q - poses[i + 1]).lpNorm<Eigen::Infinity>() > c.max_joint_travel_rad) return false;
+  // The moves into and out of pose i within the image-motion bound.
+  const std::vector<Eigen::Vector2d> here = DotImages(problem, q);
+  for (int k : {i - 1, i + 1}) {
+    if (k >= 0 && k < m &&
+        !(ImageMotionBetween(DotImages(problem, poses[k]), here).median_px <= c.max_image_motion_px)) {
+      return false;
+    }
+  }
   return true;
 }
 
@@ -301,10 +309,14 @@ void PlanExchange(const PlanningProblem& problem, const PlannerOptions& options,
   candidates.insert(candidates.end(), pool.begin(), pool.end());
   const Eigen::VectorXd rho = KinematicParameters::Nominal(problem.robot);
   std::vector<Rigid3> views;
+  std::vector<std::vector<Eigen::Vector2d>> images;  // the dots' pixels: image motion between candidates
   for (const Eigen::VectorXd& q : candidates) {
     design.AddCandidate(q);
     views.push_back(BaseFromCam(problem.robot, rho, q));
+    images.push_back(DotImages(problem, q));
   }
+  const std::vector<Eigen::Vector2d> first_verification =
+      m > m_id ? DotImages(problem, result->poses[m_id]) : std::vector<Eigen::Vector2d>();
   std::vector<Rigid3> verification;
   for (int i = m_id; i < m; ++i) verification.push_back(BaseFromCam(problem.robot, rho, result->poses[i]));
   const PlanConstraints& c = problem.constraints;
@@ -322,6 +334,11 @@ void PlanExchange(const PlanningProblem& problem, const PlannerOptions& options,
     if (m > m_id && (candidates[cand] - result->poses[m_id]).lpNorm<Eigen::Infinity>() > c.max_joint_travel_rad) {
       return false;
     }
+    // Image motion of the moves into and out of the slot (the visit order is the slots'): every exchange
+    // keeps each move within the bound.
+    if (!(ImageMotionBetween(images[chosen[slot - 1]], images[cand]).median_px <= c.max_image_motion_px)) return false;
+    const std::vector<Eigen::Vector2d>& next = slot + 1 < m_id ? images[chosen[slot + 1]] : first_verification;
+    if (!next.empty() && !(ImageMotionBetween(images[cand], next).median_px <= c.max_image_motion_px)) return false;
     for (const Rigid3& v : verification) {
       if ((views[cand].translation - v.translation).norm() < c.min_spread_m) return false;
     }
@@ -351,24 +368,39 @@ void PlanExchange(const PlanningProblem& problem, const PlannerOptions& options,
     }
     if (!changed) break;
   }
-  // Visit order: nearest neighbour in joint space from the reference (bounded joint travel).
-  std::vector<int> order, rest;
-  order.reserve(m_id);
-  order.push_back(chosen[0]);
-  for (int i = 1; i < m_id; ++i) rest.push_back(chosen[i]);
+  for (int i = 0; i < m_id; ++i) result->poses[i] = candidates[chosen[i]];
+}
+
+// Visit order of the identification poses after the reference: a short tour in the image, nearest
+// neighbour by the median displacement of the scene's dots (ImageMotionOfMove) among the poses within the
+// joint travel bound of the last one (the nearest in image motion when none is). Kept when the check
+// accepts it or the given order fails too: the session tracks the dots through every move.
+void OrderAsTour(const PlanningProblem& problem, std::vector<Eigen::VectorXd>* poses) {
+  const int m_id = problem.num_identification_poses;
+  const double travel_bound = problem.constraints.max_joint_travel_rad;
+  std::vector<Eigen::VectorXd> tour = {(*poses)[0]};
+  std::vector<int> rest;
+  for (int i = 1; i < m_id; ++i) rest.push_back(i);
   while (!rest.empty()) {
-    const Eigen::VectorXd& last = candidates[order.back()];
-    size_t nearest = 0;
-    for (size_t k = 1; k < rest.size(); ++k) {
-      if ((candidates[rest[k]] - last).lpNorm<Eigen::Infinity>() <
-          (candidates[rest[nearest]] - last).lpNorm<Eigen::Infinity>()) {
-        nearest = k;
+    const Eigen::VectorXd& last = tour.back();
+    size_t best = 0;
+    double best_key = std::numeric_limits<double>::infinity();
+    for (size_t k = 0; k < rest.size(); ++k) {
+      const Eigen::VectorXd& q = (*poses)[rest[k]];
+      const bool travel_ok = (q - last).lpNorm<Eigen::Infinity>() <= travel_bound;
+      // Moves within the travel bound first (key below 1e12), then by image motion.
+      const double key = (travel_ok ? 0.0 : 1e12) + ImageMotionOfMove(problem, last, q).median_px;
+      if (key < best_key) {
+        best_key = key;
+        best = k;
       }
     }
-    order.push_back(rest[nearest]);
-    rest.erase(rest.begin() + nearest);
+    tour.push_back((*poses)[rest[best]]);
+    rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(best));
   }
-  for (int i = 0; i < m_id; ++i) result->poses[i] = candidates[order[i]];
+  std::vector<Eigen::VectorXd> reordered = *poses;
+  for (int i = 0; i < m_id; ++i) reordered[i] = tour[i];
+  if (CheckPlan(problem, reordered).ok || !CheckPlan(problem, *poses).ok) *poses = reordered;
 }
 
 }  // namespace
@@ -460,6 +492,7 @@ PlanResult PlanMeasurements(const PlanningProblem& problem, const std::vector<Ei
   } else {
     PlanExchange(problem, options, &result);
   }
+  OrderAsTour(problem, &result.poses);
 
   const std::vector<Eigen::VectorXd> id_final(result.poses.begin(), result.poses.begin() + m_id);
   result.eq39_final = EvaluateEq39(problem.robot, id_final, result.free_columns, options.lambda, false);

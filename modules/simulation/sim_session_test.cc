@@ -143,7 +143,7 @@ TEST(SessionRunner, PreflightRefusesExcessiveTravelBeforeAnyCommand) {  // R2, F
   const acquisition::RunReport report = h.Run();
   EXPECT_EQ(report.outcome, acquisition::RunOutcome::kRefused);
   EXPECT_NE(report.message.find("pose p03"), std::string::npos) << report.message;
-  EXPECT_NE(report.message.find("(R2)"), std::string::npos) << report.message;
+  EXPECT_NE(report.message.find("joint_travel"), std::string::npos) << report.message;
   EXPECT_EQ(h.cell.robot->counts().start_move, 0);
 }
 

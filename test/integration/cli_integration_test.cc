@@ -236,9 +236,9 @@ TEST(Cli, IdentifiabilityNamesTheFixedParameters) {
 namespace selfcal {
 namespace {
 
-// selfcal plan: the shipped arc is refused by --check (its optical axes nearly intersect the reference's),
-// the planned file passes it, and the same seed writes the same plan byte for byte.
-TEST(Cli, PlanCheckRefusesTheArcAndAcceptsThePlannedFile) {
+// selfcal plan: the shipped arc passes --check (robot-level: it records no scene), the planned file
+// records its scene and passes every check, and the same seed writes the same plan byte for byte.
+TEST(Cli, PlanCheckAcceptsTheArcAndThePlannedFile) {
   const fs::path dir = FreshDir("plan");
   auto read_file = [](const std::string& path) {
     std::ifstream in(path);
@@ -247,17 +247,66 @@ TEST(Cli, PlanCheckRefusesTheArcAndAcceptsThePlannedFile) {
     return s.str();
   };
   std::string output;
-  EXPECT_EQ(RunSelfcal("plan --check config/trajectories/initial_puma560.yaml", &output), 3) << output;
-  EXPECT_NE(output.find("axes_intersect: pose 0 (reference) and pose 12"), std::string::npos) << output;
+  EXPECT_EQ(RunSelfcal("plan --check config/trajectories/initial_puma560.yaml", &output), 0) << output;
+  EXPECT_NE(output.find("no `planned_for` block"), std::string::npos) << output;
   const std::string a = (dir / "a.yaml").string(), b = (dir / "b.yaml").string();
   ASSERT_EQ(RunSelfcal("plan --criterion d-optimal --seed 4 --out " + a, &output), 0) << output;
-  EXPECT_NE(output.find("repaired:"), std::string::npos) << output;
   ASSERT_EQ(RunSelfcal("plan --criterion d-optimal --seed 4 --out " + b, &output), 0) << output;
   EXPECT_EQ(read_file(a), read_file(b));
-  EXPECT_EQ(RunSelfcal("plan --image-margin-px 5 --check " + a, &output), 0) << output;
+  EXPECT_EQ(RunSelfcal("plan --check " + a, &output), 0) << output;
   EXPECT_NE(output.find("plan ok"), std::string::npos) << output;
+  EXPECT_NE(output.find("image motion per move"), std::string::npos) << output;
   EXPECT_NE(output.find("predicted std at 0.2 px"), std::string::npos) << output;
   EXPECT_EQ(RunSelfcal("plan --criterion best --out " + a, &output), 2) << output;
+  // The defaults follow the robot: start and scene from initial_ur5e.yaml.
+  EXPECT_EQ(RunSelfcal("plan --robot config/robots/ur5e.yaml --criterion a-optimal --out " + a, &output), 0) << output;
+  EXPECT_NE(output.find("initial_ur5e.yaml"), std::string::npos) << output;
+}
+
+// The problem lines of `plan --check` ("  PROBLEM issue: ...") or of run's preflight ("  issue: ...").
+std::vector<std::string> ProblemLines(const std::string& output, const std::string& prefix) {
+  std::vector<std::string> lines;
+  std::istringstream in(output);
+  bool refused = false;
+  for (std::string line; std::getline(in, line);) {
+    if (line.find("preflight refused the plan:") != std::string::npos) refused = true;
+    if (prefix.empty() ? refused && line.rfind("  ", 0) == 0 : line.rfind(prefix, 0) == 0) {
+      lines.push_back(line.substr(prefix.empty() ? 2 : prefix.size()));
+    }
+  }
+  return lines;
+}
+
+// One check: `plan --check` and run's preflight give the same verdict in the same words on every shipped
+// trajectory, with either robot config; every shipped trajectory passes for its own robot, and a plan
+// for one robot is refused for the other in both paths.
+TEST(Cli, PlanCheckAndRunPreflightAgreeOnEveryShippedTrajectory) {
+  const fs::path dir = FreshDir("agree");
+  const fs::path trajectories = fs::path(SELFCAL_SOURCE_DIR) / "config" / "trajectories";
+  int files = 0;
+  for (const fs::directory_entry& e : fs::directory_iterator(trajectories)) {
+    if (e.path().extension() != ".yaml") continue;
+    ++files;
+    const std::string name = e.path().stem().string();
+    const std::string own = name.find("ur5e") != std::string::npos ? "ur5e" : "puma560";
+    for (const std::string robot : {"puma560", "ur5e"}) {
+      const std::string config = "config/robots/" + robot + ".yaml";
+      std::string check_out, run_out;
+      const int check = RunSelfcal("plan --robot " + config + " --check " + e.path().string(), &check_out);
+      const int run = RunSelfcal("run --robot sim --camera sim --dry-run --robot-config " + config + " --session " +
+                                     (dir / (name + "-" + robot)).string() + " --plan " + e.path().string(),
+                                 &run_out);
+      EXPECT_EQ(check, run) << name << " on " << robot << "\n" << check_out << "\n" << run_out;
+      EXPECT_EQ(ProblemLines(check_out, "  PROBLEM "), ProblemLines(run_out, "")) << name << " on " << robot;
+      if (robot == own) {
+        EXPECT_EQ(check, 0) << name << "\n" << check_out;
+      } else {
+        EXPECT_EQ(check, 3) << name << " on " << robot << "\n" << check_out;
+        EXPECT_NE(check_out.find("robot_mismatch: the plan is for robot `" + own + "`"), std::string::npos) << check_out;
+      }
+    }
+  }
+  EXPECT_GE(files, 8);
 }
 
 }  // namespace
