@@ -42,7 +42,10 @@ struct DotPredictionOptions {
   int depth_neighbours = 6;             // single-ray dots: this many nearest triangulated neighbours...
   int min_depth_neighbours = 3;         // ...at least this many, else not predicted
   double min_depth_sigma_fraction = 0.03;  // floor of the depth std, as a fraction of the depth
-  double image_margin_px = 0;           // predictions outside the image by more than this are left out
+  // Predictions outside the image by more than this are left out; those just outside still check a
+  // tracked dot that jumped onto another blob as its own left the view.
+  double image_margin_px = 1000;
+  double max_gate_sigma_px = 15;        // the session names nothing by a gate longer than this (std)
 };
 
 struct DotPredictionReport {

@@ -5,6 +5,8 @@
 // the ambiguity test (tracking/predicted_match.h).
 #include <map>
 
+#include <Eigen/Eigenvalues>
+
 #include "acquisition/session_runner_internal.h"
 
 namespace selfcal::acquisition::internal {
@@ -66,23 +68,43 @@ void Runner::NameByPrediction(const Capture& capture) {
     Log("prediction: no correction of the nominal predictions (" + correction.message + "): tracked dots only");
     return;
   }
+  Log("prediction: " + std::to_string(predicted.dots.size()) + " dots predicted, " +
+      std::to_string(tracked_.size()) + " tracked, correction " + correction.message);
   std::vector<tracking::PredictedDot> gates;
   std::map<int, size_t> gate_of;
   for (const tracking::PredictedDot& p : predicted.dots) {
     gate_of[p.id] = gates.size();
     gates.push_back(correction.Apply(p));
   }
-  // Tracked dots far outside their gate are dropped (never recorded under a doubtful id).
+  // Gates too long to trust (a dot seen once, at an uncertain depth) neither name nor doubt.
+  std::vector<tracking::PredictedDot> usable;
+  for (const tracking::PredictedDot& g : gates) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(g.cov_px2);
+    if (eig.eigenvalues()(1) <= o_.prediction.max_gate_sigma_px * o_.prediction.max_gate_sigma_px) usable.push_back(g);
+  }
+  // Tracked dots far outside their gate are dropped (never recorded under a doubtful id), and so are
+  // those that also lie in the gate of a dot not accounted for by another tracked dot in its own gate
+  // (a tracker that jumped onto a neighbour along a long epipolar gate).
+  auto in_gate = [&](int id, const Eigen::Vector2d& uv) {
+    const auto it = gate_of.find(id);
+    return it != gate_of.end() && tracking::Mahalanobis2(gates[it->second], uv) <= o_.predicted_match.gate_chi2;
+  };
+  std::map<int, bool> accounted;
+  for (const tracking::PreviousDot& d : tracked_) accounted[d.id] = in_gate(d.id, d.centroid_px);
   std::vector<tracking::PreviousDot> kept;
   for (const tracking::PreviousDot& d : tracked_) {
-    const auto it = gate_of.find(d.id);
-    if (it != gate_of.end() && tracking::Mahalanobis2(gates[it->second], d.centroid_px) > o_.predicted_match.gate_chi2) {
+    bool doubtful = gate_of.count(d.id) && !accounted[d.id];
+    for (const tracking::PredictedDot& g : usable) {
+      doubtful = doubtful || (g.id != d.id && !accounted[g.id] && in_gate(g.id, d.centroid_px));
+    }
+    if (doubtful) {
       ++report_.dropped_by_prediction;
       continue;
     }
     kept.push_back(d);
   }
-  // Detections on a kept tracked dot are taken; the others are named by prediction, every gate competing.
+  // Detections on a kept tracked dot are taken; the others are named by prediction, every usable gate
+  // competing.
   std::vector<size_t> free;
   std::vector<Eigen::Vector2d> free_centroids;
   for (size_t k = 0; k < detected.dots.size(); ++k) {
@@ -95,7 +117,7 @@ void Runner::NameByPrediction(const Capture& capture) {
       free_centroids.push_back(centroids[k]);
     }
   }
-  const tracking::PredictedMatch match = tracking::MatchPredictions(gates, free_centroids, o_.predicted_match);
+  const tracking::PredictedMatch match = tracking::MatchPredictions(usable, free_centroids, o_.predicted_match);
   report_.ambiguous_by_prediction += match.ambiguous;
   for (size_t f = 0; f < free.size(); ++f) {
     const int id = match.id_of_detection[f];

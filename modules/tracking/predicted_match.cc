@@ -178,7 +178,9 @@ PredictedMatch MatchPredictions(const std::vector<PredictedDot>& predictions,
                                 const std::vector<Eigen::Vector2d>& detections, const PredictedMatchOptions& options) {
   PredictedMatch m;
   m.id_of_detection.assign(detections.size(), -1);
-  std::vector<int> gates_of_detection(detections.size(), 0), last_prediction(detections.size(), -1);
+  std::vector<int>& gates_of_detection = m.gates_of_detection;
+  gates_of_detection.assign(detections.size(), 0);
+  std::vector<int> last_prediction(detections.size(), -1);
   std::vector<int> detections_in_gate(predictions.size(), 0);
   for (size_t k = 0; k < detections.size(); ++k) {
     for (size_t j = 0; j < predictions.size(); ++j) {

@@ -73,6 +73,7 @@ struct PredictedMatchOptions {
 
 struct PredictedMatch {
   std::vector<int> id_of_detection;  // per detection: the id it is named, or -1
+  std::vector<int> gates_of_detection;  // per detection: how many gates hold it
   int named = 0;
   int ambiguous = 0;       // detections left unnamed because two gates or two detections compete
   int outside_gates = 0;   // detections in no gate
