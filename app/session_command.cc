@@ -126,6 +126,7 @@ struct RunPlan {
   std::vector<acquisition::PlannedPose> plan;
   std::optional<acquisition::PlanToCheck> plan_check;  // the whole plan file, for the preflight
   session::SessionInputs inputs;
+  acquisition::PredictionModel prediction;  // the nominal robot and the setup's camera: dots named by prediction
   Result<simulation::SimCell> cell = Status::Error(ErrorCode::kInvalidInput, "no simulated cell");
 };
 
@@ -184,7 +185,9 @@ Status LoadRunPlan(const RunSettings& a, RunPlan* run) {
   if (a.robot_backend == "sim") {
     run->cell = simulation::MakeSimCell(run->nominal, run->plan, SimCellOptionsFor(a), run->plan.front().joints_rad, 0);
     if (!run->cell.ok()) return run->cell.status();
-    run->inputs.push_back({session::kSetupFileName, session::SetupFileText(simulation::SimSetup(*run->cell))});
+    const ObservationSet setup = simulation::SimSetup(*run->cell);
+    run->inputs.push_back({session::kSetupFileName, session::SetupFileText(setup)});
+    run->prediction = {run->nominal, setup.camera, setup.pixel_noise_px};
     return Status::Ok();
   }
   Result<session::SessionInput> setup = session::ReadInputFile(session::kSetupFileName, a.setup);
@@ -192,6 +195,7 @@ Status LoadRunPlan(const RunSettings& a, RunPlan* run) {
   ObservationSet probe;
   if (Status s = session::ParseSetupFile(setup->contents, a.setup, &probe); !s.ok()) return s;
   run->inputs.push_back(*setup);
+  run->prediction = {run->nominal, probe.camera, probe.pixel_noise_px};
   return Status::Ok();
 }
 
@@ -365,6 +369,7 @@ int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, se
   context.session = session;
   context.create_session = create;
   context.identifier = b.identifier;
+  context.prediction = &run.prediction;
   context.stop_requested = &g_stop_requested;
   const bool dry_run = a.dry_run;
   context.confirm = [dry_run](const std::string& preview, const robot::RobotIdentity& identity) {
@@ -381,7 +386,9 @@ int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, se
             << report.frames_grabbed << " frames grabbed, " << report.frames_tracked << " tracked";
   for (const auto& [reason, n] : report.skips) std::cout << ", skipped " << reason << " x" << n;
   for (const auto& [kind, n] : report.faults) std::cout << ", fault " << kind << " x" << n;
-  std::cout << "\n";
+  std::cout << "\nnamed by prediction: " << report.named_by_prediction << " dots, " << report.dropped_by_prediction
+            << " tracked dots dropped, " << report.ambiguous_by_prediction << " ambiguous detections, "
+            << report.prediction_uncorrected << " frames uncorrected\n";
   const bool halted =
       report.outcome == acquisition::RunOutcome::kHalted || report.outcome == acquisition::RunOutcome::kInterrupted;
   if (halted && report.halt_reason.empty()) {  // before the first motion command (connect, identity, camera)

@@ -38,7 +38,7 @@ Runner::Step Runner::VisitPose(const PlannedPose& target, int pose, bool is_retu
     Skip(pose, capture.frame.image.getWidth() == 0 ? "bad_frame" : "bad_reading", "retries exhausted");
     return Step::kSkip;
   }
-  step = NameDots(pose, capture.frame);
+  step = NameDots(pose, capture);
   if (step != Step::kOk) return step;
   if (is_return) return Step::kOk;  // the dots are found again; nothing is recorded for the return
   return RecordSample(pose, target, arrival, capture);
@@ -81,12 +81,16 @@ Runner::Step Runner::CaptureAtPose(int pose, double settle_s, Capture* capture) 
   return ReadJoints(pose, settle_s, &capture->joints);
 }
 
-Runner::Step Runner::NameDots(int pose, const capture::Frame& frame) {
-  const Step step = Identify(pose, frame);
+Runner::Step Runner::NameDots(int pose, const Capture& capture) {
+  const Step step = Identify(pose, capture.frame);
   if (step != Step::kOk) return step;
-  FindMarkedAgain(frame);
+  if (c_.prediction != nullptr) NameByPrediction(capture);
+  FindMarkedAgain(capture.frame);
   if (tracked_.empty()) {
-    return Halt(RunOutcome::kHalted, ErrorCode::kDegenerateData, "lost_track", "no dot is tracked any more", pose);
+    return Halt(RunOutcome::kHalted, ErrorCode::kDegenerateData, "lost_track",
+                c_.prediction != nullptr ? "no dot is tracked or can be named by prediction"
+                                         : "no dot is tracked any more",
+                pose);
   }
   return Step::kOk;
 }
@@ -221,6 +225,8 @@ void Runner::FindMarkedAgain(const capture::Frame& frame) {
 
 Runner::Step Runner::Identify(int pose, const capture::Frame& frame) {
   if (tracked_.empty()) {
+    // Lost during the move: prediction names the dots again (NameByPrediction), not the identifier.
+    if (c_.prediction != nullptr && !AcceptedSamples().empty()) return Step::kOk;
     const tracking::DetectionReport detections = tracking::DetectDots(frame.image, o_.detector);
     Result<std::vector<tracking::PreviousDot>> named = c_.identifier->Identify(frame, detections);
     if (!named.ok()) {
@@ -288,7 +294,7 @@ Runner::Step Runner::Move(int pose, const robot::JointReading& from, const Eigen
     if (grabbed == Step::kEnd) return Step::kEnd;
     if (grabbed == Step::kOk) {
       if (Step s = Identify(pose, frame); s == Step::kEnd) return s;
-      if (tracked_.empty()) {
+      if (tracked_.empty() && c_.prediction == nullptr) {  // with prediction: named again once settled
         return Halt(RunOutcome::kHalted, ErrorCode::kDegenerateData, "lost_track",
                     "every dot was lost during the move: identities cannot be carried on", pose);
       }

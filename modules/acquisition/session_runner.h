@@ -16,6 +16,10 @@
 // robot answered, the preflight passed and the operator confirmed, so a dry run, a refusal or an
 // unreachable robot leave nothing behind.
 //
+// Identities at a settled pose, with RunContext::prediction: the dots tracked into the frame that agree with
+// their prediction, and the detections named by prediction (dots lost in earlier moves come back); a move
+// that loses every dot then goes on, and the pose halts only when nothing can be named.
+//
 // Resume: the journal decides. RunSession continues at the first pose with neither an accepted sample
 // nor a final skip (session/samples.h), with the dots of the last accepted sample as the tracker's state;
 // if the robot is no longer where that sample was taken (beyond the start tolerance) it first returns
@@ -34,12 +38,14 @@
 #include <vector>
 
 #include "capture/frame_source.h"
+#include "acquisition/dot_prediction.h"
 #include "acquisition/motion_safety.h"
 #include "robot/clock.h"
 #include "robot/robot.h"
 #include "session/session_dir.h"
 #include "tracking/dot_detector.h"
 #include "tracking/dot_tracker.h"
+#include "tracking/predicted_match.h"
 
 namespace selfcal::acquisition {
 
@@ -97,6 +103,11 @@ struct RunOptions {
   tracking::DotDetectorOptions detector;
   tracking::DotTrackerOptions tracker = DefaultSessionTracker();
   int min_dots = 8;                 // D1: fewer named dots in a sample -> skipped (too_few_dots)
+  // Naming by prediction (RunContext::prediction): the 3-D prediction, its correction on the tracked
+  // dots and the gate (dot_prediction.h, tracking/predicted_match.h).
+  DotPredictionOptions prediction;
+  tracking::PredictionCorrectionOptions prediction_correction;
+  tracking::PredictedMatchOptions predicted_match;
   int png_compression = 1;
   std::uint64_t frame_bytes_estimate = 400 * 1024;  // P5: free space needed per frame
   bool journal_sim_clock = false;   // simulated sessions: journal the clock with each sample (resume)
@@ -126,6 +137,11 @@ struct RunReport {
   std::string halt_reason;      // when halted / interrupted
   int frames_grabbed = 0, frames_tracked = 0;
   int identity_flags = 0;       // D4: merged + inconsistent dots dropped by the tracker
+  // Naming by prediction, over this invocation's settled frames:
+  int named_by_prediction = 0;     // detections named by their predicted position
+  int dropped_by_prediction = 0;   // tracked dots far outside their prediction's gate, not recorded
+  int ambiguous_by_prediction = 0; // detections left unnamed: two gates, or two detections in one gate
+  int prediction_uncorrected = 0;  // settled frames where no correction of the predictions was found
 };
 
 struct RunContext {
@@ -138,6 +154,10 @@ struct RunContext {
   session::Session* session = nullptr;
   std::function<Result<session::Session*>()> create_session;
   DotIdentifier* identifier = nullptr;
+  // The nominal cell (robot model, camera, pixel noise) that predicts where the dots of the accepted
+  // samples appear at a settled pose, so that dots tracking lost are named again (dot_prediction.h).
+  // Optional: without it, dots are named by tracking alone and a move that loses every dot halts.
+  const PredictionModel* prediction = nullptr;
   // Polled between every step; set by a signal handler (the handler only sets it, R11).
   const std::atomic<bool>* stop_requested = nullptr;
   // Shown the preview after a successful preflight; returns true to arm (typed confirmation for real

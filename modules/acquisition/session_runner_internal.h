@@ -102,7 +102,7 @@ class Runner {
   // A frame exposed strictly after settling, then a joint reading stamped after it.
   Step CaptureAtPose(int pose, double settle_s, Capture* capture);
   // The frame's dots named (tracked or identified), marked ones found again; kEnd when none is left.
-  Step NameDots(int pose, const capture::Frame& frame);
+  Step NameDots(int pose, const Capture& capture);
   // min_dots (D1), then the image (atomic) and the records naming it (P1).
   Step RecordSample(int pose, const PlannedPose& target, const Arrival& arrival, const Capture& capture);
 
@@ -116,6 +116,11 @@ class Runner {
   Step Grab(int pose, double not_before_s, bool during_move, capture::Frame* frame);
   // Names the dots of `frame`: tracked from tracked_, or identified when there is no state.
   Step Identify(int pose, const capture::Frame& frame);
+  // With RunContext::prediction (session_naming.cc): the tracked dots checked against their predictions
+  // at the capture's joints, and detections named by prediction.
+  void NameByPrediction(const Capture& capture);
+  // The accepted samples of the session so far (the journal's), as prediction reads them.
+  std::vector<ViewedSample> AcceptedSamples() const;
   // Marked dots (DotIdentifier::FindMarked) that tracking lost, found again in a settled frame.
   void FindMarkedAgain(const capture::Frame& frame);
 

@@ -40,6 +40,8 @@ struct Harness {
     Result<SimCell> made = MakeSimCell(testing::Puma560(), plan, cell_options, plan.front().joints_rad, 0.0);
     EXPECT_TRUE(made.ok()) << made.status().message();
     cell = std::move(made).value();
+    const ObservationSet setup = SimSetup(cell);
+    prediction = {testing::Puma560(), setup.camera, setup.pixel_noise_px};
     camera = std::make_unique<capture::FaultyFrameSource>(cell.camera.get(), frame_faults);
     session::CreateOptions create;
     create.created_utc = "2026-11-23T00:00:00Z";
@@ -58,6 +60,7 @@ struct Harness {
     c.clock = cell.clock.get();
     c.session = &*session;
     c.identifier = cell.identifier.get();
+    c.prediction = &prediction;
     c.stop_requested = &stop;
     c.confirm = [this](const std::string&, const robot::RobotIdentity&) { return confirm; };
     return c;
@@ -72,6 +75,7 @@ struct Harness {
   std::vector<acquisition::PlannedPose> plan;
   testing::TempDir dir;
   SimCell cell;
+  acquisition::PredictionModel prediction;  // names again the dots tracking loses
   std::unique_ptr<capture::FaultyFrameSource> camera;
   std::optional<session::Session> session;
   acquisition::RunOptions options;
