@@ -38,6 +38,16 @@ Runner::Step Runner::VisitPose(const PlannedPose& target, int pose, bool is_retu
     Skip(pose, capture.frame.image.getWidth() == 0 ? "bad_frame" : "bad_reading", "retries exhausted");
     return Step::kSkip;
   }
+  // R4 between settle and capture: the frame may show the arm in motion, or elsewhere than the reading.
+  const double moved = (capture.joints.position_rad - arrival.settled.position_rad).cwiseAbs().maxCoeff();
+  if (!is_return && moved > o_.safety.start_tolerance_rad) {
+    std::ostringstream d;
+    d << "the arm moved by " << moved << " rad after it settled (tolerance " << o_.safety.start_tolerance_rad
+      << " rad): the frame is not trusted";
+    if (Fault("moved_after_settle", pose, d.str()) == Step::kEnd) return Step::kEnd;
+    Skip(pose, "moved_after_settle", d.str());
+    return Step::kSkip;
+  }
   step = NameDots(pose, capture);
   if (step != Step::kOk) return step;
   if (is_return) return Step::kOk;  // the dots are found again; nothing is recorded for the return

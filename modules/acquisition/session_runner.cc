@@ -272,7 +272,7 @@ Runner::Step Runner::ReturnTo(const PlannedPose& target, int pose, Eigen::Vector
                 "could not return to the last sample's pose, or no frame or reading there", pose);
   }
   tracked_ = std::move(at_sample);
-  return NameDots(pose, capture.frame);
+  return NameDots(pose, capture);
 }
 
 RunReport Runner::Run() {

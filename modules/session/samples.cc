@@ -302,12 +302,14 @@ class LogBuilder {
 
 bool IsFinalSkipReason(const std::string& reason) {
   static const std::set<std::string> kFinal = {"move_failed", "not_settled", "bad_reading",
-                                               "no_frame",    "bad_frame",   "too_few_dots"};
+                                               "no_frame",    "bad_frame",   "too_few_dots",
+                                               "moved_after_settle"};
   return kFinal.count(reason) > 0;
 }
 
 bool IsRevisitableSkipReason(const std::string& reason) {
-  static const std::set<std::string> kRevisitable = {"too_few_dots", "not_settled", "bad_frame", "bad_reading"};
+  static const std::set<std::string> kRevisitable = {"too_few_dots", "not_settled", "bad_frame", "bad_reading",
+                                                     "moved_after_settle"};
   return kRevisitable.count(reason) > 0;
 }
 

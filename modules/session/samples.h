@@ -74,13 +74,14 @@ struct SkippedSample {
 };
 
 // Whether a skip reason closes its pose: move_failed, not_settled, bad_reading, no_frame, bad_frame,
-// too_few_dots. A pose skipped for another reason (e.g. an interruption) is visited again on resume; a
+// too_few_dots, moved_after_settle. A pose skipped for another reason (e.g. an interruption) is visited again on resume; a
 // halt is not a skip.
 bool IsFinalSkipReason(const std::string& reason);
 
 // Whether a final skip reason may be retried by a resumed session (`selfcal run --resume
 // --revisit-skipped N`): too_few_dots (a fault such as a jog can lose the dots for a few poses),
-// not_settled, bad_frame and bad_reading (transient). move_failed and no_frame are not retried.
+// not_settled, bad_frame, bad_reading and moved_after_settle (transient: the arm was moved between settle
+// and capture). move_failed and no_frame are not retried.
 bool IsRevisitableSkipReason(const std::string& reason);
 
 struct SessionLog {

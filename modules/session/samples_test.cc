@@ -177,12 +177,34 @@ TEST(SamplesTest, ResumePoint) {
 }
 
 TEST(SamplesTest, FinalSkipReasons) {
-  for (const char* reason : {"move_failed", "not_settled", "bad_reading", "no_frame", "bad_frame", "too_few_dots"}) {
+  for (const char* reason : {"move_failed", "not_settled", "bad_reading", "no_frame", "bad_frame", "too_few_dots",
+                             "moved_after_settle"}) {
     EXPECT_TRUE(IsFinalSkipReason(reason)) << reason;
   }
   EXPECT_FALSE(IsFinalSkipReason("interrupted"));
   EXPECT_FALSE(IsFinalSkipReason("no_space"));
   EXPECT_STREQ(PoseRoleName(PoseRole::kVerification), "verification");
+}
+
+// --revisit-skipped N: a pose skipped for a revisitable reason k times is done once k > N; other final
+// reasons close it whatever the bound.
+TEST(SamplesTest, RevisitBoundCountsTheSkipsOfAPose) {
+  std::vector<json> records = {Started(3), Planned(0), Planned(1), Planned(2), Skipped(0, "moved_after_settle"),
+                               Skipped(1, "move_failed")};
+  Result<SessionLog> once = ReadSessionLog(records);
+  ASSERT_TRUE(once.ok()) << once.status().ToString();
+  EXPECT_TRUE(once->PoseDone(0, 0));
+  EXPECT_FALSE(once->PoseDone(0, 1));
+  EXPECT_TRUE(once->PoseDone(1, 5));  // move_failed is not retried
+  EXPECT_EQ(once->PosesToVisit(1), (std::vector<int>{0, 2}));
+  records.push_back(Skipped(0, "too_few_dots"));
+  Result<SessionLog> twice = ReadSessionLog(records);
+  ASSERT_TRUE(twice.ok());
+  EXPECT_TRUE(twice->PoseDone(0, 1));
+  EXPECT_FALSE(twice->PoseDone(0, 2));
+  EXPECT_EQ(twice->PosesToVisit(1), (std::vector<int>{2}));
+  EXPECT_TRUE(IsRevisitableSkipReason("moved_after_settle"));
+  EXPECT_FALSE(IsRevisitableSkipReason("move_failed"));
 }
 
 TEST(SamplesTest, BadRecordsAreNamedWithTheirField) {

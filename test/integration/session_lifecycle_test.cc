@@ -51,7 +51,8 @@ TEST(SessionLifecycle, PreflightRefusalLeavesNothingAndTheCorrectedRunSucceeds) 
   ASSERT_TRUE(io::SaveTrajectoryFile(*plan, bad_plan).ok());
   const std::string session = (dir / "s").string();
   std::string output;
-  EXPECT_EQ(RunSelfcal("run --session " + session + " --seed 3 --plan " + bad_plan, &output), 2) << output;
+  // The one plan check refuses it, with the exit code of `selfcal plan --check` (a plan with problems: 3).
+  EXPECT_EQ(RunSelfcal("run --session " + session + " --seed 3 --plan " + bad_plan, &output), 3) << output;
   EXPECT_TRUE(Has(output, "preflight refused")) << output;
   EXPECT_FALSE(fs::exists(session)) << output;
   ASSERT_EQ(RunSelfcal("run --session " + session + " --seed 3", &output), 0) << output;
