@@ -25,10 +25,14 @@ Ray RayOf(const PredictionModel& m, const Rigid3& base_from_cam, const Eigen::Ve
 }
 
 // Lateral std (m) of a ray at distance z from its camera for the pixel noise.
-double LateralSigma(const PredictionModel& m, double z) { return std::max(z, 1e-3) * m.pixel_noise_px / m.camera.fx_px; }
+// Lateral std (m) of a ray at distance z from its camera: the pixel noise and the nominal model's own
+// error per ray, which the rays of a nominal model carry into every triangulation.
+double LateralSigma(const PredictionModel& m, double ray_model_sigma_px, double z) {
+  return std::max(z, 1e-3) * std::hypot(m.pixel_noise_px, ray_model_sigma_px) / m.camera.fx_px;
+}
 
 // Weighted linear least squares over the rays; false when the rays do not fix a point in front of them.
-bool Triangulate(const PredictionModel& m, const std::vector<Ray>& rays, Point* out) {
+bool Triangulate(const PredictionModel& m, double ray_model_sigma_px, const std::vector<Ray>& rays, Point* out) {
   std::vector<double> w(rays.size(), 1.0);
   for (int pass = 0; pass < 2; ++pass) {
     Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
@@ -45,7 +49,7 @@ bool Triangulate(const PredictionModel& m, const std::vector<Ray>& rays, Point* 
     for (size_t i = 0; i < rays.size(); ++i) {
       const double z = rays[i].direction.dot(out->p - rays[i].origin);
       if (!(z > 0)) return false;
-      const double s = LateralSigma(m, z);
+      const double s = LateralSigma(m, ray_model_sigma_px, z);
       w[i] = 1.0 / (s * s);
     }
   }
@@ -75,43 +79,48 @@ bool ProjectPrediction(const PredictionModel& m, const Rigid3& cam_from_base, co
   return out->cov_px2.allFinite();
 }
 
-double Median(std::vector<double> v) {
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
-  return v[mid];
-}
-
-// A single-ray dot at the depth of its triangulated neighbours in the sample that saw it.
-bool PointOnRay(const PredictionModel& m, int self, const Ray& ray, const ViewedSample& sample,
-                const std::map<int, Point>& points, const DotPredictionOptions& o, Point* out) {
-  const Eigen::Vector2d uv = sample.dots_px.at(self);
-  std::vector<std::pair<double, double>> neighbours;  // image distance, depth along the ray's camera axis
+// A single-ray dot anywhere in the depth range of the scene as that sample saw it: the depths (along its
+// camera axis) of the sample's triangulated dots, widened by a margin. Its prediction is the segment of
+// its epipolar line between the projections of the nearest and farthest depth, as a gate whose
+// boundary holds the whole segment: a dot's image neighbours say nothing of its depth in a scene of
+// scattered dots, so nothing narrower is honest.
+bool SegmentOnRay(const PredictionModel& m, int self, const Ray& ray, const Rigid3& cam_from_base,
+                  const Rigid3& sample_cam_from_base, const ViewedSample& sample, const std::map<int, Point>& points,
+                  const DotPredictionOptions& o, tracking::PredictedDot* out) {
+  double z_min = 0, z_max = 0;
+  int depths = 0;
   for (const auto& [id, px] : sample.dots_px) {
     const auto it = id == self ? points.end() : points.find(id);
     if (it == points.end()) continue;
-    neighbours.push_back({(px - uv).norm(), ray.direction.dot(it->second.p - ray.origin)});
+    const double z = (sample_cam_from_base * it->second.p).z();
+    if (!(z > 0)) continue;
+    z_min = depths == 0 ? z : std::min(z_min, z);
+    z_max = depths == 0 ? z : std::max(z_max, z);
+    ++depths;
   }
-  if (static_cast<int>(neighbours.size()) < o.min_depth_neighbours) return false;
-  const size_t k = std::min(neighbours.size(), static_cast<size_t>(o.depth_neighbours));
-  std::partial_sort(neighbours.begin(), neighbours.begin() + static_cast<std::ptrdiff_t>(k), neighbours.end());
-  std::vector<double> depths;
-  for (size_t i = 0; i < k; ++i) depths.push_back(neighbours[i].second);
-  const double z = Median(depths);
-  if (!(z > 0)) return false;
-  double spread = 0;
-  for (double d : depths) spread = std::max(spread, std::abs(d - z));
-  const double sigma_z = std::max(spread, o.min_depth_sigma_fraction * z);
-  const double lateral = LateralSigma(m, z);
-  const Eigen::Matrix3d along = ray.direction * ray.direction.transpose();
-  out->p = ray.origin + z * ray.direction;
-  out->cov = sigma_z * sigma_z * along + lateral * lateral * (Eigen::Matrix3d::Identity() - along);
-  return true;
+  if (depths < o.min_depth_neighbours) return false;
+  const double axis = sample_cam_from_base.rotation.row(2).dot(ray.direction);  // depth per unit along the ray
+  if (!(axis > 0)) return false;
+  const double near = z_min * (1 - o.depth_margin_fraction) / axis, far = z_max * (1 + o.depth_margin_fraction) / axis;
+  const std::optional<Eigen::Vector2d> a = Project(m.camera, cam_from_base * (ray.origin + near * ray.direction));
+  const std::optional<Eigen::Vector2d> b = Project(m.camera, cam_from_base * (ray.origin + far * ray.direction));
+  if (!a || !b) return false;
+  const Eigen::Vector2d d = *b - *a;
+  const double half = 0.5 * d.norm();
+  const Eigen::Vector2d dir = half > 1e-9 ? Eigen::Vector2d(d / d.norm()) : Eigen::Vector2d::UnitX();
+  const double noise2 = m.pixel_noise_px * m.pixel_noise_px + o.ray_model_sigma_px * o.ray_model_sigma_px;
+  out->id = self;
+  out->uv_px = 0.5 * (*a + *b);
+  // The segment's ends at half the gate along it: the other half is left for the noise across it there.
+  out->cov_px2 = (2 * half * half / o.segment_gate_chi2) * dir * dir.transpose() + noise2 * Eigen::Matrix2d::Identity();
+  return out->cov_px2.allFinite();
 }
 
 // The rays of every dot, by id: (sample index, ray); the current frame's as sample index -1.
 using RaysById = std::map<int, std::vector<std::pair<int, Ray>>>;
 
-std::map<int, Point> TriangulateAll(const PredictionModel& model, const RaysById& rays, bool with_current) {
+std::map<int, Point> TriangulateAll(const PredictionModel& model, double ray_model_sigma_px, const RaysById& rays,
+                                    bool with_current) {
   std::map<int, Point> points;
   for (const auto& [id, r] : rays) {
     std::vector<Ray> plain;
@@ -119,7 +128,7 @@ std::map<int, Point> TriangulateAll(const PredictionModel& model, const RaysById
       if (with_current || sr.first >= 0) plain.push_back(sr.second);
     }
     Point x;
-    if (plain.size() >= 2 && Triangulate(model, plain, &x)) points[id] = x;
+    if (plain.size() >= 2 && Triangulate(model, ray_model_sigma_px, plain, &x)) points[id] = x;
   }
   return points;
 }
@@ -140,25 +149,48 @@ DotPredictionReport PredictDots(const PredictionModel& model, const std::vector<
   for (const auto& [id, uv] : current_px) {
     if (rays.count(id)) with_current[id].push_back({-1, RayOf(model, base_from_cam_now, uv)});
   }
-  const std::map<int, Point> points = TriangulateAll(model, rays, false);
-  const std::map<int, Point> depth_points = TriangulateAll(model, with_current, true);
+  // A candidate of the latest sample is a second ray of its dot for the points, never for the depths.
+  RaysById with_candidates = rays;
+  if (!samples.empty()) {
+    const size_t last = samples.size() - 1;
+    const Rigid3 base_from_cam = BaseFromCam(model.robot, rho, samples[last].joints_rad);
+    for (const auto& [id, uv] : samples[last].candidates_px) {
+      if (rays.count(id)) with_candidates[id].push_back({static_cast<int>(last), RayOf(model, base_from_cam, uv)});
+    }
+  }
+  const std::map<int, Point> points = TriangulateAll(model, options.ray_model_sigma_px, with_candidates, false);
+  const std::map<int, Point> depth_points = TriangulateAll(model, options.ray_model_sigma_px, with_current, true);
   DotPredictionReport report;
   const Rigid3 cam_from_base = base_from_cam_now.Inverse();
+  for (const auto& [id, uv] : current_px) {
+    Eigen::Vector3d x;
+    if (const auto own = points.find(id); own != points.end()) {
+      x = own->second.p;
+    } else if (const auto pair = depth_points.find(id); pair != depth_points.end() && rays.count(id)) {
+      // On the sample's ray, at the depth the new ray gives: off the tracked pixel only by the model's
+      // error across the epipolar line (the pair's own point would agree with the new ray by construction).
+      const Ray& ray = rays.at(id).back().second;
+      x = ray.origin + ray.direction.dot(pair->second.p - ray.origin) * ray.direction;
+    } else {
+      continue;
+    }
+    if (const std::optional<Eigen::Vector2d> a = Project(model.camera, cam_from_base * x)) report.anchor_px[id] = *a;
+  }
   for (const auto& [id, r] : rays) {
-    Point x;
+    tracking::PredictedDot p;
     bool have = false;
     if (const auto it = points.find(id); it != points.end()) {
-      x = it->second;
-      have = true;
+      have = ProjectPrediction(model, cam_from_base, it->second, id, &p);
       ++report.triangulated;
     } else {
-      // One ray (or rays that fix no point): the latest sample's ray at its neighbours' depth.
+      // One ray (or rays that fix no point): the latest sample's ray over the scene's depth range.
       const auto& [s, ray] = r.back();
-      have = PointOnRay(model, id, ray, samples[static_cast<size_t>(s)], depth_points, options, &x);
+      const ViewedSample& sample = samples[static_cast<size_t>(s)];
+      const Rigid3 sample_cam_from_base = BaseFromCam(model.robot, rho, sample.joints_rad).Inverse();
+      have = SegmentOnRay(model, id, ray, cam_from_base, sample_cam_from_base, sample, depth_points, options, &p);
       report.single_ray += have ? 1 : 0;
     }
-    tracking::PredictedDot p;
-    if (have && ProjectPrediction(model, cam_from_base, x, id, &p) && InImage(model.camera, p.uv_px, -options.image_margin_px)) {
+    if (have && InImage(model.camera, p.uv_px, -options.image_margin_px)) {
       report.dots.push_back(p);
     } else {
       ++report.not_predicted;

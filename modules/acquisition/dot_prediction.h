@@ -6,12 +6,14 @@
 // Per dot seen in two samples or more: the linear least-squares point nearest to its rays in the base
 // frame (each ray weighted by its lateral pixel noise at its depth, one reweighting), with the inverse of
 // that normal matrix as covariance; projected with the covariance propagated to pixels plus the new
-// frame's pixel noise. A dot seen in one sample only has a ray: it is put at the median depth (along the
-// ray) of its nearest triangulated image neighbours in that sample, their depth spread (with a floor) as
-// its uncertainty along the ray, which the projection turns into an elongated gate along the epipolar
-// line. The neighbours' depths may also come from `current_px`, the dots already known in the new frame
-// (tracked into it): a second view when only one sample has been accepted; they never enter a dot's own
-// prediction, which rests on the accepted samples alone. Nothing here is iterative beyond one reweighting, and nothing is differentiated automatically.
+// frame's pixel noise. A dot seen in one sample only has a ray, and may lie anywhere on it within the
+// depth range of the scene that sample saw (its triangulated dots, with a margin): its prediction is that
+// segment of its epipolar line, as an elongated gate that holds the whole segment. Neighbours in the
+// image say nothing about a dot's depth in a scene of scattered dots (the nearest-neighbour depth that
+// stood here named 15 of 80 simulated sessions wrongly). The depth range may also come from
+// `current_px`, the dots already known in the new frame (tracked into it): a second view when only one
+// sample has been accepted; they never enter a dot's own prediction, which rests on the accepted samples
+// alone. Nothing here is iterative beyond one reweighting, and nothing is differentiated automatically.
 #pragma once
 
 #include <map>
@@ -36,20 +38,35 @@ struct PredictionModel {
 struct ViewedSample {
   Eigen::VectorXd joints_rad;
   std::map<int, Eigen::Vector2d> dots_px;
+  std::map<int, Eigen::Vector2d> candidates_px;  // unconfirmed (session_pose.cc): used from the latest sample only
 };
 
 struct DotPredictionOptions {
-  int depth_neighbours = 6;             // single-ray dots: this many nearest triangulated neighbours...
-  int min_depth_neighbours = 3;         // ...at least this many, else not predicted
-  double min_depth_sigma_fraction = 0.03;  // floor of the depth std, as a fraction of the depth
+  // Single-ray dots: the depth range of at least this many triangulated dots of their sample, widened
+  // by this fraction at each end, projected as a segment whose ends lie on the gate of this chi-square.
+  int min_depth_neighbours = 3;
+  double depth_margin_fraction = 0.1;
+  double segment_gate_chi2 = 13.8;      // tracking::PredictedMatchOptions::gate_chi2
   // Predictions outside the image by more than this are left out; those just outside still check a
   // tracked dot that jumped onto another blob as its own left the view.
   double image_margin_px = 1000;
-  double max_gate_sigma_px = 15;        // the session names nothing by a gate longer than this (std)
+  // The session names a dot only by a gate at most this long (std along its longest axis); a detection
+  // alone in a longer gate, up to the second bound, becomes a candidate: with the next settled pose it
+  // gives the dot a second ray and a short gate, which then names it or not.
+  double max_gate_sigma_px = 4;
+  // The nominal model's error per ray, in pixels, beside the pixel noise in every triangulation: a
+  // nominal model's rays from two poses miss each other by about this much, which two close rays turn
+  // into a large error in depth.
+  double ray_model_sigma_px = 1.0;
+  double max_candidate_gate_sigma_px = 40;
 };
 
 struct DotPredictionReport {
   std::vector<tracking::PredictedDot> dots;  // in front of the camera and in the image
+  // Where the nominal model puts each dot of `current_px` with a point (triangulated from the samples,
+  // else from its sample ray and its ray in the new frame): the anchors of the correction of the raw
+  // predictions, which a segment's middle cannot be.
+  std::map<int, Eigen::Vector2d> anchor_px;
   int triangulated = 0;   // known dots with two rays or more
   int single_ray = 0;     // known dots predicted from one ray and their neighbours' depth
   int not_predicted = 0;  // known dots without a usable prediction (behind, outside, no depth)

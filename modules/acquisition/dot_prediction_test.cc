@@ -66,11 +66,13 @@ TEST(DotPrediction, ErrorsFollowTheCovarianceWithTheTrueModel) {
   const Cell c = MakeCell(0, 0, 4);
   std::mt19937_64 rng(9);
   std::vector<ViewedSample> samples;
-  for (int k = 0; k < 4; ++k) samples.push_back({c.joints[k], Observe(c, c.joints[k], &rng)});
+  for (int k = 0; k < 4; ++k) samples.push_back({c.joints[k], Observe(c, c.joints[k], &rng), {}});
   PredictionModel truth = c.nominal;
   truth.robot = ApplyParameters(c.nominal.robot, c.rho_true);
   const std::map<int, Eigen::Vector2d> next = Observe(c, c.joints[5], &rng);
-  const DotPredictionReport r = PredictDots(truth, samples, c.joints[5], {}, DotPredictionOptions());
+  DotPredictionOptions exact;
+  exact.ray_model_sigma_px = 0;  // the true model: the rays err by the pixel noise alone
+  const DotPredictionReport r = PredictDots(truth, samples, c.joints[5], {}, exact);
   EXPECT_EQ(r.triangulated, 60);
   double sum_m2 = 0;
   int n = 0;
@@ -88,7 +90,7 @@ TEST(DotPrediction, ASingleRayDotIsPredictedAlongItsEpipolarLine) {
   const Cell c = MakeCell(0, 0, 6);
   std::mt19937_64 rng(3);
   std::vector<ViewedSample> samples;
-  for (int k = 0; k < 3; ++k) samples.push_back({c.joints[k], Observe(c, c.joints[k], &rng)});
+  for (int k = 0; k < 3; ++k) samples.push_back({c.joints[k], Observe(c, c.joints[k], &rng), {}});
   const std::map<int, Eigen::Vector2d> next = Observe(c, c.joints[5], &rng);
   int lost = -1;  // a dot seen everywhere, then lost after the first sample
   for (const auto& [id, px] : samples[0].dots_px) {
@@ -113,7 +115,7 @@ TEST(DotPrediction, CorrectedOnAnchorsANominalModelNamesTheOtherDotsRight) {
   const Cell c = MakeCell(1e-3, 0.2 * 3.14159265358979 / 180, 8);  // the simulator's hidden error levels
   std::mt19937_64 rng(5);
   std::vector<ViewedSample> samples;
-  for (int k = 0; k < 4; ++k) samples.push_back({c.joints[k], Observe(c, c.joints[k], &rng)});
+  for (int k = 0; k < 4; ++k) samples.push_back({c.joints[k], Observe(c, c.joints[k], &rng), {}});
   const std::map<int, Eigen::Vector2d> next = Observe(c, c.joints[5], &rng);
   const DotPredictionReport r = PredictDots(c.nominal, samples, c.joints[5], {}, DotPredictionOptions());
   double raw_worst = 0;
@@ -145,6 +147,72 @@ TEST(DotPrediction, CorrectedOnAnchorsANominalModelNamesTheOtherDotsRight) {
     ++named;
   }
   EXPECT_GE(named, static_cast<int>(detections.size()) * 95 / 100) << fix.message;
+}
+
+// A scene of scattered dots: a dot's image neighbours say nothing of its depth, so every dot seen once
+// must lie inside its segment gate wherever it is in the scene's depth range (0.4-0.8 m here), the ends
+// of the segment included.
+TEST(DotPrediction, EveryDotSeenOnceLiesInItsSegmentGate) {
+  const Cell c = MakeCell(0, 0, 11);
+  std::mt19937_64 rng(12);
+  PredictionModel truth = c.nominal;
+  truth.robot = ApplyParameters(c.nominal.robot, c.rho_true);
+  const std::vector<ViewedSample> samples = {{c.joints[0], Observe(c, c.joints[0], &rng), {}}};
+  const std::map<int, Eigen::Vector2d> next = Observe(c, c.joints[5], &rng);
+  std::map<int, Eigen::Vector2d> tracked;  // half the dots carried into the new frame give the depths
+  for (const auto& [id, px] : next) {
+    if (id % 2 == 0) tracked[id] = px;
+  }
+  const DotPredictionReport r = PredictDots(truth, samples, c.joints[5], tracked, DotPredictionOptions());
+  int checked = 0;
+  for (const tracking::PredictedDot& p : r.dots) {
+    if (tracked.count(p.id) || !next.count(p.id)) continue;
+    EXPECT_LE(tracking::Mahalanobis2(p, next.at(p.id)), 13.8) << "dot " << p.id;
+    ++checked;
+  }
+  EXPECT_GE(checked, 20);
+  EXPECT_EQ(r.anchor_px.size(), tracked.size());
+}
+
+// A candidate (a detection alone in a dot's long gate) gives the dot a second ray: right, a short gate
+// that holds the dot; wrong (another dot's pixel), a gate that the dot is not in.
+TEST(DotPrediction, ACandidateGivesASecondRayThatConfirmsOrForgets) {
+  const Cell c = MakeCell(0, 0, 6);
+  std::mt19937_64 rng(3);
+  PredictionModel truth = c.nominal;
+  truth.robot = ApplyParameters(c.nominal.robot, c.rho_true);
+  std::vector<ViewedSample> samples;
+  for (int k = 0; k < 3; ++k) samples.push_back({c.joints[2 * k], Observe(c, c.joints[2 * k], &rng), {}});
+  const std::map<int, Eigen::Vector2d> next = Observe(c, c.joints[5], &rng);
+  std::vector<int> everywhere;  // dots seen in the first and last sample and in the new frame
+  for (const auto& [id, px] : samples[0].dots_px) {
+    if (samples[2].dots_px.count(id) && next.count(id)) everywhere.push_back(id);
+  }
+  ASSERT_FALSE(everywhere.empty());
+  const int lost = everywhere.front();
+  // The wrong candidate lies on the dot's epipolar line, as every candidate does: the point of its first
+  // ray 30 % farther away, seen from the last sample.
+  const Rigid3 base_from_first = BaseFromCam(truth.robot, KinematicParameters::Nominal(truth.robot), c.joints[0]);
+  const Eigen::Vector3d in_first = base_from_first.Inverse() * c.dots_in_base[static_cast<size_t>(lost)];
+  const Rigid3 last_from_base = BaseFromCam(truth.robot, KinematicParameters::Nominal(truth.robot), c.joints[4]).Inverse();
+  const std::optional<Eigen::Vector2d> farther = Project(truth.camera, last_from_base * (base_from_first * (1.3 * in_first)));
+  ASSERT_TRUE(farther.has_value());
+  const Eigen::Vector2d right = samples[2].dots_px.at(lost), wrong = *farther;
+  for (int k = 1; k < 3; ++k) samples[k].dots_px.erase(lost);
+  auto predicted = [&](const Eigen::Vector2d& candidate) {
+    samples[2].candidates_px = {{lost, candidate}};
+    DotPredictionOptions exact;
+    exact.ray_model_sigma_px = 0;  // the true model
+    const DotPredictionReport r = PredictDots(truth, samples, c.joints[5], {}, exact);
+    const auto it = std::find_if(r.dots.begin(), r.dots.end(), [&](const auto& p) { return p.id == lost; });
+    EXPECT_NE(it, r.dots.end());
+    return it == r.dots.end() ? tracking::PredictedDot() : *it;
+  };
+  const tracking::PredictedDot confirmed = predicted(right);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(confirmed.cov_px2);
+  EXPECT_LE(std::sqrt(eig.eigenvalues()(1)), DotPredictionOptions().max_gate_sigma_px);
+  EXPECT_LE(tracking::Mahalanobis2(confirmed, next.at(lost)), 13.8);
+  EXPECT_GT(tracking::Mahalanobis2(predicted(wrong), next.at(lost)), 13.8);
 }
 
 }  // namespace

@@ -2,7 +2,7 @@
 // the accepted samples are predicted at the capture's joints (dot_prediction.h), the raw predictions
 // corrected on the dots tracking carried into the frame (or, without them, by votes), the tracked dots
 // checked against their gates, and the detections nobody tracked named by gated nearest prediction with
-// the ambiguity test (tracking/predicted_match.h).
+// the ambiguity test (tracking/predicted_match.h), or kept as candidates of dots seen once.
 #include <map>
 
 #include <Eigen/Eigenvalues>
@@ -20,6 +20,7 @@ std::vector<ViewedSample> Runner::AcceptedSamples() const {
     ViewedSample s;
     s.joints_rad = Eigen::Map<const Eigen::VectorXd>(a->joints_rad.data(), static_cast<Eigen::Index>(a->joints_rad.size()));
     for (const session::SampleDot& d : a->dots) s.dots_px[d.id] = {d.u_px, d.v_px};
+    for (const session::SampleDot& d : a->candidates) s.candidates_px[d.id] = {d.u_px, d.v_px};
     samples.push_back(std::move(s));
   }
   return samples;
@@ -29,15 +30,14 @@ namespace {
 
 // The correction of the raw predictions: from the tracked dots when there are enough, else by votes.
 tracking::PredictionCorrection Correction(const std::vector<tracking::PredictedDot>& predicted,
+                                          const std::map<int, Eigen::Vector2d>& anchor_px,
                                           const std::vector<tracking::PreviousDot>& tracked,
                                           const std::vector<Eigen::Vector2d>& detections,
                                           const tracking::PredictionCorrectionOptions& options) {
-  std::map<int, const tracking::PredictedDot*> by_id;
-  for (const tracking::PredictedDot& p : predicted) by_id[p.id] = &p;
   std::vector<Eigen::Vector2d> from, to;
   for (const tracking::PreviousDot& d : tracked) {
-    if (const auto it = by_id.find(d.id); it != by_id.end()) {
-      from.push_back(it->second->uv_px);
+    if (const auto it = anchor_px.find(d.id); it != anchor_px.end()) {
+      from.push_back(it->second);
       to.push_back(d.centroid_px);
     }
   }
@@ -51,6 +51,7 @@ tracking::PredictionCorrection Correction(const std::vector<tracking::PredictedD
 }  // namespace
 
 void Runner::NameByPrediction(const Capture& capture) {
+  candidates_.clear();
   const std::vector<ViewedSample> samples = AcceptedSamples();
   if (samples.empty()) return;
   std::map<int, Eigen::Vector2d> tracked_px;
@@ -62,7 +63,7 @@ void Runner::NameByPrediction(const Capture& capture) {
   std::vector<Eigen::Vector2d> centroids;
   for (const tracking::DotDetection& d : detected.dots) centroids.push_back(d.centroid_px);
   const tracking::PredictionCorrection correction =
-      Correction(predicted.dots, tracked_, centroids, o_.prediction_correction);
+      Correction(predicted.dots, predicted.anchor_px, tracked_, centroids, o_.prediction_correction);
   if (!correction.ok) {
     ++report_.prediction_uncorrected;
     Log("prediction: no correction of the nominal predictions (" + correction.message + "): tracked dots only");
@@ -76,11 +77,14 @@ void Runner::NameByPrediction(const Capture& capture) {
     gate_of[p.id] = gates.size();
     gates.push_back(correction.Apply(p));
   }
-  // Gates too long to trust (a dot seen once, at an uncertain depth) neither name nor doubt.
+  // Gates too long to name (a dot seen once, anywhere over the scene's depth range) doubt no tracked dot,
+  // but they compete: a detection in one of them is never given another dot's id.
   std::vector<tracking::PredictedDot> usable;
+  std::map<int, double> gate_sigma;  // along the gate's longest axis
   for (const tracking::PredictedDot& g : gates) {
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(g.cov_px2);
-    if (eig.eigenvalues()(1) <= o_.prediction.max_gate_sigma_px * o_.prediction.max_gate_sigma_px) usable.push_back(g);
+    gate_sigma[g.id] = std::sqrt(std::max(0.0, eig.eigenvalues()(1)));
+    if (gate_sigma[g.id] <= o_.prediction.max_gate_sigma_px) usable.push_back(g);
   }
   // Tracked dots far outside their gate are dropped (never recorded under a doubtful id), and so are
   // those that also lie in the gate of a dot not accounted for by another tracked dot in its own gate
@@ -103,28 +107,31 @@ void Runner::NameByPrediction(const Capture& capture) {
     }
     kept.push_back(d);
   }
-  // Detections on a kept tracked dot are taken; the others are named by prediction, every usable gate
-  // competing.
+  // Detections on a kept tracked dot are taken; the others are named by prediction, every gate competing
+  // and every detection counted (one on a tracked dot in another's gate makes that gate ambiguous). A
+  // detection alone in a gate too long to name becomes a candidate (dot_prediction.h).
   std::vector<size_t> free;
-  std::vector<Eigen::Vector2d> free_centroids;
   for (size_t k = 0; k < detected.dots.size(); ++k) {
     bool taken = false;
     for (const tracking::PreviousDot& d : kept) {
       taken = taken || (d.centroid_px - centroids[k]).norm() < o_.detector.duplicate_distance_px;
     }
-    if (!taken) {
-      free.push_back(k);
-      free_centroids.push_back(centroids[k]);
-    }
+    if (!taken) free.push_back(k);
   }
-  const tracking::PredictedMatch match = tracking::MatchPredictions(usable, free_centroids, o_.predicted_match);
+  const tracking::PredictedMatch match = tracking::MatchPredictions(gates, centroids, o_.predicted_match);
   report_.ambiguous_by_prediction += match.ambiguous;
   for (size_t f = 0; f < free.size(); ++f) {
-    const int id = match.id_of_detection[f];
+    const int id = match.id_of_detection[free[f]];
     if (id < 0) continue;
     bool known = false;
     for (const tracking::PreviousDot& d : kept) known = known || d.id == id;
     if (known) continue;  // its tracked blob is elsewhere in the gate: keep the tracked one
+    if (gate_sigma[id] > o_.prediction.max_gate_sigma_px) {
+      if (gate_sigma[id] <= o_.prediction.max_candidate_gate_sigma_px) {
+        candidates_.push_back(tracking::MakePreviousDot(id, detected.dots[free[f]]));
+      }
+      continue;
+    }
     kept.push_back(tracking::MakePreviousDot(id, detected.dots[free[f]]));
     ++report_.named_by_prediction;
   }

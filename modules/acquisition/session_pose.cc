@@ -125,15 +125,26 @@ Runner::Step Runner::RecordSample(int pose, const PlannedPose& target, const Arr
                {"exposure_time_s", frame.exposure_time_s}, {"sequence", frame.sequence}})) {
     return Step::kEnd;
   }
-  json dots = json::array();
-  for (const tracking::PreviousDot& d : tracked_) {
-    dots.push_back({{"id", d.id}, {"u", d.centroid_px.x()}, {"v", d.centroid_px.y()}, {"area", d.area_px2},
-                    {"w", d.width_px}, {"h", d.height_px}});
-  }
+  auto dots_json = [](const std::vector<tracking::PreviousDot>& named) {
+    json dots = json::array();
+    for (const tracking::PreviousDot& d : named) {
+      dots.push_back({{"id", d.id}, {"u", d.centroid_px.x()}, {"v", d.centroid_px.y()}, {"area", d.area_px2},
+                      {"w", d.width_px}, {"h", d.height_px}});
+    }
+    return dots;
+  };
+  const json dots = dots_json(tracked_);
   json sample = {{"type", "sample_accepted"}, {"pose", pose}, {"id", target.id}, {"role", RoleName(target.role)},
                  {"joints_rad", ToJson(capture.joints.position_rad)}, {"joint_time_s", capture.joints.time_s},
                  {"settle_time_s", arrival.settle_s}, {"arrival_time_s", arrival.arrival_s},
                  {"exposure_time_s", frame.exposure_time_s}, {"image", image}, {"dots", dots}};
+  std::vector<tracking::PreviousDot> candidates;  // never beside a dot of the same id
+  for (const tracking::PreviousDot& c : candidates_) {
+    bool named = false;
+    for (const tracking::PreviousDot& d : tracked_) named = named || d.id == c.id;
+    if (!named) candidates.push_back(c);
+  }
+  if (!candidates.empty()) sample["candidates"] = dots_json(candidates);
   if (o_.journal_sim_clock) sample["sim_clock_s"] = Now();
   if (!Record(sample)) return Step::kEnd;
   ++report_.accepted;

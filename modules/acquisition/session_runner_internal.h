@@ -130,6 +130,7 @@ class Runner {
   RunReport report_;
   robot::JointLimits limits_;
   std::vector<tracking::PreviousDot> tracked_;
+  std::vector<tracking::PreviousDot> candidates_;  // of the settled frame being recorded (session_naming.cc)
   double last_frame_s_ = -std::numeric_limits<double>::infinity();
   std::map<int, int> frames_written_;  // per pose: frame_written records so far (image names)
 };

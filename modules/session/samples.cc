@@ -117,14 +117,14 @@ class Fields {
   std::string type_;
 };
 
-std::vector<SampleDot> ReadDots(const Fields& f) {
-  const nlohmann::json& value = f.Get("dots");
-  if (!value.is_array() || value.size() > kMaxDots) f.Fail("dots", "expected an array of at most 100000 dots");
+std::vector<SampleDot> ReadDots(const Fields& f, const std::string& name = "dots") {
+  const nlohmann::json& value = f.Get(name);
+  if (!value.is_array() || value.size() > kMaxDots) f.Fail(name, "expected an array of at most 100000 dots");
   std::vector<SampleDot> dots;
   std::set<int> ids;
   for (std::size_t i = 0; i < value.size(); ++i) {
     const nlohmann::json& dot = value[i];
-    const std::string key = "dots[" + std::to_string(i) + "]";
+    const std::string key = name + "[" + std::to_string(i) + "]";
     if (!dot.is_object()) f.Fail(key, "expected an object");
     for (const char* field : {"id", "u", "v", "area", "w", "h"}) {
       if (!dot.contains(field)) f.Fail(key, std::string("missing \"") + field + "\"");
@@ -284,6 +284,7 @@ class LogBuilder {
       f.Fail("image", sample.image + " was written for pose " + std::to_string(frame->second.pose));
     }
     sample.dots = ReadDots(f);
+    if (f.Has("candidates")) sample.candidates = ReadDots(f, "candidates");
     if (f.Has("sim_clock_s")) sample.sim_clock_s = f.Number("sim_clock_s");
     sample.record = index;
     if (log_.accepted[sample.pose]) {

@@ -62,6 +62,9 @@ struct AcceptedSample {
   double exposure_time_s = 0;
   std::string image;  // "images/<name>", named by an earlier frame_written of the same pose
   std::vector<SampleDot> dots;
+  // Detections the session could pin to a dot only up to its epipolar segment (a dot seen once): never
+  // observations, only a second ray that the next pose's prediction confirms or forgets (optional).
+  std::vector<SampleDot> candidates;
   std::optional<double> sim_clock_s;
   std::size_t record = 0;
 };
