@@ -138,5 +138,20 @@ TEST(HostileInput, ForgedJournalRecordIsRefusedNamingTheLineAndLeavesNoOutput) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// The halt message said "The robot was told to stop." whether or not STOP reached the arm: a lost
+// connection cannot carry it, a protective stop can.
+TEST(HostileInput, HaltSaysTheRobotWasToldToStopOnlyWhenTheStopWasSent) {
+  const fs::path dir = FreshDir("halt");
+  std::string output;
+  EXPECT_EQ(RunSelfcal("run --session " + (dir / "lost").string() + " --seed 3 --fault-disconnect-move 2", &output), 4)
+      << output;
+  EXPECT_FALSE(Has(output, "told to stop")) << output;
+  EXPECT_TRUE(Has(output, "The stop command could not be sent or was refused")) << output;
+  EXPECT_EQ(RunSelfcal("run --session " + (dir / "pstop").string() + " --seed 3 --fault-protective-stop-move 2", &output),
+            4)
+      << output;
+  EXPECT_TRUE(Has(output, "HALTED. The robot was told to stop.")) << output;
+}
+
 }  // namespace
 }  // namespace selfcal
