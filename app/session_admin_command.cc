@@ -19,7 +19,7 @@ Command AddSessionCommand(CLI::App& app) {
   discard->add_option("DIR", *dir, "Session directory")->required();
   return [dir]() {
     Result<session::SessionDirInspection> found = session::InspectSessionDir(*dir);
-    if (Status s = session::DiscardSession(*dir); !s.ok()) return Fail(s);
+    if (Status s = session::DiscardSession(*dir, /*take_over_stale_lock=*/true); !s.ok()) return Fail(s);
     std::cout << "removed " << *dir << " (" << session::SessionDirStateName(found->state) << ": "
               << found->journal_records << " journal records, no frame or sample)\n";
     return 0;

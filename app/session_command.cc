@@ -77,7 +77,10 @@ json RunJson(const RunSettings& a) {
   json run = {{"format", "selfcal-run"},
           {"version", 1},
           {"robot", a.robot_backend},
-          {"address", a.robot_backend == "network" ? a.address : ""},
+          // The address is a transport detail, not an input: a controller restarted on another port is the
+          // same robot (its identity is checked on resume, its limits at connect). Kept, empty, so that the
+          // run.json of earlier simulated sessions is unchanged.
+          {"address", ""},
           {"camera", a.camera_backend},
           {"device", a.camera_backend == "v4l2" ? a.device : ""},
           {"velocity_scaling", a.velocity_scaling},
@@ -202,7 +205,8 @@ Status LoadRunPlan(const RunSettings& a, RunPlan* run) {
 // Stage 2, --resume: opens the session (inputs compared, journal recovered, orphans moved: reported) and
 // restarts the simulated arm where the last accepted sample left it (sim_session.h).
 Result<session::Session> ResumeSession(const RunSettings& a, RunPlan* run) {
-  Result<session::Session> opened = session::OpenSession(a.session, run->inputs, a.force_changed_config);
+  Result<session::Session> opened = session::OpenSession(a.session, run->inputs, a.force_changed_config,
+                                                         session::JournalLimits(), a.take_over_stale_lock);
   if (!opened.ok()) return opened.status();
   const session::OpenReport& r = opened->open_report();
   if (r.journal.truncated()) {
@@ -227,7 +231,7 @@ Result<session::Session> ResumeSession(const RunSettings& a, RunPlan* run) {
 // with the same inputs first (nothing was recorded in it; session_cleanup.h).
 Result<session::Session> CreateRunSession(const RunSettings& a, const RunPlan& run, bool restart) {
   if (restart) {
-    if (Status s = session::DiscardSession(a.session); !s.ok()) return s;
+    if (Status s = session::DiscardSession(a.session, a.take_over_stale_lock); !s.ok()) return s;
   }
   const std::filesystem::path parent = std::filesystem::path(a.session).parent_path();
   if (!parent.empty()) {
@@ -285,7 +289,9 @@ Status MakeBackends(const RunSettings& a, RunPlan* run, Backends* b) {
     const size_t colon = a.address.rfind(':');
     const int port = colon == std::string::npos ? -1 : PortNumber(a.address.substr(colon + 1));
     if (port < 0) return Status::Error(ErrorCode::kInvalidInput, "--address must be HOST:PORT, not \"" + a.address + "\"");
-    robot::NetworkRobotOptions options;
+    robot::NetworkRobotOptions options;  // everything checked at connect against the robot config
+    options.config_limits = ManualJointLimits(run->nominal);
+    options.log = [](const std::string& line) { std::cout << line << "\n"; };
     b->owned_robot = std::make_unique<robot::NetworkRobot>(a.address.substr(0, colon), port, options);
   } else if (a.robot_backend == "manual") {
     b->owned_robot = std::make_unique<robot::ManualRobot>(std::cin, std::cout, ManualJointLimits(run->nominal), *b->clock);
@@ -398,9 +404,11 @@ int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, se
                                                                 a.session + " (same options)")
               << " once the cause is fixed\n";
   } else if (halted) {
-    std::cout << "HALTED. The robot was told to stop. Check the cell, then continue with: selfcal run --resume "
-                 "--session "
-              << a.session << " (same options)\n";
+    std::cout << (report.stop_sent ? "HALTED. The robot was told to stop."
+                                   : "HALTED. The stop command could not be sent or was refused: stop the arm at its "
+                                     "controller.")
+              << " Check the cell, then continue with: selfcal run --resume --session " << a.session
+              << " (same options)\n";
   }
   return static_cast<int>(ExitCodeFor(report.error));
 }
@@ -434,6 +442,9 @@ Command AddRunCommand(CLI::App& app) {
   cmd->add_flag("--resume", a->resume, "Continue a session after a stop or crash (checks every input's hash)");
   cmd->add_flag("--force-resume-with-changed-config", a->force_changed_config,
                 "Resume although an input differs from the recorded one (C9)");
+  cmd->add_flag("--take-over-stale-lock", a->take_over_stale_lock,
+                "--resume: take over a lock left by a process that ended without releasing it (you confirm that "
+                "no selfcal on the host it names uses the session)");
   cmd->add_flag("--dry-run", a->dry_run, "Check the plan and print the preview; send no motion command, create nothing");
   cmd->add_option("--revisit-skipped", a->revisit_skipped,
                   "--resume: visit poses skipped for too few dots, not settled, a bad frame or reading again, at "

@@ -19,6 +19,7 @@ struct RunSettings {
   std::string session;
   bool resume = false;
   bool force_changed_config = false;
+  bool take_over_stale_lock = false;  // the operator confirms that the process named in a stale lock is gone
   bool dry_run = false;
   int revisit_skipped = 1;  // --resume: further attempts per pose skipped for a revisitable reason
   std::string robot_config = "config/robots/puma560.yaml";

@@ -230,7 +230,8 @@ Status AddIdentityAudit(const sim::SimResult& world, const std::string& session,
 // selfcal simulate (default): the simulated arm and rendered camera through a real session directory, the
 // offline calibration of that session, and the comparison with the hidden truth.
 int SimulateSession(const SimulateArgs& args) {
-  if (Status s = EnsureDirectory(args.out); !s.ok()) return Fail(s);
+  // No EnsureDirectory(args.out) here: the run creates the session's parent once it can start, and the
+  // calibration its output, so a refused input leaves no empty output folder.
   RunSettings run;
   run.session = FreshSessionPath(args.out);
   run.robot_config = args.robot;

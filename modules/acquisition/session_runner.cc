@@ -47,6 +47,7 @@ bool Runner::Record(json record) {
 Runner::Step Runner::Halt(RunOutcome outcome, ErrorCode code, const std::string& reason, const std::string& detail,
                           int pose) {
   const Status stop = c_.robot->Stop();
+  report_.stop_sent = stop.ok();
   report_.outcome = outcome;
   report_.error = code;
   report_.halt_reason = reason;
@@ -123,10 +124,20 @@ bool Runner::ConnectRobot(const session::SessionLog& log, RobotAtStart* robot) {
   limits_ = *limits;
   if (log.started) {  // R13: the same robot as when the session started
     const json& started = c_.session->journal().records().front();
-    if (started.value("robot_model", "") != identity->model || started.value("robot_serial", "") != identity->serial) {
+    if (started.value("robot_model", "") != identity->model || started.value("robot_serial", "") != identity->serial ||
+        started.value("robot_calibration", identity->calibration_id) != identity->calibration_id) {
       report_.message = "session " + c_.session->path() + " was recorded with robot " +
                         started.value("robot_model", "?") + " serial " + started.value("robot_serial", "?") +
                         "; this robot is " + identity->model + " serial " + identity->serial + " (R13)";
+      return false;
+    }
+    // The limits the session was recorded under (the controller's, narrowed to the config's); not the
+    // address, a transport detail that may change when the controller restarts.
+    if (started.contains("robot_limits") &&
+        started["robot_limits"] != json{{"lower_rad", ToJson(limits_.lower_rad)}, {"upper_rad", ToJson(limits_.upper_rad)}}) {
+      report_.message = "session " + c_.session->path() + " was recorded under the joint limits " +
+                        started["robot_limits"].dump() + "; this robot reports lower " +
+                        ToJson(limits_.lower_rad).dump() + ", upper " + ToJson(limits_.upper_rad).dump() + " rad";
       return false;
     }
   }
@@ -227,6 +238,7 @@ bool Runner::JournalStart(const session::SessionLog& log, const std::vector<int>
     if (!Record({{"type", "session_started"}, {"time_s", Now()}, {"num_poses", num_poses}, {"mode", o_.mode},
                  {"robot_backend", identity.backend}, {"robot_model", identity.model},
                  {"robot_serial", identity.serial}, {"robot_calibration", identity.calibration_id},
+                 {"robot_limits", {{"lower_rad", ToJson(limits_.lower_rad)}, {"upper_rad", ToJson(limits_.upper_rad)}}},
                  {"camera", c_.camera->Describe()}})) {
       return false;
     }

@@ -135,6 +135,7 @@ struct RunReport {
   std::map<std::string, int> skips;   // by reason, this invocation
   std::map<std::string, int> faults;  // by kind, this invocation (each retried or tolerated fault)
   std::string halt_reason;      // when halted / interrupted
+  bool stop_sent = false;       // the halt's STOP was sent and acknowledged (false: not sent, or it failed)
   int frames_grabbed = 0, frames_tracked = 0;
   int identity_flags = 0;       // D4: merged + inconsistent dots dropped by the tracker
   // Naming by prediction, over this invocation's settled frames:

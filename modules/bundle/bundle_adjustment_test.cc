@@ -251,6 +251,28 @@ TEST(BundleAdjustment, OutliersAreRemovedByPoseAndDotAndTheResultHolds) {
             << " removed; worst free parameter at " << worst_z << " sigma; " << r.seconds * 1e3 << " ms\n";
 }
 
+// Issue 16 (K1, K3): the gauge does not depend on the stated pixel noise. Before, 1e-10 px made the
+// yardstick's rows vanish below the rank tolerance (j3.d fixed: a false "insufficient excitation") and
+// 1e-150 px overflowed the weighted Jacobian (a crash in the QR of SelectColumns).
+TEST(BundleAdjustment, GaugeIsTheSameAtEveryStatedPixelNoise) {
+  const sim::SimResult world = World(0.0);
+  const ObservationSet& obs = world.observations;
+  internal::BundleState state{KinematicParameters::Nominal(obs.robot), obs.camera.fx_px, 0.0, {}};
+  internal::BundleData data = internal::MakeBundleData(obs, 1e-6);
+  for (int id : data.dot_ids) state.dots.push_back(world.truth.dots_in_base[id]);
+  internal::Gauge reference;
+  ASSERT_TRUE(internal::AnalyzeGauge(data, state, true, false, BundleOptions().rank_tolerance, &reference));
+  EXPECT_EQ(reference.free_kinematic, world.truth.perturbed_indices);
+  for (double sigma_px : {1e-150, 1e-100, 1e-10, 1e-6, 0.02, 1.0, 100.0}) {
+    data.sigma_px = sigma_px;
+    internal::Gauge gauge;
+    ASSERT_TRUE(internal::AnalyzeGauge(data, state, true, false, BundleOptions().rank_tolerance, &gauge)) << sigma_px;
+    EXPECT_EQ(gauge.free_kinematic, reference.free_kinematic) << sigma_px;
+    EXPECT_EQ(gauge.fixed_names, reference.fixed_names) << sigma_px;
+    EXPECT_TRUE(gauge.fx_identifiable) << sigma_px;
+  }
+}
+
 TEST(BundleAdjustment, MissingYardstickLeavesTheScaleUnresolved) {
   sim::SimResult world = World(0.2);
   const Eigen::VectorXd rho0 = KinematicParameters::Nominal(world.observations.robot);

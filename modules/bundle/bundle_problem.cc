@@ -300,8 +300,14 @@ bool AnalyzeGauge(const BundleData& data, const BundleState& state, bool estimat
   std::iota(columns.kinematic.begin(), columns.kinematic.end(), 0);
   columns.fx = estimate_fx;
   columns.k1 = estimate_k1;
+  // The gauge is a property of the poses, the dots and the yardsticks, not of the stated pixel noise: the
+  // pixel rows are weighted as at 1 px, so that a noise of 1e-150 px neither overflows the Jacobian (a
+  // crash in the QR) nor makes the yardstick's rows vanish below the rank tolerance (scale then looked
+  // unobservable and a length parameter was fixed: a false "insufficient excitation").
+  BundleData unit_weights = data;
+  unit_weights.sigma_px = 1.0;
   Eigen::MatrixXd reduced;
-  if (!ReducedJacobian(data, state, columns, &reduced)) return false;
+  if (!ReducedJacobian(unit_weights, state, columns, &reduced)) return false;
   const std::vector<std::string> names = GlobalNames(columns, num_joints);
   const identification::RankSelection selection =
       identification::SelectColumns(reduced, SelectionOrder(num_joints, estimate_fx, estimate_k1), rank_tolerance, names);

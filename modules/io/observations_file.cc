@@ -220,7 +220,7 @@ Result<ObservationSet> ParseObservations(const yaml::YamlDocument& doc) {
     root.AddMissing("`robot` (or `robot_file`)");
   }
   const bool camera_ok = ReadCamera(&root, &problems, &set.camera);
-  root.Double("pixel_noise_px", Range::Positive(100.0), &set.pixel_noise_px);
+  root.Double("pixel_noise_px", Range::Closed(kMinPixelNoisePx, kMaxPixelNoisePx), &set.pixel_noise_px);
   ReadDistances(&root, "yardsticks", /*required=*/true, &problems, &set.yardsticks);
   ReadDistances(&root, "check_distances", /*required=*/false, &problems, &set.check_distances);
   if (const yaml::YamlNode* poses = root.Required("poses")) {

@@ -202,6 +202,10 @@ TEST_F(ObservationsEdits, C3CameraValues) {
   EXPECT_TRUE(Refused(Load("width_px: 640", "width_px: 640.5"), "`camera.width_px` = `640.5`"));
   EXPECT_TRUE(Refused(Load("cx_px: 319.5", "cx_px: 900"), "cx_px = 900 must lie in [0, width]"));
   EXPECT_TRUE(Refused(Load("pixel_noise_px: 0.2", "pixel_noise_px: -0.2"), "`pixel_noise_px` = `-0.2`"));
+  // Issue 16: a noise far below any camera's (the weighted normal equations overflow) is named by key and line.
+  EXPECT_TRUE(Refused(Load("pixel_noise_px: 0.2", "pixel_noise_px: 1e-150"),
+                      "`pixel_noise_px` = `1e-150` at " + path_ + ":5 is out of range: must be in [1e-06, 100]"));
+  EXPECT_TRUE(Load("pixel_noise_px: 0.2", "pixel_noise_px: 1e-6").ok());
   EXPECT_TRUE(Refused(Load("length_mm: 250.0", "length_mm: 0"), "`yardsticks[0].length_mm` = `0`"));
 }
 
@@ -346,6 +350,21 @@ TEST(TrajectoryFile, C5WrongJointCountNamesEveryBadPose) {
   WriteFile(path, "format: selfcal-trajectory\nversion: 1\nposes:\n  - [0, 30, -150, 0, 45, 0]\n");
   EXPECT_NE(LoadTrajectory(path, 6).status().message().find("`poses` at " + path + ":3 is not allowed here: the unit goes in the key"),
             std::string::npos) << LoadTrajectory(path, 6).status().message();
+}
+
+// Issue 16: an empty plan crashed run (with and without --dry-run) and simulate --trajectory at its first
+// pose; it is a config error naming the file and the line.
+TEST(TrajectoryFile, C7AnEmptyPoseListIsRefusedNamingFileAndLine) {
+  TempDir dir;
+  const std::string path = dir.File("plan.yaml");
+  for (const char* key : {"poses_rad", "poses_deg"}) {
+    WriteFile(path, std::string("format: selfcal-trajectory\nversion: 1\n") + key + ": []\n");
+    const Status status = LoadTrajectory(path, 6).status();
+    EXPECT_EQ(status.code(), ErrorCode::kInvalidInput) << key;
+    EXPECT_NE(status.message().find(std::string("`") + key + "` at " + path + ":3 is empty: a plan needs at least one pose"),
+              std::string::npos)
+        << status.message();
+  }
 }
 
 TEST(TrajectoryFile, C6PosesOutsideTheLimitsAreRefused) {

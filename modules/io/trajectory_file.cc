@@ -60,7 +60,7 @@ void ReadPlannedFor(MapReader* root, Problems* problems, std::optional<planning:
   ok &= map.Quantity("max_joint_travel", Unit::kAngle, Range::Positive(2 * kPi), &c.max_joint_travel_rad);
   ok &= map.Double("max_image_motion_px", Range::Positive(1e5), &c.max_image_motion_px);
   ok &= map.Double("max_fx_stddev_rel", Range::Positive(1), &c.max_fx_stddev_rel);
-  ok &= map.Double("pixel_noise_px", Range::Positive(100), &c.pixel_noise_px);
+  ok &= map.Double("pixel_noise_px", Range::Closed(kMinPixelNoisePx, kMaxPixelNoisePx), &c.pixel_noise_px);
   long long min_poses = 0;
   ok &= map.Int("min_identification_poses", 3, 100000, &min_poses);
   c.min_identification_poses = static_cast<int>(min_poses);
@@ -147,6 +147,8 @@ Result<TrajectoryFile> Load(const std::string& path, int num_joints, const Robot
     if (!list.IsSequence()) {
       problems.Add("`" + key + "` at " + problems.At(list.line) + " must be a sequence of joint-angle rows (found " +
                    list.KindName() + ")");
+    } else if (list.items.empty()) {  // a run, a simulation and a plan check all start at the first pose
+      problems.Add("`" + key + "` at " + problems.At(list.line) + " is empty: a plan needs at least one pose");
     }
     for (size_t i = 0; list.IsSequence() && i < list.items.size(); ++i) {
       const yaml::YamlNode& row = list.items[i];

@@ -21,8 +21,9 @@ std::vector<int> ObservationSet::PosesWithRole(PoseRole role) const {
 std::string ObservationSet::Validate() const {
   std::ostringstream out;
   out << robot.Validate() << camera.Validate();
-  if (!std::isfinite(pixel_noise_px) || pixel_noise_px <= 0) {
-    out << "pixel_noise_px = " << pixel_noise_px << " must be finite and > 0\n";
+  if (!(pixel_noise_px >= kMinPixelNoisePx && pixel_noise_px <= kMaxPixelNoisePx)) {
+    out << "pixel_noise_px = " << pixel_noise_px << " must lie in [" << kMinPixelNoisePx << ", " << kMaxPixelNoisePx
+        << "] px\n";
   }
   std::set<std::string> ids;
   std::set<int> seen_dots;

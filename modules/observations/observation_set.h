@@ -31,6 +31,12 @@ struct KnownDistance {
   double length_m = 0;
 };
 
+// The range of a stated centroid noise, px. Below 1e-6 px the weighted Jacobian (entries ~ f_x / sigma)
+// squares beyond what the solvers' normal equations hold without overflow at 1e-150 px, and no camera's
+// centroids come near it (0.01 px is excellent; a double pixel coordinate resolves ~1e-13 px).
+inline constexpr double kMinPixelNoisePx = 1e-6;
+inline constexpr double kMaxPixelNoisePx = 100.0;
+
 struct ObservationSet {
   RobotModel robot;                  // nominal model
   CameraIntrinsics camera;           // fx_px is the nominal / initial value (f_x is estimated)

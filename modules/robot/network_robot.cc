@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <sstream>
 #include <utility>
@@ -27,6 +28,33 @@ std::string IdentityDifference(const RobotIdentity& expected, const RobotIdentit
   return difference;
 }
 
+// "\x1b" for ESC: every byte outside ' '..'~' escaped, so that a controller cannot drive the terminal.
+std::string Sanitised(const std::string& text) {
+  std::string out;
+  for (const unsigned char c : text) {
+    if (c >= 0x20 && c <= 0x7e) {
+      out += static_cast<char>(c);
+    } else {
+      char escaped[8];
+      std::snprintf(escaped, sizeof(escaped), "\\x%02x", c);
+      out += escaped;
+    }
+  }
+  return out;
+}
+
+Status SanitisedStatus(const Status& status) {
+  if (status.ok()) return status;
+  return RobotFailure(RobotErrorOf(status), Sanitised(status.message()));
+}
+
+std::string Numbers(const Eigen::VectorXd& v) {
+  std::ostringstream out;
+  out.precision(6);
+  for (Eigen::Index i = 0; i < v.size(); ++i) out << (i ? " " : "") << v[i];
+  return out.str();
+}
+
 }  // namespace
 
 Status NetworkRobotOptions::Validate() const {
@@ -38,6 +66,16 @@ Status NetworkRobotOptions::Validate() const {
     problems << " reply_timeout_s = " << reply_timeout_s << " must be finite and > 0;";
   }
   if (max_line_bytes < 256) problems << " max_line_bytes = " << max_line_bytes << " must be at least 256;";
+  if (config_limits) {
+    const JointLimits& c = *config_limits;
+    if (c.lower_rad.size() == 0 || c.lower_rad.size() != c.upper_rad.size() || !c.lower_rad.allFinite() ||
+        !c.upper_rad.allFinite() || (c.upper_rad - c.lower_rad).minCoeff() < 0) {
+      problems << " config_limits must give finite lower <= upper bounds for at least one joint;";
+    }
+  }
+  if (!(rest_interval_s >= 0 && rest_interval_s <= 1 && rest_tolerance_rad > 0 && rest_velocity_rad_s > 0)) {
+    problems << " rest_interval_s must lie in [0, 1] s, rest_tolerance_rad and rest_velocity_rad_s be > 0;";
+  }
   if (problems.str().empty()) return Status::Ok();
   return Status::Error(ErrorCode::kInvalidInput, "network robot options:" + problems.str());
 }
@@ -107,11 +145,17 @@ Result<std::string> NetworkRobot::RoundTrip(RequestKind kind, const std::string&
   return RobotFailure(RobotError::kDisconnected, name_ + ": connection " + reason);
 }
 
-Status NetworkRobot::Handshake() {
+Status NetworkRobot::Handshake() { return SanitisedStatus(HandshakeUnsanitised()); }
+
+Status NetworkRobot::HandshakeUnsanitised() {
   const Result<std::string> hello_line = RoundTrip(RequestKind::kHello, protocol::HelloRequest());
   if (!hello_line.ok()) return hello_line.status();
   Result<protocol::HelloInfo> hello = protocol::ParseHelloReply(*hello_line, name_);
   if (!hello.ok()) return hello.status();
+  RobotIdentity& said = hello.value().identity;
+  for (std::string* field : {&said.model, &said.serial, &said.calibration_id}) {
+    *field = Sanitised(*field);
+  }
   if (first_hello_) {  // R10, R13: after a reconnect it must be the same arm
     std::string difference = IdentityDifference(first_hello_->identity, hello->identity, false);
     if (first_hello_->num_joints != hello->num_joints) {
@@ -140,10 +184,84 @@ Status NetworkRobot::Handshake() {
   if (const std::string problem = CheckJointLimits(*limits); !problem.empty()) {
     return RobotFailure(RobotError::kProtocol, name_ + ": LIMITS: " + problem);
   }
+  if (Status s = CheckAgainstConfig(*hello, &limits.value()); !s.ok()) return s;
   hello_ = std::move(hello).value();
   hello_.identity.backend = "network";
   limits_ = std::move(limits).value();
   if (!first_hello_) first_hello_ = hello_;
+  return Status::Ok();
+}
+
+Status NetworkRobot::CheckAgainstConfig(const protocol::HelloInfo& hello, JointLimits* limits) {
+  if (!options_.config_limits) return Status::Ok();
+  const JointLimits& config = *options_.config_limits;
+  const Eigen::Index n = config.lower_rad.size();
+  if (hello.num_joints != n) {
+    return RobotFailure(RobotError::kProtocol, name_ + ": HELLO reports " + std::to_string(hello.num_joints) +
+                                                   " joints, the robot config has " + std::to_string(n));
+  }
+  if (limits->lower_rad.size() != n || limits->upper_rad.size() != n || limits->max_velocity_rad_s.size() != n) {
+    return RobotFailure(RobotError::kProtocol, name_ + ": LIMITS has " + std::to_string(limits->lower_rad.size()) +
+                                                   " joints, the robot config has " + std::to_string(n));
+  }
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double lower = std::max(limits->lower_rad[j], config.lower_rad[j]);
+    const double upper = std::min(limits->upper_rad[j], config.upper_rad[j]);
+    std::ostringstream what;
+    what.precision(6);
+    what << "joint " << j + 1 << ": the controller's limits [" << limits->lower_rad[j] << ", " << limits->upper_rad[j]
+         << "] rad and the robot config's [" << config.lower_rad[j] << ", " << config.upper_rad[j] << "] rad";
+    if (lower > upper) {
+      return RobotFailure(RobotError::kProtocol, name_ + ": LIMITS: " + what.str() + " do not overlap");
+    }
+    if ((lower != limits->lower_rad[j] || upper != limits->upper_rad[j]) && options_.log) {
+      options_.log(name_ + ": " + what.str() + ": the narrower [" + Numbers(Eigen::Vector2d(lower, upper)) +
+                   "] rad is used");
+    }
+    limits->lower_rad[j] = lower;
+    limits->upper_rad[j] = upper;
+  }
+  return Status::Ok();
+}
+
+Status NetworkRobot::CheckStartReading() {
+  if (!options_.config_limits) return Status::Ok();
+  JointReading readings[2];
+  for (int k = 0; k < 2; ++k) {
+    if (k == 1) clock_.SleepFor(options_.rest_interval_s);
+    Result<JointReading> r = ReadJoints();
+    if (!r.ok()) return r.status();
+    const JointReading& q = *r;
+    const std::string which = name_ + ": the start reading " + (k == 0 ? "" : "(again) ");
+    if (q.position_rad.size() != limits_.lower_rad.size() || q.velocity_rad_s.size() != q.position_rad.size()) {
+      return RobotFailure(RobotError::kBadReading, which + "has " + std::to_string(q.position_rad.size()) +
+                                                       " joints, the robot config has " +
+                                                       std::to_string(limits_.lower_rad.size()));
+    }
+    if (!q.position_rad.allFinite() || !q.velocity_rad_s.allFinite()) {
+      return RobotFailure(RobotError::kBadReading, which + "is not finite: " + Numbers(q.position_rad) + " rad, " +
+                                                       Numbers(q.velocity_rad_s) + " rad/s");
+    }
+    for (Eigen::Index j = 0; j < q.position_rad.size(); ++j) {
+      if (q.position_rad[j] < limits_.lower_rad[j] - 1e-9 || q.position_rad[j] > limits_.upper_rad[j] + 1e-9) {
+        std::ostringstream what;
+        what << which << "has joint " << j + 1 << " at " << q.position_rad[j] << " rad, outside its limits ["
+             << limits_.lower_rad[j] << ", " << limits_.upper_rad[j] << "] rad";
+        return RobotFailure(RobotError::kBadReading, what.str());
+      }
+    }
+    readings[k] = q;
+  }
+  const double moved = (readings[1].position_rad - readings[0].position_rad).cwiseAbs().maxCoeff();
+  const double speed = std::max(readings[0].velocity_rad_s.cwiseAbs().maxCoeff(),
+                                readings[1].velocity_rad_s.cwiseAbs().maxCoeff());
+  if (moved > options_.rest_tolerance_rad || speed > options_.rest_velocity_rad_s) {
+    std::ostringstream what;
+    what << name_ << ": the arm is not at rest at connect: two readings " << options_.rest_interval_s
+         << " s apart differ by up to " << moved << " rad, joint speeds up to " << speed << " rad/s (at rest: "
+         << options_.rest_tolerance_rad << " rad, " << options_.rest_velocity_rad_s << " rad/s)";
+    return RobotFailure(RobotError::kBadReading, what.str());
+  }
   return Status::Ok();
 }
 
@@ -160,6 +278,11 @@ Status NetworkRobot::Connect() {
   }
   link_ = Link::kUp;
   broken_reason_.clear();
+  if (Status start = SanitisedStatus(CheckStartReading()); !start.ok()) {
+    socket_.Close();  // nothing was sent to the arm: no MOVE, no STOP
+    link_ = Link::kClosed;
+    return start;
+  }
   return Status::Ok();
 }
 
@@ -182,7 +305,9 @@ Result<JointLimits> NetworkRobot::Limits() {
   const Result<std::string> line = RoundTrip(RequestKind::kLimits, "LIMITS");
   if (!line.ok()) return line.status();
   Result<JointLimits> limits = protocol::ParseLimitsReply(*line, hello_.num_joints, name_);
-  if (limits.ok()) limits_ = *limits;
+  if (!limits.ok()) return SanitisedStatus(limits.status());
+  if (Status s = CheckAgainstConfig(hello_, &limits.value()); !s.ok()) return SanitisedStatus(s);
+  limits_ = *limits;
   return limits;
 }
 
@@ -192,7 +317,7 @@ Result<JointReading> NetworkRobot::ReadJoints() {
   const double arrived_s = clock_.Now();  // the session's clock, not the controller's (see header)
   if (!line.ok()) return line.status();
   Result<JointReading> reading = protocol::ParseJointsReply(*line, name_);
-  if (!reading.ok()) return reading;
+  if (!reading.ok()) return SanitisedStatus(reading.status());
   last_controller_time_s_ = reading->time_s;
   reading.value().time_s = arrived_s;
   return reading;
@@ -205,21 +330,24 @@ Status NetworkRobot::StartMove(const Eigen::VectorXd& target_rad, double velocit
   }
   const Result<std::string> line = RoundTrip(RequestKind::kMove, protocol::MoveRequest(target_rad, velocity_scaling));
   if (!line.ok()) return line.status();
-  return protocol::ParseOkReply(*line, RequestKind::kMove, RobotError::kRejected, name_);
+  return SanitisedStatus(protocol::ParseOkReply(*line, RequestKind::kMove, RobotError::kRejected, name_));
 }
 
 Result<RobotStatus> NetworkRobot::GetStatus() {
   if (Status link = LinkStatus("GetStatus"); !link.ok()) return link;
   const Result<std::string> line = RoundTrip(RequestKind::kStatus, "STATUS");
   if (!line.ok()) return line.status();
-  return protocol::ParseStatusReply(*line, name_);
+  Result<RobotStatus> status = protocol::ParseStatusReply(*line, name_);
+  if (!status.ok()) return SanitisedStatus(status.status());
+  status.value().message = Sanitised(status->message);
+  return status;
 }
 
 Status NetworkRobot::Stop() {
   if (Status link = LinkStatus("Stop"); !link.ok()) return link;
   const Result<std::string> line = RoundTrip(RequestKind::kStop, "STOP");
   if (!line.ok()) return line.status();
-  return protocol::ParseOkReply(*line, RequestKind::kStop, RobotError::kRejected, name_);
+  return SanitisedStatus(protocol::ParseOkReply(*line, RequestKind::kStop, RobotError::kRejected, name_));
 }
 
 }  // namespace selfcal::robot

@@ -10,6 +10,8 @@
 //   - a line the protocol does not allow -> kProtocol quoting the line (a line over max_line_bytes also
 //     closes the connection);
 //   - `ERR <code>` replies -> the error the code names (line_protocol.h).
+// Text from the controller (identity, ERR texts, quoted lines) reaches messages sanitised: control bytes,
+// NUL, DEL and bytes above 0x7e (ANSI escapes among them) are written as \xNN.
 // A reconnect re-checks the controller's identity against the one seen at the first connection and
 // refuses a different arm with kProtocol (R10, R13), before anything else is sent.
 //
@@ -19,6 +21,7 @@
 // LAN). The controller's own time is kept in last_controller_time_s() for logs.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -37,6 +40,19 @@ struct NetworkRobotOptions {
   // the non-empty fields here (R12, R13).
   std::optional<RobotIdentity> expected_identity;
   size_t max_line_bytes = protocol::kMaxLineBytes;
+  // The robot config's joint position limits (lower_rad, upper_rad; max_velocity_rad_s unused). When set,
+  // Connect() checks everything a session checks later, before anything moves: the joint count in HELLO,
+  // LIMITS and JOINTS against the config's; the controller's limits intersected with the config's (the
+  // narrower bound wins per joint, and `log` says which joints were narrowed; an empty intersection is
+  // refused); and the start reading: two readings rest_interval_s apart, each of the config's length,
+  // finite and within the limits, agreeing within rest_tolerance_rad with velocities within
+  // rest_velocity_rad_s (at rest). A refusal at connect sends nothing to the arm (no MOVE, no STOP).
+  std::optional<JointLimits> config_limits;
+  double rest_interval_s = 0.05;
+  double rest_tolerance_rad = 1e-3;
+  double rest_velocity_rad_s = 1e-2;
+  // Where Connect() reports what it adapted (the narrowed limits); may be empty.
+  std::function<void(const std::string&)> log;
   // OK, or ErrorCode::kInvalidInput naming the bad field.
   Status Validate() const;
 };
@@ -79,6 +95,10 @@ class NetworkRobot : public Robot {
   void Break(const std::string& reason);
   // HELLO and LIMITS on a fresh socket; the identity checks.
   Status Handshake();
+  Status HandshakeUnsanitised();
+  // With config_limits: the joint count, the intersection of the limits, and the start reading at rest.
+  Status CheckAgainstConfig(const protocol::HelloInfo& hello, JointLimits* limits);
+  Status CheckStartReading();
 
   std::string host_;
   int port_;

@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <thread>
@@ -300,6 +301,122 @@ TEST(NetworkRobotTest, ExpectedIdentityIsCheckedAtConnectR12) {
   EXPECT_EQ(RobotErrorOf(refused), RobotError::kProtocol);
   EXPECT_THAT(refused.message(), HasSubstr("not the expected robot (expected serial \"sn-9\", now \"sn-1\")"));
   EXPECT_EQ(RobotErrorOf(client.GetStatus().status()), RobotError::kNotConnected);
+}
+
+// Issue 16 item 4: with the robot config's limits, Connect() checks the joint count, intersects the
+// limits and checks the start reading; a refusal there sends neither MOVE nor STOP.
+NetworkRobotOptions ConfigClientOptions(std::vector<std::string>* log) {
+  NetworkRobotOptions options = FastClientOptions();
+  options.config_limits = testing::ThreeJointOptions().limits;
+  options.rest_interval_s = 0.01;
+  options.log = [log](const std::string& line) { log->push_back(line); };
+  return options;
+}
+
+JointReading Reading(const Eigen::Vector3d& q, const Eigen::Vector3d& qdot = Eigen::Vector3d::Zero()) {
+  JointReading r;
+  r.position_rad = q;
+  r.velocity_rad_s = qdot;
+  r.time_s = 1.0;
+  return r;
+}
+
+// A three-joint controller with `hello` and `limits` replies and JOINTS answered by `joints(k)` for the
+// k-th reading; counts the MOVE and STOP requests it received.
+struct ScriptedController {
+  ScriptedController(std::string hello, std::string limits, std::function<std::string(int)> joints)
+      : server([this, hello, limits, joints](const std::string& request) -> std::optional<std::string> {
+          if (request.rfind("HELLO", 0) == 0) return hello;
+          if (request == "LIMITS") return limits;
+          if (request == "JOINTS") return joints(readings++);
+          if (request.rfind("MOVE", 0) == 0 || request == "STOP") ++motion_commands;
+          return protocol::OkReply();
+        }) {}
+  std::atomic<int> readings{0}, motion_commands{0};
+  FakeServer server;
+};
+
+TEST(NetworkRobotTest, ConnectChecksJointCountLimitsAndTheStartReadingAgainstTheConfig) {
+  const std::string hello3 = protocol::HelloReply({"", "fake", "f-1", "", false}, 3);
+  const std::string limits3 = protocol::LimitsReply(testing::ThreeJointOptions().limits);
+  const std::string at_rest = protocol::JointsReply(Reading(Eigen::Vector3d(0.1, 0.2, 0.3)));
+  struct Case {
+    const char* what;
+    std::string hello, limits;
+    std::function<std::string(int)> joints;
+    const char* expected;
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  const std::vector<Case> cases = {
+      {"2 joints in HELLO", protocol::HelloReply({"", "fake", "f-1", "", false}, 2), protocol::LimitsReply([] {
+         JointLimits l;
+         l.lower_rad = Eigen::Vector2d(-1, -1);
+         l.upper_rad = Eigen::Vector2d(1, 1);
+         l.max_velocity_rad_s = Eigen::Vector2d(1, 1);
+         return l;
+       }()),
+       [&](int) { return at_rest; }, "HELLO reports 2 joints, the robot config has 3"},
+      {"short reading", hello3, limits3, [](int) { return std::string("OK 1 0.1 0.2 0 0"); },
+       "the start reading has 2 joints, the robot config has 3"},
+      {"NaN", hello3, limits3, [&](int) { return protocol::JointsReply(Reading(Eigen::Vector3d(0.1, nan, 0.3))); },
+       "the start reading is not finite"},
+      {"inf", hello3, limits3, [&](int) { return protocol::JointsReply(Reading(Eigen::Vector3d(inf, 0.2, 0.3))); },
+       "the start reading is not finite"},
+      {"out of limits", hello3, limits3,
+       [&](int) { return protocol::JointsReply(Reading(Eigen::Vector3d(0.1, 2.5, 0.3))); },
+       "has joint 2 at 2.5 rad, outside its limits [-2, 2] rad"},
+      {"moving", hello3, limits3,
+       [&](int k) { return protocol::JointsReply(Reading(Eigen::Vector3d(0.1 + 0.01 * k, 0.2, 0.3))); },
+       "the arm is not at rest at connect"},
+      {"moving, by its velocities", hello3, limits3,
+       [&](int) { return protocol::JointsReply(Reading(Eigen::Vector3d(0.1, 0.2, 0.3), Eigen::Vector3d(0, 0.5, 0))); },
+       "the arm is not at rest at connect"},
+  };
+  for (const Case& c : cases) {
+    ScriptedController controller(c.hello, c.limits, c.joints);
+    std::vector<std::string> log;
+    NetworkRobot client("127.0.0.1", controller.server.port(), ConfigClientOptions(&log));
+    const Status refused = client.Connect();
+    EXPECT_FALSE(refused.ok()) << c.what;
+    EXPECT_THAT(refused.message(), HasSubstr(c.expected)) << c.what;
+    EXPECT_EQ(controller.motion_commands.load(), 0) << c.what << ": nothing is sent to the arm at connect";
+    EXPECT_EQ(RobotErrorOf(client.GetStatus().status()), RobotError::kNotConnected) << c.what;
+  }
+  // Controller limits of +-10 rad, wider than the config's +-2: the config's are used, and the log says so.
+  JointLimits wide = testing::ThreeJointOptions().limits;
+  wide.lower_rad = Eigen::Vector3d(-10, -1, -10);
+  wide.upper_rad = Eigen::Vector3d(10, 1, 1.5);
+  ScriptedController controller(hello3, protocol::LimitsReply(wide), [&](int) { return at_rest; });
+  std::vector<std::string> log;
+  NetworkRobot client("127.0.0.1", controller.server.port(), ConfigClientOptions(&log));
+  ASSERT_TRUE(client.Connect().ok());
+  const Result<JointLimits> limits = client.Limits();
+  ASSERT_TRUE(limits.ok());
+  EXPECT_EQ(limits->lower_rad, Eigen::Vector3d(-2, -1, -2));
+  EXPECT_EQ(limits->upper_rad, Eigen::Vector3d(2, 1, 1.5));
+  ASSERT_EQ(log.size(), 4u);  // joints 1 and 3 at connect and again at Limits(); joint 2 is narrower already
+  EXPECT_THAT(log[0], HasSubstr("joint 1: the controller's limits [-10, 10] rad and the robot config's [-2, 2] rad: "
+                                "the narrower [-2 2] rad is used"));
+  EXPECT_EQ(RobotErrorOf(client.StartMove(Eigen::Vector3d(0, 0, 1.8), 0.5)), RobotError::kRejected);
+  EXPECT_EQ(controller.motion_commands.load(), 0);
+}
+
+TEST(NetworkRobotTest, ControllerTextIsSanitisedBeforeItReachesAMessage) {
+  FakeServer server([](const std::string& request) -> std::optional<std::string> {
+    if (request.rfind("HELLO", 0) == 0) return protocol::HelloReply({"", "arm\x1b[2J", "s\x01n", "", false}, 3);
+    if (request == "LIMITS") return protocol::LimitsReply(testing::ThreeJointOptions().limits);
+    if (request == "STATUS") return std::string("OK idle ready\x1b]0;owned\x07");
+    if (request == "STOP") return std::string("ERR rejected no\x1b[31m red");
+    return std::nullopt;
+  });
+  NetworkRobot client("127.0.0.1", server.port(), FastClientOptions());
+  ASSERT_TRUE(client.Connect().ok());
+  EXPECT_EQ(client.Identity()->model, "arm\\x1b[2J");
+  EXPECT_EQ(client.Identity()->serial, "s\\x01n");
+  EXPECT_EQ(client.GetStatus()->message, "ready\\x1b]0;owned\\x07");
+  const Status stop = client.Stop();
+  EXPECT_THAT(stop.message(), HasSubstr("no\\x1b[31m red"));
+  EXPECT_EQ(stop.message().find('\x1b'), std::string::npos);
 }
 
 TEST(NetworkRobotTest, MalformedRepliesAreProtocolErrors) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 #include "base/atomic_file.h"
@@ -365,6 +366,68 @@ Result<SessionLog> ReadSessionLog(const std::vector<nlohmann::json>& records) {
     return Status::Error(ErrorCode::kInvalidInput, std::string("journal: ") + error.what());
   }
   return builder.Take();
+}
+
+namespace {
+
+// The problems of one accepted sample's dots and joints, each a phrase naming the value.
+void SampleContentProblems(const AcceptedSample& sample, const CameraIntrinsics& camera, const RobotModel& robot,
+                           std::vector<std::string>* problems) {
+  const double width = camera.width_px, height = camera.height_px;
+  const auto outside = [](double x, double size) { return !(x >= -0.5 && x <= size - 0.5); };
+  const auto bad_size = [](double x, double size) { return !(x > 0 && x <= size); };
+  for (std::size_t i = 0; i < sample.dots.size(); ++i) {
+    const SampleDot& d = sample.dots[i];
+    std::ostringstream what;
+    what.precision(9);
+    what << "dots[" << i << "] (dot " << d.id << "): ";
+    const std::size_t prefix = what.str().size();
+    if (outside(d.u_px, width) || outside(d.v_px, height)) {
+      what << "centre (" << d.u_px << ", " << d.v_px << ") px lies outside the " << camera.width_px << "x"
+           << camera.height_px << " image";
+    } else if (bad_size(d.width_px, width) || bad_size(d.height_px, height) || !(d.area_px2 > 0) ||
+               d.area_px2 > width * height) {
+      what << "size " << d.width_px << " x " << d.height_px << " px, area " << d.area_px2
+           << " px^2 is not a dot of the image";
+    }
+    if (what.str().size() > prefix) problems->push_back(what.str());
+  }
+  if (sample.joints_rad.size() != robot.limits.size()) {
+    problems->push_back(std::to_string(sample.joints_rad.size()) + " joint values, the robot has " +
+                        std::to_string(robot.limits.size()));
+    return;
+  }
+  for (std::size_t j = 0; j < sample.joints_rad.size(); ++j) {
+    const double q = sample.joints_rad[j];
+    if (q >= robot.limits[j].min_rad - 1e-9 && q <= robot.limits[j].max_rad + 1e-9) continue;
+    std::ostringstream what;
+    what.precision(9);
+    what << "joint " << j + 1 << " = " << q << " rad lies outside its limits [" << robot.limits[j].min_rad << ", "
+         << robot.limits[j].max_rad << "] rad";
+    problems->push_back(what.str());
+  }
+}
+
+}  // namespace
+
+Status CheckSampleContents(const SessionLog& log, const std::string& journal_path, const CameraIntrinsics& camera,
+                           const RobotModel& robot) {
+  std::vector<std::string> problems;
+  for (const std::optional<AcceptedSample>& sample : log.accepted) {
+    if (!sample) continue;
+    std::vector<std::string> found;
+    SampleContentProblems(*sample, camera, robot, &found);
+    for (const std::string& what : found) {
+      problems.push_back(journal_path + ":" + std::to_string(sample->record + 1) + " (sample_accepted of pose " +
+                         sample->id + "): " + what);
+    }
+  }
+  if (problems.empty()) return Status::Ok();
+  std::string message = "journal records refused (" + std::to_string(problems.size()) + " problems):";
+  constexpr std::size_t kShown = 10;
+  for (std::size_t i = 0; i < problems.size() && i < kShown; ++i) message += "\n  " + problems[i];
+  if (problems.size() > kShown) message += "\n  ... and " + std::to_string(problems.size() - kShown) + " more";
+  return Status::Error(ErrorCode::kInvalidInput, message);
 }
 
 Status VerifySampleImages(const std::string& session_path, const SessionLog& log) {

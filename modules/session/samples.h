@@ -136,6 +136,15 @@ struct SessionLog {
 // duplicate_accepts. kInvalidInput naming the record, its type and field.
 Result<SessionLog> ReadSessionLog(const std::vector<nlohmann::json>& records);
 
+// Checks what the per-field checks of ReadSessionLog cannot: the contents of every accepted sample against
+// the session's camera and robot (a damaged or forged record whose CRC is valid): each dot's centre inside
+// the `camera` image (u in [-0.5, width - 0.5], v likewise), its area, width and height > 0 and within the
+// image, and the joints within the robot's limits (1e-9 rad, the session loop's own tolerance).
+// kInvalidInput listing every problem, each naming the journal line (`journal_path`:N, N = the record
+// counted from 1), the pose id and the value.
+Status CheckSampleContents(const SessionLog& log, const std::string& journal_path, const CameraIntrinsics& camera,
+                           const RobotModel& robot);
+
 // Checks that the image of every accepted sample exists in the session directory `session_path` and has
 // the size and CRC-32 its frame_written record gives (P2); reads only. kInvalidInput listing every missing or
 // differing image.

@@ -9,6 +9,7 @@
 
 #include "base/crc32.h"
 #include "session/session_test_util.h"
+#include "support/test_robots.h"
 
 namespace selfcal::session {
 namespace {
@@ -285,6 +286,34 @@ TEST(SamplesTest, BadRecordsAreNamedWithTheirField) {
   ASSERT_FALSE(early.ok());
   EXPECT_TRUE(Contains(early.status().message(), "record 3 (frame_written): field \"pose\": pose 1 is not planned"))
       << early.status().message();
+}
+
+// Issue 16: a record with a valid CRC and a dot at u = 1e6 (or joints beyond the robot's limits) passed the
+// journal reading and was refused only while writing calibrate's output, naming neither record nor line.
+TEST(SamplesTest, SampleContentsAreCheckedAgainstTheCameraAndTheRobotNamingTheLine) {
+  CameraIntrinsics camera;
+  camera.width_px = 640;
+  camera.height_px = 480;
+  const RobotModel robot = selfcal::testing::Puma560();
+  Result<SessionLog> log = ReadSessionLog(SyntheticJournal());
+  ASSERT_TRUE(log.ok()) << log.status().message();
+  EXPECT_TRUE(CheckSampleContents(*log, "s/journal.log", camera, robot).ok());
+  std::vector<json> forged = SyntheticJournal();
+  ASSERT_EQ(forged[9]["type"], "sample_accepted");
+  forged[9]["dots"][0]["u"] = 1e6;
+  forged[9]["joints_rad"][1] = 10.0;
+  forged[19]["dots"][1]["w"] = 0.0;
+  log = ReadSessionLog(forged);
+  ASSERT_TRUE(log.ok()) << "the per-field checks alone accept it: " << log.status().message();
+  const Status status = CheckSampleContents(*log, "s/journal.log", camera, robot);
+  EXPECT_EQ(status.code(), ErrorCode::kInvalidInput);
+  for (const std::string part :
+       {"s/journal.log:10 (sample_accepted of pose p00): dots[0] (dot 0): centre (1000000, 200.25) px lies outside "
+        "the 640x480 image",
+        "s/journal.log:10 (sample_accepted of pose p00): joint 2 = 10 rad lies outside its limits",
+        "s/journal.log:20 (sample_accepted of pose p02): dots[1] (dot 3): size 0 x 8 px"}) {
+    EXPECT_TRUE(Contains(status.message(), part)) << part << " in: " << status.message();
+  }
 }
 
 TEST(SamplesTest, VerifySampleImages) {

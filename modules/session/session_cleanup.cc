@@ -147,7 +147,7 @@ std::vector<std::string> DifferingInputs(const SessionDirInspection& inspection,
   return differing;
 }
 
-Status DiscardSession(const std::string& path) {
+Status DiscardSession(const std::string& path, bool take_over_stale_lock) {
   Result<SessionDirInspection> inspection = InspectSessionDir(path);
   if (!inspection.ok()) return Usage("cannot discard session " + path + ": " + inspection.status().message());
   const SessionDirInspection& in = *inspection;
@@ -164,7 +164,7 @@ Status DiscardSession(const std::string& path) {
                  "); nothing was removed");
   }
   // The lock first: a process still creating or running this session keeps it.
-  Result<SessionLock> lock = SessionLock::Acquire(path);
+  Result<SessionLock> lock = SessionLock::Acquire(path, false, take_over_stale_lock);
   if (!lock.ok()) return Usage("cannot discard session " + path + ": " + lock.status().message());
   Result<std::vector<fs::directory_entry>> entries = Entries(path);
   if (!entries.ok()) return entries.status();

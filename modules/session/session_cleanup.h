@@ -43,7 +43,9 @@ std::vector<std::string> DifferingInputs(const SessionDirInspection& inspection,
 // kNothingRecorded) and nothing selfcal did not write: takes the lock first (refused while another process
 // holds it), then removes the known entries and the directory. Refused with kInvalidInput, changing
 // nothing, for a recorded session ("holds N recorded samples ..."), foreign entries (named) or a damaged
-// journal; kInvalidInput for a missing path.
-Status DiscardSession(const std::string& path);
+// journal; kInvalidInput for a missing path. A stale lock (its holder died) is taken over only with
+// `take_over_stale_lock` (session_lock.h); `selfcal session discard` passes true: the command is the
+// operator's confirmation.
+Status DiscardSession(const std::string& path, bool take_over_stale_lock);
 
 }  // namespace selfcal::session

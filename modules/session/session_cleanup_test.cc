@@ -62,7 +62,7 @@ TEST(SessionCleanup, DiscardRemovesOnlyWhatRecordedNothing) {
   TempDir dir;
   const std::string cut = dir.path() + "/cut";
   MakeInterruptedCreation(cut, "x");
-  ASSERT_TRUE(DiscardSession(cut).ok());
+  ASSERT_TRUE(DiscardSession(cut, false).ok());
   EXPECT_FALSE(fs::exists(cut));
 
   const std::string started = dir.path() + "/started";
@@ -70,11 +70,11 @@ TEST(SessionCleanup, DiscardRemovesOnlyWhatRecordedNothing) {
     Result<Session> s = CreateTestSession(started);
     ASSERT_TRUE(s.ok());
     ASSERT_TRUE(s.value().journal().Append(Started()).ok());
-    const Status busy = DiscardSession(started);  // the lock is held by the open session
+    const Status busy = DiscardSession(started, false);  // the lock is held by the open session
     EXPECT_FALSE(busy.ok());
     EXPECT_TRUE(Contains(busy.message(), "in use")) << busy.message();
   }
-  ASSERT_TRUE(DiscardSession(started).ok());
+  ASSERT_TRUE(DiscardSession(started, false).ok());
   EXPECT_FALSE(fs::exists(started));
 
   const std::string recorded = dir.path() + "/recorded";
@@ -83,7 +83,7 @@ TEST(SessionCleanup, DiscardRemovesOnlyWhatRecordedNothing) {
     ASSERT_TRUE(s.ok());
     ASSERT_TRUE(s.value().WriteImage("p00_0.png", "png").ok());
   }
-  const Status refused = DiscardSession(recorded);
+  const Status refused = DiscardSession(recorded, false);
   EXPECT_EQ(refused.code(), ErrorCode::kInvalidInput);
   EXPECT_TRUE(Contains(refused.message(), "recorded data")) << refused.message();
   EXPECT_TRUE(fs::exists(recorded + "/images/p00_0.png"));
@@ -91,11 +91,11 @@ TEST(SessionCleanup, DiscardRemovesOnlyWhatRecordedNothing) {
   const std::string foreign = dir.path() + "/foreign";
   MakeInterruptedCreation(foreign, "x");
   testing::WriteFile(foreign + "/notes.txt", "mine");
-  const Status kept = DiscardSession(foreign);
+  const Status kept = DiscardSession(foreign, false);
   EXPECT_FALSE(kept.ok());
   EXPECT_TRUE(Contains(kept.message(), "notes.txt")) << kept.message();
   EXPECT_TRUE(fs::exists(foreign + "/notes.txt"));
-  EXPECT_FALSE(DiscardSession(dir.path() + "/none").ok());
+  EXPECT_FALSE(DiscardSession(dir.path() + "/none", false).ok());
 }
 
 }  // namespace

@@ -416,7 +416,7 @@ Result<Session> CreateSession(const std::string& path, const SessionInputs& inpu
 }
 
 Result<Session> OpenSession(const std::string& path, const SessionInputs& expected, bool allow_changed_inputs,
-                            const JournalLimits& journal_limits) {
+                            const JournalLimits& journal_limits, bool take_over_stale_lock) {
   Result<SessionManifest> manifest = ReadManifest(path);
   if (!manifest.ok()) return manifest.status();
 
@@ -441,7 +441,7 @@ Result<Session> OpenSession(const std::string& path, const SessionInputs& expect
   }
   if (Status s = CheckSessionLayout(path); !s.ok()) return s;
 
-  Result<SessionLock> lock = SessionLock::Acquire(path);
+  Result<SessionLock> lock = SessionLock::Acquire(path, false, take_over_stale_lock);
   if (!lock.ok()) return lock.status();
   report.stale_lock_from = lock->stale_from();
   Result<Journal> journal = Journal::Open(Join(path, kJournalFileName), journal_limits);

@@ -107,7 +107,7 @@ class Session {
  private:
   friend Result<Session> CreateSession(const std::string&, const SessionInputs&, const std::string&,
                                        const CreateOptions&);
-  friend Result<Session> OpenSession(const std::string&, const SessionInputs&, bool, const JournalLimits&);
+  friend Result<Session> OpenSession(const std::string&, const SessionInputs&, bool, const JournalLimits&, bool);
   Session(std::string path, SessionManifest manifest, Journal journal, SessionLock lock, OpenReport report)
       : path_(std::move(path)),
         manifest_(std::move(manifest)),
@@ -140,14 +140,15 @@ Result<Session> CreateSession(const std::string& path, const SessionInputs& inpu
 //  2. compares every `expected` input with the recorded SHA-256 (inputs recorded but not expected are
 //     not compared); differences are refused with kInvalidInput listing every differing input, unless
 //     `allow_changed_inputs` (then listed in open_report().changed_inputs);
-//  3. takes the lock (kInvalidInput when in use; a dead holder's lock is taken over and reported);
+//  3. takes the lock (kInvalidInput when in use; a dead holder's lock is taken over and reported only with
+//     `take_over_stale_lock`, the operator's confirmation, and refused otherwise: session_lock.h);
 //  4. opens the journal with recovery (a torn tail truncated and reported; damage refused);
 //  5. moves every non-directory entry of images/ that no durable journal record names (the "image"
 //     field of any record, "images/<name>") to orphans/ (a name taken there gets ".1", ".2", ...),
 //     reported in open_report().orphans.
 // Nothing is changed when steps 1-3 refuse.
 Result<Session> OpenSession(const std::string& path, const SessionInputs& expected, bool allow_changed_inputs,
-                            const JournalLimits& journal_limits = JournalLimits());
+                            const JournalLimits& journal_limits = JournalLimits(), bool take_over_stale_lock = false);
 
 // True when `path` holds a session.json, or the lock, inputs/ or journal.log of an interrupted creation:
 // what `selfcal calibrate` reads as a session rather than as an observations file (whether the session is

@@ -182,12 +182,21 @@ TEST(SessionDirTest, LockRefusesASecondSessionAndIsReleasedOnDestruction) {
   EXPECT_EQ(again->open_report().stale_lock_from, "");
 }
 
-TEST(SessionDirTest, AStaleLockIsTakenOverAndReported) {
+// P6 (issue 16): a stale lock is taken over only when the operator confirms it; refused, it is left as it was.
+TEST(SessionDirTest, AStaleLockIsTakenOverOnlyWhenConfirmedAndReported) {
   TempDir dir;
   const std::string path = dir.File("s");
   ASSERT_TRUE(CreateTestSession(path).ok());
   WriteFile(path + "/lock", "4242 deadhost 2025-03-01T11:00:00Z\n");  // left by a process that died
-  Result<Session> session = OpenSession(path, TestInputs(), false);
+  const Result<Session> refused = OpenSession(path, TestInputs(), false);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), ErrorCode::kInvalidInput);
+  EXPECT_TRUE(Contains(refused.status().message(), "its lock was left by pid 4242 on host deadhost (since "
+                                                   "2025-03-01T11:00:00Z)"))
+      << refused.status().message();
+  EXPECT_TRUE(Contains(refused.status().message(), "--take-over-stale-lock")) << refused.status().message();
+  EXPECT_EQ(ReadFile(path + "/lock"), "4242 deadhost 2025-03-01T11:00:00Z\n");
+  Result<Session> session = OpenSession(path, TestInputs(), false, JournalLimits(), /*take_over_stale_lock=*/true);
   ASSERT_TRUE(session.ok()) << session.status().ToString();
   EXPECT_EQ(session->open_report().stale_lock_from, "4242 deadhost 2025-03-01T11:00:00Z");
   EXPECT_TRUE(Contains(ReadFile(path + "/lock"), std::to_string(::getpid()) + " "));

@@ -89,7 +89,7 @@ TEST(SessionKillTest, SigkillAtRandomMomentsKeepsEveryAcknowledgedRecord) {
     ::close(pipe_fds[0]);
     if (acknowledged > 0) ++kills_with_progress;
 
-    Result<Session> session = OpenSession(path, TestInputs(), false);
+    Result<Session> session = OpenSession(path, TestInputs(), false, JournalLimits(), /*take_over_stale_lock=*/true);
     ASSERT_TRUE(session.ok()) << session.status().ToString();
     const std::string& stale = session->open_report().stale_lock_from;
     if (!stale.empty()) {

@@ -60,7 +60,7 @@ std::string UtcNowIso8601() {
   return text;
 }
 
-Result<SessionLock> SessionLock::Acquire(const std::string& session_path, bool must_create) {
+Result<SessionLock> SessionLock::Acquire(const std::string& session_path, bool must_create, bool take_over_stale) {
   const std::string path = internal::Join(session_path, kLockFileName);
   SessionLock lock;
   const int flags = O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW | (must_create ? O_EXCL : 0);
@@ -84,8 +84,14 @@ Result<SessionLock> SessionLock::Acquire(const std::string& session_path, bool m
     }
     return SystemError("cannot lock", path, error);
   }
-  lock.held_ = true;
   lock.stale_from_ = ReadHolder(lock.fd_);
+  if (!lock.stale_from_.empty() && !take_over_stale) {  // P6: the operator confirms; the line stays (held_ false)
+    return Status::Error(ErrorCode::kInvalidInput,
+                         "session " + session_path + ": its lock was left by " + DescribeHolder(lock.stale_from_) +
+                             ", which no longer holds it (it ended without releasing it). If no selfcal on that host "
+                             "uses this session, take the lock over with --take-over-stale-lock");
+  }
+  lock.held_ = true;
   const std::string line = std::to_string(::getpid()) + " " + HostName() + " " + UtcNowIso8601() + "\n";
   if (::ftruncate(lock.fd_, 0) != 0) return SystemError("cannot write the lock file", path, errno);
   if (!WriteAllToFd(lock.fd_, line)) return SystemError("cannot write the lock file", path, errno);

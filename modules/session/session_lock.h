@@ -5,8 +5,10 @@
 // one line "<pid> <host> <start time, UTC ISO 8601>" naming the holder. flock belongs to the open file
 // description, so a second process, and a second SessionLock in the same process, are refused; the kernel
 // drops the lock when its holder dies, however it dies. A lock file that still names a holder but is not
-// locked was left by a process that died (a clean release empties the file): it is taken over, and the
-// dead holder's line is reported (stale_from) for the log. The file itself is never deleted, which keeps
+// locked was left by a process that died (a clean release empties the file), or by one on another host
+// whose file system does not share flock: it is taken over only when the caller says the operator
+// confirmed it (`take_over_stale`; `selfcal run --take-over-stale-lock`), and the dead holder's line is
+// reported (stale_from) for the log; otherwise it is refused, left as it was. The file itself is never deleted, which keeps
 // flock free of the races of unlink-and-recreate.
 #pragma once
 
@@ -23,8 +25,10 @@ class SessionLock {
   // Locks `<session_path>/lock`. With `must_create` the lock file must not exist yet (a new session:
   // two processes creating the same directory cannot both succeed). Errors: kInvalidInput "session <path> is in
   // use by pid N on host H (since T)" when another holder has it; kInvalidInput or kHardware (full disk) naming
-  // the file when it cannot be created, locked or written.
-  static Result<SessionLock> Acquire(const std::string& session_path, bool must_create = false);
+  // the file when it cannot be created, locked or written; kInvalidInput "... was left by pid N on host H
+  // ... take it over with --take-over-stale-lock" for a stale lock without `take_over_stale`.
+  static Result<SessionLock> Acquire(const std::string& session_path, bool must_create = false,
+                                     bool take_over_stale = false);
 
   SessionLock(SessionLock&& other) noexcept;
   SessionLock& operator=(SessionLock&& other) noexcept;

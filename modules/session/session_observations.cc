@@ -63,6 +63,8 @@ Result<SessionObservations> LoadSessionObservations(const std::string& session_p
   Result<RobotModel> robot = io::ParseRobotModelText(*robot_text, InputPath(session_path, kRobotInputName));
   if (!robot.ok()) return robot.status();
   set.robot = *robot;
+  const std::string journal_path = internal::Join(session_path, kJournalFileName);
+  if (Status c = CheckSampleContents(*log, journal_path, set.camera, set.robot); !c.ok()) return c;
   for (const std::optional<AcceptedSample>& sample : log->accepted) {
     if (sample) set.poses.push_back(ObservationOf(*sample));
   }

@@ -70,7 +70,7 @@ struct RecoveryCounts {
 };
 
 int AcceptedSamples(const fs::path& session_dir, std::string* problem, RecoveryCounts* counts = nullptr) {
-  Result<session::Session> s = session::OpenSession(session_dir.string(), {}, false);
+  Result<session::Session> s = session::OpenSession(session_dir.string(), {}, false, session::JournalLimits(), true);
   if (!s.ok()) {
     *problem = s.status().message();
     return -1;
@@ -101,7 +101,10 @@ TEST(KillResume, RandomKillsLoseNothingAndTheResultIsIdentical) {
   const std::vector<std::string> common = {"--seed", "4", "--supersampling", "2"};
   auto run_args = [&](const fs::path& dir, bool resume) {
     std::vector<std::string> a = {"run", "--session", dir.string()};
-    if (resume) a.push_back("--resume");
+    if (resume) {  // the harness killed the previous run: it confirms the stale lock (P6)
+      a.push_back("--resume");
+      a.push_back("--take-over-stale-lock");
+    }
     a.insert(a.end(), common.begin(), common.end());
     return a;
   };

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "io/trajectory_file.h"
 
@@ -126,6 +127,60 @@ TEST(SessionLifecycle, InterruptedCreationIsCompletedByResumeOrRemovedByDiscard)
   MakeInterruptedCreation(cut2, dir / "clean");
   ASSERT_EQ(RunSelfcal("session discard " + cut2.string(), &output), 0) << output;
   EXPECT_FALSE(fs::exists(cut2));
+}
+
+// Issue 16 item 5: what a SIGKILL inside the creation leaves (the lock still naming the dead process, the
+// temporary file of robot.yaml, no session.json): calibrate names the interrupted creation, a resume names
+// the flag that takes the stale lock over and completes the creation once the operator gives it.
+TEST(SessionLifecycle, KilledCreationWithAStaleLockIsCompletedOnlyWhenTheOperatorConfirms) {
+  const fs::path dir = FreshDir("stale");
+  std::string output;
+  ASSERT_EQ(RunSelfcal("run --session " + (dir / "clean").string() + " --seed 3", &output), 0) << output;
+  const fs::path cut = dir / "cut";
+  fs::create_directories(cut / "inputs");
+  std::ofstream(cut / "lock") << "4242 deadhost 2026-01-01T00:00:00Z\n";
+  fs::copy_file(dir / "clean" / "inputs" / "robot.yaml", cut / "inputs" / ".robot.yaml.tmp.Xy12Zw");
+  EXPECT_EQ(RunSelfcal("calibrate " + cut.string() + " --out " + (dir / "cal").string(), &output), 2) << output;
+  EXPECT_TRUE(Has(output, "creation was interrupted")) << output;
+  EXPECT_FALSE(Has(output, "is not a regular file")) << output;
+  EXPECT_FALSE(fs::exists(dir / "cal"));
+  EXPECT_EQ(RunSelfcal("run --resume --session " + cut.string() + " --seed 3", &output), 2) << output;
+  EXPECT_TRUE(Has(output, "its lock was left by pid 4242 on host deadhost")) << output;
+  EXPECT_TRUE(Has(output, "--take-over-stale-lock")) << output;
+  EXPECT_FALSE(fs::exists(cut / "session.json"));
+  EXPECT_TRUE(fs::exists(cut / "inputs" / ".robot.yaml.tmp.Xy12Zw"));
+  ASSERT_EQ(RunSelfcal("run --resume --take-over-stale-lock --session " + cut.string() + " --seed 3", &output), 0)
+      << output;
+  EXPECT_TRUE(Has(output, "25 samples accepted")) << output;
+  EXPECT_TRUE(fs::exists(cut / "session.json"));
+}
+
+// Issue 16 item 1 (g): the network address is a transport detail, not a recorded input: a resume after the
+// controller restarted on another port is not refused as "interrupted with other inputs" (it goes on to
+// connect; nothing listens on port 1 here, so it halts before any command: exit 4, nothing sent).
+TEST(SessionLifecycle, ANetworkResumeOnAnotherPortIsNotAChangedInput) {
+  const fs::path dir = FreshDir("port");
+  std::string output;
+  ASSERT_EQ(RunSelfcal("run --session " + (dir / "clean").string() + " --seed 3", &output), 0) << output;
+  const fs::path cut = dir / "cut";
+  fs::create_directories(cut / "inputs");
+  std::ofstream(cut / "lock").put('\n');
+  for (const char* input : {"robot.yaml", "plan.yaml"}) {
+    fs::copy_file(dir / "clean" / "inputs" / input, cut / "inputs" / input);
+  }
+  // The run.json a network run with a v4l2 camera records, whatever its --address was.
+  std::ifstream in(dir / "clean" / "inputs" / "run.json");
+  nlohmann::json run = nlohmann::json::parse(in);
+  run["robot"] = "network";
+  run["camera"] = "v4l2";
+  run["device"] = "/dev/video0";
+  run["velocity_scaling"] = 0.1;
+  std::ofstream(cut / "inputs" / "run.json") << run.dump(2) << "\n";
+  const std::string command = "run --resume --session " + cut.string() + " --robot network --camera v4l2 --setup " +
+                              (dir / "clean" / "inputs" / "setup.json").string() + " --seed 3 --address 127.0.0.1:1";
+  EXPECT_EQ(RunSelfcal(command, &output), 4) << output;
+  EXPECT_FALSE(Has(output, "other inputs")) << output;
+  EXPECT_TRUE(Has(output, "nothing was sent to the arm")) << output;
 }
 
 }  // namespace
