@@ -18,7 +18,9 @@
 //
 // Identities at a settled pose, with RunContext::prediction: the dots tracked into the frame that agree with
 // their prediction, and the detections named by prediction (dots lost in earlier moves come back); a move
-// that loses every dot then goes on, and the pose halts only when nothing can be named.
+// that loses every dot then goes on, and the pose halts only when nothing can be named. A dot seen in one
+// sample only is predicted as a segment of its epipolar line: a detection alone on it is journaled as a
+// candidate (never an observation), which the next settled pose confirms by a short gate or forgets.
 //
 // Resume: the journal decides. RunSession continues at the first pose with neither an accepted sample
 // nor a final skip (session/samples.h), with the dots of the last accepted sample as the tracker's state;
