@@ -140,8 +140,10 @@ DotPredictionReport PredictDots(const PredictionModel& model, const std::vector<
                                 const DotPredictionOptions& options) {
   const Eigen::VectorXd rho = KinematicParameters::Nominal(model.robot);
   RaysById rays;
+  std::vector<Rigid3> base_from_cams;  // of every sample, once
   for (size_t s = 0; s < samples.size(); ++s) {
-    const Rigid3 base_from_cam = BaseFromCam(model.robot, rho, samples[s].joints_rad);
+    base_from_cams.push_back(BaseFromCam(model.robot, rho, samples[s].joints_rad));
+    const Rigid3& base_from_cam = base_from_cams.back();
     for (const auto& [id, uv] : samples[s].dots_px) rays[id].push_back({static_cast<int>(s), RayOf(model, base_from_cam, uv)});
   }
   const Rigid3 base_from_cam_now = BaseFromCam(model.robot, rho, joints_rad);
@@ -153,7 +155,7 @@ DotPredictionReport PredictDots(const PredictionModel& model, const std::vector<
   RaysById with_candidates = rays;
   if (!samples.empty()) {
     const size_t last = samples.size() - 1;
-    const Rigid3 base_from_cam = BaseFromCam(model.robot, rho, samples[last].joints_rad);
+    const Rigid3& base_from_cam = base_from_cams[last];
     for (const auto& [id, uv] : samples[last].candidates_px) {
       if (rays.count(id)) with_candidates[id].push_back({static_cast<int>(last), RayOf(model, base_from_cam, uv)});
     }
@@ -186,7 +188,7 @@ DotPredictionReport PredictDots(const PredictionModel& model, const std::vector<
       // One ray (or rays that fix no point): the latest sample's ray over the scene's depth range.
       const auto& [s, ray] = r.back();
       const ViewedSample& sample = samples[static_cast<size_t>(s)];
-      const Rigid3 sample_cam_from_base = BaseFromCam(model.robot, rho, sample.joints_rad).Inverse();
+      const Rigid3 sample_cam_from_base = base_from_cams[static_cast<size_t>(s)].Inverse();
       have = SegmentOnRay(model, id, ray, cam_from_base, sample_cam_from_base, sample, depth_points, options, &p);
       report.single_ray += have ? 1 : 0;
     }
