@@ -24,7 +24,14 @@ Ray RayOf(const PredictionModel& m, const Rigid3& base_from_cam, const Eigen::Ve
   return {base_from_cam.translation, (base_from_cam.rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized()};
 }
 
-// Lateral std (m) of a ray at distance z from its camera for the pixel noise.
+// A pixel through a correction (the identity when none was fitted).
+Eigen::Vector2d MapPixel(const tracking::PredictionCorrection& c, const Eigen::Vector2d& uv) {
+  if (!c.ok) return uv;
+  tracking::PredictedDot d;
+  d.uv_px = uv;
+  return c.Apply(d).uv_px;
+}
+
 // Lateral std (m) of a ray at distance z from its camera: the pixel noise and the nominal model's own
 // error per ray, which the rays of a nominal model carry into every triangulation.
 double LateralSigma(const PredictionModel& m, double ray_model_sigma_px, double z) {
@@ -133,6 +140,45 @@ std::map<int, Point> TriangulateAll(const PredictionModel& model, double ray_mod
   return points;
 }
 
+// Each sample's pixels mapped onto its nominal camera: the nominal model puts every sample's camera a
+// little off, by an amount that differs from pose to pose, so rays from distant poses miss each other
+// and a point triangulated from them is off in a way no correction of the new frame can remove. For
+// each sample after the first (which holds the gauge), the robust planar map from its observed pixels
+// to the projections of the points triangulated from all samples absorbs most of its camera's error;
+// a few rounds of triangulating and mapping make the rays agree.
+std::vector<tracking::PredictionCorrection> SampleCorrections(const PredictionModel& model,
+                                                              const std::vector<ViewedSample>& samples,
+                                                              const std::vector<Rigid3>& base_from_cams,
+                                                              const DotPredictionOptions& options) {
+  std::vector<tracking::PredictionCorrection> corrections(samples.size());
+  for (int round = 0; round < options.sample_correction_rounds && samples.size() > 2; ++round) {
+    RaysById rays;
+    for (size_t s = 0; s < samples.size(); ++s) {
+      for (const auto& [id, uv] : samples[s].dots_px) {
+        rays[id].push_back({static_cast<int>(s), RayOf(model, base_from_cams[s], MapPixel(corrections[s], uv))});
+      }
+    }
+    const std::map<int, Point> points = TriangulateAll(model, options.ray_model_sigma_px, rays, false);
+    for (size_t s = 1; s < samples.size(); ++s) {
+      const Rigid3 cam_from_base = base_from_cams[s].Inverse();
+      std::vector<Eigen::Vector2d> observed, nominal;
+      for (const auto& [id, uv] : samples[s].dots_px) {
+        const auto it = points.find(id);
+        if (it == points.end() || rays.at(id).size() < 3) continue;
+        if (const std::optional<Eigen::Vector2d> p = Project(model.camera, cam_from_base * it->second.p)) {
+          observed.push_back(uv);
+          nominal.push_back(*p);
+        }
+      }
+      if (static_cast<int>(observed.size()) < options.min_sample_correction_dots) continue;
+      tracking::PredictionCorrection c =
+          tracking::FitPredictionCorrection(observed, nominal, tracking::PredictionCorrectionOptions());
+      if (c.ok) corrections[s] = c;
+    }
+  }
+  return corrections;
+}
+
 }  // namespace
 
 DotPredictionReport PredictDots(const PredictionModel& model, const std::vector<ViewedSample>& samples,
@@ -141,10 +187,13 @@ DotPredictionReport PredictDots(const PredictionModel& model, const std::vector<
   const Eigen::VectorXd rho = KinematicParameters::Nominal(model.robot);
   RaysById rays;
   std::vector<Rigid3> base_from_cams;  // of every sample, once
+  for (size_t s = 0; s < samples.size(); ++s) base_from_cams.push_back(BaseFromCam(model.robot, rho, samples[s].joints_rad));
+  const std::vector<tracking::PredictionCorrection> corrections =
+      SampleCorrections(model, samples, base_from_cams, options);
   for (size_t s = 0; s < samples.size(); ++s) {
-    base_from_cams.push_back(BaseFromCam(model.robot, rho, samples[s].joints_rad));
-    const Rigid3& base_from_cam = base_from_cams.back();
-    for (const auto& [id, uv] : samples[s].dots_px) rays[id].push_back({static_cast<int>(s), RayOf(model, base_from_cam, uv)});
+    for (const auto& [id, uv] : samples[s].dots_px) {
+      rays[id].push_back({static_cast<int>(s), RayOf(model, base_from_cams[s], MapPixel(corrections[s], uv))});
+    }
   }
   const Rigid3 base_from_cam_now = BaseFromCam(model.robot, rho, joints_rad);
   RaysById with_current = rays;
@@ -157,7 +206,9 @@ DotPredictionReport PredictDots(const PredictionModel& model, const std::vector<
     const size_t last = samples.size() - 1;
     const Rigid3& base_from_cam = base_from_cams[last];
     for (const auto& [id, uv] : samples[last].candidates_px) {
-      if (rays.count(id)) with_candidates[id].push_back({static_cast<int>(last), RayOf(model, base_from_cam, uv)});
+      if (rays.count(id)) {
+        with_candidates[id].push_back({static_cast<int>(last), RayOf(model, base_from_cam, MapPixel(corrections[last], uv))});
+      }
     }
   }
   const std::map<int, Point> points = TriangulateAll(model, options.ray_model_sigma_px, with_candidates, false);
@@ -179,17 +230,28 @@ DotPredictionReport PredictDots(const PredictionModel& model, const std::vector<
     if (const std::optional<Eigen::Vector2d> a = Project(model.camera, cam_from_base * x)) report.anchor_px[id] = *a;
   }
   for (const auto& [id, r] : rays) {
+    // One ray (or rays that fix no point): the latest sample's ray over the scene's depth range.
+    auto segment = [&](tracking::PredictedDot* p) {
+      const auto& [s, ray] = r.back();
+      const Rigid3 sample_cam_from_base = base_from_cams[static_cast<size_t>(s)].Inverse();
+      return SegmentOnRay(model, id, ray, cam_from_base, sample_cam_from_base, samples[static_cast<size_t>(s)],
+                          depth_points, options, p);
+    };
     tracking::PredictedDot p;
     bool have = false;
     if (const auto it = points.find(id); it != points.end()) {
       have = ProjectPrediction(model, cam_from_base, it->second, id, &p);
       ++report.triangulated;
+      // A point that rests on a candidate may be wrong: the dot may still lie anywhere on its segment,
+      // which competes beside the point's gate.
+      tracking::PredictedDot whole;
+      if (have && r.size() == 1 && segment(&whole) && InImage(model.camera, whole.uv_px, -options.image_margin_px)) {
+        whole.names = false;
+        report.dots.push_back(whole);
+        ++report.on_candidates;
+      }
     } else {
-      // One ray (or rays that fix no point): the latest sample's ray over the scene's depth range.
-      const auto& [s, ray] = r.back();
-      const ViewedSample& sample = samples[static_cast<size_t>(s)];
-      const Rigid3 sample_cam_from_base = base_from_cams[static_cast<size_t>(s)].Inverse();
-      have = SegmentOnRay(model, id, ray, cam_from_base, sample_cam_from_base, sample, depth_points, options, &p);
+      have = segment(&p);
       report.single_ray += have ? 1 : 0;
     }
     if (have && InImage(model.camera, p.uv_px, -options.image_margin_px)) {

@@ -13,7 +13,11 @@
 // stood here named 15 of 80 simulated sessions wrongly). The depth range may also come from
 // `current_px`, the dots already known in the new frame (tracked into it): a second view when only one
 // sample has been accepted; they never enter a dot's own prediction, which rests on the accepted samples
-// alone. Nothing here is iterative beyond one reweighting, and nothing is differentiated automatically.
+// alone. The nominal model puts each sample's camera a little off, differently at every pose; before the
+// points are triangulated, each sample's pixels are mapped onto its nominal camera by the robust planar
+// map that makes its rays agree with the other samples' (a few rounds; the first sample holds the gauge),
+// so that a point seen from distant poses lands where the dots around it do. Nothing here is iterative
+// beyond those rounds and one reweighting, and nothing is differentiated automatically.
 #pragma once
 
 #include <map>
@@ -59,16 +63,23 @@ struct DotPredictionOptions {
   // into a large error in depth.
   double ray_model_sigma_px = 1.0;
   double max_candidate_gate_sigma_px = 40;
+  // Each sample's pixels are mapped onto its nominal camera (dot_prediction.cc, SampleCorrections) in
+  // this many rounds, from at least this many of its dots seen in three samples or more.
+  int sample_correction_rounds = 2;
+  int min_sample_correction_dots = 8;
 };
 
 struct DotPredictionReport {
-  std::vector<tracking::PredictedDot> dots;  // in front of the camera and in the image
+  // In front of the camera and in the image. A dot whose point rests on a candidate also has the segment
+  // of its one sample ray, which only competes (names = false); every other dot has one gate.
+  std::vector<tracking::PredictedDot> dots;
   // Where the nominal model puts each dot of `current_px` with a point (triangulated from the samples,
   // else from its sample ray and its ray in the new frame): the anchors of the correction of the raw
   // predictions, which a segment's middle cannot be.
   std::map<int, Eigen::Vector2d> anchor_px;
-  int triangulated = 0;   // known dots with two rays or more
-  int single_ray = 0;     // known dots predicted from one ray and their neighbours' depth
+  int triangulated = 0;   // known dots with two rays or more (a candidate's included)
+  int on_candidates = 0;  // of them, those whose second ray is a candidate
+  int single_ray = 0;     // known dots predicted from one ray, over the scene's depth range
   int not_predicted = 0;  // known dots without a usable prediction (behind, outside, no depth)
 };
 

@@ -71,35 +71,33 @@ void Runner::NameByPrediction(const Capture& capture) {
   }
   Log("prediction: " + std::to_string(predicted.dots.size()) + " dots predicted, " +
       std::to_string(tracked_.size()) + " tracked, correction " + correction.message);
-  std::vector<tracking::PredictedDot> gates;
-  std::map<int, size_t> gate_of;
+  // Gates too long to name (a dot seen once, anywhere over the scene's depth range) name nothing and
+  // doubt no tracked dot, but they compete: a detection in one of them is never given another dot's id.
+  std::vector<tracking::PredictedDot> gates, naming;
+  std::vector<double> gate_sigma;  // along the gate's longest axis
   for (const tracking::PredictedDot& p : predicted.dots) {
-    gate_of[p.id] = gates.size();
     gates.push_back(correction.Apply(p));
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(gates.back().cov_px2);
+    gate_sigma.push_back(std::sqrt(std::max(0.0, eig.eigenvalues()(1))));
+    gates.back().names = p.names && gate_sigma.back() <= o_.prediction.max_gate_sigma_px;
+    if (gates.back().names) naming.push_back(gates.back());
   }
-  // Gates too long to name (a dot seen once, anywhere over the scene's depth range) doubt no tracked dot,
-  // but they compete: a detection in one of them is never given another dot's id.
-  std::vector<tracking::PredictedDot> usable;
-  std::map<int, double> gate_sigma;  // along the gate's longest axis
-  for (const tracking::PredictedDot& g : gates) {
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(g.cov_px2);
-    gate_sigma[g.id] = std::sqrt(std::max(0.0, eig.eigenvalues()(1)));
-    if (gate_sigma[g.id] <= o_.prediction.max_gate_sigma_px) usable.push_back(g);
-  }
-  // Tracked dots far outside their gate are dropped (never recorded under a doubtful id), and so are
+  auto in_gate = [&](const tracking::PredictedDot& g, const Eigen::Vector2d& uv) {
+    return tracking::Mahalanobis2(g, uv) <= o_.predicted_match.gate_chi2;
+  };
+  // Tracked dots far outside their gates are dropped (never recorded under a doubtful id), and so are
   // those that also lie in the gate of a dot not accounted for by another tracked dot in its own gate
   // (a tracker that jumped onto a neighbour along a long epipolar gate).
-  auto in_gate = [&](int id, const Eigen::Vector2d& uv) {
-    const auto it = gate_of.find(id);
-    return it != gate_of.end() && tracking::Mahalanobis2(gates[it->second], uv) <= o_.predicted_match.gate_chi2;
-  };
-  std::map<int, bool> accounted;
-  for (const tracking::PreviousDot& d : tracked_) accounted[d.id] = in_gate(d.id, d.centroid_px);
+  std::map<int, bool> predicted_id, accounted;
+  for (const tracking::PredictedDot& g : gates) predicted_id[g.id] = true;
+  for (const tracking::PreviousDot& d : tracked_) {
+    for (const tracking::PredictedDot& g : gates) accounted[d.id] = accounted[d.id] || (g.id == d.id && in_gate(g, d.centroid_px));
+  }
   std::vector<tracking::PreviousDot> kept;
   for (const tracking::PreviousDot& d : tracked_) {
-    bool doubtful = gate_of.count(d.id) && !accounted[d.id];
-    for (const tracking::PredictedDot& g : usable) {
-      doubtful = doubtful || (g.id != d.id && !accounted[g.id] && in_gate(g.id, d.centroid_px));
+    bool doubtful = predicted_id[d.id] && !accounted[d.id];
+    for (const tracking::PredictedDot& g : naming) {
+      doubtful = doubtful || (g.id != d.id && !accounted[g.id] && in_gate(g, d.centroid_px));
     }
     if (doubtful) {
       ++report_.dropped_by_prediction;
@@ -107,33 +105,44 @@ void Runner::NameByPrediction(const Capture& capture) {
     }
     kept.push_back(d);
   }
-  // Detections on a kept tracked dot are taken; the others are named by prediction, every gate competing
-  // and every detection counted (one on a tracked dot in another's gate makes that gate ambiguous). A
-  // detection alone in a gate too long to name becomes a candidate (dot_prediction.h).
-  std::vector<size_t> free;
+  // Detections on a kept tracked dot are taken. The others are named by gated nearest prediction, every
+  // gate competing and every detection counted (one on a tracked dot in another's gate makes that gate
+  // ambiguous), but only a gate short enough names. A dot with no such gate gets a candidate
+  // (dot_prediction.h): the one detection in its long gate that nobody tracked and no naming gate holds,
+  // which the next settled pose confirms or forgets.
+  std::vector<bool> taken(detected.dots.size(), false), loose(detected.dots.size(), true);
   for (size_t k = 0; k < detected.dots.size(); ++k) {
-    bool taken = false;
     for (const tracking::PreviousDot& d : kept) {
-      taken = taken || (d.centroid_px - centroids[k]).norm() < o_.detector.duplicate_distance_px;
+      taken[k] = taken[k] || (d.centroid_px - centroids[k]).norm() < o_.detector.duplicate_distance_px;
     }
-    if (!taken) free.push_back(k);
+    for (const tracking::PredictedDot& g : naming) loose[k] = loose[k] && !taken[k] && !in_gate(g, centroids[k]);
   }
+  std::map<int, bool> known;
+  for (const tracking::PreviousDot& d : kept) known[d.id] = true;
   const tracking::PredictedMatch match = tracking::MatchPredictions(gates, centroids, o_.predicted_match);
   report_.ambiguous_by_prediction += match.ambiguous;
-  for (size_t f = 0; f < free.size(); ++f) {
-    const int id = match.id_of_detection[free[f]];
-    if (id < 0) continue;
-    bool known = false;
-    for (const tracking::PreviousDot& d : kept) known = known || d.id == id;
-    if (known) continue;  // its tracked blob is elsewhere in the gate: keep the tracked one
-    if (gate_sigma[id] > o_.prediction.max_gate_sigma_px) {
-      if (gate_sigma[id] <= o_.prediction.max_candidate_gate_sigma_px) {
-        candidates_.push_back(tracking::MakePreviousDot(id, detected.dots[free[f]]));
-      }
-      continue;
-    }
-    kept.push_back(tracking::MakePreviousDot(id, detected.dots[free[f]]));
+  for (size_t k = 0; k < detected.dots.size(); ++k) {
+    const int id = match.id_of_detection[k];
+    if (taken[k] || id < 0 || known[id]) continue;  // a known id: its tracked blob is elsewhere in the gate
+    kept.push_back(tracking::MakePreviousDot(id, detected.dots[k]));
+    known[id] = true;
     ++report_.named_by_prediction;
+  }
+  for (size_t j = 0; j < gates.size(); ++j) {
+    const tracking::PredictedDot& g = gates[j];
+    if (known[g.id] || g.names || gate_sigma[j] > o_.prediction.max_candidate_gate_sigma_px) continue;
+    int inside = 0;
+    size_t which = 0;
+    for (size_t k = 0; k < detected.dots.size(); ++k) {
+      if (loose[k] && in_gate(g, centroids[k])) {
+        ++inside;
+        which = k;
+      }
+    }
+    if (inside == 1) {
+      candidates_.push_back(tracking::MakePreviousDot(g.id, detected.dots[which]));
+      known[g.id] = true;  // one candidate per dot
+    }
   }
   tracked_ = std::move(kept);
 }

@@ -178,24 +178,32 @@ PredictedMatch MatchPredictions(const std::vector<PredictedDot>& predictions,
                                 const std::vector<Eigen::Vector2d>& detections, const PredictedMatchOptions& options) {
   PredictedMatch m;
   m.id_of_detection.assign(detections.size(), -1);
-  std::vector<int>& gates_of_detection = m.gates_of_detection;
-  gates_of_detection.assign(detections.size(), 0);
-  std::vector<int> last_prediction(detections.size(), -1);
+  m.gates_of_detection.assign(detections.size(), 0);
   std::vector<int> detections_in_gate(predictions.size(), 0);
+  std::vector<std::vector<size_t>> gates_holding(detections.size());
   for (size_t k = 0; k < detections.size(); ++k) {
     for (size_t j = 0; j < predictions.size(); ++j) {
       if (Mahalanobis2(predictions[j], detections[k]) <= options.gate_chi2) {
-        ++gates_of_detection[k];
+        gates_holding[k].push_back(j);
         ++detections_in_gate[j];
-        last_prediction[k] = static_cast<int>(j);
       }
     }
   }
   for (size_t k = 0; k < detections.size(); ++k) {
-    if (gates_of_detection[k] == 0) {
+    // The dots whose gates hold the detection, and the gate that may name it.
+    int naming = -1;
+    std::vector<int> ids;
+    for (size_t j : gates_holding[k]) {
+      ids.push_back(predictions[j].id);
+      if (predictions[j].names && naming < 0) naming = static_cast<int>(j);
+    }
+    std::sort(ids.begin(), ids.end());
+    const int dots = static_cast<int>(std::unique(ids.begin(), ids.end()) - ids.begin());
+    m.gates_of_detection[k] = dots;
+    if (dots == 0) {
       ++m.outside_gates;
-    } else if (gates_of_detection[k] == 1 && detections_in_gate[static_cast<size_t>(last_prediction[k])] == 1) {
-      m.id_of_detection[k] = predictions[static_cast<size_t>(last_prediction[k])].id;
+    } else if (dots == 1 && naming >= 0 && detections_in_gate[static_cast<size_t>(naming)] == 1) {
+      m.id_of_detection[k] = predictions[static_cast<size_t>(naming)].id;
       ++m.named;
     } else {
       ++m.ambiguous;

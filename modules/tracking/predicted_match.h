@@ -1,8 +1,9 @@
 // Naming detections by predicted positions (issue 12 item 1; RELIABILITY.md D4): each known dot has a
 // predicted pixel with a 2x2 covariance (from the session's 3-D prediction, acquisition/dot_prediction.h),
-// and a detection takes the id of the one prediction whose chi-square gate holds it, when no other
-// prediction's gate holds it and no other detection lies in that prediction's gate. Never a wrong identity
-// rather than a missing one: every ambiguity leaves both sides unnamed.
+// and a detection takes the id of the one prediction whose chi-square gate holds it, when no other dot's
+// gate holds it and no other detection lies in that prediction's gate. A dot may have several gates (a
+// short one that names and a long one that only competes): they never compete with each other. Never a
+// wrong identity rather than a missing one: every ambiguity leaves both sides unnamed.
 //
 // The raw predictions of a nominal model are off by several pixels, mostly a smooth image-wide offset.
 // FitPredictionCorrection estimates that offset from anchors (dots whose identity is known in the frame:
@@ -25,6 +26,9 @@ struct PredictedDot {
   int id = -1;
   Eigen::Vector2d uv_px = Eigen::Vector2d::Zero();
   Eigen::Matrix2d cov_px2 = Eigen::Matrix2d::Identity();  // of the prediction (noise + triangulation)
+  // False: the gate competes (a detection in it is never given another dot's id) but names nothing, as a
+  // gate too long to name. A dot may have several gates: they never compete with each other.
+  bool names = true;
 };
 
 struct PredictionCorrectionOptions {
@@ -73,7 +77,7 @@ struct PredictedMatchOptions {
 
 struct PredictedMatch {
   std::vector<int> id_of_detection;  // per detection: the id it is named, or -1
-  std::vector<int> gates_of_detection;  // per detection: how many gates hold it
+  std::vector<int> gates_of_detection;  // per detection: how many dots' gates hold it
   int named = 0;
   int ambiguous = 0;       // detections left unnamed because two gates or two detections compete
   int outside_gates = 0;   // detections in no gate
