@@ -11,19 +11,33 @@
 
 namespace selfcal::acquisition::internal {
 
-std::vector<ViewedSample> Runner::AcceptedSamples() const {
-  std::vector<ViewedSample> samples;
-  Result<session::SessionLog> log = session::ReadSessionLog(c_.session->journal().records());
-  if (!log.ok()) return samples;
-  for (const std::optional<session::AcceptedSample>& a : log->accepted) {
-    if (!a) continue;
-    ViewedSample s;
-    s.joints_rad = Eigen::Map<const Eigen::VectorXd>(a->joints_rad.data(), static_cast<Eigen::Index>(a->joints_rad.size()));
-    for (const session::SampleDot& d : a->dots) s.dots_px[d.id] = {d.u_px, d.v_px};
-    for (const session::SampleDot& d : a->candidates) s.candidates_px[d.id] = {d.u_px, d.v_px};
-    samples.push_back(std::move(s));
+std::vector<ViewedSample> Runner::AcceptedSamples() {
+  if (!viewed_) {
+    viewed_.emplace();
+    Result<session::SessionLog> log = session::ReadSessionLog(c_.session->journal().records());
+    if (!log.ok()) return {};
+    for (size_t pose = 0; pose < log->accepted.size(); ++pose) {
+      const std::optional<session::AcceptedSample>& a = log->accepted[pose];
+      if (!a) continue;
+      ViewedSample& s = (*viewed_)[static_cast<int>(pose)];
+      s.joints_rad = Eigen::Map<const Eigen::VectorXd>(a->joints_rad.data(), static_cast<Eigen::Index>(a->joints_rad.size()));
+      for (const session::SampleDot& d : a->dots) s.dots_px[d.id] = {d.u_px, d.v_px};
+      for (const session::SampleDot& d : a->candidates) s.candidates_px[d.id] = {d.u_px, d.v_px};
+    }
   }
+  std::vector<ViewedSample> samples;
+  for (const auto& [pose, s] : *viewed_) samples.push_back(s);
   return samples;
+}
+
+void Runner::RememberSample(int pose, const Eigen::VectorXd& joints_rad, const std::vector<tracking::PreviousDot>& dots,
+                            const std::vector<tracking::PreviousDot>& candidates) {
+  if (!viewed_) return;  // read from the journal, this sample included, when first asked for
+  ViewedSample& s = (*viewed_)[pose];
+  s = ViewedSample();
+  s.joints_rad = joints_rad;
+  for (const tracking::PreviousDot& d : dots) s.dots_px[d.id] = d.centroid_px;
+  for (const tracking::PreviousDot& d : candidates) s.candidates_px[d.id] = d.centroid_px;
 }
 
 namespace {

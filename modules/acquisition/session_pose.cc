@@ -147,6 +147,7 @@ Runner::Step Runner::RecordSample(int pose, const PlannedPose& target, const Arr
   if (!candidates.empty()) sample["candidates"] = dots_json(candidates);
   if (o_.journal_sim_clock) sample["sim_clock_s"] = Now();
   if (!Record(sample)) return Step::kEnd;
+  RememberSample(pose, capture.joints.position_rad, tracked_, candidates);
   ++report_.accepted;
   Log("pose " + target.id + ": sample accepted, " + std::to_string(tracked_.size()) + " dots");
   return Step::kOk;

@@ -6,6 +6,7 @@
 
 #include <limits>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -119,8 +120,11 @@ class Runner {
   // With RunContext::prediction (session_naming.cc): the tracked dots checked against their predictions
   // at the capture's joints, and detections named by prediction.
   void NameByPrediction(const Capture& capture);
-  // The accepted samples of the session so far (the journal's), as prediction reads them.
-  std::vector<ViewedSample> AcceptedSamples() const;
+  // The accepted samples of the session so far (the journal's), as prediction reads them, by pose: read
+  // from the journal once, then kept up to date as this run accepts samples (RememberSample).
+  std::vector<ViewedSample> AcceptedSamples();
+  void RememberSample(int pose, const Eigen::VectorXd& joints_rad, const std::vector<tracking::PreviousDot>& dots,
+                      const std::vector<tracking::PreviousDot>& candidates);
   // Marked dots (DotIdentifier::FindMarked) that tracking lost, found again in a settled frame.
   void FindMarkedAgain(const capture::Frame& frame);
 
@@ -131,6 +135,7 @@ class Runner {
   robot::JointLimits limits_;
   std::vector<tracking::PreviousDot> tracked_;
   std::vector<tracking::PreviousDot> candidates_;  // of the settled frame being recorded (session_naming.cc)
+  std::optional<std::map<int, ViewedSample>> viewed_;  // AcceptedSamples, once read from the journal
   double last_frame_s_ = -std::numeric_limits<double>::infinity();
   std::map<int, int> frames_written_;  // per pose: frame_written records so far (image names)
 };

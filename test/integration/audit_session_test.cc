@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "base/sha256.h"
+#include "support/cli.h"
 #include "support/run_binary.h"
 #include "support/temp_files.h"
 
@@ -22,9 +23,7 @@ namespace fs = std::filesystem;
 using testing::ReadFile;
 using testing::WriteFile;
 
-int RunSelfcal(const std::string& arguments, std::string* output) {
-  return testing::RunBinary(SELFCAL_BINARY, arguments, output);
-}
+int RunSelfcal(const std::string& arguments, std::string* output) { return testing::RunSelfcal(arguments, output); }
 
 bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "base/sha256.h"
+#include "support/cli.h"
 #include "support/temp_files.h"
 
 namespace selfcal {
@@ -22,14 +23,7 @@ using testing::ReadFile;
 using testing::WriteFile;
 
 // Runs the selfcal binary with arguments; returns its exit code, stdout and stderr in *output.
-int RunSelfcal(const std::string& arguments, std::string* output) {
-  const fs::path log = fs::temp_directory_path() / ("selfcal_calsession_" + std::to_string(::getpid()) + ".log");
-  const std::string command = std::string(SELFCAL_BINARY) + " " + arguments + " > " + log.string() + " 2>&1";
-  const int status = std::system(command.c_str());
-  *output = ReadFile(log.string());
-  fs::remove(log);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+int RunSelfcal(const std::string& arguments, std::string* output) { return testing::RunSelfcal(arguments, output); }
 
 // Every entry under `root`, directories included: its type and permissions, and for a file its size and
 // SHA-256.

@@ -15,32 +15,17 @@
 #include "io/trajectory_file.h"
 #include "sim/trajectory_generator.h"
 
+#include "support/cli.h"
+
 namespace selfcal {
 namespace {
 
 namespace fs = std::filesystem;
 
 // Runs the selfcal binary with arguments; returns its exit code, output in *output.
-int RunSelfcal(const std::string& arguments, std::string* output = nullptr) {
-  const fs::path log = fs::temp_directory_path() / ("selfcal_cli_" + std::to_string(::getpid()) + ".log");
-  const std::string command = std::string(SELFCAL_BINARY) + " " + arguments + " > " + log.string() + " 2>&1";
-  const int status = std::system(command.c_str());
-  if (output != nullptr) {
-    std::ifstream in(log);
-    std::stringstream s;
-    s << in.rdbuf();
-    *output = s.str();
-  }
-  fs::remove(log);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+using testing::RunSelfcal;
 
-fs::path FreshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("selfcal_it_" + std::to_string(::getpid()) + "_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path FreshDir(const std::string& name) { return testing::FreshDir("it", name); }
 
 nlohmann::json ReadJson(const fs::path& path) {
   std::ifstream in(path);

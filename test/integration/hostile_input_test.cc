@@ -11,32 +11,22 @@
 
 #include <gtest/gtest.h>
 
+#include "support/cli.h"
 #include "support/run_binary.h"
+#include "support/temp_files.h"
 
 namespace selfcal {
 namespace {
 
 namespace fs = std::filesystem;
 
-int RunSelfcal(const std::string& arguments, std::string* output) {
-  return testing::RunBinary("cd " + std::string(SELFCAL_SOURCE_DIR) + " && " + SELFCAL_BINARY, arguments, output);
-}
+int RunSelfcal(const std::string& arguments, std::string* output) { return testing::RunSelfcalInSource(arguments, output); }
 
-fs::path FreshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("selfcal_hostile_" + std::to_string(::getpid()) + "_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path FreshDir(const std::string& name) { return testing::FreshDir("hostile", name); }
 
 bool Has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
-std::string ReadText(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string ReadText(const fs::path& path) { return testing::ReadFile(path.string()); }
 
 // The stated pixel noise: 1e-150 px crashed (SIGSEGV in the gauge's QR) and 1e-10 px gave a false
 // "insufficient excitation"; now the gauge is independent of it, and a value below the documented range is

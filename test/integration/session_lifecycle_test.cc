@@ -14,30 +14,16 @@
 
 #include "io/trajectory_file.h"
 
+#include "support/cli.h"
+
 namespace selfcal {
 namespace {
 
 namespace fs = std::filesystem;
 
-int RunSelfcal(const std::string& arguments, std::string* output) {
-  const fs::path log = fs::temp_directory_path() / ("selfcal_life_" + std::to_string(::getpid()) + ".log");
-  const std::string command = "cd " + std::string(SELFCAL_SOURCE_DIR) + " && " + SELFCAL_BINARY + " " + arguments +
-                              " > " + log.string() + " 2>&1";
-  const int status = std::system(command.c_str());
-  std::ifstream in(log);
-  std::stringstream s;
-  s << in.rdbuf();
-  *output = s.str();
-  fs::remove(log);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+int RunSelfcal(const std::string& arguments, std::string* output) { return testing::RunSelfcalInSource(arguments, output); }
 
-fs::path FreshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("selfcal_life_" + std::to_string(::getpid()) + "_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path FreshDir(const std::string& name) { return testing::FreshDir("life", name); }
 
 bool Has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
