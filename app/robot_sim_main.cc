@@ -83,18 +83,18 @@ int main(int argc, char** argv) {
   app.add_option("--latency-s", args.latency_s, "Delay from MOVE to motion (s)")->check(CLI::Range(0.0, 10.0));
   app.add_option("--encoder-noise-deg", args.encoder_noise_deg, "Std of the joint reading noise (deg)")
       ->check(CLI::Range(0.0, 10.0));
-  AddFaultOption(app, "--reject-move", &args.reject, "Refuse move K (R5)");
-  AddFaultOption(app, "--hang-move", &args.hang, "Move K freezes half way and never finishes (R6)");
-  AddFaultOption(app, "--protective-stop-move", &args.protective_stop, "Protective stop half way through move K (R9)");
-  AddFaultOption(app, "--emergency-stop-move", &args.emergency_stop, "Emergency stop half way through move K (R9)");
+  AddFaultOption(app, "--reject-move", &args.reject, "Refuse move K");
+  AddFaultOption(app, "--hang-move", &args.hang, "Move K freezes half way and never finishes");
+  AddFaultOption(app, "--protective-stop-move", &args.protective_stop, "Protective stop half way through move K");
+  AddFaultOption(app, "--emergency-stop-move", &args.emergency_stop, "Emergency stop half way through move K");
   AddFaultOption(app, "--drop-connection-move", &args.drop_connection,
-                 "Lose the connection half way through move K; the socket is closed (R10)");
-  AddFaultOption(app, "--jog-after-move", &args.jog_after, "Someone jogs the arm after move K settled (R4)");
+                 "Lose the connection half way through move K; the socket is closed");
+  AddFaultOption(app, "--jog-after-move", &args.jog_after, "Someone jogs the arm after move K settled");
   app.add_option("--jog-deg", args.jog_deg, "Size of that jog on joint 1 (deg; default 0.02 rad)");
-  AddFaultOption(app, "--slow-settle-move", &args.slow_settle, "Move K rings down 20 times slower (R7)");
-  AddFaultOption(app, "--stale-read", &args.stale_read, "Joint reading N is stale (R8)");
-  AddFaultOption(app, "--nan-read", &args.nan_read, "Joint reading N has NaN in joint 2 (R8)");
-  AddFaultOption(app, "--short-read", &args.short_read, "Joint reading N lacks a joint (R8)");
+  AddFaultOption(app, "--slow-settle-move", &args.slow_settle, "Move K rings down 20 times slower");
+  AddFaultOption(app, "--stale-read", &args.stale_read, "Joint reading N is stale");
+  AddFaultOption(app, "--nan-read", &args.nan_read, "Joint reading N has NaN in joint 2");
+  AddFaultOption(app, "--short-read", &args.short_read, "Joint reading N lacks a joint");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -152,11 +152,11 @@ Status CheckRunSettings(RunSettings* a) {
   if ((a->camera_backend == "sim") != sim_robot) {
     return Status::Error(ErrorCode::kInvalidInput,
                          "--camera sim renders what the simulated arm sees: it needs --robot sim, and --robot sim "
-                         "needs --camera sim (C9)");
+                         "needs --camera sim");
   }
   if (!sim_robot && a->setup.empty()) {
     return Status::Error(ErrorCode::kInvalidInput,
-                         "--setup FILE (camera, yardstick; docs/session-format.md) is required with a real camera (C2)");
+                         "--setup FILE (camera, yardstick; docs/session-format.md) is required with a real camera");
   }
   if (a->velocity_scaling < 0) a->velocity_scaling = sim_robot ? 1.0 : 0.1;
   return Status::Ok();
@@ -326,7 +326,7 @@ Status PrepareSession(const RunSettings& a, RunPlan* run, Backends* backends, Se
     if (state == session::SessionDirState::kAbsent || state == session::SessionDirState::kEmpty) return Status::Ok();
     return Status::Error(ErrorCode::kInvalidInput,
                          "session directory " + a.session +
-                             " exists and is not empty: a session is never overwritten (C10); " +
+                             " exists and is not empty: a session is never overwritten; " +
                              (unrecorded ? "it holds no recorded sample: `selfcal run --resume` with the same options "
                                            "completes it, `selfcal session discard " + a.session + "` removes it"
                                          : std::string("choose a new directory")));
@@ -340,7 +340,7 @@ Status PrepareSession(const RunSettings& a, RunPlan* run, Backends* backends, Se
       return Status::Error(ErrorCode::kInvalidInput,
                            "session " + a.session + ": its creation was interrupted with other inputs (" + differing +
                                "); run with the same files, or remove it with `selfcal session discard " + a.session +
-                               "` (C9)");
+                               "`");
     }
     std::cout << "session " << a.session << ": its creation was interrupted (no session.json, nothing recorded); "
               << "it is created again once the run can start\n";
@@ -441,7 +441,7 @@ Command AddRunCommand(CLI::App& app) {
   cmd->add_option("--session", a->session, "Session directory (created; never overwritten)")->required();
   cmd->add_flag("--resume", a->resume, "Continue a session after a stop or crash (checks every input's hash)");
   cmd->add_flag("--force-resume-with-changed-config", a->force_changed_config,
-                "Resume although an input differs from the recorded one (C9)");
+                "Resume although an input differs from the recorded one");
   cmd->add_flag("--take-over-stale-lock", a->take_over_stale_lock,
                 "--resume: take over a lock left by a process that ended without releasing it (you confirm that "
                 "no selfcal on the host it names uses the session)");
@@ -458,7 +458,7 @@ Command AddRunCommand(CLI::App& app) {
   cmd->add_option("--camera", a->camera_backend, "Camera backend")->check(CLI::IsMember({"sim", "v4l2"}));
   cmd->add_option("--device", a->device, "v4l2 camera device");
   cmd->add_option("--velocity-scaling", a->velocity_scaling,
-                  "Fraction of the joint velocity limits (default 1 simulated, 0.1 real: R1)")
+                  "Fraction of the joint velocity limits (default 1 simulated, 0.1 real)")
       ->check(CLI::Range(1e-3, 1.0));
   cmd->add_option("--seed", a->seed, "sim: world, noise and robot seed");
   cmd->add_option("--grey-noise", a->grey_noise, "sim: pixel noise std, grey levels")->check(CLI::Range(0.0, 50.0));
@@ -468,20 +468,20 @@ Command AddRunCommand(CLI::App& app) {
   auto fault = [&](const char* name, std::vector<int>* v, const char* what) {
     cmd->add_option(name, *v, what)->delimiter(',')->group("Simulated faults (sim robot, 0-based call counts)");
   };
-  fault("--fault-reject-move", &a->fault_reject_moves, "R5: reject move #k");
-  fault("--fault-protective-stop-move", &a->fault_pstop_moves, "R9: protective stop half way through move #k");
-  fault("--fault-hang-move", &a->fault_hang_moves, "R6: move #k never finishes");
-  fault("--fault-disconnect-move", &a->fault_disconnect_moves, "R10: connection lost during move #k");
-  fault("--fault-jog-after-move", &a->fault_jog_after_moves, "R4: someone jogs the arm after move #k");
+  fault("--fault-reject-move", &a->fault_reject_moves, "reject move #k");
+  fault("--fault-protective-stop-move", &a->fault_pstop_moves, "protective stop half way through move #k");
+  fault("--fault-hang-move", &a->fault_hang_moves, "move #k never finishes");
+  fault("--fault-disconnect-move", &a->fault_disconnect_moves, "connection lost during move #k");
+  fault("--fault-jog-after-move", &a->fault_jog_after_moves, "someone jogs the arm after move #k");
   cmd->add_option("--fault-jog-delay-s", a->fault_jog_delay_s,
-                  "R4: the jog comes this long after the move's arrival (0.5: while settling; the simulated session "
+                  "the jog comes this long after the move's arrival (0.5: while settling; the simulated session "
                   "settles 0.6 s after arrival, so a little more jogs between settle and capture)")
       ->check(CLI::Range(0.0, 10.0))
       ->group("Simulated faults (sim robot, 0-based call counts)");
-  fault("--fault-slow-settle-move", &a->fault_slow_settle_moves, "R7: move #k rings 20x longer");
-  fault("--fault-stale-read", &a->fault_stale_reads, "R8: joint reading #n is stale");
-  fault("--fault-nan-read", &a->fault_nan_reads, "R8: joint reading #n has a NaN");
-  fault("--fault-short-read", &a->fault_short_reads, "R8: joint reading #n misses a joint");
+  fault("--fault-slow-settle-move", &a->fault_slow_settle_moves, "move #k rings 20x longer");
+  fault("--fault-stale-read", &a->fault_stale_reads, "joint reading #n is stale");
+  fault("--fault-nan-read", &a->fault_nan_reads, "joint reading #n has a NaN");
+  fault("--fault-short-read", &a->fault_short_reads, "joint reading #n misses a joint");
   return [a]() { return RunFromSettings(*a); };
 }
 

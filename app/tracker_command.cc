@@ -126,7 +126,7 @@ Command AddTrackerCommand(CLI::App& app) {
     PrintErrors("in-sample, before                ", r.insample_before);
     PrintErrors("in-sample, after                 ", r.insample_after);
     const double ratio = r.insample_after.rms_m > 0 ? r.holdout_after.rms_m / r.insample_after.rms_m : 0.0;
-    std::cout << "held-out / in-sample RMS after identification (K10): " << ratio << "\n";
+    std::cout << "held-out / in-sample RMS after identification: " << ratio << "\n";
     doc["holdout_before"] = ErrorsJson(r.holdout_before);
     doc["holdout_after"] = ErrorsJson(r.holdout_after);
     doc["insample_before"] = ErrorsJson(r.insample_before);

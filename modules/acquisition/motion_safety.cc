@@ -45,13 +45,13 @@ PreflightReport Preflight(const std::vector<PlannedPose>& plan, const robot::Joi
   if (!invalid.empty()) problem("motion safety options: " + invalid.substr(0, invalid.size() - 1));
   const int n = static_cast<int>(limits.lower_rad.size());
   if (n == 0 || limits.upper_rad.size() != n) {
-    problem("the robot reports no joint limits: refusing to move (R3)");
+    problem("the robot reports no joint limits: refusing to move");
     return report;
   }
   if (plan.empty()) problem("the plan has no poses");
   if (start_rad.size() != n || !start_rad.allFinite()) {
     problem("the robot's current joint reading has " + std::to_string(start_rad.size()) +
-            " values or non-finite ones; expected " + std::to_string(n) + " finite values (R8)");
+            " values or non-finite ones; expected " + std::to_string(n) + " finite values");
   }
   if (!report.problems.empty()) return report;
   const planning::ControllerLimits controller{limits.lower_rad, limits.upper_rad, limits.max_velocity_rad_s};
@@ -86,7 +86,7 @@ PreflightReport Preflight(const std::vector<PlannedPose>& plan, const robot::Joi
     if (move.max_travel_rad > options.max_joint_travel_rad) {
       std::snprintf(text, sizeof(text),
                     "move %s -> pose %s: joint %d travels %.2f deg, more than the bound of %.2f deg; add an "
-                    "intermediate pose (R2)",
+                    "intermediate pose",
                     from_name.c_str(), p.id.c_str(), worst + 1, RadToDeg(move.max_travel_rad),
                     RadToDeg(options.max_joint_travel_rad));
       problem(text);

@@ -86,7 +86,7 @@ bool Runner::StartFromJournal(const session::SessionLog& log, std::vector<int>* 
              log.plan[i].joints_rad == plan_[i].joints_rad;
     }
     if (!same) {
-      report_.message = "session " + c_.session->path() + " recorded another plan than the one given (C9)";
+      report_.message = "session " + c_.session->path() + " recorded another plan than the one given";
       return false;
     }
     *todo = log.PosesToVisit(o_.revisit_skipped);
@@ -128,7 +128,7 @@ bool Runner::ConnectRobot(const session::SessionLog& log, RobotAtStart* robot) {
         started.value("robot_calibration", identity->calibration_id) != identity->calibration_id) {
       report_.message = "session " + c_.session->path() + " was recorded with robot " +
                         started.value("robot_model", "?") + " serial " + started.value("robot_serial", "?") +
-                        "; this robot is " + identity->model + " serial " + identity->serial + " (R13)";
+                        "; this robot is " + identity->model + " serial " + identity->serial + "";
       return false;
     }
     // The limits the session was recorded under (the controller's, narrowed to the config's); not the

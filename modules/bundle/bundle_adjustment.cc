@@ -315,7 +315,7 @@ std::string WhyNotIdentifiable(const internal::Gauge& gauge, const BundleOptions
   if (gauge.free_kinematic.empty() ||
       (options.require_generic_rank && static_cast<int>(gauge.free_kinematic.size()) < generic_rank)) {
     std::ostringstream msg;
-    msg << "insufficient excitation (K3): these " << num_poses << " identification poses identify "
+    msg << "insufficient excitation: these " << num_poses << " identification poses identify "
         << gauge.free_kinematic.size() << " kinematic parameters, generic poses of this robot " << generic_rank
         << "; fixed here: " << Join(gauge.fixed_names);
     return msg.str();
@@ -476,19 +476,19 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
   TriangulateStartDots(rho_start, fx_start, &data, &state, &report.dropped_dots);
   if (data.yardsticks.empty()) {
     return finish(Outcome::kScaleUnresolved,
-                  "no yardstick has both ends seen (and triangulable) in two or more identification poses (S1)");
+                  "no yardstick has both ends seen (and triangulable) in two or more identification poses");
   }
 
   internal::Gauge gauge;
   if (!AnalyzeStartGauge(data, state, options, &gauge, &report)) {
-    return finish(Outcome::kFailure, "the start model puts a triangulated dot behind a camera (K5)");
+    return finish(Outcome::kFailure, "the start model puts a triangulated dot behind a camera");
   }
   const std::string not_identifiable = WhyNotIdentifiable(gauge, options, num_poses, report.generic_rank);
   if (!not_identifiable.empty()) return finish(Outcome::kDegenerate, not_identifiable);
 
   const ScreenedFit fit = SolveScreened(gauge.free_kinematic, options, &data, &state, &report);
   if (fit.scale_lost) {
-    return finish(Outcome::kScaleUnresolved, "the residual screen removed the yardstick's views (S1)");
+    return finish(Outcome::kScaleUnresolved, "the residual screen removed the yardstick's views");
   }
   const ceres::Solver::Summary& summary = fit.summary;
   report.final_cost = summary.final_cost;

@@ -107,7 +107,7 @@ bool CheckExcitation(const RobotModel& robot, const Eigen::VectorXd& rho_nominal
   if (report->identifiability.condition_number <= options.max_condition_number) return true;
   report->outcome = Outcome::kDegenerate;
   std::ostringstream msg;
-  msg << "insufficient excitation (K3): the identification poses give a condition number of "
+  msg << "insufficient excitation: the identification poses give a condition number of "
       << report->identifiability.condition_number << " (limit " << options.max_condition_number
       << "); move the joints further apart between poses";
   report->message = msg.str();

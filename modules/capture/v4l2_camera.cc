@@ -160,7 +160,7 @@ Status V4l2Camera::Impl::VerifyFormat(const char* when) {
             FormatText(options.width_px, options.height_px, want_fourcc, want_bpl) + " but the driver has " +
             FormatText(now.width_px, now.height_px, now.pixel_format, now.bytes_per_line) + " " + when +
             "; choose a mode the camera lists (v4l2-ctl --list-formats-ext) and intrinsics of that "
-            "resolution (C11)");
+            "resolution");
   }
   return Status::Ok();
 }
@@ -354,7 +354,7 @@ Status V4l2Camera::Open() {
     why.precision(6);
     why << "camera " << m.options.device << ": the test frame's driver timestamp is " << skew
         << " s away from CLOCK_MONOTONIC: the driver stamps buffers with another clock, so stale frames "
-           "cannot be told from fresh ones (V5)";
+           "cannot be told from fresh ones";
     return fail(CaptureFailure(CaptureError::kClockMismatch, why.str()));
   }
   return Status::Ok();

@@ -476,13 +476,13 @@ IdentificationReport IdentifyFromRelativePoses(const RobotModel& model, const Ei
       if (!std::isfinite(rho_start[i])) names.push_back(params.name(i));
     }
     report.outcome = Outcome::kFailure;
-    report.message = "non-finite start parameters (K5): " + JoinNames(names);
+    report.message = "non-finite start parameters: " + JoinNames(names);
     return report;
   }
   const std::string bad = NonFiniteBlocks(costs, measurements, rho_start, n);
   if (!bad.empty()) {
     report.outcome = Outcome::kFailure;
-    report.message = "non-finite residual or Jacobian at the start (K5): " + bad;
+    report.message = "non-finite residual or Jacobian at the start: " + bad;
     return report;
   }
 

@@ -164,7 +164,7 @@ ScaleEstimate EstimateYardstickScale(const CameraIntrinsics& camera, double fx_p
                                      double max_relative_sigma) {
   ScaleEstimate estimate;
   if (yardsticks.empty()) {
-    estimate.message = "no yardstick measurements (S1)";
+    estimate.message = "no yardstick measurements";
     return estimate;
   }
   if (!(std::isfinite(sigma_px) && sigma_px > 0)) {
@@ -183,7 +183,7 @@ ScaleEstimate EstimateYardstickScale(const CameraIntrinsics& camera, double fx_p
     for (const PointTrack* end : {&y.end_a, &y.end_b}) {
       if (end->pixels.size() < 2) {
         estimate.message = name + ": end " + (end == &y.end_a ? "a" : "b") + " seen in " +
-                           std::to_string(end->pixels.size()) + " view(s), need 2 (S1)";
+                           std::to_string(end->pixels.size()) + " view(s), need 2";
         return estimate;
       }
     }
@@ -226,7 +226,7 @@ ScaleEstimate EstimateYardstickScale(const CameraIntrinsics& camera, double fx_p
   const double relative = estimate.scale_sigma / s;
   if (!(relative <= max_relative_sigma)) {
     std::ostringstream out;
-    out << "scale ill-conditioned (S3): relative sigma " << relative << " exceeds " << max_relative_sigma;
+    out << "scale ill-conditioned: relative sigma " << relative << " exceeds " << max_relative_sigma;
     estimate.message = out.str();
     return estimate;
   }

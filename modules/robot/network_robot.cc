@@ -167,14 +167,14 @@ Status NetworkRobot::HandshakeUnsanitised() {
     }
     if (!difference.empty()) {
       return RobotFailure(RobotError::kProtocol, name_ + ": the controller is not the one first connected (" +
-                                                     difference + "); refusing it (R10, R13)");
+                                                     difference + "); refusing it");
     }
   }
   if (options_.expected_identity) {  // R12, R13
     const std::string difference = IdentityDifference(*options_.expected_identity, hello->identity, true);
     if (!difference.empty()) {
       return RobotFailure(RobotError::kProtocol, name_ + ": the controller is not the expected robot (expected " +
-                                                     difference + "); refusing it (R12, R13)");
+                                                     difference + "); refusing it");
     }
   }
   const Result<std::string> limits_line = RoundTrip(RequestKind::kLimits, "LIMITS");

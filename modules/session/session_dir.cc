@@ -356,7 +356,7 @@ Result<Session> CreateSession(const std::string& path, const SessionInputs& inpu
     if (!empty.ok()) return Usage("cannot create session " + path + ": " + empty.status().message());
     if (!*empty) {
       return Usage("session directory " + path +
-                   " exists and is not empty: a session is never overwritten (C10); choose a new directory");
+                   " exists and is not empty: a session is never overwritten; choose a new directory");
     }
   } else {
     std::filesystem::path normal = std::filesystem::path(path).lexically_normal();
@@ -376,7 +376,7 @@ Result<Session> CreateSession(const std::string& path, const SessionInputs& inpu
   if (*available < needed) {
     return Usage("cannot create session " + path + ": only " + std::to_string(*available) +
                  " bytes are free on the file system of " + checked_dir + ", the session needs " +
-                 std::to_string(needed) + " (C10)");
+                 std::to_string(needed) + "");
   }
 
   if (!exists) {
@@ -437,7 +437,7 @@ Result<Session> OpenSession(const std::string& path, const SessionInputs& expect
   }
   if (!report.changed_inputs.empty() && !allow_changed_inputs) {
     return Usage("session " + path + " was recorded with other inputs: " + JoinProblems(report.changed_inputs) +
-                 "; resume with the same files, or allow changed inputs explicitly (C9)");
+                 "; resume with the same files, or allow changed inputs explicitly");
   }
   if (Status s = CheckSessionLayout(path); !s.ok()) return s;
 
@@ -476,7 +476,7 @@ Status Session::CheckFreeSpace(std::uint64_t bytes_needed) const {
   if (*available < bytes_needed) {
     return Status::Error(ErrorCode::kHardware, "only " + std::to_string(*available) +
                                                   " bytes are free on the file system of session " + path_ + ", " +
-                                                  std::to_string(bytes_needed) + " are needed (P5)");
+                                                  std::to_string(bytes_needed) + " are needed");
   }
   return Status::Ok();
 }

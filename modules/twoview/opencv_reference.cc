@@ -43,7 +43,7 @@ EssentialChoice ChooseEssentialCandidate(const Eigen::MatrixXd& stacked, const C
   choice.good.assign(n, false);
   if (stacked.rows() == 0 || stacked.cols() != 3 || stacked.rows() % 3 != 0) {
     std::ostringstream m;
-    m << "essential matrix of " << stacked.rows() << " x " << stacked.cols() << " is not 3N x 3 (G2)";
+    m << "essential matrix of " << stacked.rows() << " x " << stacked.cols() << " is not 3N x 3";
     choice.message = m.str();
     return choice;
   }
@@ -126,7 +126,7 @@ TwoViewReport EstimateTwoViewOpenCv(const TwoViewOptions& options, const CameraI
   }
   // G1: an empty result is a failure. G2: a 3N x 3 result stacks N solutions; one is chosen explicitly.
   if (essential.empty()) {
-    return Finish(report, Outcome::kDegenerate, "cv::findEssentialMat returned no essential matrix (G1)");
+    return Finish(report, Outcome::kDegenerate, "cv::findEssentialMat returned no essential matrix");
   }
   cv::Mat essential_64f;
   essential.convertTo(essential_64f, CV_64F);
@@ -145,7 +145,7 @@ TwoViewReport EstimateTwoViewOpenCv(const TwoViewOptions& options, const CameraI
   const Eigen::Matrix3d r = choice.rotation;
   const Eigen::Vector3d t = choice.translation;
   if (!r.allFinite() || !t.allFinite() || !(t.norm() > 0)) {
-    return Finish(report, Outcome::kDegenerate, "recoverPose returned a non-finite pose (G8)");
+    return Finish(report, Outcome::kDegenerate, "recoverPose returned a non-finite pose");
   }
   std::vector<int> inliers;
   for (int i = 0; i < n; ++i) {
@@ -164,10 +164,10 @@ TwoViewReport EstimateTwoViewOpenCv(const TwoViewOptions& options, const CameraI
   std::ostringstream m;
   m << "OpenCV: " << choice.message;
   if (report.num_inliers < options.min_inlier_ratio * n) {
-    return Finish(report, Outcome::kTooManyOutliers, m.str() + ", below the inlier floor (G7)");
+    return Finish(report, Outcome::kTooManyOutliers, m.str() + ", below the inlier floor");
   }
   if (report.num_inliers < options.min_points) {
-    return Finish(report, Outcome::kTooFewPoints, m.str() + ", too few (G1)");
+    return Finish(report, Outcome::kTooFewPoints, m.str() + ", too few");
   }
   report.translation_observable = true;
   return Finish(report, Outcome::kSuccess, m.str());

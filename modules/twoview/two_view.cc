@@ -108,7 +108,7 @@ void WarnIfFewInliers(int num_inliers, int n, TwoViewReport* report) {
   if (ratio >= kWarnInlierRatio) return;
   std::ostringstream m;
   m << "inlier ratio " << ratio << ": outliers or wrong intrinsics (" << num_inliers << " of " << n
-    << " correspondences fit the final model, below " << kWarnInlierRatio << "; G10)";
+    << " correspondences fit the final model, below " << kWarnInlierRatio << ")";
   report->warnings.push_back(m.str());
 }
 
@@ -140,7 +140,7 @@ void WarnIfRadialDistortion(const TwoViewOptions& options, const CameraIntrinsic
   m << "intrinsics/distortion suspect: residuals grow with radius (a radial term k1 = " << score.k1
     << " explains them with z = " << score.z << ", |z| > " << kRadialTestMinZ << ", over " << score.n
     << " correspondences within " << gate_px << " px; it moves the outermost point by " << score.max_displacement_px
-    << " px; G10)";
+    << " px)";
   report->warnings.push_back(m.str());
 }
 
@@ -244,7 +244,7 @@ bool SelectModel(const TwoViewOptions& options, const CameraIntrinsics& camera, 
   if (most_inliers < options.min_inlier_ratio * n) {
     std::ostringstream m;
     m << "best model explains " << most_inliers << " of " << n << " correspondences, below the floor "
-      << options.min_inlier_ratio << " (G7; fundamental " << fundamental.num_inliers << " inliers after "
+      << options.min_inlier_ratio << " (fundamental " << fundamental.num_inliers << " inliers after "
       << fundamental.iterations << " iterations, homography " << homography.num_inliers << ")";
     *report = Finish(*report, Outcome::kTooManyOutliers, m.str());
     return false;
@@ -402,7 +402,7 @@ Outcome JudgeParallaxAndDepth(const TwoViewOptions& options, Outcome outcome, do
     report->translation_observable = false;
     report->translation_direction.setZero();
     *message = "rotation only: median parallax below " + std::to_string(options.min_parallax_deg) +
-               " deg, translation unobservable (G3); " + summary;
+               " deg, translation unobservable; " + summary;
     return Outcome::kPureRotation;
   }
   if (outcome == Outcome::kSuccess && report->far_point_fraction > options.max_far_point_fraction) {
@@ -411,7 +411,7 @@ Outcome JudgeParallaxAndDepth(const TwoViewOptions& options, Outcome outcome, do
     std::ostringstream m;
     m << "low depth variation: " << 100 * report->far_point_fraction << " % of the inliers lie farther than "
       << internal::kFarDepthBaselines << " baselines (limit " << 100 * options.max_far_point_fraction
-      << " %), translation direction unreliable (G6); " << summary;
+      << " %), translation direction unreliable; " << summary;
     *message = m.str();
     return Outcome::kLowDepthVariation;
   }
@@ -438,7 +438,7 @@ bool internal::ScreenInput(const TwoViewOptions& options, const CameraIntrinsics
   }
   for (size_t i = 0; i < pixels1.size(); ++i) {
     if (!pixels1[i].allFinite() || !pixels2[i].allFinite()) {
-      *report = Finish(*report, Outcome::kInvalidInput, "non-finite pixel at correspondence " + std::to_string(i) + " (D7)");
+      *report = Finish(*report, Outcome::kInvalidInput, "non-finite pixel at correspondence " + std::to_string(i) + "");
       return false;
     }
   }
@@ -446,7 +446,7 @@ bool internal::ScreenInput(const TwoViewOptions& options, const CameraIntrinsics
   report->inliers.assign(n, false);
   if (n < options.min_points) {
     std::ostringstream m;
-    m << n << " correspondences, at least " << options.min_points << " needed (G1)";
+    m << n << " correspondences, at least " << options.min_points << " needed";
     *report = Finish(*report, Outcome::kTooFewPoints, m.str());
     return false;
   }
@@ -475,7 +475,7 @@ TwoViewReport EstimateTwoView(const TwoViewOptions& options, const CameraIntrins
   };
   if (chosen.num_inliers < options.min_points) {
     std::ostringstream m;
-    m << chosen.num_inliers << " inliers, at least " << options.min_points << " needed (G1)";
+    m << chosen.num_inliers << " inliers, at least " << options.min_points << " needed";
     return finish(Outcome::kTooFewPoints, m.str());
   }
 
@@ -514,7 +514,7 @@ TwoViewReport EstimateTwoView(const TwoViewOptions& options, const CameraIntrins
     report.fx_linear_px = 0;
     return finish(Outcome::kPureRotation,
                   "rotation only: a rotation alone explains the inliers within the noise gate, translation "
-                  "unobservable (G3); " +
+                  "unobservable; " +
                       summary.str());
   }
   if (candidates.empty()) {
@@ -529,7 +529,7 @@ TwoViewReport EstimateTwoView(const TwoViewOptions& options, const CameraIntrins
     std::ostringstream m;
     m << "no clear cheirality winner: best candidate has " << choice.best_in_front << " points in front ("
       << choice.best_behind << " clearly behind), strongest rival " << choice.runner_up_in_front << " ("
-      << choice.runner_up_behind << ") (G5); " << summary.str();
+      << choice.runner_up_behind << "); " << summary.str();
     return finish(Outcome::kAmbiguousPose, m.str());
   }
   report.translation_observable = true;
