@@ -414,6 +414,10 @@ void EstimateCovariance(const BundleData& data, const BundleState& state, const 
   const int num_unknowns = columns.size() + 3 * static_cast<int>(data.dot_ids.size());
   const int dof = 2 * report->num_observations + static_cast<int>(data.yardsticks.size()) - num_unknowns;
   Eigen::MatrixXd reduced, covariance;
+  if (dof > 0) {
+    report->pixel_noise_estimate_px = data.sigma_px * std::sqrt(2.0 * final_cost / dof);
+    report->residual_dof = dof;
+  }
   if (dof <= 0) {
     report->covariance_message = "uncertainty unavailable (no redundancy)";
   } else if (!internal::ReducedJacobian(data, state, columns, &reduced)) {

@@ -38,6 +38,7 @@
 // the start's base and joint-1 parameters); pixels as in camera/camera.h; f_x in px.
 #pragma once
 
+#include <cmath>
 #include <map>
 #include <string>
 #include <vector>
@@ -118,6 +119,10 @@ struct BundleReport {
   std::vector<int> dropped_dots;              // seen fewer than twice, or not triangulable at the start
   int num_observations = 0;                   // used in the final fit
   double rms_reprojection_px = 0;             // RMS of |r| over them
+  // The pixel noise these residuals imply, per coordinate: pixel_noise_px * s, s^2 = 2 final_cost / dof
+  // (dof = residuals - unknowns). NaN without redundancy. The covariance above is scaled by s^2.
+  double pixel_noise_estimate_px = NAN;
+  int residual_dof = 0;                       // that dof (0 without redundancy)
   double initial_cost = 0, final_cost = 0;    // Ceres cost of the first and the final solve
   int iterations = 0;                         // over every solve
   std::string termination;                    // of the final solve

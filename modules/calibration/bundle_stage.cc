@@ -44,6 +44,41 @@ Eigen::VectorXd BundleStartFromPaper(const ObservationSet& obs, const PaperPipel
   return rho;
 }
 
+namespace {
+
+// The held-out reprojection figures of the calibrated and the nominal model (see bundle_stage.h).
+void VerifyHeldOutReprojection(const ObservationSet& obs, const BundleStageOptions& options, BundleStageReport* report) {
+  const bundle::BundleReport& b = report->bundle;
+  const bool estimated = std::isfinite(b.pixel_noise_estimate_px) && b.pixel_noise_estimate_px > 0;
+  const double noise = estimated ? b.pixel_noise_estimate_px : obs.pixel_noise_px;
+  PredictionModel calibrated;
+  calibrated.robot = obs.robot;
+  calibrated.rho = b.rho;
+  calibrated.camera = obs.camera;
+  calibrated.camera.fx_px = b.fx_px;
+  if (options.bundle.estimate_k1) calibrated.camera.k1 = b.k1;
+  calibrated.free_indices = b.free_indices;
+  calibrated.fx_estimated = options.bundle.estimate_fx;
+  calibrated.k1_estimated = options.bundle.estimate_k1;
+  if (b.covariance_available) calibrated.covariance = b.covariance_free;
+  ExcludedObservations excluded;
+  for (const bundle::RemovedObservation& o : b.removed) excluded.insert({o.pose_id, o.dot_id});
+  const int noise_dof = estimated ? b.residual_dof : 0;
+  report->heldout = HeldOutReprojectionOf(obs, calibrated, b.dots_in_base, excluded, noise, noise_dof);
+  report->heldout.noise_source = estimated ? "the bundle's estimate from its identification residuals"
+                                           : "the stated pixel noise (the bundle has no redundancy to estimate it)";
+  if (!b.covariance_available) report->heldout.message = "prediction uncertainty of the parameters left out: " + b.covariance_message;
+  report->heldout_at_stated_noise = Renormalised(report->heldout.overall, noise, obs.pixel_noise_px);
+  PredictionModel nominal;
+  nominal.robot = obs.robot;
+  nominal.rho = KinematicParameters::Nominal(obs.robot);
+  nominal.camera = obs.camera;
+  report->heldout_nominal = HeldOutReprojectionOf(obs, nominal, TriangulateIdentificationDots(obs, nominal), {}, noise, noise_dof);
+  report->heldout_nominal.noise_source = report->heldout.noise_source;
+}
+
+}  // namespace
+
 BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineReport& paper,
                                  const BundleStageOptions& options) {
   const auto clock_start = std::chrono::steady_clock::now();
@@ -66,7 +101,8 @@ BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineR
   }
   const bundle::BundleReport& b = report.bundle;
   const std::vector<int> verification_poses = obs.PosesWithRole(PoseRole::kVerification);
-  const bool verify = !verification_poses.empty() && !obs.check_distances.empty() && obs.Validate().empty();
+  const bool valid = !verification_poses.empty() && obs.Validate().empty();
+  const bool verify = valid && !obs.check_distances.empty();
   if (verify) {
     report.verification_nominal = VerifyDistances(obs, verification_poses, obs.robot, KinematicParameters::Nominal(obs.robot),
                                                   obs.camera.fx_px, obs.check_distances);
@@ -74,6 +110,7 @@ BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineR
   if (b.rho.size() == obs.robot.num_parameters() && b.rho.allFinite() && std::isfinite(b.fx_px) && b.fx_px > 0) {
     report.calibrated_robot = ApplyParameters(obs.robot, b.rho);
     report.calibrated_rho = KinematicParameters::Nominal(report.calibrated_robot);
+    if (valid) VerifyHeldOutReprojection(obs, options, &report);
     if (verify) {
       if (options.bundle.estimate_k1) {
         ObservationSet with_k1 = obs;

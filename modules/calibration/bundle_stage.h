@@ -20,6 +20,7 @@
 
 #include "bundle/bundle_adjustment.h"
 #include "observations/observation_set.h"
+#include "calibration/heldout_reprojection.h"
 #include "calibration/paper_pipeline.h"
 #include "calibration/predicted_error.h"
 
@@ -50,6 +51,13 @@ struct BundleStageReport {
   // parameters and f_x, and the stated pixel noise (observations.pixel_noise_px) of the verification
   // images. ok = false when the covariance was unavailable.
   PredictedDistanceErrors predicted_error;
+  // Held-out reprojection (heldout_reprojection.h), with no check distance needed: the bundle's dots and
+  // model (its covariance in the normalisation), and the nominal model with the prior f_x and the dots it
+  // triangulates from the identification images (taken as exact). Both are normalised with the bundle's
+  // pixel noise estimate from the identification residuals (the stated noise when there is none);
+  // heldout_at_stated_noise is the calibrated overall figure normalised with observations.pixel_noise_px.
+  HeldOutReprojection heldout, heldout_nominal;
+  HeldOutFigure heldout_at_stated_noise;
   double seconds_total = 0;
 };
 

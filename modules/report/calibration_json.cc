@@ -56,6 +56,56 @@ json PredictedErrorJson(const calibration::PredictedDistanceErrors& p) {
           {"distances", distances}};
 }
 
+// A held-out reprojection figure; its numbers null when it has no residual.
+json HeldOutFigureJson(const calibration::HeldOutFigure& f) {
+  const bool any = f.num_residuals > 0;
+  json j = {{"num_residuals", f.num_residuals},
+            {"dof", f.dof},
+            {"rms_px", any ? Finite(f.rms_px) : json()},
+            {"max_px", any ? Finite(f.max_px) : json()},
+            {"chi_square", any ? Finite(f.chi_square) : json()},
+            {"noise_dof", f.noise_dof},
+            {"chi_square_limit_99", any ? Finite(f.chi_square_limit) : json()},
+            {"p_value", any ? Finite(f.p_value) : json()},
+            {"test_passed", any ? json(f.test_passed) : json()}};
+  if (!f.pose_id.empty()) j["pose"] = f.pose_id;
+  return j;
+}
+
+json HeldOutModelJson(const calibration::HeldOutReprojection& h) {
+  json poses = json::array();
+  for (const calibration::HeldOutFigure& f : h.poses) poses.push_back(HeldOutFigureJson(f));
+  return {{"ok", h.ok},
+          {"message", h.message},
+          {"prediction_uncertainty", h.prediction_uncertainty},
+          {"num_not_predicted", h.num_not_predicted},
+          {"overall", h.ok ? HeldOutFigureJson(h.overall) : json()},
+          {"poses", poses}};
+}
+
+// The bundle's held-out reprojection; null when it was not computed (no converged rho, no verification pose).
+json HeldOutJson(const ObservationSet& obs, const calibration::BundleStageReport& stage) {
+  const calibration::HeldOutReprojection& c = stage.heldout;
+  const calibration::HeldOutReprojection& n = stage.heldout_nominal;
+  if (!c.ok && c.overall.num_residuals == 0 && c.poses.empty() && c.message.empty()) return nullptr;
+  json calibrated = HeldOutModelJson(c);
+  calibrated["overall_at_stated_noise"] = c.ok ? HeldOutFigureJson(stage.heldout_at_stated_noise) : json();
+  const bool compare = c.ok && n.ok;
+  return {{"description", "the dots placed from the identification images (the bundle's, or triangulated with the nominal "
+                          "model) projected into every verification image with the same model and compared with the "
+                          "detections; chi-square of the residuals normalised by the detection noise and the "
+                          "prediction's own first-order uncertainty, 2 degrees of freedom per dot, tested at 99 %: "
+                          "chi-square (Wilson-Hilferty) when the noise is taken as known, dof x F(dof, noise_dof) "
+                          "(Paulson) when it is the bundle's estimate from noise_dof residual degrees of freedom"},
+          {"noise_px", Finite(c.noise_px)},
+          {"noise_source", c.noise_source},
+          {"stated_noise_px", obs.pixel_noise_px},
+          {"test_passed", c.ok ? json(c.overall.test_passed) : json()},
+          {"beats_nominal", compare ? json(c.overall.rms_px < n.overall.rms_px) : json()},
+          {"calibrated_model", calibrated},
+          {"nominal_model", HeldOutModelJson(n)}};
+}
+
 json PoseMeasurementsJson(const calibration::PaperPipelineReport& r) {
   json measurements = json::array();
   for (const calibration::PoseMeasurement& m : r.measurements) {
@@ -171,7 +221,8 @@ json BundleSectionJson(const ObservationSet& obs, const calibration::BundleStage
           {"covariance_message", b.covariance_message},
           {"parameters", ParametersJson(obs, b.rho, b.stddev, b.free_indices, "value", true)},
           {"verification", VerificationJson(obs, stage.verification_nominal, stage.verification)},
-          {"predicted_3d_error", PredictedErrorJson(stage.predicted_error)}};
+          {"predicted_3d_error", PredictedErrorJson(stage.predicted_error)},
+          {"heldout_reprojection", HeldOutJson(obs, stage)}};
 }
 
 // The session block: the input's path and manifest hash, the journal's counts, the findings.
@@ -213,6 +264,7 @@ json CalibrationReportJson(const ObservationSet& obs, const calibration::Calibra
   j["fx_px"] = chosen["fx_px"];
   j["verification"] = chosen["verification"];
   j["predicted_3d_error"] = chosen["predicted_3d_error"];
+  j["heldout_reprojection"] = chosen.contains("heldout_reprojection") ? chosen["heldout_reprojection"] : json();
   j["methods"] = methods;
   j["session"] = context.session ? SessionJson(context.input, *context.session) : json();
   // Timing in one place, so that two reports of the same input compare equal without it.

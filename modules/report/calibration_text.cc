@@ -37,6 +37,34 @@ void PrintPaperSummary(const calibration::PaperPipelineReport& r, std::ostream& 
 }
 
 
+// The held-out reprojection: overall for both models, and the verification poses that fail their own test.
+void PrintHeldOut(const calibration::BundleStageReport& stage, std::ostream& out) {
+  const calibration::HeldOutReprojection& c = stage.heldout;
+  if (!c.ok) {
+    if (!c.message.empty()) out << "  held-out reprojection: not computed (" << c.message << ")\n";
+    return;
+  }
+  const calibration::HeldOutFigure& f = c.overall;
+  out << std::fixed << std::setprecision(3) << "  held-out reprojection on " << c.poses.size() << " verification poses, "
+      << f.num_residuals << " dots: RMS " << f.rms_px << " px per coordinate (noise " << c.noise_px << " px, "
+      << c.noise_source << "); chi-square " << std::setprecision(1) << f.chi_square << " for " << f.dof
+      << " degrees of freedom, 99 % limit " << f.chi_square_limit << (f.noise_dof > 0 ? " (F test)" : "") << ": "
+      << (f.test_passed ? "passed" : "failed") << "\n";
+  if (!c.prediction_uncertainty) out << "    (the parameters' uncertainty is not in the test: " << c.message << ")\n";
+  const calibration::HeldOutReprojection& n = stage.heldout_nominal;
+  if (n.ok) {
+    out << std::setprecision(3) << "    nominal model on the same images: RMS " << n.overall.rms_px << " px ("
+        << n.overall.num_residuals << " dots); the calibrated model " << (f.rms_px < n.overall.rms_px ? "beats" : "does not beat")
+        << " it\n";
+  }
+  for (const calibration::HeldOutFigure& p : c.poses) {
+    if (p.test_passed) continue;
+    out << std::setprecision(3) << "    pose " << p.pose_id << ": RMS " << p.rms_px << " px over " << p.num_residuals
+        << " dots, chi-square " << std::setprecision(1) << p.chi_square << " > " << p.chi_square_limit << "\n";
+  }
+  out.unsetf(std::ios::floatfield);
+}
+
 void PrintBundleSummary(const calibration::BundleStageReport& stage, std::ostream& out) {
   const bundle::BundleReport& b = stage.bundle;
   out << "kinematic bundle adjustment: " << bundle::OutcomeName(b.outcome);
@@ -61,6 +89,7 @@ void PrintBundleSummary(const calibration::BundleStageReport& stage, std::ostrea
         << " mm, verification pixels " << stage.predicted_error.rms_pixels_std_m * kMm << " mm)\n";
     out.unsetf(std::ios::floatfield);
   }
+  PrintHeldOut(stage, out);
   out << "  time: " << std::fixed << std::setprecision(1) << b.seconds * 1e3 << " ms\n";
   out.unsetf(std::ios::floatfield);
 }

@@ -91,6 +91,29 @@ TEST(CalibrationReport, AbsentFiguresAreNullNotZero) {
   EXPECT_EQ(j["verification"]["calibrated_model"]["num_ok"], 0);
   EXPECT_TRUE(j["verification"]["calibrated_model"]["rms_error_m"].is_null());
   EXPECT_TRUE(j["verification"]["calibrated_model"]["max_error_m"].is_null());
+  // No distance figure anywhere is a number 0 (a length of exactly 0 m is never measured).
+  std::vector<std::string> keys;
+  CollectKeys(j, "", &keys);
+  int distance_figures = 0;
+  for (const std::string& k : keys) {
+    if (k.find("verification") == std::string::npos && k.find("predicted_3d_error") == std::string::npos) continue;
+    if (!EndsWith(k, "_m")) continue;
+    ++distance_figures;
+    const nlohmann::json& v = j.at(nlohmann::json::json_pointer(k));
+    EXPECT_FALSE(v.is_number() && v.get<double>() == 0.0) << k;
+  }
+  EXPECT_GT(distance_figures, 6);
+  // The held-out reprojection needs no known distance: it is there, with its test.
+  ASSERT_TRUE(j["heldout_reprojection"].is_object());
+  EXPECT_EQ(j["heldout_reprojection"], j["methods"]["bundle"]["heldout_reprojection"]);
+  EXPECT_TRUE(j["heldout_reprojection"]["test_passed"].is_boolean());
+  EXPECT_GT(j["heldout_reprojection"]["calibrated_model"]["overall"]["num_residuals"].get<int>(), 0);
+  EXPECT_EQ(j["heldout_reprojection"]["calibrated_model"]["poses"].size(),
+            world.observations.PosesWithRole(PoseRole::kVerification).size());
+  std::ostringstream text;
+  PrintCalibrationSummary(report, text);
+  EXPECT_NE(text.str().find("held-out reprojection on"), std::string::npos) << text.str();
+  EXPECT_EQ(text.str().find("held-out distances"), std::string::npos) << text.str();
 }
 
 // The paper's Table 2 comes from the literature table, as printed there.

@@ -1,0 +1,311 @@
+#include "calibration/heldout_reprojection.h"
+
+#include <algorithm>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+#include "identification/triangulation.h"
+
+namespace selfcal::calibration {
+
+namespace {
+
+constexpr double kStepRho = 1e-6;  // m or rad
+constexpr double kStepDot = 1e-6;  // m
+constexpr double kStepFx = 1e-3;   // px
+constexpr double kStepK1 = 1e-6;
+
+using Matrix23 = Eigen::Matrix<double, 2, 3>;
+
+// The camera pose of one robot configuration and its neighbours for the rho differences.
+struct PoseFrames {
+  Rigid3 cam_from_base;
+  std::vector<Rigid3> plus, minus;  // per free rho entry
+};
+
+// Projections of the model and their derivatives by central differences.
+class Projector {
+ public:
+  explicit Projector(const PredictionModel& model) : model_(model) {
+    const int n = static_cast<int>(model.free_indices.size()) + (model.fx_estimated ? 1 : 0) + (model.k1_estimated ? 1 : 0);
+    with_parameters_ = model.covariance.size() > 0 && model.covariance.rows() == n && model.covariance.cols() == n;
+    num_theta_ = with_parameters_ ? n : 0;
+  }
+  bool with_parameters() const { return with_parameters_; }
+  int num_theta() const { return num_theta_; }
+
+  PoseFrames Frames(const Eigen::VectorXd& q) const {
+    PoseFrames f;
+    f.cam_from_base = BaseFromCam(model_.robot, model_.rho, q).Inverse();
+    if (!with_parameters_) return f;
+    for (int index : model_.free_indices) {
+      Eigen::VectorXd rho = model_.rho;
+      rho[index] += kStepRho;
+      f.plus.push_back(BaseFromCam(model_.robot, rho, q).Inverse());
+      rho[index] -= 2 * kStepRho;
+      f.minus.push_back(BaseFromCam(model_.robot, rho, q).Inverse());
+    }
+    return f;
+  }
+
+  // The pixel of p_in_base, d(pixel)/d(p) and d(pixel)/d(theta); false when behind the camera at any step.
+  bool Project(const PoseFrames& f, const Eigen::Vector3d& p, Eigen::Vector2d* uv, Matrix23* jd,
+               Eigen::MatrixXd* jt) const {
+    const double fx = model_.camera.fx_px, k1 = model_.camera.k1;
+    if (!Pixel(f.cam_from_base, fx, k1, p, uv)) return false;
+    Eigen::Vector2d a, b;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d h = Eigen::Vector3d::Unit(k) * kStepDot;
+      if (!Pixel(f.cam_from_base, fx, k1, p + h, &a) || !Pixel(f.cam_from_base, fx, k1, p - h, &b)) return false;
+      jd->col(k) = (a - b) / (2 * kStepDot);
+    }
+    jt->resize(2, num_theta_);
+    if (!with_parameters_) return true;
+    int column = 0;
+    for (size_t k = 0; k < f.plus.size(); ++k, ++column) {
+      if (!Pixel(f.plus[k], fx, k1, p, &a) || !Pixel(f.minus[k], fx, k1, p, &b)) return false;
+      jt->col(column) = (a - b) / (2 * kStepRho);
+    }
+    if (model_.fx_estimated) {
+      if (!Pixel(f.cam_from_base, fx + kStepFx, k1, p, &a) || !Pixel(f.cam_from_base, fx - kStepFx, k1, p, &b)) return false;
+      jt->col(column++) = (a - b) / (2 * kStepFx);
+    }
+    if (model_.k1_estimated) {
+      if (!Pixel(f.cam_from_base, fx, k1 + kStepK1, p, &a) || !Pixel(f.cam_from_base, fx, k1 - kStepK1, p, &b)) return false;
+      jt->col(column++) = (a - b) / (2 * kStepK1);
+    }
+    return true;
+  }
+
+ private:
+  bool Pixel(const Rigid3& cam_from_base, double fx, double k1, const Eigen::Vector3d& p, Eigen::Vector2d* uv) const {
+    return ProjectPoint<double>(model_.camera, fx, k1, cam_from_base * p, &uv->x(), &uv->y());
+  }
+
+  const PredictionModel& model_;
+  bool with_parameters_ = false;
+  int num_theta_ = 0;
+};
+
+// What the identification images say about one dot: H_dd and H_dtheta (sigma = 1), and from them the
+// square root of H_dd^-1 and K = H_dd^-1 H_dtheta.
+struct DotInformation {
+  Eigen::Matrix3d hdd = Eigen::Matrix3d::Zero();
+  Eigen::MatrixXd hdt;
+  int views = 0;
+  bool usable = false;
+  Eigen::Matrix3d sqrt_inverse = Eigen::Matrix3d::Zero();
+  Eigen::MatrixXd k;
+  int column = -1;  // of its block in U
+};
+
+std::map<int, DotInformation> IdentificationInformation(const ObservationSet& obs, const Projector& projector,
+                                                        const std::map<int, Eigen::Vector3d>& dots,
+                                                        const ExcludedObservations& excluded) {
+  std::map<int, DotInformation> info;
+  for (const auto& [id, p] : dots) info[id].hdt = Eigen::MatrixXd::Zero(3, projector.num_theta());
+  for (int i : obs.PosesWithRole(PoseRole::kIdentification)) {
+    const PoseObservation& pose = obs.poses[i];
+    const PoseFrames frames = projector.Frames(pose.joints_rad);
+    for (const auto& [id, pixel] : pose.dots_px) {
+      const auto dot = dots.find(id);
+      if (dot == dots.end() || excluded.count({pose.id, id}) > 0) continue;
+      Eigen::Vector2d uv;
+      Matrix23 jd;
+      Eigen::MatrixXd jt;
+      if (!projector.Project(frames, dot->second, &uv, &jd, &jt)) continue;
+      DotInformation& d = info[id];
+      d.hdd += jd.transpose() * jd;
+      d.hdt += jd.transpose() * jt;
+      ++d.views;
+    }
+  }
+  for (auto& [id, d] : info) {
+    if (d.views < 2) continue;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(d.hdd);
+    if (eigen.info() != Eigen::Success || !(eigen.eigenvalues().minCoeff() > 1e-12 * eigen.eigenvalues().maxCoeff())) continue;
+    d.usable = true;
+    d.sqrt_inverse = eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().cwiseSqrt().asDiagonal();
+    d.k = eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().asDiagonal() * eigen.eigenvectors().transpose() * d.hdt;
+  }
+  return info;
+}
+
+// One verification residual: detection - prediction, and its row pair of U (C = sigma^2 (I + U U^T)).
+struct Residual {
+  int slot = -1;  // index into HeldOutReprojection::poses
+  Eigen::Vector2d r = Eigen::Vector2d::Zero();
+};
+
+// r^T C^-1 r over the given residuals, C = sigma^2 I + U U^T (U in px), by the Woodbury identity.
+double ChiSquareOf(const std::vector<int>& rows, const std::vector<Residual>& residuals, const Eigen::MatrixXd& u,
+                   double sigma) {
+  const int n = static_cast<int>(rows.size());
+  Eigen::VectorXd r(2 * n);
+  Eigen::MatrixXd us(2 * n, u.cols());
+  for (int k = 0; k < n; ++k) {
+    r.segment<2>(2 * k) = residuals[rows[k]].r;
+    us.middleRows<2>(2 * k) = u.middleRows<2>(2 * rows[k]);
+  }
+  Eigen::MatrixXd m = us.transpose() * us;
+  m.diagonal().array() += sigma * sigma;
+  const Eigen::VectorXd b = us.transpose() * r;
+  return (r.squaredNorm() - b.dot(m.ldlt().solve(b))) / (sigma * sigma);
+}
+
+HeldOutFigure FigureOf(const std::string& pose_id, const std::vector<int>& rows, const std::vector<Residual>& residuals,
+                       const Eigen::MatrixXd& u, double sigma, int noise_dof) {
+  HeldOutFigure f;
+  f.pose_id = pose_id;
+  f.noise_dof = noise_dof;
+  f.num_residuals = static_cast<int>(rows.size());
+  f.dof = 2 * f.num_residuals;
+  if (rows.empty()) return f;
+  double sum2 = 0, worst = 0;
+  for (int k : rows) {
+    sum2 += residuals[k].r.squaredNorm();
+    worst = std::max(worst, residuals[k].r.norm());
+  }
+  f.rms_px = std::sqrt(sum2 / f.dof);
+  f.max_px = worst;
+  f.chi_square = ChiSquareOf(rows, residuals, u, sigma);
+  f.chi_square_limit = ChiSquareQuantile(0.99, f.dof, noise_dof);
+  f.p_value = ChiSquareUpperTail(f.chi_square, f.dof, noise_dof);
+  f.test_passed = f.chi_square <= f.chi_square_limit;
+  return f;
+}
+
+// The square root of the parameters' covariance (Sigma = L L^T; semi-definite allowed).
+Eigen::MatrixXd CovarianceRoot(const Eigen::MatrixXd& covariance) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(0.5 * (covariance + covariance.transpose()));
+  return eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+}
+
+}  // namespace
+
+HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const PredictionModel& model,
+                                          const std::map<int, Eigen::Vector3d>& dots_in_base,
+                                          const ExcludedObservations& excluded, double noise_px, int noise_dof) {
+  HeldOutReprojection report;
+  report.noise_px = noise_px;
+  if (!(noise_px > 0) || !std::isfinite(noise_px)) {
+    report.message = "no pixel noise to normalise with";
+    return report;
+  }
+  const Projector projector(model);
+  report.prediction_uncertainty = projector.with_parameters();
+  std::map<int, DotInformation> info = IdentificationInformation(obs, projector, dots_in_base, excluded);
+  const int nt = projector.num_theta();
+  const Eigen::MatrixXd theta_root = nt > 0 ? CovarianceRoot(model.covariance) : Eigen::MatrixXd();
+  int columns = nt;
+  for (auto& [id, d] : info) {
+    if (d.usable) d.column = (columns += 3) - 3;
+  }
+  std::vector<Residual> residuals;
+  std::vector<Eigen::MatrixXd> rows_of_u;  // one 2 x columns block per residual
+  std::vector<std::vector<int>> rows_of_pose;
+  for (int v : obs.PosesWithRole(PoseRole::kVerification)) {
+    const PoseObservation& pose = obs.poses[v];
+    const PoseFrames frames = projector.Frames(pose.joints_rad);
+    std::vector<int> rows;
+    for (const auto& [id, pixel] : pose.dots_px) {
+      const auto d = info.find(id);
+      Eigen::Vector2d uv;
+      Matrix23 jd;
+      Eigen::MatrixXd jt;
+      if (d == info.end() || !d->second.usable || !projector.Project(frames, dots_in_base.at(id), &uv, &jd, &jt)) {
+        ++report.num_not_predicted;
+        continue;
+      }
+      Eigen::MatrixXd block = Eigen::MatrixXd::Zero(2, columns);
+      if (nt > 0) block.leftCols(nt) = (jt - jd * d->second.k) * theta_root;
+      block.middleCols<3>(d->second.column) = jd * d->second.sqrt_inverse * noise_px;
+      rows.push_back(static_cast<int>(residuals.size()));
+      residuals.push_back({static_cast<int>(rows_of_pose.size()), pixel - uv});
+      rows_of_u.push_back(std::move(block));
+    }
+    if (!rows.empty()) {
+      report.poses.push_back({pose.id});
+      rows_of_pose.push_back(std::move(rows));
+    }
+  }
+  if (residuals.empty()) {
+    report.message = "no verification image sees a dot that the identification images place";
+    return report;
+  }
+  Eigen::MatrixXd u(2 * residuals.size(), columns);
+  for (size_t k = 0; k < residuals.size(); ++k) u.middleRows<2>(2 * k) = rows_of_u[k];
+  std::vector<int> all(residuals.size());
+  for (size_t k = 0; k < all.size(); ++k) all[k] = static_cast<int>(k);
+  for (size_t s = 0; s < report.poses.size(); ++s) {
+    report.poses[s] = FigureOf(report.poses[s].pose_id, rows_of_pose[s], residuals, u, noise_px, noise_dof);
+  }
+  report.overall = FigureOf("", all, residuals, u, noise_px, noise_dof);
+  report.ok = true;
+  return report;
+}
+
+HeldOutFigure Renormalised(const HeldOutFigure& figure, double from_noise_px, double to_noise_px) {
+  HeldOutFigure f = figure;
+  if (f.dof == 0) return f;
+  f.chi_square = figure.chi_square * (from_noise_px * from_noise_px) / (to_noise_px * to_noise_px);
+  f.noise_dof = 0;
+  f.chi_square_limit = ChiSquareQuantile(0.99, f.dof);
+  f.p_value = ChiSquareUpperTail(f.chi_square, f.dof);
+  f.test_passed = f.chi_square <= f.chi_square_limit;
+  return f;
+}
+
+std::map<int, Eigen::Vector3d> TriangulateIdentificationDots(const ObservationSet& obs, const PredictionModel& model) {
+  std::map<int, identification::PointTrack> tracks;
+  for (int i : obs.PosesWithRole(PoseRole::kIdentification)) {
+    const PoseObservation& pose = obs.poses[i];
+    const Rigid3 base_from_cam = BaseFromCam(model.robot, model.rho, pose.joints_rad);
+    for (const auto& [id, pixel] : pose.dots_px) {
+      tracks[id].base_from_cam.push_back(base_from_cam);
+      tracks[id].pixels.push_back(pixel);
+    }
+  }
+  std::map<int, Eigen::Vector3d> dots;
+  for (const auto& [id, track] : tracks) {
+    if (track.pixels.size() < 2) continue;
+    const identification::TriangulationResult t =
+        identification::TriangulatePoint(model.camera, model.camera.fx_px, track, 1.0);
+    if (t.ok) dots[id] = t.point;
+  }
+  return dots;
+}
+
+namespace {
+
+// P(F > f) for F ~ F(d1, d2) (d2 = 0: infinite, i.e. chi-square(d1) / d1), Paulson's approximation:
+// z = ((1 - b) f^(1/3) - (1 - a)) / sqrt(b f^(2/3) + a), a = 2 / (9 d1), b = 2 / (9 d2), standard normal.
+double FUpperTail(double f, int d1, int d2) {
+  const double a = 2.0 / (9.0 * d1), b = d2 > 0 ? 2.0 / (9.0 * d2) : 0.0;
+  const double c = std::cbrt(f);
+  const double z = ((1 - b) * c - (1 - a)) / std::sqrt(b * c * c + a);
+  return 0.5 * std::erfc(z / std::sqrt(2.0));
+}
+
+}  // namespace
+
+double ChiSquareQuantile(double p, int dof, int noise_dof) {
+  if (dof <= 0 || noise_dof < 0 || !(p > 0 && p < 1)) return NAN;
+  // Bisection on the decreasing upper tail, in f = x / dof.
+  double lo = 0, hi = 1;
+  while (FUpperTail(hi, dof, noise_dof) > 1 - p && hi < 1e12) hi *= 2;
+  for (int iteration = 0; iteration < 200 && hi - lo > 1e-13 * hi; ++iteration) {
+    const double mid = 0.5 * (lo + hi);
+    (FUpperTail(mid, dof, noise_dof) > 1 - p ? lo : hi) = mid;
+  }
+  return dof * 0.5 * (lo + hi);
+}
+
+double ChiSquareUpperTail(double x, int dof, int noise_dof) {
+  if (dof <= 0 || noise_dof < 0 || !std::isfinite(x)) return NAN;
+  if (x <= 0) return 1.0;
+  return FUpperTail(x / dof, dof, noise_dof);
+}
+
+}  // namespace selfcal::calibration

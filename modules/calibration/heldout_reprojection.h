@@ -1,0 +1,111 @@
+// Held-out reprojection (issue 14, item 1): a verification that needs nothing but the images.
+//
+// The dots are placed from the identification images alone (for the calibrated model: as the bundle
+// adjustment estimated them; for the nominal model: triangulated with it, a structure-only solve), then
+// projected into every verification image with the same model and compared with the detections there.
+// The verification images entered no solve, so their residuals test the model's predictions.
+//
+// Test. Each residual r (2 px) is normalised by the covariance of (detection - prediction):
+//
+//   C = sigma^2 I  +  J_d H_dd^-1 J_d^T  +  G Sigma G^T,      G = J_theta - J_d H_dd^-1 H_dtheta
+//
+// sigma^2 I: the detection noise of the verification image; J_d H_dd^-1 J_d^T: the dot's position error
+// given the parameters (H_dd = sum over its identification views of J^T J / sigma^2, the same dot seen in
+// several verification images correlates them); G Sigma G^T: the parameters' error (Sigma: the bundle's
+// covariance of the free parameters, f_x, k1, dots marginalised) including the dot's correlated response
+// to it (H_dtheta: the identification views' cross term). This is the bundle's own joint covariance of
+// (dots, parameters), to first order, except that the yardstick's coupling of its two dots is left out
+// (those two dots' positions are taken as slightly less certain than they are). For the nominal model the
+// parameters are taken as exact (no Sigma). The statistic is r^T C^-1 r over the residuals of a pose
+// (per pose) or of all of them (overall), with all correlations, computed by the Woodbury identity; for a
+// correct model and a known noise it is chi-square with 2 degrees of freedom per predicted dot; with the
+// noise estimated from the identification residuals (noise_dof of them), statistic / dof is
+// F(dof, noise_dof) instead (the estimate's own scatter, ~3 % in variance for 2000 residuals, would
+// otherwise fail a correct model far more often than 1 %). The test passes when the statistic is at or
+// below its 99 % quantile: Wilson-Hilferty for chi-square (relative error of the quantile below 1e-3 for 4
+// or more degrees of freedom), Paulson's cube-root approximation for F (which is Wilson-Hilferty's when
+// noise_dof is infinite).
+//
+// Jacobians: central differences of the projection (steps 1e-6 m or rad for rho and the dots, 1e-3 px for
+// f_x, 1e-6 for k1). Frames and units as in bundle/bundle_adjustment.h; pixels in px.
+#pragma once
+
+#include <cmath>
+#include <map>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "camera/camera.h"
+#include "kinematics/robot_model.h"
+#include "observations/observation_set.h"
+
+namespace selfcal::calibration {
+
+// The model whose predictions are checked.
+struct PredictionModel {
+  RobotModel robot;           // the rho below is on this model
+  Eigen::VectorXd rho;
+  CameraIntrinsics camera;    // f_x and k1 as the model has them
+  // The covariance of the estimated entries in the order free_indices, then f_x (when fx_estimated), then
+  // k1 (when k1_estimated); empty: the model is taken as exact.
+  std::vector<int> free_indices;
+  bool fx_estimated = false, k1_estimated = false;
+  Eigen::MatrixXd covariance;
+};
+
+// One verification pose, or all of them.
+struct HeldOutFigure {
+  std::string pose_id;        // empty for the overall figure
+  int num_residuals = 0;      // predicted dots (2 coordinates each)
+  int dof = 0;                // 2 per predicted dot
+  double rms_px = NAN;        // RMS of (detection - prediction) per coordinate
+  double max_px = NAN;        // largest 2-D error
+  double chi_square = NAN;    // r^T C^-1 r
+  int noise_dof = 0;          // the noise's degrees of freedom when it was estimated, 0 when taken as known
+  double chi_square_limit = NAN;  // 99 % quantile of the statistic (chi-square, or dof F(dof, noise_dof))
+  double p_value = NAN;       // probability of a larger statistic with a correct model
+  bool test_passed = false;   // chi_square <= chi_square_limit
+};
+
+struct HeldOutReprojection {
+  bool ok = false;            // at least one residual
+  std::string message;        // why not, in words
+  double noise_px = NAN;      // the sigma of the normalisation
+  std::string noise_source;   // where it came from, in words
+  bool prediction_uncertainty = false;  // the parameters' covariance is in C (the dots' always is)
+  int num_not_predicted = 0;  // detections of dots that the identification images do not place
+  std::vector<HeldOutFigure> poses;   // verification poses in file order (those with a residual)
+  HeldOutFigure overall;
+};
+
+// The identification observations (pose id, dot id) that a solve left out, e.g. by its screen.
+using ExcludedObservations = std::set<std::pair<std::string, int>>;
+
+// The held-out figures of `model` with the dots `dots_in_base` (in the base frame of model.robot),
+// normalised with `noise_px` (estimated from noise_dof residual degrees of freedom, or 0: taken as known).
+// Dots seen in fewer than two kept identification views are not predicted.
+HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& observations, const PredictionModel& model,
+                                          const std::map<int, Eigen::Vector3d>& dots_in_base,
+                                          const ExcludedObservations& excluded, double noise_px, int noise_dof);
+
+// The same figure normalised with another noise: every term of C is proportional to sigma^2 (the
+// parameters' covariance too, as the bundle scales it by its residual variance), so the statistic scales
+// by (from / to)^2; the new noise is taken as known.
+HeldOutFigure Renormalised(const HeldOutFigure& figure, double from_noise_px, double to_noise_px);
+
+// The dots triangulated from the identification images with a model taken as exact (every dot seen in
+// at least two of them; those not triangulable are left out).
+std::map<int, Eigen::Vector3d> TriangulateIdentificationDots(const ObservationSet& observations,
+                                                             const PredictionModel& model);
+
+// The distribution of the statistic X with `dof` degrees of freedom: chi-square (noise_dof = 0,
+// Wilson-Hilferty) or dof F(dof, noise_dof) (Paulson): the quantile at probability p (0 < p < 1), and the
+// upper tail P(X > x).
+double ChiSquareQuantile(double p, int dof, int noise_dof = 0);
+double ChiSquareUpperTail(double x, int dof, int noise_dof = 0);
+
+}  // namespace selfcal::calibration
