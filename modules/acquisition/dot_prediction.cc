@@ -5,6 +5,8 @@
 
 #include <Eigen/Dense>
 
+#include "tracking/planar_fit.h"
+
 namespace selfcal::acquisition {
 namespace {
 
@@ -26,10 +28,7 @@ Ray RayOf(const PredictionModel& m, const Rigid3& base_from_cam, const Eigen::Ve
 
 // A pixel through a correction (the identity when none was fitted).
 Eigen::Vector2d MapPixel(const tracking::PredictionCorrection& c, const Eigen::Vector2d& uv) {
-  if (!c.ok) return uv;
-  tracking::PredictedDot d;
-  d.uv_px = uv;
-  return c.Apply(d).uv_px;
+  return c.ok ? tracking::MapPoint(c.observed_from_predicted, uv) : uv;
 }
 
 // Lateral std (m) of a ray at distance z from its camera: the pixel noise and the nominal model's own
@@ -140,6 +139,19 @@ std::map<int, Point> TriangulateAll(const PredictionModel& model, double ray_mod
   return points;
 }
 
+// The rays of every sample's dots, each sample's pixels through its correction.
+RaysById SampleRays(const PredictionModel& model, const std::vector<ViewedSample>& samples,
+                    const std::vector<Rigid3>& base_from_cams,
+                    const std::vector<tracking::PredictionCorrection>& corrections) {
+  RaysById rays;
+  for (size_t s = 0; s < samples.size(); ++s) {
+    for (const auto& [id, uv] : samples[s].dots_px) {
+      rays[id].push_back({static_cast<int>(s), RayOf(model, base_from_cams[s], MapPixel(corrections[s], uv))});
+    }
+  }
+  return rays;
+}
+
 // Each sample's pixels mapped onto its nominal camera: the nominal model puts every sample's camera a
 // little off, by an amount that differs from pose to pose, so rays from distant poses miss each other
 // and a point triangulated from them is off in a way no correction of the new frame can remove. For
@@ -152,12 +164,7 @@ std::vector<tracking::PredictionCorrection> SampleCorrections(const PredictionMo
                                                               const DotPredictionOptions& options) {
   std::vector<tracking::PredictionCorrection> corrections(samples.size());
   for (int round = 0; round < options.sample_correction_rounds && samples.size() > 2; ++round) {
-    RaysById rays;
-    for (size_t s = 0; s < samples.size(); ++s) {
-      for (const auto& [id, uv] : samples[s].dots_px) {
-        rays[id].push_back({static_cast<int>(s), RayOf(model, base_from_cams[s], MapPixel(corrections[s], uv))});
-      }
-    }
+    const RaysById rays = SampleRays(model, samples, base_from_cams, corrections);
     const std::map<int, Point> points = TriangulateAll(model, options.ray_model_sigma_px, rays, false);
     for (size_t s = 1; s < samples.size(); ++s) {
       const Rigid3 cam_from_base = base_from_cams[s].Inverse();
@@ -185,16 +192,11 @@ DotPredictionReport PredictDots(const PredictionModel& model, const std::vector<
                                 const Eigen::VectorXd& joints_rad, const std::map<int, Eigen::Vector2d>& current_px,
                                 const DotPredictionOptions& options) {
   const Eigen::VectorXd rho = KinematicParameters::Nominal(model.robot);
-  RaysById rays;
   std::vector<Rigid3> base_from_cams;  // of every sample, once
   for (size_t s = 0; s < samples.size(); ++s) base_from_cams.push_back(BaseFromCam(model.robot, rho, samples[s].joints_rad));
   const std::vector<tracking::PredictionCorrection> corrections =
       SampleCorrections(model, samples, base_from_cams, options);
-  for (size_t s = 0; s < samples.size(); ++s) {
-    for (const auto& [id, uv] : samples[s].dots_px) {
-      rays[id].push_back({static_cast<int>(s), RayOf(model, base_from_cams[s], MapPixel(corrections[s], uv))});
-    }
-  }
+  const RaysById rays = SampleRays(model, samples, base_from_cams, corrections);
   const Rigid3 base_from_cam_now = BaseFromCam(model.robot, rho, joints_rad);
   RaysById with_current = rays;
   for (const auto& [id, uv] : current_px) {
