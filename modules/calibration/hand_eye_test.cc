@@ -87,6 +87,32 @@ TEST(HandEye, BundleRecoversTheHandEyeTransformWithinItsSigmas) {
   EXPECT_TRUE(report.bundle->heldout.ok) << report.bundle->heldout.message;
 }
 
+// The images' own camera motions agree with the flange motions to the noise; a flange pose logged 3 deg
+// off shows in exactly the pairs that involve it.
+TEST(HandEye, ImageMotionsAgreeWithTheFlangeAndCatchAWrongFlangePose) {
+  FlangeWorld w = MakeFlangeWorld(0.2);
+  const CalibrationReport good = Calibrate(w.observations, CalibrateOptions());
+  ASSERT_TRUE(good.motion_check.has_value());
+  ASSERT_TRUE(good.motion_check->ok) << good.motion_check->message;
+  EXPECT_EQ(good.motion_check->pairs_over_2deg, 0) << good.motion_check->message;
+  EXPECT_LT(good.motion_check->p90_error_rad, 0.05 * kPi / 180) << good.motion_check->message;
+  PoseObservation& bad_pose = w.observations.poses[4];
+  bad_pose.base_from_flange->rotation =
+      bad_pose.base_from_flange->rotation * ExpSO3<double>(Eigen::Vector3d(0, 3.0 * kPi / 180, 0));
+  const CalibrationReport bad = Calibrate(w.observations, CalibrateOptions());
+  ASSERT_TRUE(bad.motion_check.has_value() && bad.motion_check->ok);
+  int involving = 0, over = 0;
+  for (const MotionPair& p : bad.motion_check->pairs) {
+    const bool with_bad = p.pose_a == bad_pose.id || p.pose_b == bad_pose.id;
+    involving += with_bad ? 1 : 0;
+    if (p.error_rad > 1.0 * kPi / 180) {
+      ++over;
+      EXPECT_TRUE(with_bad) << p.pose_a << "-" << p.pose_b << " " << p.error_rad;
+    }
+  }
+  EXPECT_GT(over, involving / 2) << bad.motion_check->message;
+}
+
 // The paper's method needs joints: refused by name, not run on flange poses.
 TEST(HandEye, PaperMethodRefusesFlangePoses) {
   const FlangeWorld w = MakeFlangeWorld(0.2);
