@@ -255,6 +255,13 @@ json HandEyeJson(const calibration::CalibrationReport& report) {
                 {"rotation_residual_rms_rad", start.rotation_rms_rad},
                 {"fx_px", start.fx_px},
                 {"fx_from_images", start.fx_from_images}};
+  if (start.ok) {
+    const Eigen::Vector3d w = LogSO3(start.flange_from_cam.rotation);
+    const Eigen::Vector3d& t = start.flange_from_cam.translation;
+    j["start"]["flange_from_cam"] = {{"xyz_m", {t.x(), t.y(), t.z()}}, {"rotvec_rad", {w.x(), w.y(), w.z()}}};
+  } else {
+    j["start"]["flange_from_cam"] = json();
+  }
   j["image_motions"] = json();
   if (report.motion_check) {
     const calibration::MotionCheck& m = *report.motion_check;
