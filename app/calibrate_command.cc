@@ -94,6 +94,10 @@ Status WriteHandEye(const LoadedInput& loaded, const calibration::CalibrationRep
     for (int k = 0; k < 6; ++k) result.stddev[k] = b.stddev.size() > cam + k ? b.stddev[cam + k] : NAN;
     result.fx_stddev_px = b.fx_stddev;
   }
+  if (report.pose_noise && report.pose_noise->ok) {
+    result.stddev = report.pose_noise->stddev;
+    result.fx_stddev_px = report.pose_noise->fx_stddev;
+  }
   result.source = "selfcal calibrate " + loaded.input.path;
   result.provenance = {{"software_version", SELFCAL_VERSION},
                        {"input_sha256", loaded.input.sha256},

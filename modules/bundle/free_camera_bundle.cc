@@ -7,6 +7,7 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
+#include "bundle/small_solve.h"
 #include "camera/camera.h"
 
 namespace selfcal::bundle {
@@ -131,28 +132,16 @@ FreeCameraReport RunFreeCameraBundle(const ObservationSet& obs, const std::vecto
                                  new CentreDistance(centre_distance, 1e-6 * std::max(centre_distance, 1e-3))),
                              nullptr, cams[0].data(), cams[1].data());
     problem.SetParameterBlockConstant(cams[0].data());
-    if (!options.estimate_fx) problem.SetParameterBlockConstant(&fx);
-    if (!options.estimate_k1) problem.SetParameterBlockConstant(&k1);
-    ceres::Solver::Options solver;
-    solver.linear_solver_type = ceres::SPARSE_SCHUR;
-    solver.num_threads = 1;
-    solver.max_num_iterations = options.max_iterations;
-    solver.logging_type = ceres::SILENT;
-    ceres::Solve(solver, &problem, &summary);
-    if (summary.termination_type == ceres::FAILURE || summary.termination_type == ceres::USER_FAILURE) {
-      report.message = "solver failed: " + summary.message;
-      return report;
-    }
+    summary = internal::SolveWithIntrinsics(&problem, &fx, &k1, options.estimate_fx, options.estimate_k1,
+                                            options.max_iterations);
+    if (internal::SolverFailed(summary, &report.message)) return report;
     // Screen against the robust solution: |r| beyond screen_sigma robust sigmas (never below the noise).
-    std::vector<double> errors, finite;
+    std::vector<double> errors;
     for (const Obs& o : all) {
       errors.push_back(dots.count(o.dot) ? ErrorPx(obs.camera, cams[o.camera], dots[o.dot], fx, k1, o.pixel) : NAN);
-      if (std::isfinite(errors.back())) finite.push_back(errors.back());
     }
-    if (finite.empty()) break;
-    std::nth_element(finite.begin(), finite.begin() + finite.size() / 2, finite.end());
-    const double robust = finite[finite.size() / 2] / std::sqrt(2.0 * std::log(2.0));
-    const double limit = options.screen_sigma * std::max(sigma, robust);
+    const double limit = internal::ScreenLimit(errors, sigma, options.screen_sigma);
+    if (!std::isfinite(limit)) break;
     if (round == 0) {
       for (size_t k = 0; k < all.size(); ++k) keep[k] = errors[k] <= limit;
     } else {

@@ -124,6 +124,19 @@ CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateO
                                             report.bundle->bundle.dots_in_base, report.bundle->bundle.fx_px,
                                             report.bundle->bundle.k1, check_options);
   }
+  if (flange_poses && report.bundle && observations.flange_translation_sigma_m > 0 &&
+      !report.bundle->bundle.dots_in_base.empty()) {
+    bundle::PoseNoiseOptions noise;
+    noise.translation_sigma_m = observations.flange_translation_sigma_m;
+    noise.rotation_sigma_rad = observations.flange_rotation_sigma_rad;
+    noise.estimate_fx = report.bundle->bundle.fx_estimated;
+    noise.estimate_k1 = report.bundle->bundle.k1_estimated;
+    ObservationSet with_k1 = obs;
+    with_k1.camera.k1 = report.bundle->bundle.k1;
+    report.pose_noise = bundle::RunPoseNoiseBundle(with_k1, report.bundle->calibrated_robot.flange_from_cam,
+                                                   report.bundle->bundle.dots_in_base, report.bundle->bundle.fx_px,
+                                                   report.bundle->bundle.k1, noise);
+  }
   if (!report.accepted()) return report;  // K4: no model for a result that is not to be applied
   CalibratedModel model;
   if (report.bundle) {
@@ -136,6 +149,11 @@ CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateO
     model.robot = report.paper.calibrated_robot;
     model.fx_px = report.paper.fx_px;
     model.method_description = "paper pipeline";
+  }
+  if (report.pose_noise && report.pose_noise->ok) {
+    model.robot.flange_from_cam = report.pose_noise->flange_from_cam;
+    model.fx_px = report.pose_noise->fx_px;
+    model.method_description += ", flange poses with their stated noise";
   }
   report.model = std::move(model);
   return report;

@@ -22,6 +22,7 @@
 
 #include "calibration/bundle_stage.h"
 #include "calibration/hand_eye_start.h"
+#include "bundle/pose_noise_bundle.h"
 #include "calibration/motion_check.h"
 #include "calibration/paper_pipeline.h"
 #include "kinematics/robot_model.h"
@@ -75,6 +76,10 @@ struct CalibrationReport {
   std::optional<HandEyeStartReport> hand_eye_start;
   // A flange-pose set whose bundle converged: the images' own camera motions against the flange motions.
   std::optional<MotionCheck> motion_check;
+  // A flange-pose set with a stated pose noise: the hand-eye bundle with a corrected flange pose per
+  // image (bundle/pose_noise_bundle.h), started from the exact-pose bundle; its hand-eye transform and
+  // f_x are the model's when it converged.
+  std::optional<bundle::PoseNoiseReport> pose_noise;
   std::optional<BundleStageReport> bundle;  // when method == kBundle
   std::optional<CalibratedModel> model;    // the chosen method's model, only when accepted
 

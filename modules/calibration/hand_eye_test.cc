@@ -2,6 +2,7 @@
 // simulator's hidden truth (the flange poses are the true arm's, the camera's true pose per image known).
 #include <cmath>
 #include <cstdint>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -141,6 +142,32 @@ TEST(HandEye, FlatSheetIsSolvedAtTheBoundOfItsBundleAdjustment) {
     EXPECT_GT(rms_z, 0.50) << k;
     EXPECT_LT(rms_z, 1.54) << k;
   }
+}
+
+// Flange poses logged with 1 mm / 0.05 deg of noise: stating that noise, the hand-eye transform is within
+// 4 of its sigmas of the truth, and the residuals return to the pixel noise.
+TEST(HandEye, StatedFlangePoseNoiseIsModelled) {
+  FlangeWorld w = MakeFlangeWorld(0.2);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  for (PoseObservation& pose : w.observations.poses) {
+    const double v[6] = {1e-3 * gauss(rng), 1e-3 * gauss(rng), 1e-3 * gauss(rng),
+                         8.7e-4 * gauss(rng), 8.7e-4 * gauss(rng), 8.7e-4 * gauss(rng)};
+    *pose.base_from_flange = *pose.base_from_flange * RigidFromTranslationRotvec(v);
+  }
+  w.observations.flange_translation_sigma_m = 1e-3;
+  w.observations.flange_rotation_sigma_rad = 8.7e-4;
+  const CalibrationReport report = Calibrate(w.observations, CalibrateOptions());
+  ASSERT_TRUE(report.accepted()) << report.message;
+  ASSERT_TRUE(report.pose_noise.has_value() && report.pose_noise->ok) << report.pose_noise->message;
+  EXPECT_LT(report.pose_noise->rms_reprojection_px, 1.5 * 0.2 * std::sqrt(2.0)) << report.pose_noise->message;
+  const Rigid3& x = report.model->robot.flange_from_cam;
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_TRUE(std::isfinite(report.pose_noise->stddev[k]));
+    EXPECT_NEAR(x.translation[k], w.flange_from_cam_true.translation[k], 4 * report.pose_noise->stddev[k]) << k;
+  }
+  const Eigen::Vector3d rotation_error = LogSO3(x.rotation.transpose() * w.flange_from_cam_true.rotation);
+  for (int k = 0; k < 3; ++k) EXPECT_LT(std::abs(rotation_error[k]), 4 * report.pose_noise->stddev[3 + k]) << k;
 }
 
 // The paper's method needs joints: refused by name, not run on flange poses.

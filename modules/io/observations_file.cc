@@ -244,6 +244,11 @@ Result<ObservationSet> ParseObservations(const yaml::YamlDocument& doc) {
                  " is for sets of flange poses; with a robot it belongs in the robot's block");
   } else if (!robot_given) {
     set.flange_from_cam_known = root.Optional("flange_from_cam") != nullptr;
+    if (const yaml::YamlNode* noise = root.Optional("flange_pose_noise")) {
+      MapReader map(*noise, "flange_pose_noise", &problems);
+      map.Quantity("translation", Unit::kLength, Range::Positive(0.1), &set.flange_translation_sigma_m);
+      map.Quantity("rotation", Unit::kAngle, Range::Positive(DegToRad(10)), &set.flange_rotation_sigma_rad);
+    }
     ReadTransform(&root, "flange_from_cam", /*required=*/false, &flange_from_cam);
     set.robot = FlangePoseModel(flange_from_cam);
   }
@@ -307,6 +312,10 @@ Status SaveObservations(const ObservationSet& set, const std::string& path) {
   if (set.UsesFlangePoses()) {
     // Version 1.1 added flange poses; a set of joint angles stays readable by every 1.x reader.
     out << "version: 1.1\n";
+    if (set.flange_translation_sigma_m > 0) {
+      out << "flange_pose_noise: {translation_m: " << YamlNumber(set.flange_translation_sigma_m)
+          << ", rotation_rad: " << YamlNumber(set.flange_rotation_sigma_rad) << "}\n";
+    }
     if (set.flange_from_cam_known) out << "flange_from_cam: " << TransformYaml(set.robot.flange_from_cam, TransformStyle::kExact) << "\n";
   } else {
     out << "version: " << kObservationsVersion << "\n"

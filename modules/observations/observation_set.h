@@ -48,6 +48,9 @@ struct ObservationSet {
   // False for a flange-pose set that gave no nominal hand-eye transform (robot.flange_from_cam is then
   // the identity): the calibration starts it from the images and the flange motions.
   bool flange_from_cam_known = true;
+  // A flange-pose set's stated pose noise (std per axis of the recorded flange poses); 0: exact poses.
+  double flange_translation_sigma_m = 0;
+  double flange_rotation_sigma_rad = 0;
   double pixel_noise_px = 0.5;       // expected std of the centroids, for weights and uncertainty
   std::vector<KnownDistance> yardsticks;
   std::vector<KnownDistance> check_distances;  // held out from the solve: verification only

@@ -280,6 +280,16 @@ json HandEyeJson(const calibration::CalibrationReport& report) {
                           {"pairs_over_2deg", m.pairs_over_2deg},
                           {"pairs", pairs}};
   }
+  j["pose_noise"] = json();
+  if (report.pose_noise) {
+    const bundle::PoseNoiseReport& n = *report.pose_noise;
+    j["pose_noise"] = {{"ok", n.ok},
+                       {"message", n.message},
+                       {"rms_reprojection_px", n.rms_reprojection_px},
+                       {"pose_ids", n.pose_ids},
+                       {"correction_translation_m", n.correction_translation_m},
+                       {"correction_rotation_rad", n.correction_rotation_rad}};
+  }
   j["flange_from_cam"] = json();
   if (report.model) {
     const Rigid3& x = report.model->robot.flange_from_cam;
@@ -292,7 +302,12 @@ json HandEyeJson(const calibration::CalibrationReport& report) {
     calibrated["stddev"] = json();
     const bundle::BundleReport& b = report.bundle->bundle;
     const int cam = KinematicParameters(0).CamOffset();
-    if (b.covariance_available && b.stddev.size() >= cam + 6) {
+    if (report.pose_noise && report.pose_noise->ok && report.pose_noise->stddev.allFinite()) {
+      const Eigen::Matrix<double, 6, 1>& sd = report.pose_noise->stddev;
+      calibrated["stddev"] = {{"xyz_m", {sd[0], sd[1], sd[2]}},
+                              {"rotvec_rad", {sd[3], sd[4], sd[5]}},
+                              {"frame", "camera (of a correction flange_from_cam * Exp(delta))"}};
+    } else if (b.covariance_available && b.stddev.size() >= cam + 6) {
       calibrated["stddev"] = {{"xyz_m", {b.stddev[cam], b.stddev[cam + 1], b.stddev[cam + 2]}},
                               {"rotvec_rad", {b.stddev[cam + 3], b.stddev[cam + 4], b.stddev[cam + 5]}},
                               {"frame", "camera (of a correction flange_from_cam * Exp(delta))"}};

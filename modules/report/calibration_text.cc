@@ -110,16 +110,25 @@ void PrintHandEye(const calibration::CalibrationReport& report, std::ostream& ou
   const Eigen::Vector3d rotvec = LogSO3(x.rotation);
   const bundle::BundleReport& b = report.bundle->bundle;
   const int cam = KinematicParameters(0).CamOffset();
+  Eigen::Matrix<double, 6, 1> sd = Eigen::Matrix<double, 6, 1>::Constant(NAN);
+  if (report.pose_noise && report.pose_noise->ok) {
+    sd = report.pose_noise->stddev;
+  } else if (b.covariance_available && b.stddev.size() >= cam + 6) {
+    sd = b.stddev.segment<6>(cam);
+  }
   out << std::fixed << std::setprecision(3) << "flange_from_cam: translation [" << x.translation.x() * kMm << ", "
       << x.translation.y() * kMm << ", " << x.translation.z() * kMm << "] mm, rotation vector ["
       << RadToDeg(rotvec.x()) << ", " << RadToDeg(rotvec.y()) << ", " << RadToDeg(rotvec.z()) << "] deg";
-  if (b.covariance_available && b.stddev.size() >= cam + 6) {
-    out << "; std " << b.stddev[cam] * kMm << ", " << b.stddev[cam + 1] * kMm << ", " << b.stddev[cam + 2] * kMm
-        << " mm, " << RadToDeg(b.stddev[cam + 3]) << ", " << RadToDeg(b.stddev[cam + 4]) << ", "
-        << RadToDeg(b.stddev[cam + 5]) << " deg (camera frame)";
+  if (sd.allFinite()) {
+    out << "; std " << sd[0] * kMm << ", " << sd[1] * kMm << ", " << sd[2] * kMm << " mm, " << RadToDeg(sd[3]) << ", "
+        << RadToDeg(sd[4]) << ", " << RadToDeg(sd[5]) << " deg (camera frame)";
   }
   out << "\n";
   out.unsetf(std::ios::floatfield);
+  if (report.pose_noise) {
+    out << "with the stated flange pose noise: " << (report.pose_noise->ok ? "" : "not solved: ")
+        << report.pose_noise->message << "\n";
+  }
   if (report.motion_check) {
     out << "camera motions from the images alone against the flange motions: "
         << (report.motion_check->ok ? "" : "not available: ") << report.motion_check->message << "\n";

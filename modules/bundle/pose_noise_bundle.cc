@@ -1,0 +1,167 @@
+#include "bundle/pose_noise_bundle.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <ceres/ceres.h>
+
+#include "bundle/small_solve.h"
+#include "camera/camera.h"
+
+namespace selfcal::bundle {
+
+namespace {
+
+struct Reprojection {
+  Reprojection(const CameraIntrinsics* camera, const Rigid3* base_from_flange, const Rigid3* x0, Eigen::Vector2d pixel,
+               double sigma)
+      : camera(camera), base_from_flange(base_from_flange), x0(x0), pixel(std::move(pixel)), inv_sigma(1.0 / sigma) {}
+  template <typename T>
+  bool operator()(const T* delta, const T* c, const T* dot, const T* fx, const T* k1, T* residual) const {
+    const Rigid3T<T> base_from_cam = base_from_flange->Cast<T>() * RigidFromTranslationRotvec(delta) *
+                                     x0->Cast<T>() * RigidFromTranslationRotvec(c);
+    const Vec3T<T> in_cam = base_from_cam.Inverse() * Vec3T<T>(dot[0], dot[1], dot[2]);
+    T u, v;
+    if (!ProjectPoint<T>(*camera, fx[0], k1[0], in_cam, &u, &v)) return false;
+    residual[0] = (u - T(pixel.x())) * T(inv_sigma);
+    residual[1] = (v - T(pixel.y())) * T(inv_sigma);
+    return true;
+  }
+  const CameraIntrinsics* camera;
+  const Rigid3* base_from_flange;
+  const Rigid3* x0;
+  Eigen::Vector2d pixel;
+  double inv_sigma;
+};
+
+struct PosePrior {
+  PosePrior(double st, double sr) : inv_t(1.0 / st), inv_r(1.0 / sr) {}
+  template <typename T>
+  bool operator()(const T* delta, T* residual) const {
+    for (int k = 0; k < 3; ++k) residual[k] = delta[k] * T(inv_t);
+    for (int k = 3; k < 6; ++k) residual[k] = delta[k] * T(inv_r);
+    return true;
+  }
+  double inv_t, inv_r;
+};
+
+struct Obs {
+  int pose = -1;
+  int dot = -1;
+  Eigen::Vector2d pixel;
+};
+
+}  // namespace
+
+PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
+                                   const std::map<int, Eigen::Vector3d>& dots_start, double fx_start, double k1_start,
+                                   const PoseNoiseOptions& options) {
+  PoseNoiseReport report;
+  if (!obs.UsesFlangePoses() || !(options.translation_sigma_m > 0) || !(options.rotation_sigma_rad > 0)) {
+    report.message = "needs a flange-pose set and a positive pose noise";
+    return report;
+  }
+  const std::vector<int> poses = obs.PosesWithRole(PoseRole::kIdentification);
+  std::vector<Rigid3> flanges;
+  std::vector<Obs> all;
+  std::map<int, int> views;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    const PoseObservation& pose = obs.poses[poses[i]];
+    report.pose_ids.push_back(pose.id);
+    flanges.push_back(*pose.base_from_flange);
+    for (const auto& [id, pixel] : pose.dots_px) {
+      if (!dots_start.count(id)) continue;
+      all.push_back({static_cast<int>(i), id, pixel});
+      ++views[id];
+    }
+  }
+  std::map<int, Eigen::Vector3d> dots;
+  for (const auto& [id, n] : views) {
+    if (n >= 2) dots[id] = dots_start.at(id);
+  }
+  std::vector<std::array<double, 6>> deltas(poses.size(), std::array<double, 6>{0, 0, 0, 0, 0, 0});
+  std::array<double, 6> c{0, 0, 0, 0, 0, 0};
+  double fx = fx_start, k1 = k1_start;
+  const double sigma = obs.pixel_noise_px;
+  ceres::HuberLoss huber(options.huber_px / sigma);
+  std::vector<bool> keep(all.size(), true);
+  ceres::Solver::Summary summary;
+  for (int round = 0; round < 2; ++round) {
+    ceres::Problem problem;
+    for (size_t k = 0; k < all.size(); ++k) {
+      if (!keep[k] || !dots.count(all[k].dot)) continue;
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Reprojection, 2, 6, 6, 3, 1, 1>(new Reprojection(
+                                   &obs.camera, &flanges[all[k].pose], &x0, all[k].pixel, sigma)),
+                               round == 0 ? new ceres::LossFunctionWrapper(&huber, ceres::DO_NOT_TAKE_OWNERSHIP) : nullptr,
+                               deltas[all[k].pose].data(), c.data(), dots[all[k].dot].data(), &fx, &k1);
+    }
+    for (auto& delta : deltas) {
+      if (!problem.HasParameterBlock(delta.data())) continue;
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PosePrior, 6, 6>(
+                                   new PosePrior(options.translation_sigma_m, options.rotation_sigma_rad)),
+                               nullptr, delta.data());
+    }
+    summary = internal::SolveWithIntrinsics(&problem, &fx, &k1, options.estimate_fx, options.estimate_k1,
+                                            options.max_iterations);
+    if (internal::SolverFailed(summary, &report.message)) return report;
+    std::vector<double> errors;
+    for (const Obs& o : all) {
+      double r[2] = {NAN, NAN};
+      if (dots.count(o.dot)) {
+        Reprojection f(&obs.camera, &flanges[o.pose], &x0, o.pixel, 1.0);
+        if (!f(deltas[o.pose].data(), c.data(), dots[o.dot].data(), &fx, &k1, r)) r[0] = NAN;
+      }
+      errors.push_back(std::hypot(r[0], r[1]));
+    }
+    const double limit = internal::ScreenLimit(errors, sigma, options.screen_sigma);
+    if (!std::isfinite(limit)) break;
+    if (round == 0) {
+      for (size_t k = 0; k < all.size(); ++k) keep[k] = errors[k] <= limit;
+      continue;
+    }
+    double sum2 = 0;
+    for (size_t k = 0; k < all.size(); ++k) {
+      if (!keep[k] || !std::isfinite(errors[k])) continue;
+      sum2 += errors[k] * errors[k];
+      ++report.num_observations;
+    }
+    report.rms_reprojection_px = report.num_observations > 0 ? std::sqrt(sum2 / report.num_observations) : 0.0;
+    // Covariance of the hand-eye correction and f_x, scaled by the residual variance.
+    const int unknowns = 6 + (options.estimate_fx ? 1 : 0) + (options.estimate_k1 ? 1 : 0) +
+                         3 * static_cast<int>(dots.size()) + 6 * static_cast<int>(deltas.size());
+    const int residuals = 2 * report.num_observations + 6 * static_cast<int>(deltas.size());
+    const int dof = residuals - unknowns;
+    ceres::Covariance::Options cov_options;
+    cov_options.algorithm_type = ceres::DENSE_SVD;
+    ceres::Covariance covariance(cov_options);
+    std::vector<std::pair<const double*, const double*>> blocks = {{c.data(), c.data()}, {&fx, &fx}};
+    if (dof > 0 && covariance.Compute(blocks, &problem)) {
+      const double s2 = 2.0 * summary.final_cost / dof;
+      double cc[36], ff = 0;
+      covariance.GetCovarianceBlock(c.data(), c.data(), cc);
+      covariance.GetCovarianceBlock(&fx, &fx, &ff);
+      for (int k = 0; k < 6; ++k) report.stddev[k] = std::sqrt(s2 * cc[7 * k]);
+      report.fx_stddev = options.estimate_fx ? std::sqrt(s2 * ff) : NAN;
+    }
+  }
+  report.num_removed = static_cast<int>(std::count(keep.begin(), keep.end(), false));
+  report.flange_from_cam = x0 * RigidFromTranslationRotvec(c.data());
+  report.fx_px = fx;
+  report.k1 = k1;
+  for (const auto& delta : deltas) {
+    report.correction_translation_m.push_back(Eigen::Vector3d(delta[0], delta[1], delta[2]).norm());
+    report.correction_rotation_rad.push_back(Eigen::Vector3d(delta[3], delta[4], delta[5]).norm());
+  }
+  report.ok = summary.termination_type == ceres::CONVERGENCE || summary.termination_type == ceres::NO_CONVERGENCE;
+  const double max_t = *std::max_element(report.correction_translation_m.begin(), report.correction_translation_m.end());
+  const double max_r = *std::max_element(report.correction_rotation_rad.begin(), report.correction_rotation_rad.end());
+  std::ostringstream msg;
+  msg << ceres::TerminationTypeToString(summary.termination_type) << ": " << report.num_observations
+      << " observations, " << report.num_removed << " removed, RMS " << report.rms_reprojection_px
+      << " px; flange pose corrections up to " << max_t * 1e3 << " mm and " << max_r * 180 / kPi << " deg";
+  report.message = msg.str();
+  return report;
+}
+
+}  // namespace selfcal::bundle

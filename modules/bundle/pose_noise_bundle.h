@@ -1,0 +1,53 @@
+// The hand-eye bundle adjustment of a flange-pose set when the controller's flange poses are not exact:
+// each recorded pose gets a correction with a Gaussian prior of the stated noise,
+//
+//   base_from_cam_i = base_from_flange_i * Exp(delta_i) * flange_from_cam,   delta_i ~ N(0, diag(s_t, s_r)),
+//
+// and the hand-eye transform, f_x (k1 when asked), the dots and every delta_i are estimated together
+// (autodiff, Huber while outliers are screened at 4 robust sigmas, then plain least squares). Started
+// from the exact-pose solution (bundle_adjustment.h on the same set). The prior fixes the gauge and the
+// scale: the scene's size comes from the flange translations, weighted by their stated noise.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "geometry/rigid3.h"
+#include "observations/observation_set.h"
+
+namespace selfcal::bundle {
+
+struct PoseNoiseOptions {
+  double translation_sigma_m = 0;  // per axis, of each recorded flange pose
+  double rotation_sigma_rad = 0;   // per axis (rotation vector)
+  bool estimate_fx = true;
+  bool estimate_k1 = false;
+  double huber_px = 2.0;
+  double screen_sigma = 4.0;
+  int max_iterations = 200;
+};
+
+struct PoseNoiseReport {
+  bool ok = false;
+  std::string message;
+  Rigid3 flange_from_cam;
+  double fx_px = 0, k1 = 0;
+  // Standard deviations of a correction flange_from_cam * Exp(c) (translation m, rotation vector rad,
+  // camera frame) and of f_x, scaled by the residual variance; NaN when unavailable.
+  Eigen::Matrix<double, 6, 1> stddev = Eigen::Matrix<double, 6, 1>::Constant(NAN);
+  double fx_stddev = NAN;
+  std::vector<std::string> pose_ids;                  // identification poses, in order
+  std::vector<double> correction_translation_m;       // |delta_i| translation per pose
+  std::vector<double> correction_rotation_rad;        // |delta_i| rotation per pose
+  int num_observations = 0, num_removed = 0;
+  double rms_reprojection_px = 0;
+};
+
+PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& observations, const Rigid3& flange_from_cam_start,
+                                   const std::map<int, Eigen::Vector3d>& dots_start, double fx_start, double k1_start,
+                                   const PoseNoiseOptions& options);
+
+}  // namespace selfcal::bundle

@@ -1,0 +1,48 @@
+// Internal to the bundle module: the solve shared by the free-camera and the pose-noise bundles
+// (autodiff problems with f_x and k1 as single blocks): f_x and k1 held unless estimated, sparse Schur,
+// one thread (deterministic), silent.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <ceres/ceres.h>
+
+namespace selfcal::bundle::internal {
+
+inline ceres::Solver::Summary SolveWithIntrinsics(ceres::Problem* problem, double* fx, double* k1, bool estimate_fx,
+                                                  bool estimate_k1, int max_iterations) {
+  if (!estimate_fx) problem->SetParameterBlockConstant(fx);
+  if (!estimate_k1) problem->SetParameterBlockConstant(k1);
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::SPARSE_SCHUR;
+  solver.num_threads = 1;
+  solver.max_num_iterations = max_iterations;
+  solver.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, problem, &summary);
+  return summary;
+}
+
+// True (and *message says why) when Ceres failed outright.
+inline bool SolverFailed(const ceres::Solver::Summary& summary, std::string* message) {
+  if (summary.termination_type != ceres::FAILURE && summary.termination_type != ceres::USER_FAILURE) return false;
+  *message = "solver failed: " + summary.message;
+  return true;
+}
+
+// The screen's limit on |r| (px): screen_sigma robust sigmas of the finite errors (median of a 2-D
+// Gaussian's norm is sigma sqrt(2 ln 2)), never below the stated noise; NaN when none is finite.
+inline double ScreenLimit(const std::vector<double>& errors, double sigma_px, double screen_sigma) {
+  std::vector<double> finite;
+  for (double e : errors) {
+    if (std::isfinite(e)) finite.push_back(e);
+  }
+  if (finite.empty()) return NAN;
+  std::nth_element(finite.begin(), finite.begin() + finite.size() / 2, finite.end());
+  return screen_sigma * std::max(sigma_px, finite[finite.size() / 2] / std::sqrt(2.0 * std::log(2.0)));
+}
+
+}  // namespace selfcal::bundle::internal
