@@ -1,0 +1,49 @@
+#include <sstream>
+
+#include "detection/detect_points.h"
+
+namespace selfcal::detection {
+
+Result<ObservationSet> BuildObservationSet(const std::vector<std::string>& pose_ids,
+                                           const std::vector<ImagePoints>& points,
+                                           const std::vector<ImageRobotPose>& robot_poses,
+                                           const ObservationSetup& setup) {
+  SELFCAL_CHECK(pose_ids.size() == points.size() && points.size() == robot_poses.size(),
+                "BuildObservationSet: " << pose_ids.size() << " ids, " << points.size() << " point sets, "
+                                        << robot_poses.size() << " robot poses");
+  ObservationSet set;
+  set.robot = setup.robot;
+  set.camera = setup.camera;
+  set.pixel_noise_px = setup.pixel_noise_px;
+  set.yardsticks = setup.yardsticks;
+  std::string failed;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!points[i].ok || points[i].points_px.empty()) {
+      failed += "\n  - " + pose_ids[i] + ": " + (points[i].message.empty() ? "no point found" : points[i].message);
+      continue;
+    }
+    if (robot_poses[i].base_from_flange.has_value()) {
+      return Status::Error(ErrorCode::kInvalidInput,
+                           pose_ids[i] + ": flange poses (base_from_flange) cannot be written to an observations "
+                                         "file by this version; give joint angles in a selfcal-poses list");
+    }
+    PoseObservation pose;
+    pose.id = pose_ids[i];
+    pose.role = PoseRole::kIdentification;
+    pose.joints_rad = robot_poses[i].joints_rad;
+    pose.dots_px = points[i].points_px;
+    set.poses.push_back(std::move(pose));
+  }
+  if (!failed.empty() && !setup.skip_failed) {
+    return Status::Error(ErrorCode::kDegenerateData,
+                         "no points in " + std::to_string(points.size() - set.poses.size()) + " of " +
+                             std::to_string(points.size()) + " images (leave them out with --skip-failed):" + failed);
+  }
+  if (set.poses.empty()) return Status::Error(ErrorCode::kDegenerateData, "no image gave any point:" + failed);
+  if (const std::string problems = set.Validate(); !problems.empty()) {
+    return Status::Error(ErrorCode::kInvalidInput, "the observations are not consistent:\n" + problems);
+  }
+  return set;
+}
+
+}  // namespace selfcal::detection
