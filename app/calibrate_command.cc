@@ -7,11 +7,11 @@
 
 #include "app/cli_util.h"
 #include "app/commands.h"
+#include "io/hand_eye_file.h"
 #include "io/observations_file.h"
 #include "io/report_json.h"
 #include "io/robot_config.h"
 #include "report/calibration_report.h"
-#include "session/session_dir.h"
 #include "session/session_dir.h"
 #include "session/session_observations.h"
 
@@ -83,7 +83,29 @@ Result<LoadedInput> LoadInput(const CalibrateRequest& request) {
   return loaded;
 }
 
-// Writes report.json, and calibrated_model.yaml when the verdict is "accepted" (K4).
+// A flange-pose set's result: the hand-eye transform and f_x with their standard deviations.
+Status WriteHandEye(const LoadedInput& loaded, const calibration::CalibrationReport& report, const std::string& out_dir) {
+  io::HandEyeResult result;
+  result.flange_from_cam = report.model->robot.flange_from_cam;
+  result.fx_px = report.model->fx_px;
+  if (report.bundle) {
+    const bundle::BundleReport& b = report.bundle->bundle;
+    const int cam = KinematicParameters(0).CamOffset();
+    for (int k = 0; k < 6; ++k) result.stddev[k] = b.stddev.size() > cam + k ? b.stddev[cam + k] : NAN;
+    result.fx_stddev_px = b.fx_stddev;
+  }
+  result.source = "selfcal calibrate " + loaded.input.path;
+  result.provenance = {{"software_version", SELFCAL_VERSION},
+                       {"input_sha256", loaded.input.sha256},
+                       {"method", report.model->method_description}};
+  const std::string path = (std::filesystem::path(out_dir) / "hand_eye.yaml").string();
+  if (Status s = io::SaveHandEye(result, path); !s.ok()) return s;
+  std::cout << "hand-eye result: " << path << "\n";
+  return Status::Ok();
+}
+
+// Writes report.json, and calibrated_model.yaml (hand_eye.yaml for flange poses) when the verdict is
+// "accepted" (K4).
 Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationReport& report, ExitCode code,
                     const std::string& out_dir) {
   const std::filesystem::path out(out_dir);
@@ -95,6 +117,7 @@ Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationRep
   }
   std::cout << "report: " << report_path << "\n";
   if (!report.model) return Status::Ok();
+  if (loaded.observations.UsesFlangePoses()) return WriteHandEye(loaded, report, out_dir);
   io::CalibratedModel model;
   model.model = report.model->robot;
   model.fx_px = report.model->fx_px;
@@ -118,6 +141,19 @@ void AddMethodOption(CLI::App* cmd, std::string* method) {
       ->check(CLI::IsMember({"bundle", "paper"}));
 }
 
+void AddParameterMaskOptions(CLI::App* cmd, std::vector<std::string>* fix, std::vector<std::string>* free) {
+  const std::string names =
+      "a parameter (j2.beta, cam.tx), a joint (j3), base, camera (or hand_eye), kinematics (base and every joint), fx, k1";
+  cmd->add_option("--fix", *fix,
+                  "Hold these at their nominal values, comma separated: " + names +
+                      ". --fix kinematics is the hand-eye-only solve (kinematics trusted)")
+      ->delimiter(',');
+  cmd->add_option("--free", *free,
+                  "Estimate only these (everything else held), comma separated, same names; fx and k1 must be named to "
+                  "be estimated")
+      ->delimiter(',');
+}
+
 int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   Result<LoadedInput> loaded = LoadInput(request);
   if (!loaded.ok()) return Fail(loaded.status());
@@ -132,6 +168,8 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   calibration::CalibrateOptions options;
   options.method = request.method;
   options.paper.two_view.seed = request.seed;
+  options.bundle.bundle.held_parameters = request.fix;
+  options.bundle.bundle.free_parameters = request.free;
   calibration::CalibrationReport report = calibration::Calibrate(loaded->observations, options);
   report::PrintCalibrationSummary(report, std::cout);
   const ExitCode code = ExitCodeFor(report.verdict);
@@ -158,6 +196,7 @@ Command AddCalibrateCommand(CLI::App& app) {
   cmd->add_option("--out", request->out_dir, "Output directory (created if missing)");
   cmd->add_option("--seed", request->seed, "Seed of the RANSAC sampling (results are deterministic per seed)");
   AddMethodOption(cmd, method.get());
+  AddParameterMaskOptions(cmd, &request->fix, &request->free);
   return [request, method]() {
     request->method = MethodFromName(*method);
     return CalibrateAndWrite(*request);

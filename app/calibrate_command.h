@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -21,11 +22,15 @@ inline calibration::Method MethodFromName(const std::string& name) {
 // Registers `--method bundle|paper` (default: whatever *method holds, "bundle").
 void AddMethodOption(CLI::App* cmd, std::string* method);
 
+// Registers --fix and --free (comma-separated parameter names and groups).
+void AddParameterMaskOptions(CLI::App* cmd, std::vector<std::string>* fix, std::vector<std::string>* free);
+
 struct CalibrateRequest {
   std::string input;  // observations file or session directory
   std::string out_dir;
   uint64_t seed = 1;  // RANSAC sampling of the two-view step
   calibration::Method method = calibration::Method::kBundle;
+  std::vector<std::string> fix, free;  // parameter names and groups (bundle::BundleOptions::held_parameters)
 };
 
 // What a calibration read and returned, for callers that compare it with a truth (`simulate`).

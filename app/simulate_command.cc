@@ -248,7 +248,7 @@ int SimulateSession(const SimulateArgs& args) {
   const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (run_code != 0) return run_code;
   CalibrationRun calibrated;
-  const int code = CalibrateAndWrite({run.session, args.out, args.seed, MethodFromName(args.method)}, &calibrated);
+  const int code = CalibrateAndWrite({run.session, args.out, args.seed, MethodFromName(args.method), {}, {}}, &calibrated);
   const ObservationSet& obs = calibrated.observations;
   const calibration::CalibrationReport& result = calibrated.report;
   const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -329,7 +329,7 @@ Command AddSimulateCommand(CLI::App& app) {
     if (Status s = io::WriteJsonFile(TruthJson(world), (out / "truth.json").string()); !s.ok()) return Fail(s);
     // Calibrate from the file, as any user's data would be.
     CalibrationRun calibrated;
-    const int code = CalibrateAndWrite({obs_path, args->out, args->seed, MethodFromName(args->method)}, &calibrated);
+    const int code = CalibrateAndWrite({obs_path, args->out, args->seed, MethodFromName(args->method), {}, {}}, &calibrated);
     const calibration::CalibrationReport& result = calibrated.report;
     const ObservationSet* obs = &calibrated.observations;
     nlohmann::json comparison = nlohmann::json::object();

@@ -40,7 +40,7 @@ class PoseCacheSet {
     const int m = static_cast<int>(free_.size());
     if (!e.valid || (derivatives && !e.derivatives) || !std::equal(free_values, free_values + m, e.values.begin())) {
       for (int k = 0; k < m; ++k) rho_[free_[k]] = free_values[k];
-      internal::ComputePoseCache(data_->robot, rho_.data(), data_->joints[pose], free_, derivatives, &e.cache);
+      internal::ComputePoseCache(*data_, pose, rho_.data(), free_, derivatives, &e.cache);
       e.values.assign(free_values, free_values + m);
       e.valid = true;
       e.derivatives = derivatives;
@@ -174,7 +174,7 @@ ceres::Solver::Summary Solve(const BundleData& data, const std::vector<int>& fre
 std::vector<double> ReprojectionErrors(const BundleData& data, const BundleState& state) {
   std::vector<internal::PoseCache> caches(data.joints.size());
   for (size_t p = 0; p < data.joints.size(); ++p) {
-    internal::ComputePoseCache(data.robot, state.rho.data(), data.joints[p], {}, false, &caches[p]);
+    internal::ComputePoseCache(data, static_cast<int>(p), state.rho.data(), {}, false, &caches[p]);
   }
   std::vector<double> errors;
   for (const internal::Observation& o : data.observations) {
@@ -260,7 +260,9 @@ std::vector<int> DotsSeenOnce(const ObservationSet& observations) {
 void TriangulateStartDots(const Eigen::VectorXd& rho_start, double fx_start, BundleData* data, BundleState* state,
                           std::vector<int>* dropped) {
   std::vector<Rigid3> base_from_cam;
-  for (const Eigen::VectorXd& q : data->joints) base_from_cam.push_back(BaseFromCam(data->robot, rho_start, q));
+  for (size_t p = 0; p < data->joints.size(); ++p) {
+    base_from_cam.push_back(internal::BaseFromCamOfPose(*data, static_cast<int>(p), rho_start));
+  }
   std::vector<identification::PointTrack> tracks(data->dot_ids.size());
   for (const internal::Observation& o : data->observations) {
     tracks[o.dot].base_from_cam.push_back(base_from_cam[o.pose]);
@@ -283,25 +285,55 @@ void TriangulateStartDots(const Eigen::VectorXd& rho_start, double fx_start, Bun
   Subset(all, all_state, keep, data, state, &dot_map);
 }
 
+// The rho indices held by request, and f_x / k1 switched off when held (or left out of a free list).
+// Returns the unknown names, one per line.
+std::string HeldParameters(int num_joints, BundleOptions* options, std::vector<int>* held) {
+  bool fx_held = false, k1_held = false, fx_free = false, k1_free = false;
+  std::vector<int> named_free;
+  std::string problems = ResolveParameterNames(options->held_parameters, num_joints, held, &fx_held, &k1_held);
+  if (!options->free_parameters.empty()) {
+    problems += ResolveParameterNames(options->free_parameters, num_joints, &named_free, &fx_free, &k1_free);
+    const int n = KinematicParameters(num_joints).size();
+    for (int i = 0; i < n; ++i) {
+      if (std::find(named_free.begin(), named_free.end(), i) == named_free.end()) held->push_back(i);
+    }
+    std::sort(held->begin(), held->end());
+    held->erase(std::unique(held->begin(), held->end()), held->end());
+    fx_held |= !fx_free;
+    k1_held |= !k1_free;
+  }
+  if (fx_held) options->estimate_fx = false;
+  if (k1_held) options->estimate_k1 = false;
+  if (!held->empty()) options->require_generic_rank = false;
+  return problems;
+}
+
 // K1: the gauge and the free set, from the rank of this problem's reduced Jacobian, copied into the
 // report. Evaluated at the nominal model, where nominally parallel axes are exactly parallel: at a
 // perturbed start the d offsets of a parallel pair look independent (rank is a tolerance game there) and
 // would run off to tens of metres (K2). False when the start model puts a dot behind a camera (K5).
 bool AnalyzeStartGauge(const BundleData& data, const BundleState& state, const BundleOptions& options,
-                       internal::Gauge* gauge, BundleReport* report) {
+                       const std::vector<int>& held, internal::Gauge* gauge, BundleReport* report) {
   BundleState nominal = state;
   nominal.rho = KinematicParameters::Nominal(data.robot);
-  if (!internal::AnalyzeGauge(data, nominal, options.estimate_fx, options.estimate_k1, options.rank_tolerance, gauge) &&
-      !internal::AnalyzeGauge(data, state, options.estimate_fx, options.estimate_k1, options.rank_tolerance, gauge)) {
+  if (!internal::AnalyzeGauge(data, nominal, options.estimate_fx, options.estimate_k1, options.rank_tolerance, gauge,
+                              held) &&
+      !internal::AnalyzeGauge(data, state, options.estimate_fx, options.estimate_k1, options.rank_tolerance, gauge,
+                              held)) {
     return false;
   }
   report->free_indices = gauge->free_kinematic;
   report->free_names = gauge->free_names;
   report->fixed_names = gauge->fixed_names;
+  report->fixed_names.insert(report->fixed_names.end(), gauge->held_names.begin(), gauge->held_names.end());
+  report->held_names = gauge->held_names;
   report->null_combinations = gauge->null_combinations;
   report->condition_number = gauge->condition_number;
-  report->generic_rank =
-      identification::GenericRank(data.robot, KinematicParameters::Nominal(data.robot), options.rank_tolerance);
+  // A flange-pose set has no kinematics: what generic motions identify is the hand-eye transform.
+  report->generic_rank = !data.base_from_flange.empty()
+                             ? 6
+                             : identification::GenericRank(data.robot, KinematicParameters::Nominal(data.robot),
+                                                           options.rank_tolerance);
   return true;
 }
 
@@ -366,7 +398,7 @@ ScreenedFit SolveScreened(const std::vector<int>& free, const BundleOptions& opt
   ceres::Solver::Summary& summary = fit.summary;
   for (int round = 0;; ++round) {
     Subset(full, full_state, keep, data, state, &dot_map);
-    if (data->yardsticks.empty()) {
+    if (data->yardsticks.empty() && data->base_from_flange.empty()) {
       fit.scale_lost = true;
       return fit;
     }
@@ -445,7 +477,7 @@ void EstimateCovariance(const BundleData& data, const BundleState& state, const 
 }  // namespace
 
 BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen::VectorXd& rho_start,
-                                 double fx_start, const BundleOptions& options) {
+                                 double fx_start, const BundleOptions& requested) {
   const auto start = Clock::now();
   BundleReport report;
   report.rho = rho_start;
@@ -461,14 +493,20 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
     return report;
   };
 
-  const std::string problems = CheckInputs(observations, rho_start, fx_start, options);
+  BundleOptions options = requested;
+  std::vector<int> held;
+  std::string problems = CheckInputs(observations, rho_start, fx_start, options);
+  problems += HeldParameters(observations.robot.num_joints(), &options, &held);
   if (!problems.empty()) return finish(Outcome::kInvalidInput, "invalid input:\n" + problems);
+  report.fx_estimated = options.estimate_fx;
+  report.k1_estimated = options.estimate_k1;
   const int num_poses = static_cast<int>(observations.PosesWithRole(PoseRole::kIdentification).size());
   if (num_poses < options.min_identification_poses) {
     return finish(Outcome::kDegenerate, "only " + std::to_string(num_poses) + " identification poses (need " +
                                             std::to_string(options.min_identification_poses) + ")");
   }
-  if (observations.yardsticks.empty()) {
+  const bool flange_poses = observations.UsesFlangePoses();
+  if (observations.yardsticks.empty() && !flange_poses) {
     return finish(Outcome::kScaleUnresolved, "no yardstick: the metric scale is unobservable from images alone");
   }
   BundleData data = internal::MakeBundleData(observations, options.yardstick_sigma_m);
@@ -478,13 +516,13 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
   state.fx_px = fx_start;
   state.k1 = observations.camera.k1;
   TriangulateStartDots(rho_start, fx_start, &data, &state, &report.dropped_dots);
-  if (data.yardsticks.empty()) {
+  if (data.yardsticks.empty() && !flange_poses) {
     return finish(Outcome::kScaleUnresolved,
                   "no yardstick has both ends seen (and triangulable) in two or more identification poses");
   }
 
   internal::Gauge gauge;
-  if (!AnalyzeStartGauge(data, state, options, &gauge, &report)) {
+  if (!AnalyzeStartGauge(data, state, options, held, &gauge, &report)) {
     return finish(Outcome::kFailure, "the start model puts a triangulated dot behind a camera");
   }
   const std::string not_identifiable = WhyNotIdentifiable(gauge, options, num_poses, report.generic_rank);
@@ -515,7 +553,7 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
   std::ostringstream msg;
   msg << (summary.termination_type == ceres::CONVERGENCE ? "converged" : "not converged") << ": "
       << report.num_observations << " observations of " << data.dot_ids.size() << " dots in " << num_poses
-      << " poses, " << report.free_indices.size() << " free kinematic parameters, " << report.removed.size()
+      << " poses, " << report.free_indices.size() << (flange_poses ? " free hand-eye parameters, " : " free kinematic parameters, ") << report.removed.size()
       << " observations removed by the screen, RMS " << report.rms_reprojection_px << " px";
   return finish(summary.termination_type == ceres::CONVERGENCE ? Outcome::kConverged : Outcome::kNoConvergence,
                 msg.str());

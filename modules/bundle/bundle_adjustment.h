@@ -74,6 +74,15 @@ struct BundleOptions {
   // K3: refuse (kDegenerate) when these poses identify fewer kinematic parameters than generic poses of
   // the same robot do (too few poses, or poses that do not excite some joint).
   bool require_generic_rank = true;
+  // Parameters held at their start values by request (e.g. a hand-eye-only solve with kinematics
+  // trusted: {"kinematics"}), and, when not empty, the only ones that may be estimated (everything else
+  // held). Names: a parameter (`j2.beta`, `cam.tx`), a joint (`j3`), a group (`base`, `camera` or
+  // `hand_eye`, `kinematics` = base and every joint), `fx`, `k1`. A held f_x or k1 is as estimate_fx or
+  // estimate_k1 false; `fx` or `k1` in free_parameters is not needed for estimation (their flags decide),
+  // but without them a non-empty free list holds them. The rank analysis still decides among the rest.
+  // With anything held, the generic-rank check (require_generic_rank) does not apply.
+  std::vector<std::string> held_parameters;
+  std::vector<std::string> free_parameters;
   // Empty when valid; otherwise every problem, one per line.
   std::string Validate() const;
 };
@@ -101,9 +110,12 @@ struct BundleReport {
   Eigen::VectorXd rho;                        // full; fixed entries keep their start values
   double fx_px = 0;
   double k1 = 0;
+  // What was estimated: BundleOptions::estimate_fx / estimate_k1, unless held by name.
+  bool fx_estimated = false, k1_estimated = false;
   std::map<int, Eigen::Vector3d> dots_in_base;  // every dot that entered the solve
   std::vector<int> free_indices;              // kinematic, in rho order
-  std::vector<std::string> free_names, fixed_names;
+  std::vector<std::string> free_names, fixed_names;  // fixed: by the rank analysis and by request
+  std::vector<std::string> held_names;        // held by request (BundleOptions::held_parameters, free_parameters)
   std::vector<std::string> null_combinations; // "1.00 base.tx", "0.71 j2.d - 0.71 j3.d", ...
   int generic_rank = 0;                       // free kinematic count for generic poses of this robot
   double condition_number = 0;                // column-normalised reduced Jacobian of the free set
@@ -135,6 +147,11 @@ struct BundleReport {
 // (identification/triangulation.h). Single-threaded and deterministic.
 BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen::VectorXd& rho_start,
                                  double fx_start, const BundleOptions& options);
+
+// rho indices named by `names` (see BundleOptions::held_parameters; `fx` and `k1` are set in *fx, *k1 and
+// not returned). Returns the unknown names, one per line with the valid forms, or empty.
+std::string ResolveParameterNames(const std::vector<std::string>& names, int num_joints, std::vector<int>* indices,
+                                  bool* fx = nullptr, bool* k1 = nullptr);
 
 // The rho on `target` (same joint count) that gives the same base_from_cam(q) for every q as `source_rho`
 // on `source`: joint parameters copied, base and camera corrections re-expressed against target's

@@ -133,15 +133,18 @@ TEST(BundleAdjustment, ReprojectionJacobianMatchesNumericDifferentiation) {
   x.tail(5) << 1000.0, -0.08, 0, 0, 0;
   x.tail(3) = base_from_cam * Eigen::Vector3d(0.1, -0.05, 0.6);
   const Eigen::Vector2d pixel(300, 250);
+  internal::BundleData one;
+  one.robot = robot;
+  one.joints = {q};
   auto f = [&](const double* v, double* out) {
     internal::PoseCache cache;
-    internal::ComputePoseCache(robot, v, q, {}, false, &cache);
+    internal::ComputePoseCache(one, 0, v, {}, false, &cache);
     internal::EvaluateReprojection(camera, 0.5, cache, v[n], v[n + 1], Eigen::Vector3d(v[n + 2], v[n + 3], v[n + 4]),
                                    pixel, out, nullptr, nullptr, nullptr, nullptr);
   };
   const Eigen::MatrixXd numeric = NumericJacobian(f, x, 2, 1e-7);
   internal::PoseCache cache;
-  internal::ComputePoseCache(robot, x.data(), q, columns, true, &cache);
+  internal::ComputePoseCache(one, 0, x.data(), columns, true, &cache);
   double residual[2], d_fx[2], d_k1[2], d_dot[6];
   std::vector<double> d_columns(2 * n);
   ASSERT_TRUE(internal::EvaluateReprojection(camera, 0.5, cache, x[n], x[n + 1], x.tail<3>(), pixel, residual,
@@ -182,7 +185,7 @@ TEST(BundleAdjustment, ReducedJacobianIsTheSchurComplementOfTheDots) {
     for (size_t k = 0; k < data.observations.size(); ++k) {
       const internal::Observation& o = data.observations[k];
       internal::PoseCache cache;
-      internal::ComputePoseCache(data.robot, s.rho.data(), data.joints[o.pose], {}, false, &cache);
+      internal::ComputePoseCache(data, o.pose, s.rho.data(), {}, false, &cache);
       internal::EvaluateReprojection(data.camera, data.sigma_px, cache, s.fx_px, s.k1, s.dots[o.dot], o.pixel,
                                      out.data() + 2 * k, nullptr, nullptr, nullptr, nullptr);
     }

@@ -1,5 +1,6 @@
 // Options validation, outcome names, and re-expressing a model's parameters on another model.
 #include <cmath>
+#include <set>
 #include <sstream>
 
 #include "base/status.h"
@@ -25,6 +26,38 @@ std::string BundleOptions::Validate() const {
     out << "min_identification_poses = " << min_identification_poses << " must be >= 2\n";
   }
   return out.str();
+}
+
+std::string ResolveParameterNames(const std::vector<std::string>& names, int num_joints, std::vector<int>* indices,
+                                  bool* fx, bool* k1) {
+  const KinematicParameters params(num_joints);
+  std::set<int> chosen;
+  std::ostringstream unknown;
+  auto add_range = [&](int begin, int count) {
+    for (int i = begin; i < begin + count; ++i) chosen.insert(i);
+  };
+  for (const std::string& name : names) {
+    if (name == "fx" || name == "k1") {
+      if (name == "fx" && fx != nullptr) *fx = true;
+      if (name == "k1" && k1 != nullptr) *k1 = true;
+    } else if (name == "kinematics") {
+      add_range(0, params.CamOffset());
+    } else if (name == "base") {
+      add_range(0, 6);
+    } else if (name == "camera" || name == "hand_eye") {
+      add_range(params.CamOffset(), 6);
+    } else if (name.size() > 1 && name[0] == 'j' && name.find_first_not_of("0123456789", 1) == std::string::npos &&
+               std::stoi(name.substr(1)) >= 1 && std::stoi(name.substr(1)) <= num_joints) {
+      add_range(KinematicParameters::JointOffset(std::stoi(name.substr(1)) - 1), 5);
+    } else if (const int index = params.IndexOf(name); index >= 0) {
+      chosen.insert(index);
+    } else {
+      unknown << "unknown parameter `" << name << "`: give a parameter (e.g. j2.beta, cam.tx), a joint j1..j"
+              << num_joints << ", base, camera (or hand_eye), kinematics, fx or k1\n";
+    }
+  }
+  indices->assign(chosen.begin(), chosen.end());
+  return unknown.str();
 }
 
 const char* OutcomeName(Outcome outcome) {

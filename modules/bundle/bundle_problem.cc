@@ -12,11 +12,27 @@
 
 namespace selfcal::bundle::internal {
 
-void ComputePoseCache(const RobotModel& model, const double* rho, const Eigen::VectorXd& q,
-                      const std::vector<int>& columns, bool derivatives, PoseCache* out) {
+namespace {
+
+template <typename T>
+Rigid3T<T> BaseFromCamOf(const BundleData& data, int pose, const T* rho, const T* q) {
+  if (!data.base_from_flange.empty()) return BaseFromCamGivenFlange<T>(data.robot, rho, data.base_from_flange[pose]);
+  return BaseFromCam<T>(data.robot, rho, q);
+}
+
+}  // namespace
+
+Rigid3 BaseFromCamOfPose(const BundleData& data, int pose, const Eigen::VectorXd& rho) {
+  return BaseFromCamOf<double>(data, pose, rho.data(), data.joints[pose].data());
+}
+
+void ComputePoseCache(const BundleData& data, int pose, const double* rho, const std::vector<int>& columns,
+                      bool derivatives, PoseCache* out) {
+  const RobotModel& model = data.robot;
+  const Eigen::VectorXd& q = data.joints[pose];
   const int m = static_cast<int>(columns.size());
   if (!derivatives || m == 0) {
-    const Rigid3 cam_from_base = BaseFromCam<double>(model, rho, q.data()).Inverse();
+    const Rigid3 cam_from_base = BaseFromCamOf<double>(data, pose, rho, q.data()).Inverse();
     out->rotation = cam_from_base.rotation;
     out->translation = cam_from_base.translation;
     out->d_rotation.assign(derivatives ? m : 0, Eigen::Matrix3d::Zero());
@@ -36,7 +52,7 @@ void ComputePoseCache(const RobotModel& model, const double* rho, const Eigen::V
     for (int i = 0; i < n; ++i) rho_jet[i] = Jet(rho[i]);
     const int count = std::min(kStride, m - start);
     for (int k = 0; k < count; ++k) rho_jet[columns[start + k]].v[k] = 1.0;
-    const Rigid3T<Jet> cam_from_base = BaseFromCam<Jet>(model, rho_jet.data(), q_jet.data()).Inverse();
+    const Rigid3T<Jet> cam_from_base = BaseFromCamOf<Jet>(data, pose, rho_jet.data(), q_jet.data()).Inverse();
     if (start == 0) {
       for (int r = 0; r < 3; ++r) {
         for (int c = 0; c < 3; ++c) out->rotation(r, c) = cam_from_base.rotation(r, c).a;
@@ -116,7 +132,7 @@ bool ReducedJacobian(const BundleData& data, const BundleState& state, const Glo
   const int num_global = columns.size();
   std::vector<PoseCache> caches(num_poses);
   for (int p = 0; p < num_poses; ++p) {
-    ComputePoseCache(data.robot, state.rho.data(), data.joints[p], columns.kinematic, true, &caches[p]);
+    ComputePoseCache(data, p, state.rho.data(), columns.kinematic, true, &caches[p]);
   }
   // Dots joined by a yardstick share a residual, so they are eliminated together.
   std::vector<int> parent(num_dots);
@@ -267,6 +283,7 @@ BundleData MakeBundleData(const ObservationSet& observations, double yardstick_s
   for (int p : observations.PosesWithRole(PoseRole::kIdentification)) {
     data.pose_ids.push_back(observations.poses[p].id);
     data.joints.push_back(observations.poses[p].joints_rad);
+    if (observations.UsesFlangePoses()) data.base_from_flange.push_back(*observations.poses[p].base_from_flange);
     for (const auto& entry : observations.poses[p].dots_px) ++views[entry.first];
   }
   std::map<int, int> index_of;
@@ -283,7 +300,8 @@ BundleData MakeBundleData(const ObservationSet& observations, double yardstick_s
     }
     ++pose;
   }
-  for (const KnownDistance& k : observations.yardsticks) {
+  // A flange-pose set is metric through the flange translations: its yardsticks are checks, not constraints.
+  for (const KnownDistance& k : observations.UsesFlangePoses() ? std::vector<KnownDistance>{} : observations.yardsticks) {
     auto a = index_of.find(k.dot_a);
     auto b = index_of.find(k.dot_b);
     if (a != index_of.end() && b != index_of.end()) data.yardsticks.push_back({a->second, b->second, k.length_m});
@@ -292,7 +310,7 @@ BundleData MakeBundleData(const ObservationSet& observations, double yardstick_s
 }
 
 bool AnalyzeGauge(const BundleData& data, const BundleState& state, bool estimate_fx, bool estimate_k1,
-                  double rank_tolerance, Gauge* gauge) {
+                  double rank_tolerance, Gauge* gauge, const std::vector<int>& held) {
   const int num_joints = data.robot.num_joints();
   const int n = data.robot.num_parameters();
   GlobalColumns columns;
@@ -309,9 +327,13 @@ bool AnalyzeGauge(const BundleData& data, const BundleState& state, bool estimat
   Eigen::MatrixXd reduced;
   if (!ReducedJacobian(unit_weights, state, columns, &reduced)) return false;
   const std::vector<std::string> names = GlobalNames(columns, num_joints);
-  const identification::RankSelection selection =
-      identification::SelectColumns(reduced, SelectionOrder(num_joints, estimate_fx, estimate_k1), rank_tolerance, names);
+  std::vector<int> order;
+  for (int c : SelectionOrder(num_joints, estimate_fx, estimate_k1)) {
+    if (std::find(held.begin(), held.end(), c) == held.end()) order.push_back(c);
+  }
+  const identification::RankSelection selection = identification::SelectColumns(reduced, order, rank_tolerance, names);
   *gauge = Gauge();
+  for (int c : held) gauge->held_names.push_back(names[c]);
   for (int c : selection.kept) {
     if (c < n) {
       gauge->free_kinematic.push_back(c);

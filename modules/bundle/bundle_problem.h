@@ -37,6 +37,9 @@ struct BundleData {
   double yardstick_sigma_m = 1e-6;
   std::vector<std::string> pose_ids;
   std::vector<Eigen::VectorXd> joints;  // identification poses
+  // A flange-pose set (ObservationSet::UsesFlangePoses): the recorded flange pose of each identification
+  // pose, and joints holds empty vectors. Empty otherwise.
+  std::vector<Rigid3> base_from_flange;
   std::vector<int> dot_ids;
   std::vector<Observation> observations;
   std::vector<Yardstick> yardsticks;
@@ -58,15 +61,16 @@ struct GlobalColumns {
 };
 
 // cam_from_base of one pose and its derivative with respect to rho[columns[c]] (forward-mode autodiff
-// through BaseFromCam, 8 columns per pass).
+// through BaseFromCam, or BaseFromCamGivenFlange for a flange-pose set, 8 columns per pass).
 struct PoseCache {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
   std::vector<Eigen::Matrix3d> d_rotation;
   std::vector<Eigen::Vector3d> d_translation;
 };
-void ComputePoseCache(const RobotModel& model, const double* rho, const Eigen::VectorXd& q,
-                      const std::vector<int>& columns, bool derivatives, PoseCache* out);
+Rigid3 BaseFromCamOfPose(const BundleData& data, int pose, const Eigen::VectorXd& rho);
+void ComputePoseCache(const BundleData& data, int pose, const double* rho, const std::vector<int>& columns,
+                      bool derivatives, PoseCache* out);
 
 // Whitened residual (project(fx, k1, R p + t) - pixel) / sigma of one observation. Derivatives (each
 // optional, row-major): d_columns 2 x cache.d_rotation.size(), d_fx 2, d_k1 2, d_dot 2 x 3. Returns false
@@ -95,18 +99,21 @@ bool CovarianceFromJacobian(const Eigen::MatrixXd& jacobian, const std::vector<s
                             Eigen::MatrixXd* covariance, std::string* message);
 
 // The identification poses of `observations`, every dot seen in at least two of them (dot ids
-// ascending), their observations, and the yardsticks with both ends among those dots.
+// ascending), their observations, and the yardsticks with both ends among those dots (none for a
+// flange-pose set, whose scale the flange translations fix).
 BundleData MakeBundleData(const ObservationSet& observations, double yardstick_sigma_m);
 
-// The gauge and the free set of the problem at `state` (DESIGN.md section 4, K1): SelectColumns on the
+// The gauge and the free set of the problem at `state` (DESIGN.md section 4): SelectColumns on the
 // reduced Jacobian of every rho entry plus f_x / k1 when estimated.
 struct Gauge {
   std::vector<int> free_kinematic;  // rho indices, ascending
   std::vector<std::string> free_names, fixed_names, null_combinations;
+  std::vector<std::string> held_names;  // held at their start by request (BundleOptions::held_parameters)
   bool fx_identifiable = false, k1_identifiable = false;
   double condition_number = 0;
 };
+// `held`: rho indices held at their start by request; they take no part in the selection.
 bool AnalyzeGauge(const BundleData& data, const BundleState& state, bool estimate_fx, bool estimate_k1,
-                  double rank_tolerance, Gauge* gauge);
+                  double rank_tolerance, Gauge* gauge, const std::vector<int>& held = {});
 
 }  // namespace selfcal::bundle::internal

@@ -47,7 +47,7 @@ Eigen::VectorXd BundleStartFromPaper(const ObservationSet& obs, const PaperPipel
 namespace {
 
 // The held-out reprojection figures of the calibrated and the nominal model (see bundle_stage.h).
-void VerifyHeldOutReprojection(const ObservationSet& obs, const BundleStageOptions& options, BundleStageReport* report) {
+void VerifyHeldOutReprojection(const ObservationSet& obs, BundleStageReport* report) {
   const bundle::BundleReport& b = report->bundle;
   const bool estimated = std::isfinite(b.pixel_noise_estimate_px) && b.pixel_noise_estimate_px > 0;
   const double noise = estimated ? b.pixel_noise_estimate_px : obs.pixel_noise_px;
@@ -56,10 +56,10 @@ void VerifyHeldOutReprojection(const ObservationSet& obs, const BundleStageOptio
   calibrated.rho = b.rho;
   calibrated.camera = obs.camera;
   calibrated.camera.fx_px = b.fx_px;
-  if (options.bundle.estimate_k1) calibrated.camera.k1 = b.k1;
+  if (b.k1_estimated) calibrated.camera.k1 = b.k1;
   calibrated.free_indices = b.free_indices;
-  calibrated.fx_estimated = options.bundle.estimate_fx;
-  calibrated.k1_estimated = options.bundle.estimate_k1;
+  calibrated.fx_estimated = b.fx_estimated;
+  calibrated.k1_estimated = b.k1_estimated;
   if (b.covariance_available) calibrated.covariance = b.covariance_free;
   ExcludedObservations excluded;
   for (const bundle::RemovedObservation& o : b.removed) excluded.insert({o.pose_id, o.dot_id});
@@ -110,9 +110,9 @@ BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineR
   if (b.rho.size() == obs.robot.num_parameters() && b.rho.allFinite() && std::isfinite(b.fx_px) && b.fx_px > 0) {
     report.calibrated_robot = ApplyParameters(obs.robot, b.rho);
     report.calibrated_rho = KinematicParameters::Nominal(report.calibrated_robot);
-    if (valid) VerifyHeldOutReprojection(obs, options, &report);
+    if (valid) VerifyHeldOutReprojection(obs, &report);
     if (verify) {
-      if (options.bundle.estimate_k1) {
+      if (b.k1_estimated) {
         ObservationSet with_k1 = obs;
         with_k1.camera.k1 = b.k1;
         report.verification = VerifyDistances(with_k1, verification_poses, obs.robot, b.rho, b.fx_px, obs.check_distances);
@@ -124,13 +124,13 @@ BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineR
         const int nf = static_cast<int>(b.free_indices.size());
         Eigen::MatrixXd sigma = Eigen::MatrixXd::Zero(nf + 1, nf + 1);
         sigma.topLeftCorner(nf, nf) = b.covariance_free.topLeftCorner(nf, nf);
-        if (options.bundle.estimate_fx) sigma = b.covariance_free.topLeftCorner(nf + 1, nf + 1);
+        if (b.fx_estimated) sigma = b.covariance_free.topLeftCorner(nf + 1, nf + 1);
         ObservationSet with_k1;
-        if (options.bundle.estimate_k1) {
+        if (b.k1_estimated) {
           with_k1 = obs;
           with_k1.camera.k1 = b.k1;
         }
-        report.predicted_error = PredictDistanceErrors(options.bundle.estimate_k1 ? with_k1 : obs, verification_poses, obs.robot,
+        report.predicted_error = PredictDistanceErrors(b.k1_estimated ? with_k1 : obs, verification_poses, obs.robot,
                                                        b.rho, b.fx_px, b.free_indices, sigma, obs.pixel_noise_px,
                                                        obs.check_distances);
       } else {

@@ -56,14 +56,61 @@ const VerificationSummary& CalibrationReport::verification_nominal() const {
   return bundle ? bundle->verification_nominal : paper.verification_nominal;
 }
 
+namespace {
+
+// A flange-pose set, ready for the bundle stage: its yardsticks become checks (the flange translations
+// are metric), and without a nominal hand-eye transform the start from the images becomes the nominal.
+ObservationSet PrepareFlangePoseSet(const ObservationSet& observations, const CalibrateOptions& options,
+                                    CalibrationReport* report) {
+  ObservationSet prepared = observations;
+  for (const KnownDistance& y : observations.yardsticks) prepared.check_distances.push_back(y);
+  prepared.yardsticks.clear();
+  report->paper.outcome = Outcome::kNotRun;
+  report->paper.message = "not run: the paper's method identifies kinematics from joint angles, and these poses are "
+                          "flange poses";
+  HandEyeStartOptions start_options = options.hand_eye;
+  start_options.two_view.seed = options.paper.two_view.seed;
+  report->hand_eye_start = StartHandEye(observations, start_options);
+  if (!observations.flange_from_cam_known && report->hand_eye_start->ok) {
+    prepared.robot.flange_from_cam = report->hand_eye_start->flange_from_cam;
+    prepared.camera.fx_px = report->hand_eye_start->fx_px;
+    prepared.flange_from_cam_known = true;
+  }
+  return prepared;
+}
+
+}  // namespace
+
 CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateOptions& options) {
   CalibrationReport report;
   report.method = options.method;
-  report.paper = RunPaperPipeline(observations, options.paper);
+  const bool flange_poses = observations.UsesFlangePoses();
+  if (flange_poses && options.method == Method::kPaper) {
+    report.verdict = Verdict::kInvalidInput;
+    report.message = "the paper's method needs joint angles; these poses are flange poses (use the bundle method)";
+    return report;
+  }
+  ObservationSet prepared;
+  if (flange_poses) {
+    prepared = PrepareFlangePoseSet(observations, options, &report);
+    if (!observations.flange_from_cam_known && !report.hand_eye_start->ok) {
+      report.verdict = Verdict::kDegenerate;
+      report.message = "no hand-eye start: " + report.hand_eye_start->message;
+      return report;
+    }
+  } else {
+    report.paper = RunPaperPipeline(observations, options.paper);
+  }
+  const ObservationSet& obs = flange_poses ? prepared : observations;
   report.verdict = VerdictFor(report.paper.outcome);
   report.message = report.paper.message;
   if (options.method == Method::kBundle) {
-    report.bundle = RunBundleStage(observations, report.paper, options.bundle);
+    report.bundle = RunBundleStage(obs, report.paper, options.bundle);
+    if (flange_poses) {
+      report.bundle->start_note = observations.flange_from_cam_known
+                                      ? "the set's nominal hand-eye transform and prior f_x"
+                                      : "the hand-eye transform and f_x of the start from the images";
+    }
     report.verdict = VerdictFor(report.bundle->bundle.outcome);
     report.message = report.bundle->bundle.message;
   }
@@ -73,7 +120,8 @@ CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateO
     model.robot = report.bundle->calibrated_robot;
     model.fx_px = report.bundle->bundle.fx_px;
     model.parameters = report.bundle->bundle.rho;
-    model.method_description = "kinematic bundle adjustment";
+    model.method_description = flange_poses ? "hand-eye bundle adjustment on recorded flange poses"
+                                            : "kinematic bundle adjustment";
   } else {
     model.robot = report.paper.calibrated_robot;
     model.fx_px = report.paper.fx_px;

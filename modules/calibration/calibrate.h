@@ -2,7 +2,9 @@
 // and, when the verdict is "accepted", the model to write.
 //
 //   Calibrate(observations, options)
-//     -> RunPaperPipeline                 (always: the baseline, and the bundle adjustment's start)
+//     -> RunPaperPipeline                 (joint angles: the baseline, and the bundle adjustment's start)
+//        or StartHandEye                  (flange poses: the hand-eye transform from the images; the
+//                                          yardsticks become checks, the flange translations are metric)
 //     -> RunBundleStage                   (Method::kBundle, the default: the product's answer)
 //     -> verdict of the chosen method     (one vocabulary for every method: Verdict)
 //     -> the chosen method's model        (only when accepted)
@@ -19,6 +21,7 @@
 #include <Eigen/Core>
 
 #include "calibration/bundle_stage.h"
+#include "calibration/hand_eye_start.h"
 #include "calibration/paper_pipeline.h"
 #include "kinematics/robot_model.h"
 #include "observations/observation_set.h"
@@ -47,6 +50,7 @@ struct CalibrateOptions {
   Method method = Method::kBundle;
   PaperPipelineOptions paper;  // paper.two_view.seed seeds the RANSAC sampling
   BundleStageOptions bundle;
+  HandEyeStartOptions hand_eye;  // flange-pose sets (its two-view seed is paper.two_view.seed)
 };
 
 // The chosen method's calibrated model, ready for writing.
@@ -63,7 +67,10 @@ struct CalibrationReport {
   Method method = Method::kBundle;
   Verdict verdict = Verdict::kSolverFailure;
   std::string message;  // why, when not accepted (the chosen method's own message)
-  PaperPipelineReport paper;               // always run
+  PaperPipelineReport paper;               // run on joint-angle sets (kNotRun on flange-pose sets)
+  // A flange-pose set (ObservationSet::UsesFlangePoses): the hand-eye start from the images, which is the
+  // bundle's nominal hand-eye transform when the set gave none.
+  std::optional<HandEyeStartReport> hand_eye_start;
   std::optional<BundleStageReport> bundle;  // when method == kBundle
   std::optional<CalibratedModel> model;    // the chosen method's model, only when accepted
 

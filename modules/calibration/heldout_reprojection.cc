@@ -35,16 +35,16 @@ class Projector {
   bool with_parameters() const { return with_parameters_; }
   int num_theta() const { return num_theta_; }
 
-  PoseFrames Frames(const Eigen::VectorXd& q) const {
+  PoseFrames Frames(const PoseObservation& q) const {
     PoseFrames f;
-    f.cam_from_base = BaseFromCam(model_.robot, model_.rho, q).Inverse();
+    f.cam_from_base = BaseFromCamAt(model_.robot, model_.rho, q).Inverse();
     if (!with_parameters_) return f;
     for (int index : model_.free_indices) {
       Eigen::VectorXd rho = model_.rho;
       rho[index] += kStepRho;
-      f.plus.push_back(BaseFromCam(model_.robot, rho, q).Inverse());
+      f.plus.push_back(BaseFromCamAt(model_.robot, rho, q).Inverse());
       rho[index] -= 2 * kStepRho;
-      f.minus.push_back(BaseFromCam(model_.robot, rho, q).Inverse());
+      f.minus.push_back(BaseFromCamAt(model_.robot, rho, q).Inverse());
     }
     return f;
   }
@@ -107,7 +107,7 @@ std::map<int, DotInformation> IdentificationInformation(const ObservationSet& ob
   for (const auto& [id, p] : dots) info[id].hdt = Eigen::MatrixXd::Zero(3, projector.num_theta());
   for (int i : obs.PosesWithRole(PoseRole::kIdentification)) {
     const PoseObservation& pose = obs.poses[i];
-    const PoseFrames frames = projector.Frames(pose.joints_rad);
+    const PoseFrames frames = projector.Frames(pose);
     for (const auto& [id, pixel] : pose.dots_px) {
       const auto dot = dots.find(id);
       if (dot == dots.end() || excluded.count({pose.id, id}) > 0) continue;
@@ -207,7 +207,7 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
   std::vector<std::vector<int>> rows_of_pose;
   for (int v : obs.PosesWithRole(PoseRole::kVerification)) {
     const PoseObservation& pose = obs.poses[v];
-    const PoseFrames frames = projector.Frames(pose.joints_rad);
+    const PoseFrames frames = projector.Frames(pose);
     std::vector<int> rows;
     for (const auto& [id, pixel] : pose.dots_px) {
       const auto d = info.find(id);
@@ -261,7 +261,7 @@ std::map<int, Eigen::Vector3d> TriangulateIdentificationDots(const ObservationSe
   std::map<int, identification::PointTrack> tracks;
   for (int i : obs.PosesWithRole(PoseRole::kIdentification)) {
     const PoseObservation& pose = obs.poses[i];
-    const Rigid3 base_from_cam = BaseFromCam(model.robot, model.rho, pose.joints_rad);
+    const Rigid3 base_from_cam = BaseFromCamAt(model.robot, model.rho, pose);
     for (const auto& [id, pixel] : pose.dots_px) {
       tracks[id].base_from_cam.push_back(base_from_cam);
       tracks[id].pixels.push_back(pixel);

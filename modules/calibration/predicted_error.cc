@@ -58,7 +58,7 @@ struct Ends {
 std::vector<Rigid3> Cameras(const ObservationSet& obs, const std::vector<int>& pose_indices, const RobotModel& robot,
                             const Eigen::VectorXd& rho) {
   std::vector<Rigid3> cams;
-  for (int p : pose_indices) cams.push_back(BaseFromCam(robot, rho, obs.poses[p].joints_rad));
+  for (int p : pose_indices) cams.push_back(BaseFromCamAt(robot, rho, obs.poses[p]));
   return cams;
 }
 

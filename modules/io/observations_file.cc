@@ -7,6 +7,7 @@
 
 #include "io/atomic_file.h"
 #include "io/robot_config.h"
+#include "io/transform_yaml.h"
 #include "io/yaml_schema.h"
 #include "io/yaml_writer.h"
 
@@ -141,6 +142,26 @@ bool ReadDots(const yaml::YamlNode& node, const std::string& name, const CameraI
   return ok;
 }
 
+// `joints_deg` or `joints_rad` of a pose, each value inside the robot's limits when the robot is known.
+bool ReadJoints(MapReader* map, const RobotModel* robot, Problems* problems, PoseObservation* pose) {
+  std::vector<double> joints;
+  std::vector<int> lines;
+  std::string key;
+  const int num_joints = robot ? robot->num_joints() : -1;
+  if (!map->QuantityList("joints", Unit::kAngle, num_joints, kJointValue, &joints, true, &key, &lines)) return false;
+  pose->joints_rad = Eigen::Map<const Eigen::VectorXd>(joints.data(), static_cast<Eigen::Index>(joints.size()));
+  bool ok = true;
+  for (int j = 0; robot && j < num_joints; ++j) {
+    if (const std::string p = JointLimitProblem(*robot, j, joints[j]); !p.empty()) {
+      const bool degrees = key.size() > 4 && key.compare(key.size() - 4, 4, "_deg") == 0;
+      problems->Add("`" + map->Path(key) + "[" + std::to_string(j) + "]` = " +
+                    Short(degrees ? RadToDeg(joints[j]) : joints[j]) + " at " + problems->At(lines[j]) + " " + p);
+      ok = false;
+    }
+  }
+  return ok;
+}
+
 bool ReadPose(const yaml::YamlNode& node, const std::string& name, const RobotModel* robot, const CameraIntrinsics* camera,
               Problems* problems, PoseObservation* pose) {
   MapReader map(node, name, problems);
@@ -160,22 +181,21 @@ bool ReadPose(const yaml::YamlNode& node, const std::string& name, const RobotMo
       ok = false;
     }
   }
-  std::vector<double> joints;
-  std::vector<int> lines;
-  std::string key;
-  const int num_joints = robot ? robot->num_joints() : -1;
-  if (map.QuantityList("joints", Unit::kAngle, num_joints, kJointValue, &joints, true, &key, &lines)) {
-    pose->joints_rad = Eigen::Map<const Eigen::VectorXd>(joints.data(), static_cast<Eigen::Index>(joints.size()));
-    for (int j = 0; robot && j < num_joints; ++j) {
-      if (const std::string p = JointLimitProblem(*robot, j, joints[j]); !p.empty()) {
-        const bool degrees = key.size() > 4 && key.compare(key.size() - 4, 4, "_deg") == 0;
-        problems->Add("`" + map.Path(key) + "[" + std::to_string(j) + "]` = " +
-                      Short(degrees ? RadToDeg(joints[j]) : joints[j]) + " at " + problems->At(lines[j]) + " " + p);
+  const bool has_flange = map.Optional("base_from_flange") != nullptr;
+  if (has_flange) {
+    // Set even when unreadable (its problem is recorded): the set is still one of flange poses.
+    Rigid3 base_from_flange;
+    ok &= ReadTransform(&map, "base_from_flange", /*required=*/true, &base_from_flange);
+    pose->base_from_flange = base_from_flange;
+    for (const char* joint_key : {"joints_deg", "joints_rad"}) {
+      if (map.Optional(joint_key)) {
+        problems->Add("`" + map.Path(joint_key) + "` at " + problems->At(map.KeyLine(joint_key)) +
+                      " and `base_from_flange` both give the pose; keep one");
         ok = false;
       }
     }
   } else {
-    ok = false;
+    ok &= ReadJoints(&map, robot, problems, pose);
   }
   if (const yaml::YamlNode* dots = map.Required("dots")) {
     ok &= ReadDots(*dots, map.Path("dots"), camera, problems, &pose->dots_px);
@@ -216,12 +236,21 @@ Result<ObservationSet> ParseObservations(const yaml::YamlDocument& doc) {
         problems.Add("`robot_file` at " + problems.At(robot_file->line) + ": " + loaded.status().message());
       }
     }
-  } else {
-    root.AddMissing("`robot` (or `robot_file`)");
+  }
+  const bool robot_given = robot || robot_file;
+  Rigid3 flange_from_cam;
+  if (robot_given && root.Optional("flange_from_cam")) {
+    problems.Add("`flange_from_cam` at " + problems.At(root.KeyLine("flange_from_cam")) +
+                 " is for sets of flange poses; with a robot it belongs in the robot's block");
+  } else if (!robot_given) {
+    set.flange_from_cam_known = root.Optional("flange_from_cam") != nullptr;
+    ReadTransform(&root, "flange_from_cam", /*required=*/false, &flange_from_cam);
+    set.robot = FlangePoseModel(flange_from_cam);
   }
   const bool camera_ok = ReadCamera(&root, &problems, &set.camera);
   root.Double("pixel_noise_px", Range::Closed(kMinPixelNoisePx, kMaxPixelNoisePx), &set.pixel_noise_px);
-  ReadDistances(&root, "yardsticks", /*required=*/true, &problems, &set.yardsticks);
+  // A set of flange poses takes its scale from the flange translations: yardsticks are then optional.
+  ReadDistances(&root, "yardsticks", /*required=*/robot_given, &problems, &set.yardsticks);
   ReadDistances(&root, "check_distances", /*required=*/false, &problems, &set.check_distances);
   if (const yaml::YamlNode* poses = root.Required("poses")) {
     if (!poses->IsSequence()) {
@@ -234,6 +263,9 @@ Result<ObservationSet> ParseObservations(const yaml::YamlDocument& doc) {
                  camera_ok ? &set.camera : nullptr, &problems, &set.poses[i]);
       }
     }
+  }
+  if (!robot_given && !set.UsesFlangePoses()) {
+    root.AddMissing("`robot` (or `robot_file`), or `base_from_flange` in every pose");
   }
   root.Finish();
   if (problems.empty()) {
@@ -271,11 +303,17 @@ Status SaveObservations(const ObservationSet& set, const std::string& path) {
   std::ostringstream out;
   out << "# selfcal observations (docs/observations-format.md), written in SI units (m, rad) so that the\n"
       << "# file loads back bit-identical. Pixels: origin at the centre of the top-left pixel, u right, v down.\n"
-      << "format: " << kObservationsFormat << "\n"
-      << "version: " << kObservationsVersion << "\n"
-      << "robot:\n"
-      << RobotModelYaml(set.robot, TransformStyle::kExact, 2)
-      << "camera: {width_px: " << c.width_px << ", height_px: " << c.height_px << ", fx_px: " << YamlNumber(c.fx_px)
+      << "format: " << kObservationsFormat << "\n";
+  if (set.UsesFlangePoses()) {
+    // Version 1.1 added flange poses; a set of joint angles stays readable by every 1.x reader.
+    out << "version: 1.1\n";
+    if (set.flange_from_cam_known) out << "flange_from_cam: " << TransformYaml(set.robot.flange_from_cam, TransformStyle::kExact) << "\n";
+  } else {
+    out << "version: " << kObservationsVersion << "\n"
+        << "robot:\n"
+        << RobotModelYaml(set.robot, TransformStyle::kExact, 2);
+  }
+  out << "camera: {width_px: " << c.width_px << ", height_px: " << c.height_px << ", fx_px: " << YamlNumber(c.fx_px)
       << ", mu: " << YamlNumber(c.mu) << ", cx_px: " << YamlNumber(c.cx_px) << ", cy_px: " << YamlNumber(c.cy_px)
       << ", k1: " << YamlNumber(c.k1) << "}\n"
       << "pixel_noise_px: " << YamlNumber(set.pixel_noise_px) << "\n";
@@ -290,10 +328,15 @@ Status SaveObservations(const ObservationSet& set, const std::string& path) {
   out << "poses:" << (set.poses.empty() ? " []\n" : "\n");
   for (const PoseObservation& pose : set.poses) {
     out << "  - id: " << YamlQuoted(pose.id) << "\n"
-        << "    role: " << PoseRoleName(pose.role) << "\n"
-        << "    joints_rad: " << YamlNumberList(pose.joints_rad) << "\n    # joints_deg (rounded): [";
-    for (int j = 0; j < pose.joints_rad.size(); ++j) out << (j ? ", " : "") << Short(RadToDeg(pose.joints_rad[j]));
-    out << "]\n    dots:" << (pose.dots_px.empty() ? " []\n" : "\n");
+        << "    role: " << PoseRoleName(pose.role) << "\n";
+    if (pose.base_from_flange) {
+      out << "    base_from_flange: " << TransformYaml(*pose.base_from_flange, TransformStyle::kExact) << "\n";
+    } else {
+      out << "    joints_rad: " << YamlNumberList(pose.joints_rad) << "\n    # joints_deg (rounded): [";
+      for (int j = 0; j < pose.joints_rad.size(); ++j) out << (j ? ", " : "") << Short(RadToDeg(pose.joints_rad[j]));
+      out << "]\n";
+    }
+    out << "    dots:" << (pose.dots_px.empty() ? " []\n" : "\n");
     for (const auto& [dot, uv] : pose.dots_px) {
       out << "      - [" << dot << ", " << YamlNumber(uv.x()) << ", " << YamlNumber(uv.y()) << "]\n";
     }

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include <Eigen/Dense>
+#include <Eigen/Geometry>
 
 #include "io/yaml_writer.h"
 
@@ -43,6 +44,21 @@ bool ReadRotationMatrix(const yaml::YamlNode& node, const std::string& name, Pro
   return true;
 }
 
+// (x, y, z, w) of a unit quaternion, as ROS and Eigen write it; its norm must be 1 to 1e-6 (a file that
+// swapped w to the front is caught only by the reader's eye, so the order is in the key's name).
+bool ReadQuaternion(const std::vector<double>& q, const std::string& name, const std::string& at, Problems* problems,
+                    Eigen::Matrix3d* out) {
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (std::abs(norm - 1.0) > 1e-6) {
+    char detail[64];
+    std::snprintf(detail, sizeof(detail), "%.9g", norm);
+    problems->Add("`" + name + "` at " + at + " has norm " + detail + "; a rotation quaternion [x, y, z, w] has norm 1");
+    return false;
+  }
+  *out = Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix();
+  return true;
+}
+
 }  // namespace
 
 Eigen::Matrix3d RotationFromRpy(double roll_rad, double pitch_rad, double yaw_rad) {
@@ -72,19 +88,39 @@ bool ReadTransform(MapReader* parent, const std::string& key, bool required, Rig
   std::string rpy_key;
   const bool rpy_ok = map.QuantityList("rpy", Unit::kAngle, 3, Range::Closed(DegToRad(-360), DegToRad(360)), &rpy,
                                        /*required=*/false, &rpy_key);
+  std::vector<double> rotvec;
+  std::string rotvec_key;
+  const bool rotvec_ok = map.QuantityList("rotvec", Unit::kAngle, 3, Range::Closed(DegToRad(-720), DegToRad(720)),
+                                          &rotvec, /*required=*/false, &rotvec_key);
+  std::vector<double> quat;
+  const yaml::YamlNode* quat_node = map.Optional("quat_xyzw");
+  const bool quat_given = quat_node != nullptr;
+  const bool quat_ok = quat_given && ReadDoubleList(*quat_node, map.Path("quat_xyzw"), 4,
+                                                    Range::Closed(-100.0, 100.0), problems, &quat);
   const yaml::YamlNode* matrix_node = map.Optional("rotation");
+  std::vector<std::string> given;
+  if (matrix_node) given.push_back("rotation");
+  if (!rpy_key.empty()) given.push_back(rpy_key);
+  if (!rotvec_key.empty()) given.push_back(rotvec_key);
+  if (quat_given) given.push_back("quat_xyzw");
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
-  if (matrix_node && !rpy_key.empty()) {
-    problems->Add("`" + map.Path("rotation") + "` and `" + map.Path(rpy_key) + "` at " +
-                  problems->At(map.KeyLine("rotation")) + " both give the rotation; keep one");
+  if (given.size() > 1) {
+    problems->Add("`" + map.Path(given[0]) + "` and `" + map.Path(given[1]) + "` at " +
+                  problems->At(map.KeyLine(given[1])) + " both give the rotation; keep one");
     ok = false;
   } else if (matrix_node) {
     ok &= ReadRotationMatrix(*matrix_node, map.Path("rotation"), problems, &rotation);
   } else if (!rpy_key.empty()) {
     ok &= rpy_ok;
     if (rpy_ok) rotation = RotationFromRpy(rpy[0], rpy[1], rpy[2]);
+  } else if (!rotvec_key.empty()) {
+    ok &= rotvec_ok;
+    if (rotvec_ok) rotation = ExpSO3<double>(Eigen::Vector3d(rotvec[0], rotvec[1], rotvec[2]));
+  } else if (quat_given) {
+    ok &= quat_ok && ReadQuaternion(quat, map.Path("quat_xyzw"), problems->At(map.KeyLine("quat_xyzw")), problems,
+                                    &rotation);
   } else {
-    map.AddMissing("`rpy_deg` (or `rpy_rad`, or `rotation`)");
+    map.AddMissing("`rpy_deg` (or `rpy_rad`, `rotation`, `rotvec_rad`, `quat_xyzw`)");
     ok = false;
   }
   map.Finish();

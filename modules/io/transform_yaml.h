@@ -11,7 +11,10 @@
 // Units are in the key: xyz_mm or xyz_m, rpy_deg or rpy_rad. Instead of rpy, `rotation` may give the
 // 3x3 matrix row by row ([[r00, r01, r02], [r10, ...], [...]]); it must be orthonormal to 1e-9 with
 // determinant +1 and is used as written. selfcal writes that form where a file must load back
-// bit-identical (observations files), and rpy where people read it (calibrated models).
+// bit-identical (observations files), and rpy where people read it (calibrated models). Two more forms
+// are read, as other tools write them: `rotvec_rad` / `rotvec_deg` (axis times angle: ViSP's theta-u
+// vector, OpenCV's Rodrigues vector) and `quat_xyzw` (a unit quaternion [x, y, z, w] as ROS writes it,
+// its norm 1 to 1e-6).
 #pragma once
 
 #include <string>

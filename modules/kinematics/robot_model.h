@@ -130,6 +130,16 @@ Rigid3T<T> BaseFromCam(const RobotModel& model, const T* rho, const T* q) {
   return BaseFromFlange(model, rho, q) * model.flange_from_cam.Cast<T>() * RigidFromTranslationRotvec(cam);
 }
 
+// The camera of a pose whose flange pose was recorded by the controller (data without joint angles):
+//   base_from_cam = base_from_link0 * Exp(base correction) * base_from_flange * flange_from_cam * Exp(cam)
+// with the camera correction at rho[CamOffset()]; the link parameters of rho take no part.
+template <typename T>
+Rigid3T<T> BaseFromCamGivenFlange(const RobotModel& model, const T* rho, const Rigid3& base_from_flange) {
+  const T* cam = rho + 6 + 5 * model.num_joints();
+  return model.base_from_link0.Cast<T>() * RigidFromTranslationRotvec(rho) * base_from_flange.Cast<T>() *
+         model.flange_from_cam.Cast<T>() * RigidFromTranslationRotvec(cam);
+}
+
 // Double convenience overloads.
 Rigid3 BaseFromFlange(const RobotModel& model, const Eigen::VectorXd& rho, const Eigen::VectorXd& q);
 Rigid3 BaseFromCam(const RobotModel& model, const Eigen::VectorXd& rho, const Eigen::VectorXd& q);

@@ -18,9 +18,33 @@ std::vector<int> ObservationSet::PosesWithRole(PoseRole role) const {
   return out;
 }
 
+RobotModel FlangePoseModel(const Rigid3& flange_from_cam) {
+  RobotModel model;
+  model.name = "flange poses";
+  model.flange_from_cam = flange_from_cam;
+  return model;
+}
+
+bool ObservationSet::UsesFlangePoses() const {
+  if (poses.empty() || robot.num_joints() != 0) return false;
+  for (const PoseObservation& pose : poses) {
+    if (!pose.base_from_flange) return false;
+  }
+  return true;
+}
+
+Rigid3 BaseFromCamAt(const RobotModel& robot, const Eigen::VectorXd& rho, const PoseObservation& pose) {
+  if (pose.base_from_flange) return BaseFromCamGivenFlange<double>(robot, rho.data(), *pose.base_from_flange);
+  return BaseFromCam(robot, rho, pose.joints_rad);
+}
+
 std::string ObservationSet::Validate() const {
   std::ostringstream out;
-  out << robot.Validate() << camera.Validate();
+  bool any_flange_pose = false;
+  for (const PoseObservation& pose : poses) any_flange_pose |= pose.base_from_flange.has_value();
+  // A flange-pose set's model has no joints: only its hand-eye transform is the robot's part.
+  if (robot.num_joints() != 0 || !any_flange_pose) out << robot.Validate();
+  out << camera.Validate();
   if (!(pixel_noise_px >= kMinPixelNoisePx && pixel_noise_px <= kMaxPixelNoisePx)) {
     out << "pixel_noise_px = " << pixel_noise_px << " must lie in [" << kMinPixelNoisePx << ", " << kMaxPixelNoisePx
         << "] px\n";
@@ -29,6 +53,17 @@ std::string ObservationSet::Validate() const {
   std::set<int> seen_dots;
   for (const PoseObservation& pose : poses) {
     if (!ids.insert(pose.id).second) out << "pose " << pose.id << ": duplicate pose id\n";
+    if (pose.base_from_flange) {
+      if (robot.num_joints() != 0) {
+        out << "pose " << pose.id << ": gives a flange pose, but the robot has joints (give joint angles with a "
+            << "robot, or flange poses without one)\n";
+      }
+      if (!pose.base_from_flange->translation.allFinite() || !pose.base_from_flange->rotation.allFinite()) {
+        out << "pose " << pose.id << ": the flange pose is not finite\n";
+      }
+    } else if (robot.num_joints() == 0) {
+      out << "pose " << pose.id << ": no flange pose (a set without a robot needs base_from_flange in every pose)\n";
+    }
     if (pose.joints_rad.size() != robot.num_joints()) {
       out << "pose " << pose.id << ": " << pose.joints_rad.size() << " joint values, the robot has "
           << robot.num_joints() << "\n";

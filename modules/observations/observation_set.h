@@ -1,9 +1,13 @@
 // What a calibration consumes, independent of where it came from (simulator, session, or a file written
 // by another tool; docs/observations-format.md is the file form): the nominal robot, the camera, and per
-// pose the joint angles and the pixel of each detected dot, by dot id.
+// pose the joint angles and the pixel of each detected dot, by dot id. Data recorded by a cell that logs
+// the controller's flange pose instead of joint angles gives base_from_flange per pose; such a set has no
+// kinematic model to identify (ObservationSet::robot has no joints: only the base and camera corrections
+// exist, and the calibration solves the hand-eye transform, the intrinsics and the scene).
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,7 +24,8 @@ const char* PoseRoleName(PoseRole role);
 struct PoseObservation {
   std::string id;                               // unique within the set (e.g. "p07")
   PoseRole role = PoseRole::kIdentification;
-  Eigen::VectorXd joints_rad;                   // one per robot joint
+  Eigen::VectorXd joints_rad;                   // one per robot joint (none for a flange-pose set)
+  std::optional<Rigid3> base_from_flange;       // the controller's flange pose, m and rad (flange-pose sets)
   std::map<int, Eigen::Vector2d> dots_px;       // dot id -> pixel (u right, v down, origin top-left centre)
 };
 
@@ -40,17 +45,32 @@ inline constexpr double kMaxPixelNoisePx = 100.0;
 struct ObservationSet {
   RobotModel robot;                  // nominal model
   CameraIntrinsics camera;           // fx_px is the nominal / initial value (f_x is estimated)
+  // False for a flange-pose set that gave no nominal hand-eye transform (robot.flange_from_cam is then
+  // the identity): the calibration starts it from the images and the flange motions.
+  bool flange_from_cam_known = true;
   double pixel_noise_px = 0.5;       // expected std of the centroids, for weights and uncertainty
   std::vector<KnownDistance> yardsticks;
   std::vector<KnownDistance> check_distances;  // held out from the solve: verification only
   std::vector<PoseObservation> poses;
 
+  // True when every pose gives base_from_flange (and the robot has no joints): the calibration then
+  // estimates the hand-eye transform, the intrinsics and the scene, not kinematics; the scale comes from
+  // the flange translations, so yardsticks are checks.
+  bool UsesFlangePoses() const;
   // Indices of poses with the given role, in file order.
   std::vector<int> PosesWithRole(PoseRole role) const;
   // Empty when consistent; otherwise every problem, one per line, naming the pose id and dot id
-  // (joint count, non-finite values, duplicate pose ids, yardstick dots never seen, ...).
+  // (joint count, non-finite values, duplicate pose ids, yardstick dots never seen, flange poses in some
+  // poses only, ...).
   std::string Validate() const;
 };
+
+// The model of a flange-pose set: no joints, identity base, the nominal hand-eye transform.
+RobotModel FlangePoseModel(const Rigid3& flange_from_cam);
+
+// The camera of `pose` in the base frame of `robot` with parameters rho: through the joints, or, for a
+// flange-pose set, through the recorded flange pose (kinematics/robot_model.h, BaseFromCamGivenFlange).
+Rigid3 BaseFromCamAt(const RobotModel& robot, const Eigen::VectorXd& rho, const PoseObservation& pose);
 
 // Pixels of the dots seen in both poses, matched by id (D6: correspondence by id, never by index).
 struct Matches {

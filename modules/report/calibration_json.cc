@@ -155,7 +155,9 @@ json PaperSectionJson(const ObservationSet& obs, const calibration::PaperPipelin
   for (double l : r.yardstick.measured_lengths_m) lengths.push_back(l);
   return {
       {"description", "paper pipeline (Meng & Zhuang 2001): factor method, eq. (21) scale, LM identification, yardstick"},
-      {"verdict", calibration::VerdictName(calibration::VerdictFor(r.outcome))},
+      // A paper pipeline that was not run (flange poses) has no verdict of its own.
+      {"verdict", r.outcome == calibration::Outcome::kNotRun ? "not_run"
+                                                               : calibration::VerdictName(calibration::VerdictFor(r.outcome))},
       {"outcome", calibration::OutcomeName(r.outcome)},
       {"message", r.message},
       {"fx_px", r.fx_px},
@@ -241,6 +243,40 @@ json SessionJson(const ReportInput& input, const SessionContext& session) {
           {"warnings", session.findings}};
 }
 
+// A flange-pose set's hand-eye start and, when accepted, the calibrated transform with its sigmas.
+json HandEyeJson(const calibration::CalibrationReport& report) {
+  const calibration::HandEyeStartReport& start = *report.hand_eye_start;
+  json j;
+  j["start"] = {{"ok", start.ok},
+                {"message", start.message},
+                {"pairs_tried", start.pairs.size()},
+                {"rotation_pairs", start.rotation_pairs},
+                {"translation_pairs", start.translation_pairs},
+                {"rotation_residual_rms_rad", start.rotation_rms_rad},
+                {"fx_px", start.fx_px},
+                {"fx_from_images", start.fx_from_images}};
+  j["flange_from_cam"] = json();
+  if (report.model) {
+    const Rigid3& x = report.model->robot.flange_from_cam;
+    const Eigen::Vector3d w = LogSO3(x.rotation);
+    json calibrated = {{"xyz_m", {x.translation.x(), x.translation.y(), x.translation.z()}},
+                       {"rotvec_rad", {w.x(), w.y(), w.z()}}};
+    json rows = json::array();
+    for (int r = 0; r < 3; ++r) rows.push_back({x.rotation(r, 0), x.rotation(r, 1), x.rotation(r, 2)});
+    calibrated["rotation"] = rows;
+    calibrated["stddev"] = json();
+    const bundle::BundleReport& b = report.bundle->bundle;
+    const int cam = KinematicParameters(0).CamOffset();
+    if (b.covariance_available && b.stddev.size() >= cam + 6) {
+      calibrated["stddev"] = {{"xyz_m", {b.stddev[cam], b.stddev[cam + 1], b.stddev[cam + 2]}},
+                              {"rotvec_rad", {b.stddev[cam + 3], b.stddev[cam + 4], b.stddev[cam + 5]}},
+                              {"frame", "camera (of a correction flange_from_cam * Exp(delta))"}};
+    }
+    j["flange_from_cam"] = calibrated;
+  }
+  return j;
+}
+
 }  // namespace
 
 json CalibrationReportJson(const ObservationSet& obs, const calibration::CalibrationReport& report,
@@ -267,6 +303,7 @@ json CalibrationReportJson(const ObservationSet& obs, const calibration::Calibra
   j["heldout_reprojection"] = chosen.contains("heldout_reprojection") ? chosen["heldout_reprojection"] : json();
   j["methods"] = methods;
   j["session"] = context.session ? SessionJson(context.input, *context.session) : json();
+  if (report.hand_eye_start) j["hand_eye"] = HandEyeJson(report);
   // Timing in one place, so that two reports of the same input compare equal without it.
   const calibration::PaperPipelineReport& p = report.paper;
   j["timing"] = {{"paper_two_view_s", p.seconds_two_view},

@@ -65,14 +65,17 @@ void PrintHeldOut(const calibration::BundleStageReport& stage, std::ostream& out
   out.unsetf(std::ios::floatfield);
 }
 
-void PrintBundleSummary(const calibration::BundleStageReport& stage, std::ostream& out) {
+void PrintBundleSummary(const calibration::BundleStageReport& stage, bool flange_poses, std::ostream& out) {
   const bundle::BundleReport& b = stage.bundle;
-  out << "kinematic bundle adjustment: " << bundle::OutcomeName(b.outcome);
+  out << (flange_poses ? "hand-eye bundle adjustment (recorded flange poses): " : "kinematic bundle adjustment: ")
+      << bundle::OutcomeName(b.outcome);
   if (!b.message.empty()) out << " (" << b.message << ")";
   out << "\n  start: " << stage.start_note << "\n";
   if (b.rho.size() == 0) return;
-  out << "  " << b.free_names.size() << " free kinematic parameters + f_x, " << b.fixed_names.size()
-      << " fixed; " << b.num_observations << " observations, " << b.removed.size() << " removed by the screen, "
+  out << "  " << b.free_names.size() << (flange_poses ? " free hand-eye parameters" : " free kinematic parameters")
+      << (b.fx_estimated ? " + f_x, " : ", ") << b.fixed_names.size() << " fixed";
+  if (!b.held_names.empty()) out << " (" << b.held_names.size() << " held by request)";
+  out << "; " << b.num_observations << " observations, " << b.removed.size() << " removed by the screen, "
       << b.dropped_dots.size() << " dots dropped\n";
   out << "  " << b.iterations << " iterations (" << b.termination << "), reprojection RMS " << std::setprecision(4)
       << b.rms_reprojection_px << " px; f_x = " << std::fixed << std::setprecision(3) << b.fx_px << " +- "
@@ -97,12 +100,38 @@ void PrintBundleSummary(const calibration::BundleStageReport& stage, std::ostrea
 
 }  // namespace
 
+// The hand-eye start of a flange-pose set and, when accepted, the calibrated transform with its sigmas.
+void PrintHandEye(const calibration::CalibrationReport& report, std::ostream& out) {
+  const calibration::HandEyeStartReport& start = *report.hand_eye_start;
+  out << "hand-eye start from the images and the flange motions: " << (start.ok ? "" : "failed: ") << start.message
+      << "\n";
+  if (!report.model || !report.bundle) return;
+  const Rigid3& x = report.model->robot.flange_from_cam;
+  const Eigen::Vector3d rotvec = LogSO3(x.rotation);
+  const bundle::BundleReport& b = report.bundle->bundle;
+  const int cam = KinematicParameters(0).CamOffset();
+  out << std::fixed << std::setprecision(3) << "flange_from_cam: translation [" << x.translation.x() * kMm << ", "
+      << x.translation.y() * kMm << ", " << x.translation.z() * kMm << "] mm, rotation vector ["
+      << RadToDeg(rotvec.x()) << ", " << RadToDeg(rotvec.y()) << ", " << RadToDeg(rotvec.z()) << "] deg";
+  if (b.covariance_available && b.stddev.size() >= cam + 6) {
+    out << "; std " << b.stddev[cam] * kMm << ", " << b.stddev[cam + 1] * kMm << ", " << b.stddev[cam + 2] * kMm
+        << " mm, " << RadToDeg(b.stddev[cam + 3]) << ", " << RadToDeg(b.stddev[cam + 4]) << ", "
+        << RadToDeg(b.stddev[cam + 5]) << " deg (camera frame)";
+  }
+  out << "\n";
+  out.unsetf(std::ios::floatfield);
+}
+
 void PrintCalibrationSummary(const calibration::CalibrationReport& report, std::ostream& out) {
-  out << "paper pipeline (Meng & Zhuang):\n";
-  PrintPaperSummary(report.paper, out);
+  if (report.hand_eye_start) {
+    PrintHandEye(report, out);
+  } else {
+    out << "paper pipeline (Meng & Zhuang):\n";
+    PrintPaperSummary(report.paper, out);
+  }
   if (report.bundle) {
     out << "\n";
-    PrintBundleSummary(*report.bundle, out);
+    PrintBundleSummary(*report.bundle, report.hand_eye_start.has_value(), out);
   }
 }
 

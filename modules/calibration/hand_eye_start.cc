@@ -1,0 +1,197 @@
+#include "calibration/hand_eye_start.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+#include <Eigen/Dense>
+
+namespace selfcal::calibration {
+
+namespace {
+
+double RotationAngle(const Eigen::Matrix3d& r) { return LogSO3(r).norm(); }
+
+// Pairs (i, j) of identification poses, i < j, nearest in file order first (the most shared dots).
+std::vector<std::pair<int, int>> PairOrder(const std::vector<int>& poses, int max_pairs) {
+  std::vector<std::pair<int, int>> pairs;
+  const int n = static_cast<int>(poses.size());
+  for (int gap = 1; gap < n; ++gap) {
+    for (int i = 0; i + gap < n; ++i) {
+      if (static_cast<int>(pairs.size()) >= max_pairs) return pairs;
+      pairs.emplace_back(poses[i], poses[i + gap]);
+    }
+  }
+  return pairs;
+}
+
+struct PairMotion {
+  int index = -1;               // into report.pairs
+  Rigid3 flange;                // A = flange_i_from_flange_j
+  Eigen::Matrix3d camera_rotation;  // R_B of cam_i_from_cam_j
+  Eigen::Vector3d camera_direction;  // unit t_B
+  bool translation = false;
+};
+
+// Kabsch: R minimising sum |a_k - R b_k|^2.
+Eigen::Matrix3d Procrustes(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  for (size_t k = 0; k < a.size(); ++k) h += b[k] * a[k].transpose();
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+  d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
+  return svd.matrixV() * d * svd.matrixU().transpose();
+}
+
+// R_X from the pairs marked for rotation, refitted once without pairs beyond 3 robust sigmas (at least
+// 0.5 deg). Returns the RMS residual (rad) and unmarks the rejected pairs.
+double FitRotation(const std::vector<PairMotion>& motions, HandEyeStartReport* report, Eigen::Matrix3d* r_x) {
+  double rms = 0;
+  for (int round = 0; round < 2; ++round) {
+    std::vector<Eigen::Vector3d> a, b;
+    std::vector<int> used;
+    for (size_t k = 0; k < motions.size(); ++k) {
+      if (!report->pairs[motions[k].index].used_for_rotation) continue;
+      a.push_back(LogSO3(motions[k].flange.rotation));
+      b.push_back(LogSO3(motions[k].camera_rotation));
+      used.push_back(static_cast<int>(k));
+    }
+    if (a.size() < 2) return -1;
+    *r_x = Procrustes(a, b);
+    std::vector<double> residuals;
+    for (size_t k = 0; k < a.size(); ++k) residuals.push_back((a[k] - *r_x * b[k]).norm());
+    std::vector<double> sorted = residuals;
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    const double limit = std::max(3.0 * 1.4826 * sorted[sorted.size() / 2], 0.5 * kPi / 180.0);
+    double sum2 = 0;
+    int kept = 0;
+    for (size_t k = 0; k < residuals.size(); ++k) {
+      if (round == 0 && residuals[k] > limit) {
+        report->pairs[motions[used[k]].index].used_for_rotation = false;
+      } else {
+        sum2 += residuals[k] * residuals[k];
+        ++kept;
+      }
+    }
+    rms = kept > 0 ? std::sqrt(sum2 / kept) : -1;
+  }
+  return rms;
+}
+
+// t_X and the pair lengths by linear least squares; pairs whose length comes out negative (a two-view
+// translation of the wrong sign) are dropped and the fit repeated.
+bool FitTranslation(const std::vector<PairMotion>& motions, const Eigen::Matrix3d& r_x, HandEyeStartReport* report,
+                    Eigen::Vector3d* t_x) {
+  for (int round = 0; round < 3; ++round) {
+    std::vector<int> used;
+    for (size_t k = 0; k < motions.size(); ++k) {
+      if (report->pairs[motions[k].index].used_for_translation) used.push_back(static_cast<int>(k));
+    }
+    const int m = static_cast<int>(used.size());
+    if (m < 2) return false;
+    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(3 * m, 3 + m);
+    Eigen::VectorXd rhs(3 * m);
+    for (int k = 0; k < m; ++k) {
+      const PairMotion& pm = motions[used[k]];
+      a.block<3, 3>(3 * k, 0) = pm.flange.rotation - Eigen::Matrix3d::Identity();
+      a.block<3, 1>(3 * k, 3 + k) = -(r_x * pm.camera_direction);
+      rhs.segment<3>(3 * k) = -pm.flange.translation;
+    }
+    const Eigen::VectorXd x = a.colPivHouseholderQr().solve(rhs);
+    if (!x.allFinite()) return false;
+    *t_x = x.head<3>();
+    bool changed = false;
+    for (int k = 0; k < m; ++k) {
+      if (x[3 + k] <= 0) {
+        report->pairs[motions[used[k]].index].used_for_translation = false;
+        changed = true;
+      }
+    }
+    if (!changed) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+HandEyeStartReport StartHandEye(const ObservationSet& obs, const HandEyeStartOptions& options) {
+  HandEyeStartReport report;
+  report.fx_px = obs.camera.fx_px;
+  if (!obs.UsesFlangePoses()) {
+    report.message = "the hand-eye start needs a flange pose in every pose";
+    return report;
+  }
+  std::vector<PairMotion> motions;
+  std::vector<double> focal;
+  for (const auto& [i, j] : PairOrder(obs.PosesWithRole(PoseRole::kIdentification), options.max_pairs)) {
+    const PoseObservation& pi = obs.poses[i];
+    const PoseObservation& pj = obs.poses[j];
+    HandEyePair pair;
+    pair.pose_a = pi.id;
+    pair.pose_b = pj.id;
+    PairMotion pm;
+    pm.flange = pi.base_from_flange->Inverse() * *pj.base_from_flange;
+    pair.flange_angle_rad = RotationAngle(pm.flange.rotation);
+    const Matches matches = MatchById(pi, pj);
+    if (static_cast<int>(matches.dot_ids.size()) >= options.min_matches) {
+      const twoview::TwoViewReport tv = twoview::EstimateTwoView(options.two_view, obs.camera, matches.pixels_a, matches.pixels_b);
+      pair.outcome = tv.outcome;
+      const bool has_rotation = tv.outcome == twoview::Outcome::kSuccess || tv.outcome == twoview::Outcome::kAmbiguousPose ||
+                                tv.outcome == twoview::Outcome::kPureRotation || tv.outcome == twoview::Outcome::kNoConvergence;
+      if (has_rotation) {
+        // The estimate is cam_j_from_cam_i: B = its inverse.
+        pm.camera_rotation = tv.rotation.transpose();
+        pm.camera_direction = -(tv.rotation.transpose() * tv.translation_direction);
+        pair.camera_angle_rad = RotationAngle(pm.camera_rotation);
+        const bool angles_agree = std::abs(pair.camera_angle_rad - pair.flange_angle_rad) <= options.max_angle_mismatch_rad;
+        pair.used_for_rotation = angles_agree && pair.flange_angle_rad >= options.min_flange_angle_rad;
+        pair.used_for_translation = angles_agree && tv.translation_observable &&
+                                    (tv.outcome == twoview::Outcome::kSuccess || tv.outcome == twoview::Outcome::kAmbiguousPose);
+        if (tv.outcome == twoview::Outcome::kSuccess && tv.fx_observable && angles_agree) focal.push_back(tv.fx_px);
+      }
+    }
+    pm.index = static_cast<int>(report.pairs.size());
+    report.pairs.push_back(pair);
+    if (pair.used_for_rotation || pair.used_for_translation) motions.push_back(pm);
+  }
+  Eigen::Matrix3d r_x;
+  report.rotation_rms_rad = FitRotation(motions, &report, &r_x);
+  if (report.rotation_rms_rad < 0) {
+    report.message = "fewer than two pose pairs with a rotation of at least 2 deg whose camera motion, estimated from "
+                     "the dots both images see, turns by the flange's angle: rotate the wrist more between poses";
+    return report;
+  }
+  // A pair whose rotation disagrees with the fitted hand-eye rotation gives no trusted direction either.
+  for (const PairMotion& pm : motions) {
+    HandEyePair& pair = report.pairs[pm.index];
+    if (pair.used_for_translation && pair.flange_angle_rad >= options.min_flange_angle_rad && !pair.used_for_rotation) {
+      pair.used_for_translation = false;
+    }
+  }
+  Eigen::Vector3d t_x;
+  if (!FitTranslation(motions, r_x, &report, &t_x)) {
+    report.message = "the hand-eye translation is not determined: too few pose pairs with an observable camera "
+                     "translation, or only parallel rotation axes";
+    return report;
+  }
+  for (const HandEyePair& p : report.pairs) {
+    report.rotation_pairs += p.used_for_rotation ? 1 : 0;
+    report.translation_pairs += p.used_for_translation ? 1 : 0;
+  }
+  if (!focal.empty()) {
+    std::nth_element(focal.begin(), focal.begin() + focal.size() / 2, focal.end());
+    report.fx_px = focal[focal.size() / 2];
+    report.fx_from_images = true;
+  }
+  report.flange_from_cam = Rigid3(r_x, t_x);
+  report.ok = true;
+  std::ostringstream msg;
+  msg << "hand-eye start from " << report.rotation_pairs << " rotation and " << report.translation_pairs
+      << " translation pairs of " << report.pairs.size() << ", rotation residual RMS "
+      << report.rotation_rms_rad * 180.0 / kPi << " deg";
+  report.message = msg.str();
+  return report;
+}
+
+}  // namespace selfcal::calibration

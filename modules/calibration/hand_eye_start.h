@@ -1,0 +1,58 @@
+// The start of a flange-pose calibration: the hand-eye transform flange_from_cam from the images and
+// the recorded flange motions, without any target (the scene's dots are unknown).
+//
+// For pairs (i, j) of identification poses, A = flange_i_from_flange_j (recorded) and
+// B = cam_i_from_cam_j (the two-view estimate from the dots both images see: its rotation and the
+// direction of its translation) satisfy A X = X B with X = flange_from_cam. Then:
+//   rotation:    the rotation vectors obey a_A = R_X a_B, so R_X is the orthogonal Procrustes (Kabsch)
+//                fit over every pair whose two rotation angles agree (the angle of a relative motion is
+//                the same for the flange and the camera, whatever X is: a free consistency check that
+//                throws out a pair with a wrong two-view rotation, e.g. the wrong one of a flat scene's
+//                two solutions), refitted without the pairs that leave large residuals;
+//   translation: (R_A - I) t_X - s_ij R_X b_ij = -t_A with b_ij the unit translation of B and one unknown
+//                length s_ij > 0 per pair: linear least squares in t_X and the s_ij (Tsai and Lenz's
+//                equation with the camera's translation known only in direction).
+// f_x: the median of the pairs' focal estimates where a pair observes it, else the prior.
+//
+// Works on an ObservationSet only (its poses' base_from_flange); no files, no hardware.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "geometry/rigid3.h"
+#include "observations/observation_set.h"
+#include "twoview/two_view.h"
+
+namespace selfcal::calibration {
+
+struct HandEyePair {
+  std::string pose_a, pose_b;
+  twoview::Outcome outcome = twoview::Outcome::kNotRun;
+  double flange_angle_rad = 0;  // rotation angle of the recorded flange motion
+  double camera_angle_rad = 0;  // of the two-view estimate of the camera motion
+  bool used_for_rotation = false, used_for_translation = false;
+};
+
+struct HandEyeStartReport {
+  bool ok = false;
+  std::string message;
+  Rigid3 flange_from_cam;
+  double fx_px = 0;
+  bool fx_from_images = false;
+  int rotation_pairs = 0, translation_pairs = 0;
+  double rotation_rms_rad = 0;     // of |a_A - R_X a_B| over the rotation pairs used
+  std::vector<HandEyePair> pairs;
+};
+
+struct HandEyeStartOptions {
+  twoview::TwoViewOptions two_view;
+  int max_pairs = 200;                       // pairs tried, nearest poses in file order first
+  double min_flange_angle_rad = 0.035;       // ~2 deg: below it a pair's rotation axis is noise
+  double max_angle_mismatch_rad = 0.035;     // flange angle vs camera angle
+  int min_matches = 8;
+};
+
+HandEyeStartReport StartHandEye(const ObservationSet& observations, const HandEyeStartOptions& options);
+
+}  // namespace selfcal::calibration

@@ -1,0 +1,118 @@
+// Flange-pose sets: the hand-eye start from the images and the hand-eye bundle adjustment, against the
+// simulator's hidden truth (the flange poses are the true arm's, the camera's true pose per image known).
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "calibration/calibrate.h"
+#include "calibration/hand_eye_start.h"
+#include "support/sim_worlds.h"
+
+namespace selfcal::calibration {
+namespace {
+
+struct FlangeWorld {
+  ObservationSet observations;
+  Rigid3 flange_from_cam_true;
+  double fx_true = 0;
+};
+
+// The standard world recorded as a cell that logs flange poses: each pose's joints replaced by the true
+// arm's flange pose, no robot, no nominal hand-eye transform.
+FlangeWorld MakeFlangeWorld(double noise_px) {
+  const sim::SimResult world = testing::PumaArcWorld(noise_px, 3, 3);
+  FlangeWorld out;
+  out.fx_true = world.truth.camera_true.fx_px;
+  ObservationSet& obs = out.observations;
+  obs = world.observations;
+  obs.robot = FlangePoseModel(Rigid3());
+  obs.flange_from_cam_known = false;
+  for (size_t i = 0; i < obs.poses.size(); ++i) {
+    PoseObservation& pose = obs.poses[i];
+    const Rigid3 base_from_flange = BaseFromFlange(world.truth.nominal, world.truth.rho_true, pose.joints_rad);
+    if (i == 0) out.flange_from_cam_true = base_from_flange.Inverse() * world.truth.base_from_cam[i];
+    pose.base_from_flange = base_from_flange;
+    pose.joints_rad.resize(0);
+  }
+  return out;
+}
+
+double AngleBetween(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) { return LogSO3(a.transpose() * b).norm(); }
+
+TEST(HandEye, TheFlangePoseSetIsValidAndUsesFlangePoses) {
+  const FlangeWorld w = MakeFlangeWorld(0.2);
+  EXPECT_EQ(w.observations.Validate(), "");
+  EXPECT_TRUE(w.observations.UsesFlangePoses());
+  ObservationSet mixed = w.observations;
+  mixed.poses[1].base_from_flange.reset();
+  EXPECT_FALSE(mixed.UsesFlangePoses());
+  EXPECT_NE(mixed.Validate().find("pose " + mixed.poses[1].id + ": no flange pose"), std::string::npos) << mixed.Validate();
+}
+
+// Noise-free and with the true f_x (pairs that cannot observe f_x use the prior): the linear start is
+// exact up to the two-view estimates' convergence.
+TEST(HandEye, StartIsExactOnNoiseFreeImages) {
+  FlangeWorld w = MakeFlangeWorld(0.0);
+  w.observations.camera.fx_px = w.fx_true;
+  const HandEyeStartReport start = StartHandEye(w.observations, HandEyeStartOptions());
+  ASSERT_TRUE(start.ok) << start.message;
+  EXPECT_GE(start.rotation_pairs, 5);
+  EXPECT_LT(AngleBetween(start.flange_from_cam.rotation, w.flange_from_cam_true.rotation), 1e-6);
+  EXPECT_LT((start.flange_from_cam.translation - w.flange_from_cam_true.translation).norm(), 1e-6);
+}
+
+// With 0.2 px noise the bundle recovers the hand-eye transform and f_x within 4 of its own sigmas
+// (the flange poses are exact here, so nothing else limits it), and the yardstick became a check that
+// the metric flange translations reproduce.
+TEST(HandEye, BundleRecoversTheHandEyeTransformWithinItsSigmas) {
+  const FlangeWorld w = MakeFlangeWorld(0.2);
+  const CalibrationReport report = Calibrate(w.observations, CalibrateOptions());
+  ASSERT_TRUE(report.accepted()) << report.message;
+  ASSERT_TRUE(report.hand_eye_start.has_value());
+  ASSERT_TRUE(report.bundle.has_value());
+  const bundle::BundleReport& b = report.bundle->bundle;
+  EXPECT_EQ(b.free_names.size(), 6u) << b.message;  // cam.tx .. cam.rz; the base is the gauge
+  ASSERT_TRUE(b.covariance_available) << b.covariance_message;
+  const Rigid3 estimated = report.model->robot.flange_from_cam;
+  const KinematicParameters params(0);
+  for (int k = 0; k < 3; ++k) {
+    const double sd = b.stddev[params.CamOffset() + k];
+    EXPECT_NEAR(estimated.translation[k], w.flange_from_cam_true.translation[k], 4 * sd) << k;
+  }
+  // Rotation: the error vector in the camera frame against the camera correction's sigmas.
+  const Eigen::Vector3d rotation_error = LogSO3(estimated.rotation.transpose() * w.flange_from_cam_true.rotation);
+  for (int k = 0; k < 3; ++k) EXPECT_LT(std::abs(rotation_error[k]), 4 * b.stddev[params.CamOffset() + 3 + k]) << k;
+  EXPECT_NEAR(b.fx_px, w.fx_true, 4 * b.fx_stddev);
+  EXPECT_EQ(report.model->method_description, "hand-eye bundle adjustment on recorded flange poses");
+  EXPECT_TRUE(report.bundle->heldout.ok) << report.bundle->heldout.message;
+}
+
+// The paper's method needs joints: refused by name, not run on flange poses.
+TEST(HandEye, PaperMethodRefusesFlangePoses) {
+  const FlangeWorld w = MakeFlangeWorld(0.2);
+  CalibrateOptions options;
+  options.method = Method::kPaper;
+  const CalibrationReport report = Calibrate(w.observations, options);
+  EXPECT_EQ(report.verdict, Verdict::kInvalidInput);
+  EXPECT_NE(report.message.find("flange poses"), std::string::npos) << report.message;
+}
+
+// With joints and a robot, holding the kinematics gives the hand-eye-only solve: only the camera
+// correction (and f_x) is estimated.
+TEST(HandEye, HoldingTheKinematicsLeavesOnlyTheCamera) {
+  const sim::SimResult world = testing::PumaArcWorld(0.2, 3, 3);
+  CalibrateOptions options;
+  options.bundle.bundle.held_parameters = {"kinematics"};
+  const CalibrationReport report = Calibrate(world.observations, options);
+  ASSERT_TRUE(report.bundle.has_value());
+  const bundle::BundleReport& b = report.bundle->bundle;
+  for (const std::string& name : b.free_names) EXPECT_EQ(name.rfind("cam.", 0), 0u) << name;
+  EXPECT_FALSE(b.free_names.empty()) << b.message;
+  options.bundle.bundle.held_parameters = {"j9"};
+  const CalibrationReport bad = Calibrate(world.observations, options);
+  EXPECT_EQ(bad.verdict, Verdict::kInvalidInput);
+  EXPECT_NE(bad.message.find("unknown parameter `j9`"), std::string::npos) << bad.message;
+}
+
+}  // namespace
+}  // namespace selfcal::calibration

@@ -1,0 +1,44 @@
+// The result of a hand-eye calibration on recorded flange poses (a flange-pose observations set,
+// docs/observations-format.md): the camera in the flange frame, f_x, and their standard deviations.
+//
+//   format: selfcal-hand-eye
+//   version: 1
+//   flange_from_cam: {xyz_mm: [...], rpy_deg: [...]}            # for people (rpy as in transform_yaml.h)
+//   flange_from_cam_exact: {xyz_m: [...], rotation: [[...], [...], [...]]}   # loads back bit-identical
+//   flange_from_cam_quat_xyzw: [x, y, z, w]                       # the same rotation as ROS writes it
+//   flange_from_cam_stddev: {xyz_mm: [...], rotvec_deg: [...]}    # of the correction in the camera frame
+//   fx_px: 607.2
+//   fx_stddev_px: 0.4
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "base/status.h"
+#include "geometry/rigid3.h"
+
+namespace selfcal::io {
+
+inline constexpr const char* kHandEyeFormat = "selfcal-hand-eye";
+
+struct HandEyeResult {
+  Rigid3 flange_from_cam;
+  // Of flange_from_cam * Exp(correction): translation (m) and rotation vector (rad), camera frame;
+  // NaN where unavailable.
+  Eigen::Matrix<double, 6, 1> stddev = Eigen::Matrix<double, 6, 1>::Constant(NAN);
+  double fx_px = 0;
+  double fx_stddev_px = NAN;
+  std::string source;
+  std::vector<std::pair<std::string, std::string>> provenance;
+};
+
+// Writes the result atomically; refuses non-finite values.
+Status SaveHandEye(const HandEyeResult& result, const std::string& path);
+
+// Reads a file written by SaveHandEye (the exact transform; the rounded one must agree to 1e-6).
+Result<HandEyeResult> LoadHandEye(const std::string& path);
+
+}  // namespace selfcal::io
