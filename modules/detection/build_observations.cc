@@ -11,8 +11,18 @@ Result<ObservationSet> BuildObservationSet(const std::vector<std::string>& pose_
   SELFCAL_CHECK(pose_ids.size() == points.size() && points.size() == robot_poses.size(),
                 "BuildObservationSet: " << pose_ids.size() << " ids, " << points.size() << " point sets, "
                                         << robot_poses.size() << " robot poses");
+  size_t flange_poses = 0;
+  for (const ImageRobotPose& p : robot_poses) flange_poses += p.base_from_flange.has_value() ? 1 : 0;
+  if (flange_poses != 0 && flange_poses != robot_poses.size()) {
+    return Status::Error(ErrorCode::kInvalidInput, std::to_string(flange_poses) + " of " +
+                                                       std::to_string(robot_poses.size()) +
+                                                       " images have flange poses and the others joint angles: give "
+                                                       "one or the other for every image");
+  }
+  const bool flange_set = flange_poses != 0;
   ObservationSet set;
-  set.robot = setup.robot;
+  set.robot = flange_set ? FlangePoseModel(setup.flange_from_cam.value_or(Rigid3())) : setup.robot;
+  set.flange_from_cam_known = !flange_set || setup.flange_from_cam.has_value();
   set.camera = setup.camera;
   set.pixel_noise_px = setup.pixel_noise_px;
   set.yardsticks = setup.yardsticks;
@@ -22,15 +32,14 @@ Result<ObservationSet> BuildObservationSet(const std::vector<std::string>& pose_
       failed += "\n  - " + pose_ids[i] + ": " + (points[i].message.empty() ? "no point found" : points[i].message);
       continue;
     }
-    if (robot_poses[i].base_from_flange.has_value()) {
-      return Status::Error(ErrorCode::kInvalidInput,
-                           pose_ids[i] + ": flange poses (base_from_flange) cannot be written to an observations "
-                                         "file by this version; give joint angles in a selfcal-poses list");
-    }
     PoseObservation pose;
     pose.id = pose_ids[i];
     pose.role = PoseRole::kIdentification;
-    pose.joints_rad = robot_poses[i].joints_rad;
+    if (flange_set) {
+      pose.base_from_flange = robot_poses[i].base_from_flange;
+    } else {
+      pose.joints_rad = robot_poses[i].joints_rad;
+    }
     pose.dots_px = points[i].points_px;
     set.poses.push_back(std::move(pose));
   }

@@ -26,9 +26,11 @@ double WorstError(const std::vector<Eigen::Vector2d>& found, const std::vector<E
   return worst;
 }
 
-// cornerSubPix on a supersampled board with grey noise 1: a few hundredths of a pixel; a corner on the
-// wrong id is at least one square (~28 px) off.
-constexpr double kCornerTolPx = 0.2;
+// cornerSubPix on a supersampled board with grey noise 1, measured: worst 0.06 px (RMS 0.04) on a board
+// turned by 30 degrees, worst 0.25 px (RMS 0.11) when its edges run along the pixel rows and columns (the
+// refinement's known weakness there; no mean offset either way). A corner on the wrong id is at least one
+// square (~28 px) off.
+constexpr double kCornerTolPx = 0.3;
 
 TEST(Chessboard, ValidateNamesEveryProblem) {
   ChessboardOptions o = Board(1, 9);

@@ -84,16 +84,19 @@ struct ImageRobotPose {
 };
 
 struct ObservationSetup {
-  RobotModel robot;                    // nominal; required for joint poses
+  RobotModel robot;                    // nominal; for joint poses (a flange-pose set has FlangePoseModel)
+  std::optional<Rigid3> flange_from_cam;  // flange poses: the nominal hand-eye transform, when known
   CameraIntrinsics camera;             // nominal (width and height are the images')
   double pixel_noise_px = 0.5;
   std::vector<KnownDistance> yardsticks;
   bool skip_failed = false;            // leave images without points out instead of refusing the set
 };
 
-// One identification pose per image, id `pose_ids[i]`, with the image's points and robot pose. An image
-// whose detection failed is refused (kDegenerateData naming the pose id and why) unless skip_failed; so
-// is a set with no points, and any set ObservationSet::Validate() refuses (kInvalidInput).
+// One identification pose per image, id `pose_ids[i]`, with the image's points and robot pose: joint
+// angles on setup.robot, or flange poses (every image, or none) on FlangePoseModel(flange_from_cam), with
+// flange_from_cam_known when it was given. An image whose detection failed is refused (kDegenerateData
+// naming the pose id and why) unless skip_failed; so is a set with no points; mixed flange and joint
+// poses, and any set ObservationSet::Validate() refuses, are kInvalidInput.
 Result<ObservationSet> BuildObservationSet(const std::vector<std::string>& pose_ids,
                                            const std::vector<ImagePoints>& points,
                                            const std::vector<ImageRobotPose>& robot_poses,

@@ -118,7 +118,7 @@ TEST(DetectAllImagePoints, ChessboardSequenceKeepsIds) {
     ASSERT_TRUE(points[i].ok) << "image " << i << ": " << points[i].message;
     const std::vector<Eigen::Vector2d> truth = TruePoints(views[i], kBoardRows, kBoardCols);
     for (const auto& [id, px] : points[i].points_px) {
-      EXPECT_LT((px - truth[static_cast<size_t>(id)]).norm(), 0.2) << "image " << i << " id " << id;
+      EXPECT_LT((px - truth[static_cast<size_t>(id)]).norm(), 0.3) << "image " << i << " id " << id;  // chessboard_test.cc
     }
   }
 }
@@ -130,7 +130,7 @@ ImagePoints Found(std::map<int, Eigen::Vector2d> px) {
   return p;
 }
 
-ObservationSetup Setup() {
+ObservationSetup JointSetup() {
   ObservationSetup s;
   s.robot = selfcal::testing::Puma560();
   s.camera.width_px = 640;
@@ -144,7 +144,7 @@ TEST(BuildObservationSet, OneIdentificationPosePerImage) {
   const std::vector<ImagePoints> points = {Found({{0, {10, 20}}, {1, {30, 40}}}), Found({{0, {11, 21}}, {1, {31, 41}}})};
   const std::vector<ImageRobotPose> poses = {{std::nullopt, Eigen::VectorXd::Zero(6)},
                                              {std::nullopt, Eigen::VectorXd::Constant(6, 0.1)}};
-  ObservationSetup setup = Setup();
+  ObservationSetup setup = JointSetup();
   setup.yardsticks.push_back({0, 1, 0.25});
   const Result<ObservationSet> set = BuildObservationSet({"img_0", "img_1"}, points, poses, setup);
   ASSERT_TRUE(set.ok()) << set.status().message();
@@ -163,7 +163,7 @@ TEST(BuildObservationSet, AFailedImageIsRefusedUnlessSkipped) {
   const std::vector<ImagePoints> points = {Found({{0, {10, 20}}}), failed};
   const std::vector<ImageRobotPose> poses = {{std::nullopt, Eigen::VectorXd::Zero(6)},
                                              {std::nullopt, Eigen::VectorXd::Zero(6)}};
-  ObservationSetup setup = Setup();
+  ObservationSetup setup = JointSetup();
   const Result<ObservationSet> refused = BuildObservationSet({"a", "b"}, points, poses, setup);
   ASSERT_FALSE(refused.ok());
   EXPECT_EQ(refused.status().code(), ErrorCode::kDegenerateData);
@@ -179,6 +179,33 @@ TEST(BuildObservationSet, AFailedImageIsRefusedUnlessSkipped) {
   const Result<ObservationSet> bad = BuildObservationSet({"a", "b"}, points, short_joints, setup);
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.status().message().find("pose a: 5 joint values"), std::string::npos) << bad.status().message();
+}
+
+// Flange poses: the set has no joints (FlangePoseModel), the hand-eye transform is known only when given;
+// flange poses in some images only are refused.
+TEST(BuildObservationSet, FlangePoses) {
+  const std::vector<ImagePoints> points = {Found({{0, {10, 20}}}), Found({{0, {12, 22}}})};
+  const Rigid3 a(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.5, 0, 0.4));
+  const Rigid3 b(RotZ(0.3), Eigen::Vector3d(0.5, 0.1, 0.4));
+  const std::vector<ImageRobotPose> poses = {{a, Eigen::VectorXd()}, {b, Eigen::VectorXd()}};
+  ObservationSetup setup = JointSetup();
+  Result<ObservationSet> set = BuildObservationSet({"1", "2"}, points, poses, setup);
+  ASSERT_TRUE(set.ok()) << set.status().message();
+  EXPECT_TRUE(set->UsesFlangePoses());
+  EXPECT_EQ(set->robot.num_joints(), 0);
+  EXPECT_FALSE(set->flange_from_cam_known);
+  ASSERT_TRUE(set->poses[1].base_from_flange.has_value());
+  EXPECT_EQ(set->poses[1].base_from_flange->translation, b.translation);
+  EXPECT_EQ(set->poses[1].joints_rad.size(), 0);
+  setup.flange_from_cam = Rigid3(RotX(0.1), Eigen::Vector3d(0, 0, 0.06));
+  set = BuildObservationSet({"1", "2"}, points, poses, setup);
+  ASSERT_TRUE(set.ok()) << set.status().message();
+  EXPECT_TRUE(set->flange_from_cam_known);
+  EXPECT_EQ(set->robot.flange_from_cam.translation, setup.flange_from_cam->translation);
+  const std::vector<ImageRobotPose> mixed = {{a, Eigen::VectorXd()}, {std::nullopt, Eigen::VectorXd::Zero(6)}};
+  const Result<ObservationSet> refused = BuildObservationSet({"1", "2"}, points, mixed, setup);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.status().message().find("1 of 2 images have flange poses"), std::string::npos);
 }
 
 }  // namespace

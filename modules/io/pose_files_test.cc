@@ -87,8 +87,7 @@ TEST(PerImagePoseFile, BadFilesNameFileLineAndKey) {
   WriteFile(bad_key, text);
   const Status s = LoadPerImagePoseFile(bad_key).status();
   EXPECT_TRUE(MessageHas(s, "unknown key `qq` at " + bad_key + ":7"));
-  EXPECT_TRUE(MessageHas(s, "did you mean `qw`"));
-  EXPECT_TRUE(MessageHas(s, "missing required key"));
+  EXPECT_TRUE(MessageHas(s, "missing required key `qw`"));
   EXPECT_EQ(s.code(), ErrorCode::kInvalidInput);
 
   const std::string not_unit = dir.File("2.yaml");
@@ -130,10 +129,10 @@ TEST(PosesList, FlangePosesAndJoints) {
 
   const RobotModel puma = selfcal::testing::Puma560();
   WriteFile(dir.File("joints.yaml"),
-            "format: selfcal-poses\nversion: 1\nposes:\n  - {image: a1.png, joints_deg: [0, -30, 120, 0, 45, 0]}\n");
+            "format: selfcal-poses\nversion: 1\nposes:\n  - {image: a1.png, joints_deg: [0, -30, -120, 0, 45, 0]}\n");
   Result<std::vector<ImagePose>> joints = LoadPosesList(dir.File("joints.yaml"), &puma);
   ASSERT_TRUE(joints.ok()) << joints.status().message();
-  EXPECT_NEAR((*joints)[0].joints_rad[2], DegToRad(120), 1e-15);
+  EXPECT_NEAR((*joints)[0].joints_rad[2], DegToRad(-120), 1e-15);
   EXPECT_FALSE((*joints)[0].base_from_flange.has_value());
   EXPECT_TRUE(MessageHas(LoadPosesList(dir.File("joints.yaml"), nullptr).status(), "need the robot's config"));
 }
@@ -155,7 +154,7 @@ TEST(PosesList, BadListsNameFileLineAndKey) {
   EXPECT_TRUE(MessageHas(s, "pose `poses[1]` at " + path + ":5 must give exactly one of"));
   EXPECT_TRUE(MessageHas(s, "poses[2].joints_deg"));
   EXPECT_TRUE(MessageHas(s, "poses[3].joints_deg[5]"));
-  EXPECT_TRUE(MessageHas(s, "unknown key `imag` at " + path + ":8"));
+  EXPECT_TRUE(MessageHas(s, "unknown key `imag` in `poses[4]` at " + path + ":8"));
   WriteFile(path, "format: selfcal-observations\nversion: 1\n");
   EXPECT_TRUE(MessageHas(LoadPosesList(path, nullptr).status(), "selfcal-poses"));
 }
