@@ -14,8 +14,8 @@ ImagePoints GridPoints(const tracking::DetectionReport& det, const DetectionOpti
   ImagePoints out;
   out.candidates = static_cast<int>(det.dots.size());
   if (r.outcome != tracking::GridOutcome::kSuccess) {
-    out.message = std::string("grid not identified (") + tracking::GridOutcomeName(r.outcome) + "): " + r.message +
-                  " [" + std::to_string(det.dots.size()) + " dots detected]";
+    out.message = std::string("grid not identified (") + tracking::GridOutcomeName(r.outcome) + "): " + r.message;
+    if (r.outcome != tracking::GridOutcome::kTooFewDots) out.message += " (" + std::to_string(det.dots.size()) + " dots detected)";
     return out;
   }
   for (const tracking::GridDot& g : r.dots) out.points_px[g.id] = g.centroid_px;
@@ -52,7 +52,7 @@ ImagePoints AprilTagPoints(const vpImage<unsigned char>& image, const tracking::
   out.ok = !out.points_px.empty();
   out.message = std::to_string(tags.size()) + " AprilTags, " + std::to_string(out.points_px.size()) + " of " +
                 std::to_string(det.dots.size()) + " dots named";
-  if (tags.empty()) out.message = "no AprilTag found [" + std::to_string(det.dots.size()) + " dots detected]";
+  if (tags.empty()) out.message = "no AprilTag found (" + std::to_string(det.dots.size()) + " dots detected)";
   return out;
 }
 

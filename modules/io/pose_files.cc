@@ -213,6 +213,15 @@ Result<std::vector<ImagePose>> LoadPosesList(const std::string& path, const Robo
 Result<std::vector<ImagePose>> LoadImagePoses(const std::string& spec, const RobotModel* robot) {
   std::vector<ImagePose> poses;
   if (!IsDirectory(spec) && !HasGlobCharacters(spec)) {
+    Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(spec);
+    if (!doc.ok()) return doc.status();
+    const yaml::YamlNode& root = doc->root;
+    if (root.IsMap() && root.Find("format") == nullptr &&
+        (root.Find("qw") || root.Find("x") || root.Find("rows") || root.Find("data"))) {
+      return Status::Error(ErrorCode::kInvalidInput,
+                           spec + ": is the pose of one image; give the directory or a glob of every image's pose "
+                                  "file (--poses DIR or 'DIR/pose_*.yaml'), or one selfcal-poses list");
+    }
     Result<std::vector<ImagePose>> list = LoadPosesList(spec, robot);
     if (!list.ok()) return list.status();
     poses = std::move(*list);

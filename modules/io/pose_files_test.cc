@@ -187,6 +187,8 @@ TEST(ImagePoses, DirectoryOfPerImageFilesMatchedToImages) {
   WriteFile(dir.File("poses/pose_3.yaml"), "x: 1\n");
   EXPECT_TRUE(MessageHas(LoadImagePoses(dir.File("poses"), nullptr).status(), dir.File("poses/pose_3.yaml")));
   EXPECT_TRUE(MessageHas(LoadImagePoses(dir.File("nothing"), nullptr).status(), dir.File("nothing")));
+  EXPECT_TRUE(MessageHas(LoadImagePoses(dir.File("poses/pose_0.yaml"), nullptr).status(),
+                         dir.File("poses/pose_0.yaml") + ": is the pose of one image; give the directory or a glob"));
 }
 
 TEST(ImageFiles, ReadsGreyAndRefusesBadOrMismatchedImages) {

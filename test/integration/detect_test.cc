@@ -271,5 +271,39 @@ TEST(DetectCli, AFailedDetectionIsDegenerateDataUnlessSkipped) {
   EXPECT_TRUE(fs::exists(dir / "sheet.png"));
 }
 
+// A selfcal-poses list of joint angles on a robot config, and the yardstick option.
+TEST(DetectCli, JointAnglesFromAPosesListAndAYardstick) {
+  const fs::path dir = SmallRosCopy("joints");
+  fs::remove_all(dir / "poses");
+  WriteText(dir / "poses.yaml",
+            "format: selfcal-poses\nversion: 1\nposes:\n"
+            "  - {image: 0.png, joints_deg: [0, -30, -120, 0, 45, 0]}\n"
+            "  - {image: 1.png, joints_deg: [5, -35, -115, 3, 40, 10]}\n"
+            "  - {image: 2.png, joints_deg: [-5, -25, -125, -3, 50, -10]}\n");
+  const std::string base = "detect --images " + (dir / "images").string() + " --poses " + (dir / "poses.yaml").string() +
+                           " --camera-fx-px 542.3 --out " + (dir / "obs.yaml").string();
+  std::string out;
+  EXPECT_EQ(RunSelfcal(base, &out), 2) << out;
+  EXPECT_NE(out.find("need the robot's config"), std::string::npos) << out;
+  EXPECT_EQ(RunSelfcal(base + " --robot " + std::string(SELFCAL_SOURCE_DIR) + "/config/robots/puma560.yaml --yardstick 0,9", &out), 2)
+      << out;
+  EXPECT_FALSE(fs::exists(dir / "obs.yaml"));
+  ASSERT_EQ(RunSelfcal(base + " --robot " + std::string(SELFCAL_SOURCE_DIR) +
+                           "/config/robots/puma560.yaml --yardstick 0,9,228.6 --pixel-noise-px 0.3",
+                       &out),
+            0)
+      << out;
+  const ObservationSet set = Load(dir / "obs.yaml");
+  ASSERT_EQ(set.poses.size(), 3u);
+  EXPECT_FALSE(set.UsesFlangePoses());
+  EXPECT_EQ(set.robot.num_joints(), 6);
+  EXPECT_NEAR(set.poses[1].joints_rad[5], 10 * M_PI / 180, 1e-12);
+  EXPECT_EQ(set.poses[2].dots_px.size(), 100u);
+  EXPECT_DOUBLE_EQ(set.pixel_noise_px, 0.3);
+  ASSERT_EQ(set.yardsticks.size(), 1u);
+  EXPECT_EQ(set.yardsticks[0].dot_b, 9);
+  EXPECT_NEAR(set.yardsticks[0].length_m, 0.2286, 1e-15);
+}
+
 }  // namespace
 }  // namespace selfcal
