@@ -149,8 +149,8 @@ void AddParameterMaskOptions(CLI::App* cmd, std::vector<std::string>* fix, std::
                       ". --fix kinematics is the hand-eye-only solve (kinematics trusted)")
       ->delimiter(',');
   cmd->add_option("--free", *free,
-                  "Estimate only these (everything else held), comma separated, same names; fx and k1 must be named to "
-                  "be estimated")
+                  "Estimate only these (everything else held), comma separated, same names; naming k1 estimates the "
+                  "radial distortion, and fx must be named to stay estimated")
       ->delimiter(',');
 }
 

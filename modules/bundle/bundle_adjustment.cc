@@ -301,6 +301,9 @@ std::string HeldParameters(int num_joints, BundleOptions* options, std::vector<i
     held->erase(std::unique(held->begin(), held->end()), held->end());
     fx_held |= !fx_free;
     k1_held |= !k1_free;
+    // Naming f_x or k1 in the free list asks for it to be estimated.
+    if (fx_free && !fx_held) options->estimate_fx = true;
+    if (k1_free && !k1_held) options->estimate_k1 = true;
   }
   if (fx_held) options->estimate_fx = false;
   if (k1_held) options->estimate_k1 = false;

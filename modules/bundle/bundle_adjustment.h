@@ -78,8 +78,8 @@ struct BundleOptions {
   // trusted: {"kinematics"}), and, when not empty, the only ones that may be estimated (everything else
   // held). Names: a parameter (`j2.beta`, `cam.tx`), a joint (`j3`), a group (`base`, `camera` or
   // `hand_eye`, `kinematics` = base and every joint), `fx`, `k1`. A held f_x or k1 is as estimate_fx or
-  // estimate_k1 false; `fx` or `k1` in free_parameters is not needed for estimation (their flags decide),
-  // but without them a non-empty free list holds them. The rank analysis still decides among the rest.
+  // estimate_k1 false; `fx` or `k1` in free_parameters turns its estimation on, and a non-empty free
+  // list without them holds them. The rank analysis still decides among the rest.
   // With anything held, the generic-rank check (require_generic_rank) does not apply.
   std::vector<std::string> held_parameters;
   std::vector<std::string> free_parameters;

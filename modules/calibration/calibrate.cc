@@ -114,6 +114,16 @@ CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateO
     report.verdict = VerdictFor(report.bundle->bundle.outcome);
     report.message = report.bundle->bundle.message;
   }
+  if (flange_poses && report.bundle && report.bundle->calibrated_robot.flange_from_cam.rotation.allFinite() &&
+      !report.bundle->bundle.dots_in_base.empty()) {
+    bundle::FreeCameraOptions check_options = options.motion_check;
+    check_options.estimate_k1 = report.bundle->bundle.k1_estimated;
+    ObservationSet with_k1 = obs;
+    with_k1.camera.k1 = report.bundle->bundle.k1;
+    report.motion_check = CheckImageMotions(with_k1, report.bundle->calibrated_robot.flange_from_cam,
+                                            report.bundle->bundle.dots_in_base, report.bundle->bundle.fx_px,
+                                            report.bundle->bundle.k1, check_options);
+  }
   if (!report.accepted()) return report;  // K4: no model for a result that is not to be applied
   CalibratedModel model;
   if (report.bundle) {

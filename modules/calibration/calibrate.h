@@ -22,6 +22,7 @@
 
 #include "calibration/bundle_stage.h"
 #include "calibration/hand_eye_start.h"
+#include "calibration/motion_check.h"
 #include "calibration/paper_pipeline.h"
 #include "kinematics/robot_model.h"
 #include "observations/observation_set.h"
@@ -51,6 +52,7 @@ struct CalibrateOptions {
   PaperPipelineOptions paper;  // paper.two_view.seed seeds the RANSAC sampling
   BundleStageOptions bundle;
   HandEyeStartOptions hand_eye;  // flange-pose sets (its two-view seed is paper.two_view.seed)
+  bundle::FreeCameraOptions motion_check;  // flange-pose sets: the images' own camera motions
 };
 
 // The chosen method's calibrated model, ready for writing.
@@ -71,6 +73,8 @@ struct CalibrationReport {
   // A flange-pose set (ObservationSet::UsesFlangePoses): the hand-eye start from the images, which is the
   // bundle's nominal hand-eye transform when the set gave none.
   std::optional<HandEyeStartReport> hand_eye_start;
+  // A flange-pose set whose bundle converged: the images' own camera motions against the flange motions.
+  std::optional<MotionCheck> motion_check;
   std::optional<BundleStageReport> bundle;  // when method == kBundle
   std::optional<CalibratedModel> model;    // the chosen method's model, only when accepted
 

@@ -140,9 +140,18 @@ HandEyeStartReport StartHandEye(const ObservationSet& obs, const HandEyeStartOpt
       const bool has_rotation = tv.outcome == twoview::Outcome::kSuccess || tv.outcome == twoview::Outcome::kAmbiguousPose ||
                                 tv.outcome == twoview::Outcome::kPureRotation || tv.outcome == twoview::Outcome::kNoConvergence;
       if (has_rotation) {
-        // The estimate is cam_j_from_cam_i: B = its inverse.
-        pm.camera_rotation = tv.rotation.transpose();
-        pm.camera_direction = -(tv.rotation.transpose() * tv.translation_direction);
+        // The estimate is cam_j_from_cam_i: B = its inverse. Of an ambiguous pair's two solutions, the
+        // one whose rotation angle is the flange's.
+        Eigen::Matrix3d rotation = tv.rotation;
+        Eigen::Vector3d direction = tv.translation_direction;
+        if (tv.has_rival && std::abs(RotationAngle(tv.rival_rotation) - pair.flange_angle_rad) <
+                                std::abs(RotationAngle(tv.rotation) - pair.flange_angle_rad)) {
+          rotation = tv.rival_rotation;
+          direction = tv.rival_translation_direction;
+          pair.rival_chosen = true;
+        }
+        pm.camera_rotation = rotation.transpose();
+        pm.camera_direction = -(rotation.transpose() * direction);
         pair.camera_angle_rad = RotationAngle(pm.camera_rotation);
         const bool angles_agree = std::abs(pair.camera_angle_rad - pair.flange_angle_rad) <= options.max_angle_mismatch_rad;
         pair.used_for_rotation = angles_agree && pair.flange_angle_rad >= options.min_flange_angle_rad;

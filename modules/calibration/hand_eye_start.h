@@ -8,7 +8,8 @@
 //                fit over every pair whose two rotation angles agree (the angle of a relative motion is
 //                the same for the flange and the camera, whatever X is: a free consistency check that
 //                throws out a pair with a wrong two-view rotation, e.g. the wrong one of a flat scene's
-//                two solutions), refitted without the pairs that leave large residuals;
+//                two solutions: of an ambiguous pair the solution whose angle matches is taken), refitted
+//                without the pairs that leave large residuals;
 //   translation: (R_A - I) t_X - s_ij R_X b_ij = -t_A with b_ij the unit translation of B and one unknown
 //                length s_ij > 0 per pair: linear least squares in t_X and the s_ij (Tsai and Lenz's
 //                equation with the camera's translation known only in direction).
@@ -32,6 +33,7 @@ struct HandEyePair {
   double flange_angle_rad = 0;  // rotation angle of the recorded flange motion
   double camera_angle_rad = 0;  // of the two-view estimate of the camera motion
   bool used_for_rotation = false, used_for_translation = false;
+  bool rival_chosen = false;    // an ambiguous pair's rival matched the flange's angle better
 };
 
 struct HandEyeStartReport {

@@ -255,6 +255,31 @@ json HandEyeJson(const calibration::CalibrationReport& report) {
                 {"rotation_residual_rms_rad", start.rotation_rms_rad},
                 {"fx_px", start.fx_px},
                 {"fx_from_images", start.fx_from_images}};
+  if (start.ok) {
+    const Eigen::Vector3d w = LogSO3(start.flange_from_cam.rotation);
+    const Eigen::Vector3d& t = start.flange_from_cam.translation;
+    j["start"]["flange_from_cam"] = {{"xyz_m", {t.x(), t.y(), t.z()}}, {"rotvec_rad", {w.x(), w.y(), w.z()}}};
+  } else {
+    j["start"]["flange_from_cam"] = json();
+  }
+  j["image_motions"] = json();
+  if (report.motion_check) {
+    const calibration::MotionCheck& m = *report.motion_check;
+    json pairs = json::array();
+    for (const calibration::MotionPair& p : m.pairs) {
+      pairs.push_back({{"pose_a", p.pose_a}, {"pose_b", p.pose_b}, {"flange_angle_rad", p.flange_angle_rad},
+                       {"camera_angle_rad", p.camera_angle_rad}, {"error_rad", p.error_rad}});
+    }
+    j["image_motions"] = {{"ok", m.ok},
+                          {"message", m.message},
+                          {"images_rms_reprojection_px", m.images.rms_reprojection_px},
+                          {"images_fx_px", m.images.fx_px},
+                          {"median_error_rad", m.median_error_rad},
+                          {"p90_error_rad", m.p90_error_rad},
+                          {"max_error_rad", m.max_error_rad},
+                          {"pairs_over_2deg", m.pairs_over_2deg},
+                          {"pairs", pairs}};
+  }
   j["flange_from_cam"] = json();
   if (report.model) {
     const Rigid3& x = report.model->robot.flange_from_cam;

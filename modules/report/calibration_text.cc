@@ -120,6 +120,10 @@ void PrintHandEye(const calibration::CalibrationReport& report, std::ostream& ou
   }
   out << "\n";
   out.unsetf(std::ios::floatfield);
+  if (report.motion_check) {
+    out << "camera motions from the images alone against the flange motions: "
+        << (report.motion_check->ok ? "" : "not available: ") << report.motion_check->message << "\n";
+  }
 }
 
 void PrintCalibrationSummary(const calibration::CalibrationReport& report, std::ostream& out) {

@@ -217,6 +217,7 @@ CheiralityChoice ChooseByCheirality(const std::vector<Rigid3>& candidates, const
       if (counts[c].in_front > choice.runner_up_in_front) {
         choice.runner_up_in_front = counts[c].in_front;
         choice.runner_up_behind = counts[c].behind;
+        choice.runner_up = static_cast<int>(c);
       }
     }
   }

@@ -526,6 +526,11 @@ TwoViewReport EstimateTwoView(const TwoViewOptions& options, const CameraIntrins
   report.rotation = pose.rotation;
   report.translation_direction = pose.translation;
   if (!choice.clear) {
+    if (choice.runner_up >= 0) {
+      report.has_rival = true;
+      report.rival_rotation = candidates[choice.runner_up].rotation;
+      report.rival_translation_direction = candidates[choice.runner_up].translation.normalized();
+    }
     std::ostringstream m;
     m << "no clear cheirality winner: best candidate has " << choice.best_in_front << " points in front ("
       << choice.best_behind << " clearly behind), strongest rival " << choice.runner_up_in_front << " ("

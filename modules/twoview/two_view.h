@@ -65,6 +65,12 @@ struct TwoViewReport {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();       // R of cam2_from_cam1
   Eigen::Vector3d translation_direction = Eigen::Vector3d::Zero();  // unit t of cam2_from_cam1
   bool translation_observable = false;
+  // kAmbiguousPose: the strongest rival the cheirality test could not rule out (for a flat scene the
+  // other of the homography's two solutions), so that a caller with other evidence (the robot's motion,
+  // more views) can choose; cam2_from_cam1 as above, unit translation.
+  bool has_rival = false;
+  Eigen::Matrix3d rival_rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d rival_translation_direction = Eigen::Vector3d::Zero();
 
   double fx_px = 0;              // final f_x (estimated, or the prior when !fx_observable)
   bool fx_observable = false;    // false when the optical axes (nearly) intersect, or f_x was given

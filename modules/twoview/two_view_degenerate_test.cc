@@ -233,6 +233,13 @@ TEST(TwoViewDegenerate, G5PlanarForwardMotionIsAmbiguous) {
   const Scene scene = MakeScene(spec, &rng);
   const TwoViewReport report = EstimateTwoView(Options(), scene.camera, scene.pixels1, scene.pixels2);
   EXPECT_EQ(report.outcome, Outcome::kAmbiguousPose) << report.message;
+  // The rival is reported, and one of the two is the truth (noise-free: to round-off).
+  ASSERT_TRUE(report.has_rival);
+  const Eigen::Matrix3d& truth = scene.cam2_from_cam1.rotation;
+  const double best_error = LogSO3(report.rotation.transpose() * truth).norm();
+  const double rival_error = LogSO3(report.rival_rotation.transpose() * truth).norm();
+  EXPECT_LT(std::min(best_error, rival_error), 1e-6) << best_error << " " << rival_error;
+  EXPECT_GT(std::max(best_error, rival_error), 1e-3) << "the two solutions should differ";
 }
 
 TEST(TwoViewDegenerate, G7Outliers) {

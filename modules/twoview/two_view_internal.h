@@ -133,6 +133,7 @@ struct CheiralityChoice {
   int best_behind = 0;
   int runner_up_in_front = 0;  // the strongest rival not ruled out, 0 if none
   int runner_up_behind = 0;
+  int runner_up = -1;          // its index, -1 if none
 };
 CheiralityChoice ChooseByCheirality(const std::vector<Rigid3>& candidates, const std::vector<Eigen::Vector2d>& n1,
                                     const std::vector<Eigen::Vector2d>& n2, const std::vector<int>& indices,

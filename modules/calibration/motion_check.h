@@ -1,0 +1,43 @@
+// A check of recorded flange poses against the images that needs no known distance and assumes no
+// hand-eye transform: the camera motions the images alone give (bundle/free_camera_bundle.h: every
+// camera free, started from the hand-eye solution) against the recorded flange motions. The rotation
+// angle of a relative motion is the same for the flange and for a camera rigidly on it, whatever the
+// hand-eye transform, so per pair of poses |angle(cam_i^-1 cam_j) - angle(flange_i^-1 flange_j)| is the
+// disagreement of images and controller: lens model errors, a pose logged at the wrong time, a flange
+// pose of the wrong frame.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "bundle/free_camera_bundle.h"
+#include "geometry/rigid3.h"
+#include "observations/observation_set.h"
+
+namespace selfcal::calibration {
+
+struct MotionPair {
+  std::string pose_a, pose_b;
+  double flange_angle_rad = 0, camera_angle_rad = 0;
+  double error_rad = 0;  // |camera - flange|
+};
+
+struct MotionCheck {
+  bool ok = false;
+  std::string message;
+  bundle::FreeCameraReport images;  // the free-camera bundle
+  std::vector<MotionPair> pairs;    // every pair of the poses it solved
+  double median_error_rad = 0, p90_error_rad = 0, max_error_rad = 0;
+  int pairs_over_2deg = 0;
+};
+
+// Every pose of the flange-pose set `obs` (identification and verification), started at
+// base_from_flange * flange_from_cam with the dots and f_x, k1 given (e.g. the hand-eye bundle's).
+MotionCheck CheckImageMotions(const ObservationSet& obs, const Rigid3& flange_from_cam,
+                              const std::map<int, Eigen::Vector3d>& dots_in_base, double fx_px, double k1,
+                              const bundle::FreeCameraOptions& options);
+
+}  // namespace selfcal::calibration
