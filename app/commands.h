@@ -21,5 +21,6 @@ Command AddRunCommand(CLI::App& app);
 Command AddAuditCommand(CLI::App& app);
 Command AddNameDotsCommand(CLI::App& app);
 Command AddSessionCommand(CLI::App& app);
+Command AddDetectCommand(CLI::App& app);
 
 }  // namespace selfcal::app

@@ -1,0 +1,224 @@
+// selfcal detect: a folder of images and the robot pose of each -> an observations file (docs/detect.md).
+// Parse -> io (image list, grey images, poses, robot, hand-eye) -> detection (points by id, the
+// ObservationSet, the contact sheet) -> io (the observations file; the sheet through base/atomic_file.h).
+// Nothing is written unless everything succeeded.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "app/cli_util.h"
+#include "app/commands.h"
+#include "base/atomic_file.h"
+#include "detection/contact_sheet.h"
+#include "detection/detect_points.h"
+#include "io/file_lists.h"
+#include "io/hand_eye_file.h"
+#include "io/image_files.h"
+#include "io/observations_file.h"
+#include "io/pose_files.h"
+#include "io/robot_config.h"
+
+namespace selfcal::app {
+
+namespace {
+
+struct DetectSettings {
+  std::string images, poses, out, contact_sheet;
+  std::string detector = "dots", identity = "grid", grid;
+  std::string robot, hand_eye;
+  double fx_px = 0, cx_px = NAN, cy_px = NAN, mu = 1.0, k1 = 0.0;
+  double pixel_noise_px = 0.5;
+  std::vector<double> yardstick;  // A, B, length_mm
+  double tag_side_mm = 0;
+  std::vector<double> tag_dots_mm;
+  double tag_tolerance_px = 3.0;
+  int sheet_tile_px = 640;
+  bool skip_failed = false;
+};
+
+Status Usage(const std::string& message) { return Status::Error(ErrorCode::kInvalidInput, message); }
+
+// "ROWSxCOLS", e.g. "6x9".
+Status ParseGrid(const std::string& text, int* rows, int* cols) {
+  const size_t x = text.find_first_of("xX");
+  int r = 0, c = 0;
+  char tail = 0;
+  if (x == std::string::npos || std::sscanf(text.c_str(), "%d", &r) != 1 ||
+      std::sscanf(text.c_str() + x + 1, "%d%c", &c, &tail) != 1 || r < 2 || c < 2 || r > 1000 || c > 1000) {
+    return Usage("--grid `" + text + "`: ROWSxCOLS expected, e.g. 10x10 (dot grid) or 6x9 (chessboard inner corners)");
+  }
+  *rows = r;
+  *cols = c;
+  return Status::Ok();
+}
+
+Result<detection::DetectionOptions> ToDetectionOptions(const DetectSettings& a) {
+  detection::DetectionOptions o;
+  Result<detection::Detector> detector = detection::ParseDetector(a.detector);
+  if (!detector.ok()) return detector.status();
+  Result<detection::Identity> identity = detection::ParseIdentity(a.identity);
+  if (!identity.ok()) return identity.status();
+  o.detector = *detector;
+  o.identity = *identity;
+  if (a.grid.empty() && o.detector == detection::Detector::kChessboard) {
+    return Usage("--detector chessboard needs --grid ROWSxCOLS (inner corners, e.g. 6x9)");
+  }
+  if (!a.grid.empty()) {
+    if (Status s = ParseGrid(a.grid, &o.rows, &o.cols); !s.ok()) return s;
+  }
+  o.tag_side_m = a.tag_side_mm * 1e-3;
+  if (a.tag_dots_mm.size() % 2 != 0) return Usage("--tag-dots-mm: x,y pairs expected");
+  for (size_t k = 0; k + 1 < a.tag_dots_mm.size(); k += 2) {
+    o.tag_dots_m.emplace_back(a.tag_dots_mm[k] * 1e-3, a.tag_dots_mm[k + 1] * 1e-3);
+  }
+  o.tag_tolerance_px = a.tag_tolerance_px;
+  if (Status s = o.Validate(); !s.ok()) return Usage("detector options:\n" + s.message());
+  return o;
+}
+
+// Camera, noise, yardstick, robot and hand-eye of the set.
+Result<detection::ObservationSetup> ToSetup(const DetectSettings& a, const vpImage<unsigned char>& first,
+                                            const RobotModel* robot) {
+  detection::ObservationSetup setup;
+  if (robot != nullptr) setup.robot = *robot;
+  setup.camera.width_px = static_cast<int>(first.getWidth());
+  setup.camera.height_px = static_cast<int>(first.getHeight());
+  setup.camera.fx_px = a.fx_px;
+  setup.camera.cx_px = std::isnan(a.cx_px) ? 0.5 * (setup.camera.width_px - 1) : a.cx_px;
+  setup.camera.cy_px = std::isnan(a.cy_px) ? 0.5 * (setup.camera.height_px - 1) : a.cy_px;
+  setup.camera.mu = a.mu;
+  setup.camera.k1 = a.k1;
+  if (const std::string problems = setup.camera.Validate(); !problems.empty()) {
+    return Usage("--camera-* options:\n" + problems);
+  }
+  setup.pixel_noise_px = a.pixel_noise_px;
+  if (!a.yardstick.empty()) {
+    const bool ints = a.yardstick.size() == 3 && a.yardstick[0] >= 0 && a.yardstick[1] >= 0 &&
+                      a.yardstick[0] == std::floor(a.yardstick[0]) && a.yardstick[1] == std::floor(a.yardstick[1]);
+    if (!ints || !(a.yardstick[2] > 0)) return Usage("--yardstick A,B,LENGTH_MM: two point ids and a length > 0 mm");
+    setup.yardsticks.push_back({static_cast<int>(a.yardstick[0]), static_cast<int>(a.yardstick[1]), a.yardstick[2] * 1e-3});
+  }
+  if (!a.hand_eye.empty()) {
+    Result<io::HandEyeResult> hand_eye = io::LoadHandEye(a.hand_eye);
+    if (!hand_eye.ok()) return hand_eye.status();
+    setup.flange_from_cam = hand_eye->flange_from_cam;
+  }
+  setup.skip_failed = a.skip_failed;
+  return setup;
+}
+
+void PrintPerImage(const std::vector<io::NamedImage>& images, const std::vector<detection::ImagePoints>& points) {
+  for (size_t i = 0; i < images.size(); ++i) {
+    std::cout << (points[i].ok ? "  " : "  FAILED ") << images[i].path << ": " << points[i].message << "\n";
+  }
+}
+
+int DetectFromSettings(const DetectSettings& a) {
+  const auto start = std::chrono::steady_clock::now();
+  Result<detection::DetectionOptions> options = ToDetectionOptions(a);
+  if (!options.ok()) return Fail(options.status());
+  if (!(a.fx_px > 0)) return Fail(Usage("--camera-fx-px: the camera's nominal focal length (px) is required"));
+  std::unique_ptr<RobotModel> robot;
+  if (!a.robot.empty()) {
+    Result<RobotModel> loaded = io::LoadRobotModel(ResolveDataPath(a.robot));
+    if (!loaded.ok()) return Fail(loaded.status());
+    robot = std::make_unique<RobotModel>(*loaded);
+  }
+  Result<std::vector<std::string>> paths = io::ListFiles(a.images, io::ImageExtensions(), "images");
+  if (!paths.ok()) return Fail(paths.status());
+  Result<std::vector<io::ImagePose>> poses = io::LoadImagePoses(a.poses, robot.get());
+  if (!poses.ok()) return Fail(poses.status());
+  Result<std::vector<io::ImagePose>> matched = io::MatchPosesToImages(*paths, *poses);
+  if (!matched.ok()) return Fail(matched.status());
+  Result<std::vector<io::NamedImage>> images = io::ReadGreyImages(*paths);
+  if (!images.ok()) return Fail(images.status());
+  Result<detection::ObservationSetup> setup = ToSetup(a, images->front().image, robot.get());
+  if (!setup.ok()) return Fail(setup.status());
+
+  std::vector<const vpImage<unsigned char>*> pixels;
+  std::vector<std::string> ids;
+  std::vector<detection::ImageRobotPose> robot_poses;
+  for (size_t i = 0; i < images->size(); ++i) {
+    pixels.push_back(&(*images)[i].image);
+    ids.push_back(io::FileStem((*images)[i].path));
+    robot_poses.push_back({(*matched)[i].base_from_flange, (*matched)[i].joints_rad});
+  }
+  const std::vector<detection::ImagePoints> points = detection::DetectAllImagePoints(pixels, *options);
+  PrintPerImage(*images, points);
+  Result<ObservationSet> set = detection::BuildObservationSet(ids, points, robot_poses, *setup);
+  if (!set.ok()) return Fail(set.status());
+
+  std::string sheet_png;
+  if (!a.contact_sheet.empty()) {
+    std::vector<detection::SheetImage> sheet;
+    for (size_t i = 0; i < images->size(); ++i) sheet.push_back({io::FileStem((*images)[i].path), pixels[i], &points[i]});
+    detection::ContactSheetOptions so;
+    so.max_tile_width_px = a.sheet_tile_px;
+    if (options->identity == detection::Identity::kGrid) so.grid_cols = options->cols;
+    Result<std::string> png = detection::ContactSheetPng(sheet, so);
+    if (!png.ok()) return Fail(png.status());
+    sheet_png = std::move(*png);
+    if (Status s = WriteFileAtomically(a.contact_sheet, sheet_png); !s.ok()) return Fail(s);
+  }
+  if (Status s = io::SaveObservations(*set, a.out); !s.ok()) {
+    if (!a.contact_sheet.empty()) std::remove(a.contact_sheet.c_str());  // nothing is left on an error
+    return Fail(s);
+  }
+  size_t fewest = SIZE_MAX, most = 0;
+  for (const PoseObservation& p : set->poses) {
+    fewest = std::min(fewest, p.dots_px.size());
+    most = std::max(most, p.dots_px.size());
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("%zu of %zu images with points (%zu to %zu points each), %s poses; wrote %s%s%s (%.2f s)\n",
+              set->poses.size(), images->size(), fewest, most, set->UsesFlangePoses() ? "flange" : "joint",
+              a.out.c_str(), a.contact_sheet.empty() ? "" : " and ", a.contact_sheet.c_str(), seconds);
+  return 0;
+}
+
+}  // namespace
+
+Command AddDetectCommand(CLI::App& app) {
+  auto a = std::make_shared<DetectSettings>();
+  CLI::App* cmd = app.add_subcommand(
+      "detect", "Detect and name the points of a folder of images and write an observations file (docs/detect.md)");
+  cmd->add_option("--images", a->images, "Directory of images (png, jpg, pgm, ...) or a glob ('shots/img_*.png')")
+      ->required();
+  cmd->add_option("--poses", a->poses,
+                  "Robot poses: a directory or glob of per-image files (ROS x,y,z,qx..qw or ViSP vpPoseVector), "
+                  "or a selfcal-poses list")
+      ->required();
+  cmd->add_option("--out", a->out, "Observations file to write (docs/observations-format.md)")->required();
+  cmd->add_option("--contact-sheet", a->contact_sheet, "Also write every image with its points and ids as one PNG");
+  cmd->add_option("--contact-sheet-tile-px", a->sheet_tile_px, "Largest thumbnail width on the contact sheet, px")
+      ->check(CLI::Range(64, 8192));
+  cmd->add_option("--detector", a->detector, "dots or chessboard")->check(CLI::IsMember({"dots", "chessboard"}));
+  cmd->add_option("--grid", a->grid, "ROWSxCOLS: the dot grid (default 10x10) or the chessboard's inner corners");
+  cmd->add_option("--identity", a->identity, "How dots are named: grid (larger origin dot), apriltag, order")
+      ->check(CLI::IsMember({"grid", "apriltag", "order"}));
+  cmd->add_option("--tag-side-mm", a->tag_side_mm, "apriltag: outer side of the tags' black border, mm")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--tag-dots-mm", a->tag_dots_mm, "apriltag: x1,y1,x2,y2,... of the dots around every tag, mm")
+      ->delimiter(',');
+  cmd->add_option("--tag-tolerance-px", a->tag_tolerance_px, "apriltag: a dot this close to its prediction is named")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--robot", a->robot, "Robot config (config/robots/*.yaml): needed for joint-angle poses");
+  cmd->add_option("--hand-eye", a->hand_eye, "Flange poses: a nominal hand-eye transform (selfcal-hand-eye file)");
+  cmd->add_option("--camera-fx-px", a->fx_px, "The camera's nominal focal length, px")->check(CLI::PositiveNumber);
+  cmd->add_option("--camera-cx-px", a->cx_px, "Principal point u, px (default: the image centre)");
+  cmd->add_option("--camera-cy-px", a->cy_px, "Principal point v, px (default: the image centre)");
+  cmd->add_option("--camera-mu", a->mu, "f_y / f_x (default 1)")->check(CLI::PositiveNumber);
+  cmd->add_option("--camera-k1", a->k1, "Radial distortion k1 (default 0)");
+  cmd->add_option("--pixel-noise-px", a->pixel_noise_px, "Standard deviation of a point's pixel, px (default 0.5)")
+      ->check(CLI::Range(kMinPixelNoisePx, kMaxPixelNoisePx));
+  cmd->add_option("--yardstick", a->yardstick, "A,B,LENGTH_MM: a known distance between points A and B")
+      ->delimiter(',')
+      ->expected(3);
+  cmd->add_flag("--skip-failed", a->skip_failed, "Leave images without points out instead of failing");
+  return [a]() { return DetectFromSettings(*a); };
+}
+
+}  // namespace selfcal::app

@@ -1,0 +1,171 @@
+#include "detection/detect_points.h"
+
+#include <sstream>
+
+namespace selfcal::detection {
+
+namespace {
+
+ImagePoints GridPoints(const tracking::DetectionReport& det, const DetectionOptions& options) {
+  tracking::GridIdentityOptions go = options.grid;
+  go.rows = options.rows;
+  go.cols = options.cols;
+  const tracking::GridIdentityReport r = tracking::IdentifyGrid(det.dots, go);
+  ImagePoints out;
+  out.candidates = static_cast<int>(det.dots.size());
+  if (r.outcome != tracking::GridOutcome::kSuccess) {
+    out.message = std::string("grid not identified (") + tracking::GridOutcomeName(r.outcome) + "): " + r.message;
+    if (r.outcome != tracking::GridOutcome::kTooFewDots) out.message += " (" + std::to_string(det.dots.size()) + " dots detected)";
+    return out;
+  }
+  for (const tracking::GridDot& g : r.dots) out.points_px[g.id] = g.centroid_px;
+  out.ok = true;
+  std::ostringstream m;
+  m << r.dots.size() << " dots on the grid, origin dot " << r.origin_area_ratio << " x its neighbours' area, "
+    << r.unassigned_detections << " other blobs";
+  out.message = m.str();
+  return out;
+}
+
+ImagePoints AprilTagPoints(const vpImage<unsigned char>& image, const tracking::DetectionReport& det,
+                           const DetectionOptions& options) {
+  std::vector<tracking::TagDot> layout;
+  for (size_t k = 0; k < options.tag_dots_m.size(); ++k) layout.push_back({static_cast<int>(k), options.tag_dots_m[k]});
+  const int per_tag = static_cast<int>(layout.size());
+  const std::vector<tracking::AprilTagDetection> tags = tracking::DetectAprilTags(image, options.apriltag);
+  std::map<int, std::vector<int>> ids_of_detection;  // detection index -> the ids that claim it
+  std::map<int, int> detections_of_id;               // id -> how many detections it names (a reprinted tag)
+  for (const tracking::AprilTagDetection& tag : tags) {
+    for (const tracking::TagDotMatch& m :
+         tracking::AssignDotsNearTag(tag, options.tag_side_m, layout, det.dots, options.tag_tolerance_px)) {
+      if (m.detection_index < 0) continue;
+      ids_of_detection[m.detection_index].push_back(tag.id * per_tag + m.id);
+      ++detections_of_id[tag.id * per_tag + m.id];
+    }
+  }
+  ImagePoints out;
+  out.candidates = static_cast<int>(det.dots.size());
+  for (const auto& [index, ids] : ids_of_detection) {
+    if (ids.size() != 1 || detections_of_id[ids.front()] != 1) continue;  // claimed twice: nobody names it
+    out.points_px[ids.front()] = det.dots[static_cast<size_t>(index)].centroid_px;
+  }
+  out.ok = !out.points_px.empty();
+  out.message = std::to_string(tags.size()) + " AprilTags, " + std::to_string(out.points_px.size()) + " of " +
+                std::to_string(det.dots.size()) + " dots named";
+  if (tags.empty()) out.message = "no AprilTag found (" + std::to_string(det.dots.size()) + " dots detected)";
+  return out;
+}
+
+ImagePoints OrderPoints(const tracking::DetectionReport& det) {
+  ImagePoints out;
+  out.candidates = static_cast<int>(det.dots.size());
+  for (size_t k = 0; k < det.dots.size(); ++k) out.points_px[static_cast<int>(k)] = det.dots[k].centroid_px;
+  out.ok = !out.points_px.empty();
+  out.message = out.ok ? std::to_string(det.dots.size()) + " dots in raster order" : "no dot detected";
+  return out;
+}
+
+ImagePoints ChessboardPoints(const vpImage<unsigned char>& image, const DetectionOptions& options,
+                             const ImagePoints* previous) {
+  ChessboardOptions co = options.chessboard;
+  co.rows = options.rows;
+  co.cols = options.cols;
+  std::vector<Eigen::Vector2d> before;
+  if (previous != nullptr && previous->ok && previous->points_px.size() == static_cast<size_t>(co.rows * co.cols)) {
+    for (const auto& [id, px] : previous->points_px) before.push_back(px);
+  }
+  const ChessboardDetection c = DetectChessboard(image, co, before);
+  ImagePoints out;
+  if (!c.found) {
+    out.message = c.message;
+    return out;
+  }
+  out.candidates = static_cast<int>(c.corners_px.size());
+  for (size_t k = 0; k < c.corners_px.size(); ++k) out.points_px[static_cast<int>(k)] = c.corners_px[k];
+  out.ok = true;
+  std::ostringstream m;
+  m << c.corners_px.size() << " corners, ordered by " << OrderingCueName(c.cue);
+  if (c.cue == OrderingCue::kColour) m << " (squares " << c.colour_contrast << " grey levels apart)";
+  out.message = m.str();
+  return out;
+}
+
+}  // namespace
+
+const char* DetectorName(Detector detector) { return detector == Detector::kDots ? "dots" : "chessboard"; }
+
+const char* IdentityName(Identity identity) {
+  switch (identity) {
+    case Identity::kGrid: return "grid";
+    case Identity::kAprilTag: return "apriltag";
+    case Identity::kOrder: return "order";
+  }
+  return "unknown";
+}
+
+Result<Detector> ParseDetector(const std::string& name) {
+  if (name == "dots") return Detector::kDots;
+  if (name == "chessboard") return Detector::kChessboard;
+  return Status::Error(ErrorCode::kInvalidInput, "unknown detector `" + name + "`: dots or chessboard");
+}
+
+Result<Identity> ParseIdentity(const std::string& name) {
+  if (name == "grid") return Identity::kGrid;
+  if (name == "apriltag") return Identity::kAprilTag;
+  if (name == "order") return Identity::kOrder;
+  return Status::Error(ErrorCode::kInvalidInput, "unknown identity `" + name + "`: grid, apriltag or order");
+}
+
+Status DetectionOptions::Validate() const {
+  std::ostringstream s;
+  if (detector == Detector::kChessboard) {
+    if (identity != Identity::kGrid) s << "a chessboard's corners are named by the grid; identity " << IdentityName(identity) << " applies to dots only\n";
+    ChessboardOptions co = chessboard;
+    co.rows = rows;
+    co.cols = cols;
+    if (Status v = co.Validate(); !v.ok()) s << v.message();
+  } else {
+    if (Status v = dots.Validate(); !v.ok()) s << v.message();
+    if (identity == Identity::kGrid) {
+      tracking::GridIdentityOptions go = grid;
+      go.rows = rows;
+      go.cols = cols;
+      if (Status v = go.Validate(); !v.ok()) s << v.message();
+    }
+    if (identity == Identity::kAprilTag) {
+      if (Status v = apriltag.Validate(); !v.ok()) s << v.message();
+      if (!(tag_side_m > 0)) s << "apriltag identity: the tag side must be positive\n";
+      if (tag_dots_m.empty()) s << "apriltag identity: give the layout of the dots around every tag\n";
+      if (!(tag_tolerance_px > 0)) s << "apriltag identity: the tolerance must be positive\n";
+    }
+  }
+  return s.str().empty() ? Status::Ok() : Status::Error(ErrorCode::kInvalidInput, s.str());
+}
+
+ImagePoints DetectImagePoints(const vpImage<unsigned char>& image, const DetectionOptions& options,
+                              const ImagePoints* previous) {
+  const Status valid = options.Validate();
+  SELFCAL_CHECK(valid.ok(), "invalid DetectionOptions:\n" << valid.message());
+  if (options.detector == Detector::kChessboard) return ChessboardPoints(image, options, previous);
+  const tracking::DetectionReport det = tracking::DetectDots(image, options.dots);
+  switch (options.identity) {
+    case Identity::kGrid: return GridPoints(det, options);
+    case Identity::kAprilTag: return AprilTagPoints(image, det, options);
+    case Identity::kOrder: return OrderPoints(det);
+  }
+  return ImagePoints();
+}
+
+std::vector<ImagePoints> DetectAllImagePoints(const std::vector<const vpImage<unsigned char>*>& images,
+                                              const DetectionOptions& options) {
+  std::vector<ImagePoints> out;
+  out.reserve(images.size());
+  int last_found = -1;
+  for (const vpImage<unsigned char>* image : images) {
+    out.push_back(DetectImagePoints(*image, options, last_found >= 0 ? &out[static_cast<size_t>(last_found)] : nullptr));
+    if (out.back().ok) last_found = static_cast<int>(out.size()) - 1;
+  }
+  return out;
+}
+
+}  // namespace selfcal::detection

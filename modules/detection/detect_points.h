@@ -1,0 +1,105 @@
+// The points of a list of images, by id, for `selfcal detect` (docs/detect.md): images in memory in,
+// per image the id -> pixel of every point named, and the ObservationSet of the images with their robot
+// poses. No file I/O: the caller reads the images and poses (io/image_files.h, io/pose_files.h) and writes
+// the result (io/observations_file.h).
+//
+// Detectors and identities:
+//   dots + grid       tracking::DetectDots, then tracking::IdentifyGrid on a rows x cols modified circle
+//                     grid (the larger dot marks the origin): id = row * cols + col, the same physical dot in
+//                     every image (tracking/grid_identity.h);
+//   dots + apriltag   tracking::DetectDots and tracking::DetectAprilTags: the dots laid out around every tag
+//                     (positions in the tag's frame) named through the tag's homography, id = tag id *
+//                     layout size + k (tracking/apriltag_identity.h). A dot two layout positions claim is
+//                     given to neither;
+//   dots + order      tracking::DetectDots: id = the dot's index in the detector's raster order. The same
+//                     id names the same dot only when every image shows the dots in the same raster order
+//                     (a nearly still camera); for anything else use grid or apriltag;
+//   chessboard        inner corners, ordered consistently (detection/chessboard.h): id = row * cols + col.
+// Pixels as tracking/dot_detector.h.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <visp3/core/vpImage.h>
+
+#include "base/status.h"
+#include "detection/chessboard.h"
+#include "geometry/rigid3.h"
+#include "observations/observation_set.h"
+#include "tracking/apriltag_identity.h"
+#include "tracking/dot_detector.h"
+#include "tracking/grid_identity.h"
+
+namespace selfcal::detection {
+
+enum class Detector { kDots, kChessboard };
+enum class Identity { kGrid, kAprilTag, kOrder };
+const char* DetectorName(Detector detector);
+const char* IdentityName(Identity identity);
+// "dots" / "chessboard", "grid" / "apriltag" / "order"; kInvalidInput otherwise.
+Result<Detector> ParseDetector(const std::string& name);
+Result<Identity> ParseIdentity(const std::string& name);
+
+struct DetectionOptions {
+  Detector detector = Detector::kDots;
+  Identity identity = Identity::kGrid;  // dots only; a chessboard names its corners by the grid
+  int rows = 10;  // dots + grid: the dot grid; chessboard: inner corners
+  int cols = 10;
+  tracking::DotDetectorOptions dots;
+  tracking::GridIdentityOptions grid;  // rows and cols are taken from above
+  tracking::AprilTagOptions apriltag;
+  double tag_side_m = 0;                    // apriltag: the black border's outer side
+  std::vector<Eigen::Vector2d> tag_dots_m;  // apriltag: the layout around every tag, (x, y) in its frame
+  double tag_tolerance_px = 3.0;
+  ChessboardOptions chessboard;  // rows and cols are taken from above
+
+  // Every problem, one per line (kInvalidInput).
+  Status Validate() const;
+};
+
+struct ImagePoints {
+  bool ok = false;
+  std::string message;                     // why not (ok false), or how the ids were chosen
+  std::map<int, Eigen::Vector2d> points_px;  // id -> pixel
+  int candidates = 0;                      // dots detected (dots) or corners found (chessboard)
+};
+
+// The points of one image. `previous` is the previous image's result (chessboard continuity), or nullptr.
+// Throws InvalidArgument when the options are invalid.
+ImagePoints DetectImagePoints(const vpImage<unsigned char>& image, const DetectionOptions& options,
+                              const ImagePoints* previous);
+
+// Every image in order (each chessboard image continues from the last image that was found).
+std::vector<ImagePoints> DetectAllImagePoints(const std::vector<const vpImage<unsigned char>*>& images,
+                                              const DetectionOptions& options);
+
+// The robot pose of one image: the flange in the base frame, or the joint angles.
+struct ImageRobotPose {
+  std::optional<Rigid3> base_from_flange;
+  Eigen::VectorXd joints_rad;
+};
+
+struct ObservationSetup {
+  RobotModel robot;                    // nominal; for joint poses (a flange-pose set has FlangePoseModel)
+  std::optional<Rigid3> flange_from_cam;  // flange poses: the nominal hand-eye transform, when known
+  CameraIntrinsics camera;             // nominal (width and height are the images')
+  double pixel_noise_px = 0.5;
+  std::vector<KnownDistance> yardsticks;
+  bool skip_failed = false;            // leave images without points out instead of refusing the set
+};
+
+// One identification pose per image, id `pose_ids[i]`, with the image's points and robot pose: joint
+// angles on setup.robot, or flange poses (every image, or none) on FlangePoseModel(flange_from_cam), with
+// flange_from_cam_known when it was given. An image whose detection failed is refused (kDegenerateData
+// naming the pose id and why) unless skip_failed; so is a set with no points; mixed flange and joint
+// poses, and any set ObservationSet::Validate() refuses, are kInvalidInput.
+Result<ObservationSet> BuildObservationSet(const std::vector<std::string>& pose_ids,
+                                           const std::vector<ImagePoints>& points,
+                                           const std::vector<ImageRobotPose>& robot_poses,
+                                           const ObservationSetup& setup);
+
+}  // namespace selfcal::detection

@@ -1,0 +1,284 @@
+#include "io/pose_files.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <system_error>
+
+#include <Eigen/Geometry>
+
+#include "io/transform_yaml.h"
+#include "io/yaml_schema.h"
+#include "yaml/yaml_reader.h"
+
+namespace selfcal::io {
+
+namespace {
+
+constexpr double kMaxTranslationM = 100.0;
+const Range kTranslation = Range::Closed(-kMaxTranslationM, kMaxTranslationM);
+const Range kJointValue = Range::Closed(DegToRad(-720), DegToRad(720));
+constexpr double kLimitToleranceRad = 1e-9;
+
+std::string Short(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.6g", v);
+  return buffer;
+}
+
+// Form (a): x, y, z (m) and the unit quaternion qx, qy, qz, qw.
+bool ReadRosPose(MapReader* root, Problems* problems, Rigid3* out) {
+  double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1};
+  const char* const kT[] = {"x", "y", "z"};
+  const char* const kQ[] = {"qx", "qy", "qz", "qw"};
+  bool ok = true;
+  for (int i = 0; i < 3; ++i) ok &= root->Double(kT[i], kTranslation, &t[i]);
+  for (int i = 0; i < 4; ++i) ok &= root->Double(kQ[i], Range::Closed(-1.001, 1.001), &q[i]);
+  if (!ok) return false;
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (!(std::abs(norm - 1.0) <= kQuaternionNormTolerance)) {
+    problems->Add("the quaternion (qx, qy, qz, qw) at " + problems->At(root->KeyLine("qx")) + " has norm " +
+                  Short(norm) + ", not 1 (within " + Short(kQuaternionNormTolerance) + ")");
+    return false;
+  }
+  const Eigen::Quaterniond quaternion(q[3] / norm, q[0] / norm, q[1] / norm, q[2] / norm);
+  *out = Rigid3(quaternion.toRotationMatrix(), Eigen::Vector3d(t[0], t[1], t[2]));
+  return true;
+}
+
+// One element of a vpPoseVector's `data`: `[v]` as ViSP writes it, or a plain number.
+bool ReadPoseVectorElement(const yaml::YamlNode& item, const std::string& name, const Range& range,
+                           Problems* problems, double* out) {
+  if (item.IsSequence()) {
+    std::vector<double> one;
+    if (!ReadDoubleList(item, name, 1, range, problems, &one)) return false;
+    *out = one[0];
+    return true;
+  }
+  return ReadDouble(item, name, range, problems, out);
+}
+
+// Form (b): rows: 6, cols: 1, data: [[tx], [ty], [tz], [tux], [tuy], [tuz]] (m, theta-u rad).
+bool ReadVispPose(MapReader* root, Problems* problems, Rigid3* out) {
+  long long rows = 0, cols = 0;
+  bool ok = root->Int("rows", 6, 6, &rows);
+  ok &= root->Int("cols", 1, 1, &cols);
+  const yaml::YamlNode* data = root->Required("data");
+  if (data == nullptr) return false;
+  if (!data->IsSequence() || data->items.size() != 6) {
+    problems->Add("`data` at " + problems->At(data->line) +
+                  " must be a list of 6 rows [tx], [ty], [tz] (m), [tux], [tuy], [tuz] (theta-u, rad), not a " +
+                  (data->IsSequence() ? "list of " + std::to_string(data->items.size()) : std::string(data->KindName())));
+    return false;
+  }
+  double v[6];
+  for (int i = 0; i < 6; ++i) {
+    const Range range = i < 3 ? kTranslation : Range::Closed(-2 * kPi, 2 * kPi);
+    ok &= ReadPoseVectorElement(data->items[static_cast<size_t>(i)], "data[" + std::to_string(i) + "]", range,
+                                problems, &v[i]);
+  }
+  if (!ok) return false;
+  const Eigen::Vector3d theta_u(v[3], v[4], v[5]);
+  if (theta_u.norm() > 2 * kPi) {
+    problems->Add("the theta-u rotation `data[3..5]` at " + problems->At(data->line) + " has angle " +
+                  Short(theta_u.norm()) + " rad, more than 2 pi");
+    return false;
+  }
+  *out = Rigid3(ExpSO3<double>(theta_u), Eigen::Vector3d(v[0], v[1], v[2]));
+  return true;
+}
+
+std::string JointLimitProblem(const RobotModel& robot, int joint, double value_rad) {
+  const JointLimits& l = robot.limits[static_cast<size_t>(joint)];
+  if (value_rad >= l.min_rad - kLimitToleranceRad && value_rad <= l.max_rad + kLimitToleranceRad) return "";
+  return "is outside joint " + std::to_string(joint + 1) + "'s limits [" + Short(RadToDeg(l.min_rad)) + ", " +
+         Short(RadToDeg(l.max_rad)) + "] deg (degrees written as radians, or the wrong robot?)";
+}
+
+// One entry of a poses list: `image` and exactly one of `base_from_flange` and joints.
+bool ReadListEntry(const yaml::YamlNode& node, const std::string& name, const RobotModel* robot, Problems* problems,
+                   ImagePose* pose) {
+  MapReader map(node, name, problems);
+  if (!map.ok()) return false;
+  std::string image;
+  bool ok = map.String("image", &image);
+  if (ok && image.empty()) {
+    problems->Add("`" + map.Path("image") + "` at " + problems->At(map.KeyLine("image")) + " is empty");
+    ok = false;
+  }
+  pose->key = ImageKey(image);
+  pose->source = problems->At(node.line);
+  const bool has_flange = map.Optional("base_from_flange") != nullptr;
+  const bool has_joints = node.Find("joints_deg") != nullptr || node.Find("joints_rad") != nullptr;
+  if (has_flange == has_joints) {
+    problems->Add("pose `" + name + "` at " + problems->At(node.line) + " must give exactly one of `base_from_flange`"
+                  " and `joints_deg` (or `joints_rad`)");
+    map.Optional("joints_deg");
+    map.Optional("joints_rad");
+    map.Finish();
+    return false;
+  }
+  if (has_flange) {
+    Rigid3 flange;
+    if (ReadTransform(&map, "base_from_flange", true, &flange)) {
+      pose->base_from_flange = flange;
+    } else {
+      ok = false;
+    }
+  } else if (robot == nullptr) {
+    problems->Add("`" + name + "` at " + problems->At(node.line) +
+                  " gives joint angles: they need the robot's config (selfcal detect --robot)");
+    map.Optional("joints_deg");
+    map.Optional("joints_rad");
+    ok = false;
+  } else {
+    std::vector<double> joints;
+    std::vector<int> lines;
+    std::string key;
+    if (map.QuantityList("joints", Unit::kAngle, robot->num_joints(), kJointValue, &joints, true, &key, &lines)) {
+      for (int j = 0; j < robot->num_joints(); ++j) {
+        if (const std::string p = JointLimitProblem(*robot, j, joints[static_cast<size_t>(j)]); !p.empty()) {
+          const bool degrees = key.size() > 4 && key.compare(key.size() - 4, 4, "_deg") == 0;
+          const double v = joints[static_cast<size_t>(j)];
+          problems->Add("`" + map.Path(key) + "[" + std::to_string(j) + "]` = " + Short(degrees ? RadToDeg(v) : v) +
+                        " at " + problems->At(lines[static_cast<size_t>(j)]) + " " + p);
+          ok = false;
+        }
+      }
+      pose->joints_rad = Eigen::Map<const Eigen::VectorXd>(joints.data(), static_cast<Eigen::Index>(joints.size()));
+    } else {
+      ok = false;
+    }
+  }
+  map.Finish();
+  return ok;
+}
+
+bool IsDirectory(const std::string& path) {
+  std::error_code ec;
+  return std::filesystem::is_directory(path, ec);
+}
+
+bool HasGlobCharacters(const std::string& spec) { return spec.find_first_of("*?[") != std::string::npos; }
+
+}  // namespace
+
+Result<Rigid3> LoadPerImagePoseFile(const std::string& path) {
+  Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(path);
+  if (!doc.ok()) return doc.status();
+  Problems problems(path);
+  MapReader root(doc->root, "", &problems);
+  Rigid3 pose;
+  bool ok = root.ok();
+  if (ok) {
+    const bool visp = doc->root.Find("rows") || doc->root.Find("cols") || doc->root.Find("data");
+    ok = visp ? ReadVispPose(&root, &problems, &pose) : ReadRosPose(&root, &problems, &pose);
+  }
+  root.Finish();
+  if (!ok || !problems.empty()) {
+    return problems.ToStatus("a pose (ROS x, y, z, qx, qy, qz, qw or ViSP vpPoseVector rows, cols, data)");
+  }
+  return pose;
+}
+
+Result<std::vector<ImagePose>> LoadPosesList(const std::string& path, const RobotModel* robot) {
+  Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(path);
+  if (!doc.ok()) return doc.status();
+  Problems problems(path);
+  MapReader root(doc->root, "", &problems);
+  if (!CheckFormatAndVersion(&root, kPosesListFormat, kPosesListVersion)) {
+    root.Abandon();
+    return problems.ToStatus("a poses list");
+  }
+  std::vector<ImagePose> poses;
+  if (const yaml::YamlNode* list = root.Required("poses")) {
+    if (!list->IsSequence() || list->items.empty()) {
+      problems.Add("`poses` at " + problems.At(list->line) + " must be a non-empty list of {image, base_from_flange"
+                   " or joints_deg}");
+    } else {
+      for (size_t i = 0; i < list->items.size(); ++i) {
+        ImagePose pose;
+        if (ReadListEntry(list->items[i], "poses[" + std::to_string(i) + "]", robot, &problems, &pose)) {
+          poses.push_back(std::move(pose));
+        }
+      }
+    }
+  }
+  root.Finish();
+  if (!problems.empty()) return problems.ToStatus("a poses list");
+  return poses;
+}
+
+Result<std::vector<ImagePose>> LoadImagePoses(const std::string& spec, const RobotModel* robot) {
+  std::vector<ImagePose> poses;
+  if (!IsDirectory(spec) && !HasGlobCharacters(spec)) {
+    Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(spec);
+    if (!doc.ok()) return doc.status();
+    const yaml::YamlNode& root = doc->root;
+    if (root.IsMap() && root.Find("format") == nullptr &&
+        (root.Find("qw") || root.Find("x") || root.Find("rows") || root.Find("data"))) {
+      return Status::Error(ErrorCode::kInvalidInput,
+                           spec + ": is the pose of one image; give the directory or a glob of every image's pose "
+                                  "file (--poses DIR or 'DIR/pose_*.yaml'), or one selfcal-poses list");
+    }
+    Result<std::vector<ImagePose>> list = LoadPosesList(spec, robot);
+    if (!list.ok()) return list.status();
+    poses = std::move(*list);
+  } else {
+    Result<std::vector<std::string>> files = ListFiles(spec, {".yaml", ".yml"}, "pose files");
+    if (!files.ok()) return files.status();
+    for (const std::string& file : *files) {
+      Result<Rigid3> pose = LoadPerImagePoseFile(file);
+      if (!pose.ok()) return pose.status();
+      ImagePose p;
+      p.key = ImageKey(file);
+      p.source = file;
+      p.base_from_flange = *pose;
+      poses.push_back(std::move(p));
+    }
+  }
+  std::map<std::string, std::string> seen;  // key -> source
+  for (const ImagePose& p : poses) {
+    const auto [it, inserted] = seen.emplace(p.key, p.source);
+    if (!inserted) {
+      return Status::Error(ErrorCode::kInvalidInput, p.source + ": a second pose for image number `" + p.key +
+                                                         "` (the first is " + it->second + ")");
+    }
+  }
+  return poses;
+}
+
+Result<std::vector<ImagePose>> MatchPosesToImages(const std::vector<std::string>& image_paths,
+                                                  const std::vector<ImagePose>& poses) {
+  std::map<std::string, const ImagePose*> by_key;
+  for (const ImagePose& p : poses) by_key.emplace(p.key, &p);
+  std::map<std::string, std::string> image_of_key;
+  std::vector<ImagePose> matched;
+  std::string problems;
+  for (const std::string& image : image_paths) {
+    const std::string key = ImageKey(image);
+    const auto [it, inserted] = image_of_key.emplace(key, image);
+    if (!inserted) {
+      problems += "\n  - " + image + ": has the same number `" + key + "` as " + it->second +
+                  " (images are matched to poses by the last number in their names)";
+      continue;
+    }
+    const auto pose = by_key.find(key);
+    if (pose == by_key.end()) {
+      problems += "\n  - " + image + ": no pose for image number `" + key + "`";
+      continue;
+    }
+    matched.push_back(*pose->second);
+  }
+  for (const ImagePose& p : poses) {
+    if (image_of_key.count(p.key) == 0) problems += "\n  - " + p.source + ": a pose for image number `" + p.key +
+                                                    "`, but there is no such image";
+  }
+  if (!problems.empty()) {
+    return Status::Error(ErrorCode::kInvalidInput, "images and poses do not match:" + problems);
+  }
+  return matched;
+}
+
+}  // namespace selfcal::io

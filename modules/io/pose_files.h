@@ -1,0 +1,66 @@
+// The robot pose of each image of a folder, in the forms people bring them (docs/detect.md), for
+// `selfcal detect`:
+//
+//  (a) ROS-style, one YAML file per image (ROS-Industrial calibration data sets):
+//        x: 0.71   y: 0.003   z: 0.85          # m
+//        qx: -0.017  qy: 0.9997  qz: -0.014  qw: -0.002   # unit quaternion
+//      the wrist (flange) in the robot base frame, base_from_flange;
+//  (b) ViSP vpPoseVector, one YAML file per image (ViSP's hand-eye tutorials, rMe):
+//        rows: 6
+//        cols: 1
+//        data: [[tx], [ty], [tz], [tux], [tuy], [tuz]]   # m, theta-u (axis * angle) rad
+//  (c) a selfcal poses list, one file for all images:
+//        format: selfcal-poses
+//        version: 1
+//        poses:
+//          - {image: 0.png, base_from_flange: {xyz_m: [0.7, 0, 0.85], rotation: [[...], [...], [...]]}}
+//          - {image: 1.png, joints_deg: [0, -30, 120, 0, 45, 0]}     # or joints_rad; needs a robot
+//      (base_from_flange in any form of io/transform_yaml.h).
+//
+// Images and poses are matched by ImageKey (io/file_lists.h) of their names: "franka_image-3.png" and
+// "franka_pose_rPe_3.yaml" both have the key "3". Every problem names the file (and the line and key when
+// there is one); the code is ErrorCode::kInvalidInput.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "base/status.h"
+#include "geometry/rigid3.h"
+#include "io/file_lists.h"
+#include "kinematics/robot_model.h"
+
+namespace selfcal::io {
+
+inline constexpr const char* kPosesListFormat = "selfcal-poses";
+inline constexpr int kPosesListVersion = 1;
+
+// A quaternion's norm may differ from 1 by this much (4-decimal files) before it is normalised.
+inline constexpr double kQuaternionNormTolerance = 1e-3;
+
+struct ImagePose {
+  std::string key;     // ImageKey of the pose file, or of the list entry's `image`
+  std::string source;  // "FILE" or "FILE:LINE", for messages
+  std::optional<Rigid3> base_from_flange;
+  Eigen::VectorXd joints_rad;  // empty unless a poses list gave joints
+};
+
+// One per-image file of form (a) or (b), told apart by its keys (`rows`, `cols` or `data`: ViSP).
+Result<Rigid3> LoadPerImagePoseFile(const std::string& path);
+
+// A poses list (c). Joints are refused without `robot`; with it their count and limits are checked.
+Result<std::vector<ImagePose>> LoadPosesList(const std::string& path, const RobotModel* robot);
+
+// `spec` is a directory (every *.yaml / *.yml file in it is a per-image pose file), a glob of per-image
+// pose files (`poses/pose_*.yaml`), or one poses list. Two files with one key are refused.
+Result<std::vector<ImagePose>> LoadImagePoses(const std::string& spec, const RobotModel* robot);
+
+// The pose of every image, in the order of `image_paths`: an image without a pose, or a pose without an
+// image, is refused, naming the image or the pose's file.
+Result<std::vector<ImagePose>> MatchPosesToImages(const std::vector<std::string>& image_paths,
+                                                  const std::vector<ImagePose>& poses);
+
+}  // namespace selfcal::io
