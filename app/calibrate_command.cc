@@ -88,16 +88,8 @@ Status WriteHandEye(const LoadedInput& loaded, const calibration::CalibrationRep
   io::HandEyeResult result;
   result.flange_from_cam = report.model->robot.flange_from_cam;
   result.fx_px = report.model->fx_px;
-  if (report.bundle) {
-    const bundle::BundleReport& b = report.bundle->bundle;
-    const int cam = KinematicParameters(0).CamOffset();
-    for (int k = 0; k < 6; ++k) result.stddev[k] = b.stddev.size() > cam + k ? b.stddev[cam + k] : NAN;
-    result.fx_stddev_px = b.fx_stddev;
-  }
-  if (report.pose_noise && report.pose_noise->ok) {
-    result.stddev = report.pose_noise->stddev;
-    result.fx_stddev_px = report.pose_noise->fx_stddev;
-  }
+  result.stddev = report.model->flange_from_cam_stddev;
+  result.fx_stddev_px = report.model->fx_stddev_px;
   result.source = "selfcal calibrate " + loaded.input.path;
   result.provenance = {{"software_version", SELFCAL_VERSION},
                        {"input_sha256", loaded.input.sha256},

@@ -22,11 +22,7 @@ struct Reprojection {
     T p[3];
     ceres::AngleAxisRotatePoint(cam, dot, p);
     const Vec3T<T> in_cam(p[0] + cam[3], p[1] + cam[4], p[2] + cam[5]);
-    T u, v;
-    if (!ProjectPoint<T>(*camera, fx[0], k1[0], in_cam, &u, &v)) return false;
-    residual[0] = (u - T(pixel.x())) * T(inv_sigma);
-    residual[1] = (v - T(pixel.y())) * T(inv_sigma);
-    return true;
+    return internal::WhitenedReprojection<T>(*camera, fx[0], k1[0], in_cam, pixel, inv_sigma, residual);
   }
   const CameraIntrinsics* camera;
   Eigen::Vector2d pixel;

@@ -22,11 +22,7 @@ struct Reprojection {
     const Rigid3T<T> base_from_cam = base_from_flange->Cast<T>() * RigidFromTranslationRotvec(delta) *
                                      x0->Cast<T>() * RigidFromTranslationRotvec(c);
     const Vec3T<T> in_cam = base_from_cam.Inverse() * Vec3T<T>(dot[0], dot[1], dot[2]);
-    T u, v;
-    if (!ProjectPoint<T>(*camera, fx[0], k1[0], in_cam, &u, &v)) return false;
-    residual[0] = (u - T(pixel.x())) * T(inv_sigma);
-    residual[1] = (v - T(pixel.y())) * T(inv_sigma);
-    return true;
+    return internal::WhitenedReprojection<T>(*camera, fx[0], k1[0], in_cam, pixel, inv_sigma, residual);
   }
   const CameraIntrinsics* camera;
   const Rigid3* base_from_flange;

@@ -1,4 +1,4 @@
-// Internal to the bundle module: the solve shared by the free-camera and the pose-noise bundles
+// Internal to the bundle module: the residual, the solve and the screen shared by the free-camera and the pose-noise bundles
 // (autodiff problems with f_x and k1 as single blocks): f_x and k1 held unless estimated, sparse Schur,
 // one thread (deterministic), silent.
 #pragma once
@@ -9,6 +9,8 @@
 #include <vector>
 
 #include <ceres/ceres.h>
+
+#include "camera/camera.h"
 
 namespace selfcal::bundle::internal {
 
@@ -24,6 +26,18 @@ inline ceres::Solver::Summary SolveWithIntrinsics(ceres::Problem* problem, doubl
   ceres::Solver::Summary summary;
   ceres::Solve(solver, problem, &summary);
   return summary;
+}
+
+// The whitened reprojection residual (project(p_in_cam) - pixel) / sigma of one observation, autodiff-ready;
+// false when the point is not in front of the camera.
+template <typename T>
+bool WhitenedReprojection(const CameraIntrinsics& camera, const T& fx, const T& k1, const Vec3T<T>& p_in_cam,
+                          const Eigen::Vector2d& pixel, double inv_sigma, T* residual) {
+  T u, v;
+  if (!ProjectPoint<T>(camera, fx, k1, p_in_cam, &u, &v)) return false;
+  residual[0] = (u - T(pixel.x())) * T(inv_sigma);
+  residual[1] = (v - T(pixel.y())) * T(inv_sigma);
+  return true;
 }
 
 // True (and *message says why) when Ceres failed outright.

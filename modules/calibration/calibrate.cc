@@ -145,6 +145,12 @@ CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateO
     model.parameters = report.bundle->bundle.rho;
     model.method_description = flange_poses ? "hand-eye bundle adjustment on recorded flange poses"
                                             : "kinematic bundle adjustment";
+    const bundle::BundleReport& b = report.bundle->bundle;
+    const int cam = KinematicParameters(0).CamOffset();
+    if (flange_poses && b.covariance_available && b.stddev.size() >= cam + 6) {
+      model.flange_from_cam_stddev = b.stddev.segment<6>(cam);
+      model.fx_stddev_px = b.fx_stddev;
+    }
   } else {
     model.robot = report.paper.calibrated_robot;
     model.fx_px = report.paper.fx_px;
@@ -153,6 +159,8 @@ CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateO
   if (report.pose_noise && report.pose_noise->ok) {
     model.robot.flange_from_cam = report.pose_noise->flange_from_cam;
     model.fx_px = report.pose_noise->fx_px;
+    model.flange_from_cam_stddev = report.pose_noise->stddev;
+    model.fx_stddev_px = report.pose_noise->fx_stddev;
     model.method_description += ", flange poses with their stated noise";
   }
   report.model = std::move(model);

@@ -14,6 +14,7 @@
 // no truth, no exit codes (the application maps the verdict to those).
 #pragma once
 
+#include <cmath>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -64,6 +65,11 @@ struct CalibratedModel {
   // camera), when the method estimates one (the bundle adjustment); empty otherwise.
   Eigen::VectorXd parameters;
   std::string method_description;  // e.g. "kinematic bundle adjustment"
+  // A flange-pose set: the standard deviations of a correction flange_from_cam * Exp(c) (translation m,
+  // rotation vector rad, camera frame) and of f_x, from the solve that gave robot.flange_from_cam and
+  // fx_px (the pose-noise bundle when it ran, else the exact-pose bundle); NaN when unavailable.
+  Eigen::Matrix<double, 6, 1> flange_from_cam_stddev = Eigen::Matrix<double, 6, 1>::Constant(NAN);
+  double fx_stddev_px = NAN;
 };
 
 struct CalibrationReport {

@@ -300,16 +300,10 @@ json HandEyeJson(const calibration::CalibrationReport& report) {
     for (int r = 0; r < 3; ++r) rows.push_back({x.rotation(r, 0), x.rotation(r, 1), x.rotation(r, 2)});
     calibrated["rotation"] = rows;
     calibrated["stddev"] = json();
-    const bundle::BundleReport& b = report.bundle->bundle;
-    const int cam = KinematicParameters(0).CamOffset();
-    if (report.pose_noise && report.pose_noise->ok && report.pose_noise->stddev.allFinite()) {
-      const Eigen::Matrix<double, 6, 1>& sd = report.pose_noise->stddev;
+    const Eigen::Matrix<double, 6, 1>& sd = report.model->flange_from_cam_stddev;
+    if (sd.allFinite()) {
       calibrated["stddev"] = {{"xyz_m", {sd[0], sd[1], sd[2]}},
                               {"rotvec_rad", {sd[3], sd[4], sd[5]}},
-                              {"frame", "camera (of a correction flange_from_cam * Exp(delta))"}};
-    } else if (b.covariance_available && b.stddev.size() >= cam + 6) {
-      calibrated["stddev"] = {{"xyz_m", {b.stddev[cam], b.stddev[cam + 1], b.stddev[cam + 2]}},
-                              {"rotvec_rad", {b.stddev[cam + 3], b.stddev[cam + 4], b.stddev[cam + 5]}},
                               {"frame", "camera (of a correction flange_from_cam * Exp(delta))"}};
     }
     j["flange_from_cam"] = calibrated;

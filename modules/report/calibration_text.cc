@@ -108,14 +108,7 @@ void PrintHandEye(const calibration::CalibrationReport& report, std::ostream& ou
   if (!report.model || !report.bundle) return;
   const Rigid3& x = report.model->robot.flange_from_cam;
   const Eigen::Vector3d rotvec = LogSO3(x.rotation);
-  const bundle::BundleReport& b = report.bundle->bundle;
-  const int cam = KinematicParameters(0).CamOffset();
-  Eigen::Matrix<double, 6, 1> sd = Eigen::Matrix<double, 6, 1>::Constant(NAN);
-  if (report.pose_noise && report.pose_noise->ok) {
-    sd = report.pose_noise->stddev;
-  } else if (b.covariance_available && b.stddev.size() >= cam + 6) {
-    sd = b.stddev.segment<6>(cam);
-  }
+  const Eigen::Matrix<double, 6, 1>& sd = report.model->flange_from_cam_stddev;
   out << std::fixed << std::setprecision(3) << "flange_from_cam: translation [" << x.translation.x() * kMm << ", "
       << x.translation.y() * kMm << ", " << x.translation.z() * kMm << "] mm, rotation vector ["
       << RadToDeg(rotvec.x()) << ", " << RadToDeg(rotvec.y()) << ", " << RadToDeg(rotvec.z()) << "] deg";
