@@ -166,6 +166,7 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   options.paper.two_view.seed = request.seed;
   options.bundle.bundle.held_parameters = request.fix;
   options.bundle.bundle.free_parameters = request.free;
+  options.flange_scale_from_yardsticks = request.scale_from == "yardstick";
   calibration::CalibrationReport report = calibration::Calibrate(loaded->observations, options);
   report::PrintCalibrationSummary(report, std::cout);
   const ExitCode code = ExitCodeFor(report.verdict);
@@ -193,6 +194,10 @@ Command AddCalibrateCommand(CLI::App& app) {
   cmd->add_option("--seed", request->seed, "Seed of the RANSAC sampling (results are deterministic per seed)");
   AddMethodOption(cmd, method.get());
   AddParameterMaskOptions(cmd, &request->fix, &request->free);
+  cmd->add_option("--scale-from", request->scale_from,
+                  "Flange poses: what fixes the metric scale. flange: the flange translations (yardsticks are checks); "
+                  "yardstick: the yardsticks as length constraints beside them")
+      ->check(CLI::IsMember({"flange", "yardstick"}));
   return [request, method]() {
     request->method = MethodFromName(*method);
     return CalibrateAndWrite(*request);

@@ -31,6 +31,7 @@ struct CalibrateRequest {
   uint64_t seed = 1;  // RANSAC sampling of the two-view step
   calibration::Method method = calibration::Method::kBundle;
   std::vector<std::string> fix, free;  // parameter names and groups (bundle::BundleOptions::held_parameters)
+  std::string scale_from = "flange";   // flange-pose sets: "flange" or "yardstick" (CalibrateOptions)
 };
 
 // What a calibration read and returned, for callers that compare it with a truth (`simulate`).

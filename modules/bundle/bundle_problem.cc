@@ -300,8 +300,9 @@ BundleData MakeBundleData(const ObservationSet& observations, double yardstick_s
     }
     ++pose;
   }
-  // A flange-pose set is metric through the flange translations: its yardsticks are checks, not constraints.
-  for (const KnownDistance& k : observations.UsesFlangePoses() ? std::vector<KnownDistance>{} : observations.yardsticks) {
+  // A flange-pose set is metric through its flange translations too: its yardsticks (when the caller left
+  // any) are length constraints beside them.
+  for (const KnownDistance& k : observations.yardsticks) {
     auto a = index_of.find(k.dot_a);
     auto b = index_of.find(k.dot_b);
     if (a != index_of.end() && b != index_of.end()) data.yardsticks.push_back({a->second, b->second, k.length_m});

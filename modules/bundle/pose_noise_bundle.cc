@@ -42,6 +42,26 @@ struct PosePrior {
   double inv_t, inv_r;
 };
 
+struct Length {
+  Length(double length_m, double sigma_m) : length_m(length_m), inv_sigma(1.0 / sigma_m) {}
+  template <typename T>
+  bool operator()(const T* a, const T* b, T* residual) const {
+    residual[0] = ((Vec3T<T>(a[0], a[1], a[2]) - Vec3T<T>(b[0], b[1], b[2])).norm() - T(length_m)) * T(inv_sigma);
+    return true;
+  }
+  double length_m, inv_sigma;
+};
+
+// The yardsticks with both ends among the solved dots.
+std::vector<KnownDistance> LengthsAmong(const std::vector<KnownDistance>& yardsticks,
+                                        const std::map<int, Eigen::Vector3d>& dots) {
+  std::vector<KnownDistance> out;
+  for (const KnownDistance& y : yardsticks) {
+    if (dots.count(y.dot_a) && dots.count(y.dot_b) && y.dot_a != y.dot_b) out.push_back(y);
+  }
+  return out;
+}
+
 struct Obs {
   int pose = -1;
   int dot = -1;
@@ -76,6 +96,7 @@ PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
   for (const auto& [id, n] : views) {
     if (n >= 2) dots[id] = dots_start.at(id);
   }
+  const std::vector<KnownDistance> lengths = LengthsAmong(obs.yardsticks, dots);
   std::vector<std::array<double, 6>> deltas(poses.size(), std::array<double, 6>{0, 0, 0, 0, 0, 0});
   std::array<double, 6> c{0, 0, 0, 0, 0, 0};
   double fx = fx_start, k1 = k1_start;
@@ -97,6 +118,11 @@ PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PosePrior, 6, 6>(
                                    new PosePrior(options.translation_sigma_m, options.rotation_sigma_rad)),
                                nullptr, delta.data());
+    }
+    for (const KnownDistance& y : lengths) {
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Length, 1, 3, 3>(
+                                   new Length(y.length_m, options.yardstick_sigma_m)),
+                               nullptr, dots[y.dot_a].data(), dots[y.dot_b].data());
     }
     summary = internal::SolveWithIntrinsics(&problem, &fx, &k1, options.estimate_fx, options.estimate_k1,
                                             options.max_iterations);
@@ -126,7 +152,8 @@ PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
     // Covariance of the hand-eye correction and f_x, scaled by the residual variance.
     const int unknowns = 6 + (options.estimate_fx ? 1 : 0) + (options.estimate_k1 ? 1 : 0) +
                          3 * static_cast<int>(dots.size()) + 6 * static_cast<int>(deltas.size());
-    const int residuals = 2 * report.num_observations + 6 * static_cast<int>(deltas.size());
+    const int residuals =
+        2 * report.num_observations + 6 * static_cast<int>(deltas.size()) + static_cast<int>(lengths.size());
     const int dof = residuals - unknowns;
     ceres::Covariance::Options cov_options;
     cov_options.algorithm_type = ceres::DENSE_SVD;
@@ -142,6 +169,9 @@ PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
     }
   }
   report.num_removed = static_cast<int>(std::count(keep.begin(), keep.end(), false));
+  for (const KnownDistance& y : lengths) {
+    report.yardstick_lengths_m.push_back((dots[y.dot_a] - dots[y.dot_b]).norm());
+  }
   report.flange_from_cam = x0 * RigidFromTranslationRotvec(c.data());
   report.fx_px = fx;
   report.k1 = k1;
@@ -154,7 +184,8 @@ PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
   const double max_r = *std::max_element(report.correction_rotation_rad.begin(), report.correction_rotation_rad.end());
   std::ostringstream msg;
   msg << ceres::TerminationTypeToString(summary.termination_type) << ": " << report.num_observations
-      << " observations, " << report.num_removed << " removed, RMS " << report.rms_reprojection_px
+      << " observations, " << lengths.size() << " yardstick constraint(s), " << report.num_removed
+      << " removed, RMS " << report.rms_reprojection_px
       << " px; flange pose corrections up to " << max_t * 1e3 << " mm and " << max_r * 180 / kPi << " deg";
   report.message = msg.str();
   return report;

@@ -6,7 +6,8 @@
 // and the hand-eye transform, f_x (k1 when asked), the dots and every delta_i are estimated together
 // (autodiff, Huber while outliers are screened at 4 robust sigmas, then plain least squares). Started
 // from the exact-pose solution (bundle_adjustment.h on the same set). The prior fixes the gauge and the
-// scale: the scene's size comes from the flange translations, weighted by their stated noise.
+// scale: the scene's size comes from the flange translations, weighted by their stated noise, and from
+// the set's yardsticks when it has any.
 #pragma once
 
 #include <map>
@@ -26,6 +27,9 @@ struct PoseNoiseOptions {
   bool estimate_fx = true;
   bool estimate_k1 = false;
   double huber_px = 2.0;
+  // Std of a yardstick's length (observations.yardsticks with both ends among the dots: length
+  // constraints beside the flange translations; the caller leaves none when the flanges alone scale).
+  double yardstick_sigma_m = 1e-6;
   double screen_sigma = 4.0;
   int max_iterations = 200;
 };
@@ -43,6 +47,7 @@ struct PoseNoiseReport {
   std::vector<double> correction_translation_m;       // |delta_i| translation per pose
   std::vector<double> correction_rotation_rad;        // |delta_i| rotation per pose
   int num_observations = 0, num_removed = 0;
+  std::vector<double> yardstick_lengths_m;            // the solved lengths of the yardsticks constrained
   double rms_reprojection_px = 0;
 };
 

@@ -59,7 +59,8 @@ const VerificationSummary& CalibrationReport::verification_nominal() const {
 namespace {
 
 // A flange-pose set, ready for the bundle stage: its yardsticks become checks (the flange translations
-// are metric), and without a nominal hand-eye transform the start from the images becomes the nominal.
+// are metric; exact flange poses leave them nothing to constrain; with a stated pose noise they can be
+// imposed in the pose-noise bundle), and without a nominal hand-eye transform the start from the images becomes the nominal.
 ObservationSet PrepareFlangePoseSet(const ObservationSet& observations, const CalibrateOptions& options,
                                     CalibrationReport* report) {
   ObservationSet prepared = observations;
@@ -93,6 +94,15 @@ CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateO
   ObservationSet prepared;
   if (flange_poses) {
     prepared = PrepareFlangePoseSet(observations, options, &report);
+    if (options.flange_scale_from_yardsticks &&
+        (observations.yardsticks.empty() || !(observations.flange_translation_sigma_m > 0))) {
+      report.verdict = Verdict::kInvalidInput;
+      report.message = observations.yardsticks.empty()
+                           ? "the scale from yardsticks needs a yardstick in the observations"
+                           : "the scale from yardsticks needs a stated flange pose noise (flange_pose_noise): exact flange "
+                             "poses fix the scale themselves";
+      return report;
+    }
     if (!observations.flange_from_cam_known && !report.hand_eye_start->ok) {
       report.verdict = Verdict::kDegenerate;
       report.message = "no hand-eye start: " + report.hand_eye_start->message;
@@ -131,11 +141,17 @@ CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateO
     noise.rotation_sigma_rad = observations.flange_rotation_sigma_rad;
     noise.estimate_fx = report.bundle->bundle.fx_estimated;
     noise.estimate_k1 = report.bundle->bundle.k1_estimated;
+    noise.yardstick_sigma_m = options.bundle.bundle.yardstick_sigma_m;
     ObservationSet with_k1 = obs;
     with_k1.camera.k1 = report.bundle->bundle.k1;
+    if (options.flange_scale_from_yardsticks) {
+      with_k1.yardsticks = observations.yardsticks;
+      with_k1.check_distances = observations.check_distances;
+    }
     report.pose_noise = bundle::RunPoseNoiseBundle(with_k1, report.bundle->calibrated_robot.flange_from_cam,
                                                    report.bundle->bundle.dots_in_base, report.bundle->bundle.fx_px,
                                                    report.bundle->bundle.k1, noise);
+    report.flange_scale_yardsticks = static_cast<int>(report.pose_noise->yardstick_lengths_m.size());
   }
   if (!report.accepted()) return report;  // K4: no model for a result that is not to be applied
   CalibratedModel model;

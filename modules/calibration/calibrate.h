@@ -55,6 +55,11 @@ struct CalibrateOptions {
   BundleStageOptions bundle;
   HandEyeStartOptions hand_eye;  // flange-pose sets (its two-view seed is paper.two_view.seed)
   bundle::FreeCameraOptions motion_check;  // flange-pose sets: the images' own camera motions
+  // Flange-pose sets: false, the flange translations alone give the metric scale and the yardsticks are
+  // checks; true, the yardsticks are length constraints (the paper's scale) beside the flange translations
+  // in the pose-noise bundle (a stated flange pose noise is required: exact poses fix the scale
+  // themselves), for controllers whose reported translations are less consistent than a known length.
+  bool flange_scale_from_yardsticks = false;
 };
 
 // The chosen method's calibrated model, ready for writing.
@@ -86,6 +91,9 @@ struct CalibrationReport {
   // image (bundle/pose_noise_bundle.h), started from the exact-pose bundle; its hand-eye transform and
   // f_x are the model's when it converged.
   std::optional<bundle::PoseNoiseReport> pose_noise;
+  // A flange-pose set: how many yardsticks constrained the scale beside the flange translations (0: the
+  // flange translations alone; the yardsticks were checks).
+  int flange_scale_yardsticks = 0;
   std::optional<BundleStageReport> bundle;  // when method == kBundle
   std::optional<CalibratedModel> model;    // the chosen method's model, only when accepted
 

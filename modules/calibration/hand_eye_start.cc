@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <sstream>
 #include <utility>
 
@@ -113,6 +114,49 @@ bool FitTranslation(const std::vector<PairMotion>& motions, const Eigen::Matrix3
   return false;
 }
 
+// The flat-target solution over the identification poses, referenced to the one with the most dots; the
+// index of each pose (into obs.poses) in the solution's views in *view_of.
+void SolvePlane(const ObservationSet& obs, const HandEyeStartOptions& options, HandEyeStartReport* report,
+                std::map<int, int>* view_of) {
+  const std::vector<int> poses = obs.PosesWithRole(PoseRole::kIdentification);
+  if (!options.try_plane || poses.size() < 3) return;
+  std::vector<std::map<int, Eigen::Vector2d>> views;
+  int reference = 0;
+  for (size_t k = 0; k < poses.size(); ++k) {
+    (*view_of)[poses[k]] = static_cast<int>(k);
+    views.push_back(obs.poses[poses[k]].dots_px);
+    if (views[k].size() > views[reference].size()) reference = static_cast<int>(k);
+  }
+  report->plane = twoview::SolvePlanarViews(obs.camera, views, reference, options.plane);
+  report->plane_reference = obs.poses[poses[reference]].id;
+  if (report->plane->ok && report->plane->median_transfer_rms_px > options.max_plane_transfer_px) {
+    report->plane->ok = false;
+    report->plane->message += ": the dots are not on one plane";
+  }
+}
+
+// Pair (i, j) from the flat-target solution: B = cam_i_from_cam_j, when both views are on the plane and
+// the motion turns by the flange's angle.
+bool PlanarPair(const HandEyeStartReport& report, const std::map<int, int>& view_of, int i, int j,
+                const HandEyeStartOptions& options, HandEyePair* pair, PairMotion* pm) {
+  if (!report.plane || !report.plane->ok) return false;
+  const twoview::PlanarView& vi = report.plane->views[view_of.at(i)];
+  const twoview::PlanarView& vj = report.plane->views[view_of.at(j)];
+  if (!vi.ok || !vj.ok) return false;
+  const Rigid3 b = vi.cam_from_ref * vj.cam_from_ref.Inverse();
+  const double angle = RotationAngle(b.rotation);
+  if (std::abs(angle - pair->flange_angle_rad) > options.max_angle_mismatch_rad) return false;
+  pm->camera_rotation = b.rotation;
+  const double length = b.translation.norm();
+  pm->camera_direction = length > 0 ? Eigen::Vector3d(b.translation / length) : Eigen::Vector3d::Zero();
+  pair->outcome = twoview::Outcome::kSuccess;
+  pair->from_plane = true;
+  pair->camera_angle_rad = angle;
+  pair->used_for_rotation = pair->flange_angle_rad >= options.min_flange_angle_rad;
+  pair->used_for_translation = length > 1e-3;  // in reference plane distances: 1 mm at 1 m
+  return true;
+}
+
 }  // namespace
 
 HandEyeStartReport StartHandEye(const ObservationSet& obs, const HandEyeStartOptions& options) {
@@ -124,6 +168,12 @@ HandEyeStartReport StartHandEye(const ObservationSet& obs, const HandEyeStartOpt
   }
   std::vector<PairMotion> motions;
   std::vector<double> focal;
+  std::map<int, int> view_of;
+  SolvePlane(obs, options, &report, &view_of);
+  // At the plane's f_x when it has one: the two-view fallback's focal prior, and the start's f_x.
+  const bool plane_focal = report.plane && report.plane->ok && report.plane->fx_estimated;
+  CameraIntrinsics camera = obs.camera;
+  if (plane_focal) camera.fx_px = report.plane->fx_px;
   for (const auto& [i, j] : PairOrder(obs.PosesWithRole(PoseRole::kIdentification), options.max_pairs)) {
     const PoseObservation& pi = obs.poses[i];
     const PoseObservation& pj = obs.poses[j];
@@ -134,8 +184,10 @@ HandEyeStartReport StartHandEye(const ObservationSet& obs, const HandEyeStartOpt
     pm.flange = pi.base_from_flange->Inverse() * *pj.base_from_flange;
     pair.flange_angle_rad = RotationAngle(pm.flange.rotation);
     const Matches matches = MatchById(pi, pj);
-    if (static_cast<int>(matches.dot_ids.size()) >= options.min_matches) {
-      const twoview::TwoViewReport tv = twoview::EstimateTwoView(options.two_view, obs.camera, matches.pixels_a, matches.pixels_b);
+    if (PlanarPair(report, view_of, i, j, options, &pair, &pm)) {
+      // the flat-target solution's motion
+    } else if (static_cast<int>(matches.dot_ids.size()) >= options.min_matches) {
+      const twoview::TwoViewReport tv = twoview::EstimateTwoView(options.two_view, camera, matches.pixels_a, matches.pixels_b);
       pair.outcome = tv.outcome;
       const bool has_rotation = tv.outcome == twoview::Outcome::kSuccess || tv.outcome == twoview::Outcome::kAmbiguousPose ||
                                 tv.outcome == twoview::Outcome::kPureRotation || tv.outcome == twoview::Outcome::kNoConvergence;
@@ -188,7 +240,10 @@ HandEyeStartReport StartHandEye(const ObservationSet& obs, const HandEyeStartOpt
     report.rotation_pairs += p.used_for_rotation ? 1 : 0;
     report.translation_pairs += p.used_for_translation ? 1 : 0;
   }
-  if (!focal.empty()) {
+  if (plane_focal) {
+    report.fx_px = report.plane->fx_px;
+    report.fx_from_images = true;
+  } else if (!focal.empty()) {
     std::nth_element(focal.begin(), focal.begin() + focal.size() / 2, focal.end());
     report.fx_px = focal[focal.size() / 2];
     report.fx_from_images = true;
@@ -199,6 +254,7 @@ HandEyeStartReport StartHandEye(const ObservationSet& obs, const HandEyeStartOpt
   msg << "hand-eye start from " << report.rotation_pairs << " rotation and " << report.translation_pairs
       << " translation pairs of " << report.pairs.size() << ", rotation residual RMS "
       << report.rotation_rms_rad * 180.0 / kPi << " deg";
+  if (report.plane && report.plane->ok) msg << "; flat target: " << report.plane->message;
   report.message = msg.str();
   return report;
 }

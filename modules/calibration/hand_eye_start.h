@@ -14,15 +14,23 @@
 //                length s_ij > 0 per pair: linear least squares in t_X and the s_ij (Tsai and Lenz's
 //                equation with the camera's translation known only in direction).
 // f_x: the median of the pairs' focal estimates where a pair observes it, else the prior.
+// A flat target: when the dots of every view lie on one plane (twoview/planar_views.h: one homography
+// per view from a reference view, whose decompositions agree on the plane's normal), the camera motions
+// come from that multi-view solution instead of pair by pair: the plane's normal resolves each view's
+// two-fold ambiguity, f_x comes from the views' agreement, and every pair's translation has a direction
+// even where a two-view estimate would call it ambiguous. A pair falls back to its two-view estimate
+// when the plane's motion does not turn by the flange's angle.
 //
 // Works on an ObservationSet only (its poses' base_from_flange); no files, no hardware.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "geometry/rigid3.h"
 #include "observations/observation_set.h"
+#include "twoview/planar_views.h"
 #include "twoview/two_view.h"
 
 namespace selfcal::calibration {
@@ -34,6 +42,7 @@ struct HandEyePair {
   double camera_angle_rad = 0;  // of the two-view estimate of the camera motion
   bool used_for_rotation = false, used_for_translation = false;
   bool rival_chosen = false;    // an ambiguous pair's rival matched the flange's angle better
+  bool from_plane = false;      // the camera motion is the flat-target solution's (outcome kSuccess)
 };
 
 struct HandEyeStartReport {
@@ -45,6 +54,10 @@ struct HandEyeStartReport {
   int rotation_pairs = 0, translation_pairs = 0;
   double rotation_rms_rad = 0;     // of |a_A - R_X a_B| over the rotation pairs used
   std::vector<HandEyePair> pairs;
+  // The flat-target solution (reference: the identification pose with the most dots), when tried; used
+  // when plane->ok.
+  std::optional<twoview::PlanarViewsReport> plane;
+  std::string plane_reference;  // its pose id
 };
 
 struct HandEyeStartOptions {
@@ -53,6 +66,9 @@ struct HandEyeStartOptions {
   double min_flange_angle_rad = 0.035;       // ~2 deg: below it a pair's rotation axis is noise
   double max_angle_mismatch_rad = 0.035;     // flange angle vs camera angle
   int min_matches = 8;
+  bool try_plane = true;                     // try the flat-target solution first
+  twoview::PlanarViewsOptions plane;
+  double max_plane_transfer_px = 3.0;        // median homography residual beyond which the dots are no plane
 };
 
 HandEyeStartReport StartHandEye(const ObservationSet& observations, const HandEyeStartOptions& options);

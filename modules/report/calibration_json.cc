@@ -255,6 +255,28 @@ json HandEyeJson(const calibration::CalibrationReport& report) {
                 {"rotation_residual_rms_rad", start.rotation_rms_rad},
                 {"fx_px", start.fx_px},
                 {"fx_from_images", start.fx_from_images}};
+  j["start"]["plane"] = json();
+  if (start.plane) {
+    const twoview::PlanarViewsReport& p = *start.plane;
+    json views = json::array();
+    for (const twoview::PlanarView& v : p.views) {
+      json view = {{"ok", v.ok}, {"resolved", v.resolved}, {"message", v.message}, {"has_rival", v.has_rival}};
+      view["normal_error_rad"] = v.ok ? json(v.normal_error_rad) : json();
+      view["rival_normal_error_rad"] = v.has_rival ? json(v.rival_normal_error_rad) : json();
+      views.push_back(view);
+    }
+    const Eigen::Vector3d& n = p.normal_in_ref;
+    j["start"]["plane"] = {{"ok", p.ok},
+                           {"message", p.message},
+                           {"reference_pose", start.plane_reference},
+                           {"normal_in_reference_cam", {n.x(), n.y(), n.z()}},
+                           {"normal_rms_rad", p.normal_rms_rad},
+                           {"fx_px", p.fx_px},
+                           {"fx_estimated", p.fx_estimated},
+                           {"views_ok", p.views_ok},
+                           {"views_resolved", p.views_resolved},
+                           {"views", views}};
+  }
   if (start.ok) {
     const Eigen::Vector3d w = LogSO3(start.flange_from_cam.rotation);
     const Eigen::Vector3d& t = start.flange_from_cam.translation;
@@ -262,6 +284,7 @@ json HandEyeJson(const calibration::CalibrationReport& report) {
   } else {
     j["start"]["flange_from_cam"] = json();
   }
+  j["scale_yardsticks"] = report.flange_scale_yardsticks;
   j["image_motions"] = json();
   if (report.motion_check) {
     const calibration::MotionCheck& m = *report.motion_check;
@@ -331,10 +354,12 @@ json CalibrationReportJson(const ObservationSet& obs, const calibration::Calibra
   j["pixel_noise_px"] = obs.pixel_noise_px;
   j["pixel_noise_note"] = "standard deviation per coordinate (the paper's N(0, s) read as a std)";
   // The chosen method's figures, so that a script reading the top level reads the product's answer.
-  j["fx_px"] = chosen["fx_px"];
-  j["verification"] = chosen["verification"];
-  j["predicted_3d_error"] = chosen["predicted_3d_error"];
-  j["heldout_reprojection"] = chosen.contains("heldout_reprojection") ? chosen["heldout_reprojection"] : json();
+  // A refusal before the chosen method ran (e.g. bad options for a flange-pose set) has no section.
+  auto field = [&chosen](const char* key) { return chosen.is_object() && chosen.contains(key) ? chosen[key] : json(); };
+  j["fx_px"] = field("fx_px");
+  j["verification"] = field("verification");
+  j["predicted_3d_error"] = field("predicted_3d_error");
+  j["heldout_reprojection"] = field("heldout_reprojection");
   j["methods"] = methods;
   j["session"] = context.session ? SessionJson(context.input, *context.session) : json();
   if (report.hand_eye_start) j["hand_eye"] = HandEyeJson(report);

@@ -105,6 +105,11 @@ void PrintHandEye(const calibration::CalibrationReport& report, std::ostream& ou
   const calibration::HandEyeStartReport& start = *report.hand_eye_start;
   out << "hand-eye start from the images and the flange motions: " << (start.ok ? "" : "failed: ") << start.message
       << "\n";
+  out << "metric scale: the flange translations"
+      << (report.flange_scale_yardsticks > 0
+              ? " and " + std::to_string(report.flange_scale_yardsticks) + " yardstick length constraint(s)"
+              : "")
+      << "\n";
   if (!report.model || !report.bundle) return;
   const Rigid3& x = report.model->robot.flange_from_cam;
   const Eigen::Vector3d rotvec = LogSO3(x.rotation);

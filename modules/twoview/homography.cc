@@ -103,4 +103,22 @@ std::vector<Rigid3> DecomposeHomography(const Eigen::Matrix3d& h_normalised) {
   return out;
 }
 
+bool PlaneOfDecomposition(const Eigen::Matrix3d& h_normalised, const Eigen::Matrix3d& rotation,
+                          const Eigen::Vector3d& ref_bearing, Eigen::Vector3d* normal, Eigen::Vector3d* t_over_distance) {
+  const Eigen::Vector3d sv = Eigen::JacobiSVD<Eigen::Matrix3d>(h_normalised).singularValues();
+  if (!(sv(1) > 0)) return false;
+  Eigen::Matrix3d hs = h_normalised / sv(1);
+  if (hs.determinant() < 0) hs = -hs;
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(hs - rotation, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::Vector3d s = svd.singularValues();
+  if (!(s(0) > 0) || s(1) > 1e-6 * (1 + s(0))) return false;
+  *normal = svd.matrixV().col(0);
+  *t_over_distance = s(0) * svd.matrixU().col(0);
+  if (normal->dot(ref_bearing) < 0) {
+    *normal = -*normal;
+    *t_over_distance = -*t_over_distance;
+  }
+  return true;
+}
+
 }  // namespace selfcal::twoview::internal

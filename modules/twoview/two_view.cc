@@ -61,6 +61,12 @@ std::string TwoViewOptions::Validate() const {
   if (!(min_parallax_deg >= 0 && min_parallax_deg < 90)) {
     out << "min_parallax_deg = " << min_parallax_deg << " must lie in [0, 90)\n";
   }
+  if (!(max_rotation_excess >= 1) || !std::isfinite(max_rotation_excess)) {
+    out << "max_rotation_excess = " << max_rotation_excess << " must be finite and >= 1\n";
+  }
+  if (!(rotation_excess_floor_px >= 0) || !std::isfinite(rotation_excess_floor_px)) {
+    out << "rotation_excess_floor_px = " << rotation_excess_floor_px << " must be finite and >= 0\n";
+  }
   if (!(max_far_point_fraction >= 0 && max_far_point_fraction <= 1)) {
     out << "max_far_point_fraction = " << max_far_point_fraction << " must lie in [0, 1]\n";
   }
@@ -188,12 +194,10 @@ double MedianParallaxRad(const Eigen::Matrix3d& r, const std::vector<Eigen::Vect
   return *mid;
 }
 
-// Median distance (px, in image 2) between each inlier and its view-1 pixel mapped by the rotation-only
-// homography K R K^-1 with the prior focal.
-double MedianRotationTransferPx(const CameraIntrinsics& camera, const Eigen::Matrix3d& rotation,
-                                const Correspondences& data, const std::vector<int>& indices) {
-  const Eigen::Matrix3d k = Eigen::Vector3d(camera.fx_px, camera.fx_px, 1).asDiagonal();
-  const Eigen::Matrix3d h = k * rotation * k.inverse();  // centred coordinates
+// Median distance (px, in image 2) between each inlier and its view-1 pixel mapped by the homography h
+// (centred coordinates).
+double MedianTransferPx(const CameraIntrinsics& camera, const Eigen::Matrix3d& h, const Correspondences& data,
+                        const std::vector<int>& indices) {
   std::vector<double> errors;
   errors.reserve(indices.size());
   for (int i : indices) {
@@ -308,6 +312,26 @@ std::vector<Rigid3> PoseCandidates(const ModelSelection& selection, double fx) {
   return FactorEssential(a.transpose() * selection.fundamental.model * a);
 }
 
+// The planar path: the plane (unit normal in cam1, towards the points' side) of the chosen decomposition
+// and of the strongest rival, so that a caller with more views of the same plane can choose.
+void SetPlanes(const ModelSelection& selection, double fx, const std::vector<Rigid3>& candidates,
+               const internal::CheiralityChoice& choice, const std::vector<Eigen::Vector2d>& n1,
+               const std::vector<int>& inliers, TwoViewReport* report) {
+  const Eigen::Matrix3d k = Eigen::Vector3d(fx, fx, 1).asDiagonal();
+  const Eigen::Matrix3d h = k.inverse() * selection.homography.model * k;
+  Eigen::Vector3d bearing = Eigen::Vector3d::Zero();
+  for (int i : inliers) bearing += Eigen::Vector3d(n1[i].x(), n1[i].y(), 1).normalized();
+  Eigen::Vector3d t;
+  if (choice.best >= 0) {
+    report->has_plane =
+        internal::PlaneOfDecomposition(h, candidates[choice.best].rotation, bearing, &report->plane_normal, &t);
+  }
+  if (choice.runner_up >= 0) {
+    report->has_rival_plane = internal::PlaneOfDecomposition(h, candidates[choice.runner_up].rotation, bearing,
+                                                             &report->rival_plane_normal, &t);
+  }
+}
+
 // G3 (a): the rotation-only model, a Wahba fit of the rays with the prior focal (Bougnoux's f means
 // nothing for a rotation), and its median transfer error over the inliers (px). If it is within the
 // homography gate, a translation is not needed to explain the data, so it is not observable: this
@@ -315,9 +339,13 @@ std::vector<Rigid3> PoseCandidates(const ModelSelection& selection, double fx) {
 // noise gate, not with min_parallax_deg: it is what is left after a rotation has absorbed most of a real
 // translation's flow (about 1 deg in the 17 deg test scene, 0.3 deg for a lateral motion over a plane),
 // small in angle yet far above the noise. (G3 (b), the parallax of the refined pose, comes later.)
+// A rotation also has to fit about as well as a general homography on the same inliers: with a lens
+// model error (real images) both leave a residual near the gate, and a real translation then shows only
+// as the rotation's excess over the homography's residual.
 struct RotationOnlyFit {
   Eigen::Matrix3d rotation;
   double residual_px = 0;
+  double homography_residual_px = 0;  // of the DLT homography on the inliers (infinite if none)
 };
 
 RotationOnlyFit FitRotationOnly(const CameraIntrinsics& camera, const Correspondences& data,
@@ -326,7 +354,12 @@ RotationOnlyFit FitRotationOnly(const CameraIntrinsics& camera, const Correspond
   Normalise(data, camera.fx_px, &p1, &p2);
   RotationOnlyFit fit;
   fit.rotation = BestRotation(p1, p2, inliers);
-  fit.residual_px = MedianRotationTransferPx(camera, fit.rotation, data, inliers);
+  const Eigen::Matrix3d k = Eigen::Vector3d(camera.fx_px, camera.fx_px, 1).asDiagonal();
+  fit.residual_px = MedianTransferPx(camera, k * fit.rotation * k.inverse(), data, inliers);
+  Eigen::Matrix3d h;
+  fit.homography_residual_px = internal::HomographyDlt(data.centred1, data.centred2, inliers, &h)
+                                   ? MedianTransferPx(camera, h, data, inliers)
+                                   : std::numeric_limits<double>::infinity();
   return fit;
 }
 
@@ -504,8 +537,10 @@ TwoViewReport EstimateTwoView(const TwoViewOptions& options, const CameraIntrins
   std::ostringstream summary;
   summary << (use_homography ? "homography" : "fundamental") << " path, " << report.num_inliers << "/" << n
           << " inliers, R_H " << report.homography_ratio << ", rotation-only residual " << rotation_only.residual_px
-          << " px; " << focal.note;
-  if (rotation_only.residual_px <= internal::HomographyThresholdPx(options)) {
+          << " px (homography " << rotation_only.homography_residual_px << " px); " << focal.note;
+  if (rotation_only.residual_px <= internal::HomographyThresholdPx(options) &&
+      rotation_only.residual_px <= options.max_rotation_excess * rotation_only.homography_residual_px +
+                                       options.rotation_excess_floor_px) {
     report.rotation = rotation_only.rotation;
     report.translation_observable = false;
     report.translation_direction.setZero();
@@ -525,6 +560,7 @@ TwoViewReport EstimateTwoView(const TwoViewOptions& options, const CameraIntrins
   Rigid3 pose = candidates[choice.best];
   report.rotation = pose.rotation;
   report.translation_direction = pose.translation;
+  if (use_homography) SetPlanes(selection, fx, candidates, choice, n1, inliers, &report);
   if (!choice.clear) {
     if (choice.runner_up >= 0) {
       report.has_rival = true;

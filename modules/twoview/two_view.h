@@ -45,6 +45,12 @@ struct TwoViewOptions {
   double min_inlier_ratio = 0.3;       // G7
   double planar_homography_ratio = 0.45;  // G4: R_H = S_H / (S_H + S_F) above this -> homography path
   double min_parallax_deg = 1.0;       // G3: median parallax below this -> pure rotation
+  // G3: a rotation alone explains a pair when its median transfer residual is within the homography
+  // gate and at most max_rotation_excess times a general homography's on the same inliers plus
+  // rotation_excess_floor_px (noise alone: a ratio near 1; a real translation, even one a rotation
+  // mostly absorbs, leaves the rotation well above the homography).
+  double max_rotation_excess = 1.5;
+  double rotation_excess_floor_px = 0.1;
   // G6: fraction of inliers triangulated farther than 50 baselines above this -> kLowDepthVariation.
   // A point that far has a triangulation angle below 1/50 rad (1.15 deg), so with the default
   // min_parallax_deg the G3 test, which is checked first, usually catches such a pair already; this
@@ -71,6 +77,12 @@ struct TwoViewReport {
   bool has_rival = false;
   Eigen::Matrix3d rival_rotation = Eigen::Matrix3d::Identity();
   Eigen::Vector3d rival_translation_direction = Eigen::Vector3d::Zero();
+  // The homography path (planar): the plane of the chosen solution and of the rival, a unit normal in
+  // cam1 towards the points' side. The normal is one vector for every view of the same plane, so a caller
+  // with several views can resolve the ambiguity (planar_views.h does so for a whole set).
+  bool has_plane = false, has_rival_plane = false;
+  Eigen::Vector3d plane_normal = Eigen::Vector3d::Zero();
+  Eigen::Vector3d rival_plane_normal = Eigen::Vector3d::Zero();
 
   double fx_px = 0;              // final f_x (estimated, or the prior when !fx_observable)
   bool fx_observable = false;    // false when the optical axes (nearly) intersect, or f_x was given

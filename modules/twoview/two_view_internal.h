@@ -109,6 +109,13 @@ double HomographyScore(const TwoViewOptions& options, const CameraIntrinsics& ca
 // with unit t. Empty when H is (a multiple of) a rotation, for which t = 0 and the plane is undefined.
 std::vector<Rigid3> DecomposeHomography(const Eigen::Matrix3d& h_normalised);
 
+// The plane of one decomposition (R, unit t) of a normalised homography h: scaled to a unit middle
+// singular value with a positive determinant, h - R = t' n^T; *normal is the unit n turned towards
+// `ref_bearing` (the points' side), *t_over_distance the translation in units of the first camera's
+// distance to the plane. False when h - R is not of rank one (the decomposition is of -h).
+bool PlaneOfDecomposition(const Eigen::Matrix3d& h_normalised, const Eigen::Matrix3d& rotation,
+                          const Eigen::Vector3d& ref_bearing, Eigen::Vector3d* normal, Eigen::Vector3d* t_over_distance);
+
 // Cheirality of one candidate: how many listed correspondences triangulate in front of both cameras,
 // and how many behind a camera with a triangulation angle of at least min_parallax_rad (for those the
 // sign of the depth is not a matter of noise).
