@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "io/atomic_file.h"
+#include "io/camera_file.h"
 #include "io/robot_config.h"
 #include "io/transform_yaml.h"
 #include "io/yaml_schema.h"
@@ -48,6 +49,31 @@ std::string PixelProblem(const CameraIntrinsics& camera, const Eigen::Vector2d& 
 }  // namespace
 
 bool ReadCamera(MapReader* root, Problems* problems, CameraIntrinsics* camera) {
+  const yaml::YamlNode* file = root->Optional("camera_file");
+  std::string camera_name;
+  const bool named = root->OptionalString("camera_name", &camera_name);
+  if (file != nullptr) {
+    if (root->Optional("camera") != nullptr) {
+      problems->Add("`camera` at " + problems->At(root->KeyLine("camera")) + " and `camera_file` at " +
+                    problems->At(file->line) + ": give the intrinsics one way, not both");
+      return false;
+    }
+    std::string relative;
+    if (!ReadString(*file, root->Path("camera_file"), problems, &relative)) return false;
+    const std::string resolved =
+        !relative.empty() && relative[0] == '/' ? relative : DirectoryOf(problems->file()) + "/" + relative;
+    Result<CameraIntrinsics> loaded = LoadCameraFile(resolved, camera_name);
+    if (!loaded.ok()) {
+      problems->Add("`" + root->Path("camera_file") + "` at " + problems->At(file->line) + ": " + loaded.status().message());
+      return false;
+    }
+    *camera = *loaded;
+    return true;
+  }
+  if (named && root->Optional("camera_name") != nullptr) {
+    problems->Add("`" + root->Path("camera_name") + "` at " + problems->At(root->KeyLine("camera_name")) +
+                  " selects a camera of a `camera_file`; there is none");
+  }
   const yaml::YamlNode* node = root->Required("camera");
   if (!node) return false;
   MapReader map(*node, "camera", problems);
@@ -60,6 +86,10 @@ bool ReadCamera(MapReader* root, Problems* problems, CameraIntrinsics* camera) {
   ok &= map.Double("cx_px", Range::Closed(0, 1e5), &camera->cx_px);
   ok &= map.Double("cy_px", Range::Closed(0, 1e5), &camera->cy_px);
   ok &= map.OptionalDouble("k1", Range::Closed(-10, 10), &camera->k1);
+  ok &= map.OptionalDouble("k2", Range::Closed(-1000, 1000), &camera->k2);
+  ok &= map.OptionalDouble("p1", Range::Closed(-1, 1), &camera->p1);
+  ok &= map.OptionalDouble("p2", Range::Closed(-1, 1), &camera->p2);
+  ok &= map.OptionalDouble("k3", Range::Closed(-1000, 1000), &camera->k3);
   camera->width_px = static_cast<int>(width);
   camera->height_px = static_cast<int>(height);
   if (!ok) return false;
@@ -70,6 +100,20 @@ bool ReadCamera(MapReader* root, Problems* problems, CameraIntrinsics* camera) {
     ok = false;
   }
   return ok;
+}
+
+std::string CameraYaml(const CameraIntrinsics& c) {
+  std::ostringstream out;
+  out << "{width_px: " << c.width_px << ", height_px: " << c.height_px << ", fx_px: " << YamlNumber(c.fx_px)
+      << ", mu: " << YamlNumber(c.mu) << ", cx_px: " << YamlNumber(c.cx_px) << ", cy_px: " << YamlNumber(c.cy_px)
+      << ", k1: " << YamlNumber(c.k1);
+  // Written only when non-zero, so that a file of a k1-only camera reads and writes as before.
+  if (c.k2 != 0) out << ", k2: " << YamlNumber(c.k2);
+  if (c.p1 != 0) out << ", p1: " << YamlNumber(c.p1);
+  if (c.p2 != 0) out << ", p2: " << YamlNumber(c.p2);
+  if (c.k3 != 0) out << ", k3: " << YamlNumber(c.k3);
+  out << "}";
+  return out.str();
 }
 
 namespace {
@@ -322,9 +366,7 @@ Status SaveObservations(const ObservationSet& set, const std::string& path) {
         << "robot:\n"
         << RobotModelYaml(set.robot, TransformStyle::kExact, 2);
   }
-  out << "camera: {width_px: " << c.width_px << ", height_px: " << c.height_px << ", fx_px: " << YamlNumber(c.fx_px)
-      << ", mu: " << YamlNumber(c.mu) << ", cx_px: " << YamlNumber(c.cx_px) << ", cy_px: " << YamlNumber(c.cy_px)
-      << ", k1: " << YamlNumber(c.k1) << "}\n"
+  out << "camera: " << CameraYaml(c) << "\n"
       << "pixel_noise_px: " << YamlNumber(set.pixel_noise_px) << "\n";
   const auto distances = [&](const char* key, const std::vector<KnownDistance>& list) {
     out << key << ":" << (list.empty() ? " []\n" : "\n");

@@ -5,6 +5,7 @@
 //   version: 1
 //   robot: {...keys of a robot config...}     # or robot_file: path (relative to this file)
 //   camera: {width_px: 640, height_px: 480, fx_px: 1000.0, mu: 1.0, cx_px: 319.5, cy_px: 239.5, k1: 0.0}
+//                                              # or camera_file: path (OpenCV or ViSP, io/camera_file.h)
 //   pixel_noise_px: 0.2
 //   yardsticks: [{dot_a: 3, dot_b: 17, length_mm: 250.0}]
 //   check_distances: [{dot_a: 1, dot_b: 40, length_mm: 512.3}]    # optional, held out
@@ -42,8 +43,13 @@ Result<ObservationSet> ParseObservations(const yaml::YamlDocument& doc);
 // that LoadObservations would refuse.
 Status SaveObservations(const ObservationSet& set, const std::string& path);
 
-// The required `camera` map of *root (width_px, height_px, fx_px, cx_px, cy_px, optional mu and k1), with
-// the intrinsics' cross-field checks; shared with the trajectory file's `planned_for` block.
+// The required `camera` map of *root (width_px, height_px, fx_px, cx_px, cy_px, optional mu, k1, k2, p1, p2,
+// k3), with the intrinsics' cross-field checks, or instead `camera_file: <path>` (relative to the file being
+// read, io/camera_file.h; optional `camera_name` for a ViSP file); shared with the trajectory file's
+// `planned_for` block.
 bool ReadCamera(MapReader* root, Problems* problems, CameraIntrinsics* camera);
+
+// The `camera` map as SaveObservations writes it, one line: k2, p1, p2, k3 only when non-zero.
+std::string CameraYaml(const CameraIntrinsics& camera);
 
 }  // namespace selfcal::io

@@ -90,9 +90,7 @@ std::string PlannedForYaml(const planning::PlannedFor& p) {
   const planning::PlanConstraints& c = p.constraints;
   std::ostringstream out;
   out << "planned_for:\n"
-      << "  camera: {width_px: " << k.width_px << ", height_px: " << k.height_px << ", fx_px: " << YamlNumber(k.fx_px)
-      << ", mu: " << YamlNumber(k.mu) << ", cx_px: " << YamlNumber(k.cx_px) << ", cy_px: " << YamlNumber(k.cy_px)
-      << ", k1: " << YamlNumber(k.k1) << "}\n"
+      << "  camera: " << CameraYaml(k) << "\n"
       << "  joint_margin_rad: " << YamlNumber(c.joint_margin_rad) << "\n"
       << "  image_margin_px: " << YamlNumber(c.image_margin_px) << "\n"
       << "  min_depth_m: " << YamlNumber(c.min_depth_m) << "\n"

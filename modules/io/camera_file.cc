@@ -1,0 +1,314 @@
+#include "io/camera_file.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <visp3/core/vpXmlParserCamera.h>
+
+#include "base/atomic_file.h"
+#include "io/camera_xml.h"
+#include "io/yaml_schema.h"
+
+namespace selfcal::io {
+
+namespace {
+
+constexpr size_t kMaxCameraFileBytes = 16u << 20;
+
+std::string Num(double v) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof(buffer), "%.17g", v);
+  return buffer;
+}
+
+bool EndsWith(const std::string& s, const std::string& suffix) {
+  if (s.size() < suffix.size()) return false;
+  for (size_t i = 0; i < suffix.size(); ++i) {
+    if (std::tolower(static_cast<unsigned char>(s[s.size() - suffix.size() + i])) != suffix[i]) return false;
+  }
+  return true;
+}
+
+// The closest of `allowed` to `key` as "; did you mean `x`?", or the list of allowed keys.
+std::string Suggestion(const std::string& key, const std::vector<std::string>& allowed) {
+  std::string best;
+  int best_distance = 1 << 30;
+  for (const std::string& candidate : allowed) {
+    const int d = EditDistance(key, candidate);
+    if (d < best_distance) best_distance = d, best = candidate;
+  }
+  const bool prefix = !best.empty() && key.size() >= 4 && best.compare(0, key.size() - 1, key, 0, key.size() - 1) == 0;
+  if (!best.empty() && (prefix || best_distance <= std::max<int>(2, static_cast<int>(key.size()) / 3))) {
+    return "; did you mean `" + best + "`?";
+  }
+  std::string list = "; allowed:";
+  for (const std::string& candidate : allowed) list += " `" + candidate + "`";
+  return list;
+}
+
+// The intrinsics' own checks (principal point inside the image, ...), one problem each.
+void AddValidation(const CameraIntrinsics& camera, const std::string& where, Problems* problems) {
+  std::istringstream invalid(camera.Validate());
+  for (std::string line; std::getline(invalid, line);) problems->Add(where + ": " + line);
+}
+
+// --- OpenCV FileStorage -------------------------------------------------------------------------------
+
+// Keys that OpenCV's calibration samples write beside the intrinsics; accepted and not used.
+const std::vector<std::string> kOpenCvKeys = {
+    "image_width", "image_height", "camera_matrix", "distortion_coefficients", "calibration_time", "calibrationDate",
+    "nframes", "nr_of_frames", "board_width", "board_height", "square_size", "aspectRatio", "fix_aspect_ratio",
+    "flags", "flagValue", "fisheye_model", "avg_reprojection_error", "per_view_reprojection_errors",
+    "extrinsic_parameters", "image_points", "grid_points"};
+
+bool ReadOpenCvInt(const cv::FileNode& node, const std::string& key, const std::string& file, Problems* problems,
+                   int* out) {
+  if (node.empty() || node.isNone()) {
+    problems->Add("missing key `" + key + "` in " + file);
+    return false;
+  }
+  if (!node.isInt() || static_cast<int>(node) < 1 || static_cast<int>(node) > 100000) {
+    problems->Add("`" + key + "` in " + file + " must be an integer in [1, 100000]");
+    return false;
+  }
+  *out = static_cast<int>(node);
+  return true;
+}
+
+bool ReadOpenCvMatrix(const cv::FileNode& node, const std::string& key, const std::string& file, Problems* problems,
+                      cv::Mat* out) {
+  if (node.empty() || node.isNone()) {
+    problems->Add("missing key `" + key + "` in " + file);
+    return false;
+  }
+  cv::Mat m;
+  try {
+    if (node.isMap()) node >> m;
+  } catch (const cv::Exception& e) {
+    m = cv::Mat();
+  }
+  if (m.empty() || m.channels() != 1) {
+    problems->Add("`" + key + "` in " + file + " must be an opencv-matrix (rows, cols, dt, data)");
+    return false;
+  }
+  m.convertTo(*out, CV_64F);
+  for (int r = 0; r < out->rows; ++r) {
+    for (int c = 0; c < out->cols; ++c) {
+      if (!std::isfinite(out->at<double>(r, c))) {
+        problems->Add("`" + key + "` in " + file + " has a non-finite entry");
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+// K = [fx 0 cx; 0 fy cy; 0 0 1] exactly (no skew: selfcal's model has none).
+void ReadCameraMatrix(const cv::Mat& k, const std::string& file, Problems* problems, CameraIntrinsics* camera) {
+  if (k.rows != 3 || k.cols != 3) {
+    problems->Add("`camera_matrix` in " + file + " is " + std::to_string(k.rows) + "x" + std::to_string(k.cols) +
+                  ", must be 3x3");
+    return;
+  }
+  if (k.at<double>(0, 1) != 0) {
+    problems->Add("`camera_matrix` in " + file + " has skew " + Num(k.at<double>(0, 1)) +
+                  " (entry [0][1]); selfcal's camera model has none and cannot represent it");
+  }
+  if (k.at<double>(1, 0) != 0 || k.at<double>(2, 0) != 0 || k.at<double>(2, 1) != 0 || k.at<double>(2, 2) != 1) {
+    problems->Add("`camera_matrix` in " + file + " must be [fx 0 cx; 0 fy cy; 0 0 1]");
+  }
+  camera->fx_px = k.at<double>(0, 0);
+  camera->cx_px = k.at<double>(0, 2);
+  camera->cy_px = k.at<double>(1, 2);
+  if (!(camera->fx_px > 0) || !(k.at<double>(1, 1) > 0)) {
+    problems->Add("`camera_matrix` in " + file + ": fx and fy must be > 0");
+    return;
+  }
+  camera->mu = k.at<double>(1, 1) / camera->fx_px;
+}
+
+// OpenCV's order k1, k2, p1, p2[, k3[, k4, k5, k6[, s1..s4[, tx, ty]]]]: the terms after k3 must be zero.
+void ReadDistortion(const cv::Mat& d, const std::string& file, Problems* problems, CameraIntrinsics* camera) {
+  const int n = static_cast<int>(d.total());
+  if ((d.rows != 1 && d.cols != 1) || (n != 4 && n != 5 && n != 8 && n != 12 && n != 14)) {
+    problems->Add("`distortion_coefficients` in " + file + " is " + std::to_string(d.rows) + "x" +
+                  std::to_string(d.cols) + ", must be a vector of 4, 5, 8, 12 or 14 coefficients");
+    return;
+  }
+  const double* v = d.ptr<double>();
+  camera->k1 = v[0];
+  camera->k2 = v[1];
+  camera->p1 = v[2];
+  camera->p2 = v[3];
+  camera->k3 = n >= 5 ? v[4] : 0.0;
+  for (int i = 5; i < n; ++i) {
+    if (v[i] == 0) continue;
+    const char* model = i < 8 ? "rational (k4, k5, k6)" : i < 12 ? "thin-prism (s1..s4)" : "tilted-sensor (tau_x, tau_y)";
+    problems->Add("`distortion_coefficients` in " + file + ": coefficient " + std::to_string(i) + " = " + Num(v[i]) +
+                  " belongs to OpenCV's " + model + " model, which selfcal cannot represent");
+  }
+}
+
+Result<CameraIntrinsics> LoadOpenCv(const std::string& path, const std::string& contents) {
+  Problems problems(path);
+  cv::FileStorage fs;
+  try {
+    if (!fs.open(contents, cv::FileStorage::READ | cv::FileStorage::MEMORY)) {
+      return Status::Error(ErrorCode::kInvalidInput, "cannot read " + path + " as an OpenCV FileStorage file");
+    }
+  } catch (const cv::Exception& e) {
+    return Status::Error(ErrorCode::kInvalidInput,
+                         "cannot read " + path + " as an OpenCV FileStorage file: " + std::string(e.what()));
+  }
+  const cv::FileNode root = fs.root();
+  if (!root.isMap()) return Status::Error(ErrorCode::kInvalidInput, path + ": the top level must be a map of keys");
+  for (const std::string& key : root.keys()) {
+    if (std::find(kOpenCvKeys.begin(), kOpenCvKeys.end(), key) == kOpenCvKeys.end()) {
+      problems.Add("unknown key `" + key + "` in " + path + Suggestion(key, {kOpenCvKeys.begin(), kOpenCvKeys.begin() + 4}));
+    }
+  }
+  CameraIntrinsics camera;
+  bool ok = ReadOpenCvInt(root["image_width"], "image_width", path, &problems, &camera.width_px);
+  ok &= ReadOpenCvInt(root["image_height"], "image_height", path, &problems, &camera.height_px);
+  cv::Mat k, d;
+  if (ReadOpenCvMatrix(root["camera_matrix"], "camera_matrix", path, &problems, &k)) {
+    ReadCameraMatrix(k, path, &problems, &camera);
+  }
+  if (ReadOpenCvMatrix(root["distortion_coefficients"], "distortion_coefficients", path, &problems, &d)) {
+    ReadDistortion(d, path, &problems, &camera);
+  }
+  const cv::FileNode fisheye = root["fisheye_model"];
+  if (!fisheye.empty() && !fisheye.isNone() && (!fisheye.isInt() || static_cast<int>(fisheye) != 0)) {
+    problems.Add("`fisheye_model` in " + path + " is set: OpenCV's fisheye model is not selfcal's and is refused");
+  }
+  if (ok && problems.empty()) AddValidation(camera, path, &problems);
+  if (!problems.empty()) return problems.ToStatus("camera intrinsics");
+  return camera;
+}
+
+// --- ViSP XML -------------------------------------------------------------------------------------------
+
+// Silences std::cout while ViSP's parser talks ("Found camera with name ...").
+class QuietCout {
+ public:
+  QuietCout() : saved_(std::cout.rdbuf(nullptr)) {}
+  ~QuietCout() { std::cout.rdbuf(saved_); }
+
+ private:
+  std::streambuf* saved_;
+};
+
+std::string TempPathFor(const std::string& path) {
+  static std::atomic<int> counter{0};
+  const std::filesystem::path dir = std::filesystem::temp_directory_path();
+  const std::string stem = std::filesystem::path(path).filename().string();
+  return (dir / ("selfcal-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + "-" + stem)).string();
+}
+
+}  // namespace
+
+Result<CameraIntrinsics> LoadCameraFile(const std::string& path, const std::string& camera_name) {
+  Result<std::string> contents = ReadFileCapped(path, kMaxCameraFileBytes);
+  if (!contents.ok()) {
+    return Status::Error(ErrorCode::kInvalidInput, "cannot read camera file " + path + ": " + contents.status().message());
+  }
+  const bool xml = EndsWith(path, ".xml");
+  const bool opencv_xml = xml && contents->find("<opencv_storage") != std::string::npos;
+  if (xml && !opencv_xml) return ParseVispCameraXml(path, *contents, camera_name);
+  if (!xml && !EndsWith(path, ".yaml") && !EndsWith(path, ".yml") && !EndsWith(path, ".json")) {
+    return Status::Error(ErrorCode::kInvalidInput, "camera file " + path +
+                                                      ": unknown format (expected .yaml, .yml or .json for OpenCV "
+                                                      "FileStorage, .xml for ViSP or OpenCV)");
+  }
+  if (!camera_name.empty()) {
+    return Status::Error(ErrorCode::kInvalidInput, "camera file " + path + " is an OpenCV file: it holds one camera, "
+                                                   "a camera name (`" + camera_name + "`) is for ViSP files");
+  }
+  return LoadOpenCv(path, *contents);
+}
+
+Status SaveCameraOpenCv(const CameraIntrinsics& camera, const std::string& path) {
+  if (const std::string invalid = camera.Validate(); !invalid.empty()) {
+    return Status::Error(ErrorCode::kInvalidInput, "refusing to write invalid intrinsics to " + path + ":\n" + invalid);
+  }
+  std::string text;
+  try {
+    cv::FileStorage fs(".yaml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+    fs.writeComment(" written by selfcal (docs/camera-files.md); pixels: the centre of the top-left pixel is (0, 0)");
+    fs << "image_width" << camera.width_px << "image_height" << camera.height_px;
+    const cv::Mat k = (cv::Mat_<double>(3, 3) << camera.fx_px, 0, camera.cx_px, 0, camera.fy_px(), camera.cy_px, 0, 0, 1);
+    const cv::Mat d = (cv::Mat_<double>(5, 1) << camera.k1, camera.k2, camera.p1, camera.p2, camera.k3);
+    fs << "camera_matrix" << k << "distortion_coefficients" << d;
+    text = fs.releaseAndGetString();
+  } catch (const cv::Exception& e) {
+    return Status::Error(ErrorCode::kInternal, "cannot format " + path + ": " + std::string(e.what()));
+  }
+  return WriteFileAtomically(path, text);
+}
+
+double FitVispKdu(const CameraIntrinsics& camera) {
+  if (camera.k1 == 0) return 0.0;
+  double num = 0, den = 0;
+  constexpr int kSteps = 40;
+  for (int i = 0; i <= kSteps; ++i) {
+    for (int j = 0; j <= kSteps; ++j) {
+      const Eigen::Vector2d uv(-0.5 + camera.width_px * i / double(kSteps), -0.5 + camera.height_px * j / double(kSteps));
+      const Eigen::Vector2d xd = CenteredPixel(camera, uv) / camera.fx_px;
+      const Eigen::Vector2d x = PixelToNormalized(camera, camera.fx_px, uv);
+      const Eigen::Vector2d basis = xd * xd.squaredNorm();  // x = xd + kdu * basis
+      num += basis.dot(x - xd);
+      den += basis.squaredNorm();
+    }
+  }
+  return den > 0 ? num / den : 0.0;
+}
+
+Status SaveCameraVisp(const CameraIntrinsics& camera, const std::string& path, const std::string& camera_name) {
+  std::string problems = camera.Validate();
+  if (camera.k2 != 0 || camera.p1 != 0 || camera.p2 != 0 || camera.k3 != 0) {
+    problems += "k2 = " + Num(camera.k2) + ", p1 = " + Num(camera.p1) + ", p2 = " + Num(camera.p2) + ", k3 = " +
+                Num(camera.k3) + ": ViSP's perspective model has one radial term (kud = k1) and no tangential "
+                "terms; write these intrinsics as an OpenCV file instead\n";
+  }
+  if (camera_name.empty()) problems += "the camera name is empty\n";
+  if (!problems.empty()) {
+    return Status::Error(ErrorCode::kInvalidInput, "refusing to write " + path + " as a ViSP camera file:\n" + problems);
+  }
+  vpCameraParameters cam;
+  if (camera.k1 != 0) {
+    cam.initPersProjWithDistortion(camera.fx_px, camera.fy_px(), camera.cx_px, camera.cy_px, camera.k1,
+                                   FitVispKdu(camera));
+  } else {
+    cam.initPersProjWithoutDistortion(camera.fx_px, camera.fy_px(), camera.cx_px, camera.cy_px);
+  }
+  // vpXmlParserCamera::save adds to an existing file; it writes a fresh temporary one, published atomically.
+  const std::string temp = TempPathFor(path);
+  int code = vpXmlParserCamera::SEQUENCE_ERROR;
+  try {
+    QuietCout quiet;
+    vpXmlParserCamera parser;
+    code = parser.save(cam, temp, camera_name, static_cast<unsigned>(camera.width_px),
+                       static_cast<unsigned>(camera.height_px));
+  } catch (const std::exception& e) {
+    code = vpXmlParserCamera::SEQUENCE_ERROR;
+  }
+  Result<std::string> text = ReadFileCapped(temp, kMaxCameraFileBytes);
+  std::error_code ignored;
+  std::filesystem::remove(temp, ignored);
+  if (code != vpXmlParserCamera::SEQUENCE_OK || !text.ok()) {
+    return Status::Error(ErrorCode::kInternal, "vpXmlParserCamera could not format " + path);
+  }
+  return WriteFileAtomically(path, *text);
+}
+
+}  // namespace selfcal::io

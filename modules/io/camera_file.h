@@ -1,0 +1,42 @@
+// Camera intrinsics files of other tools (docs/camera-files.md):
+//
+// - OpenCV FileStorage (`.yaml`, `.yml`, `.json`, or `.xml` whose root is <opencv_storage>), the form
+//   cv::calibrateCamera's samples write: image_width, image_height, camera_matrix (3x3),
+//   distortion_coefficients (k1, k2, p1, p2[, k3[, ...]]); read and written with cv::FileStorage itself.
+// - ViSP's vpXmlParserCamera XML (`.xml`): <root><camera><name>, image_width, image_height and a <model>
+//   of type perspectiveProjWithoutDistortion (px, py, u0, v0) or perspectiveProjWithDistortion (also
+//   kud, kdu); written with vpXmlParserCamera itself.
+//
+// Pixels: OpenCV's (c_x, c_y) and ViSP's (u0, v0) use selfcal's convention (the centre of the top-left
+// pixel is (0, 0)), so they are copied unchanged; f_y = mu f_x. ViSP's projection u = u0 + px x (1 + kud
+// r^2) is OpenCV's with k1 = kud; its kdu is ViSP's own approximate pixel-to-metre inverse, which selfcal
+// does not use (it inverts the projection exactly), and writes as the least-squares fit over the image.
+// What selfcal cannot represent is refused, never approximated: skew, OpenCV's rational, thin-prism and
+// tilt terms, OpenCV's fisheye model, ViSP's Kannala-Brandt model, and (writing ViSP) any of k2, p1, p2,
+// k3. Every error is ErrorCode::kInvalidInput and names the file (and the key); nothing is written on error.
+#pragma once
+
+#include <string>
+
+#include "base/status.h"
+#include "camera/camera.h"
+
+namespace selfcal::io {
+
+// Reads the intrinsics of `path` (format from the name and, for `.xml`, the root element). `camera_name`
+// selects a camera of a ViSP file (empty: the file must hold exactly one); not allowed for OpenCV files.
+Result<CameraIntrinsics> LoadCameraFile(const std::string& path, const std::string& camera_name = "");
+
+// Writes cv::FileStorage YAML (image_width, image_height, camera_matrix, distortion_coefficients with
+// all five coefficients), atomically.
+Status SaveCameraOpenCv(const CameraIntrinsics& camera, const std::string& path);
+
+// Writes vpXmlParserCamera XML with one camera `camera_name`, atomically: perspectiveProjWithDistortion
+// when k1 != 0, else perspectiveProjWithoutDistortion. Refuses a camera with k2, p1, p2 or k3.
+Status SaveCameraVisp(const CameraIntrinsics& camera, const std::string& path, const std::string& camera_name = "Camera");
+
+// kdu of ViSP's inverse x = x_d (1 + kdu r_d^2) fitted (least squares, normalised coordinates on a grid
+// over the image) to the exact inverse of the radial model with k1 = kud.
+double FitVispKdu(const CameraIntrinsics& camera);
+
+}  // namespace selfcal::io

@@ -1,0 +1,283 @@
+// Camera intrinsics files (OpenCV FileStorage, ViSP XML) and the observations file's lens keys.
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+#include <visp3/core/vpXmlParserCamera.h>
+
+#include "io/camera_file.h"
+#include "io/io_test_util.h"
+#include "io/observations_file.h"
+
+namespace selfcal::io {
+namespace {
+
+using namespace testing;  // io::testing: TempDir, ReadFile, WriteFile, SourcePath
+
+// Width, height, f_x, mu, c_x, c_y, k1, k2, p1, p2, k3; odd doubles: every bit must survive.
+CameraIntrinsics Lens() {
+  return CameraIntrinsics{1280,          720,    912.6 + 1.0 / 7.0, 1.0 - 1.0 / 1300.0, 641.3 + 1.0 / 3.0, 362.8 - 1.0 / 9.0,
+                          0.1462,        -0.4667, 0.00061,          -0.00042,           0.4103};
+}
+
+bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof(double)) == 0; }
+
+void ExpectSameCamera(const CameraIntrinsics& a, const CameraIntrinsics& b) {
+  EXPECT_EQ(a.width_px, b.width_px);
+  EXPECT_EQ(a.height_px, b.height_px);
+  const IntrinsicsVector va = IntrinsicsOf(a), vb = IntrinsicsOf(b);
+  for (int i = 0; i < kNumIntrinsics; ++i) EXPECT_NEAR(va[i], vb[i], 1e-12 * std::max(1.0, std::abs(va[i]))) << IntrinsicName(i);
+}
+
+// vpXmlParserCamera::parse, ViSP's own reader (its chatter on std::cout silenced).
+int VispParse(const std::string& path, const std::string& name, vpCameraParameters::vpCameraParametersProjType model,
+              vpCameraParameters* cam, vpXmlParserCamera* parser) {
+  std::ostringstream sink;
+  std::streambuf* saved = std::cout.rdbuf(sink.rdbuf());
+  const int code = parser->parse(*cam, path, name, model);
+  std::cout.rdbuf(saved);
+  return code;
+}
+
+TEST(CameraFile, OpenCvFileWrittenBySelfcalIsReadByOpenCv) {
+  TempDir dir;
+  const CameraIntrinsics cam = Lens();
+  const std::string path = dir.File("camera.yaml");
+  ASSERT_TRUE(SaveCameraOpenCv(cam, path).ok());
+  cv::FileStorage fs(path, cv::FileStorage::READ);
+  ASSERT_TRUE(fs.isOpened());
+  cv::Mat k, d;
+  fs["camera_matrix"] >> k;
+  fs["distortion_coefficients"] >> d;
+  EXPECT_EQ(static_cast<int>(fs["image_width"]), 1280);
+  EXPECT_EQ(static_cast<int>(fs["image_height"]), 720);
+  ASSERT_EQ(k.rows, 3);
+  ASSERT_EQ(k.cols, 3);
+  ASSERT_EQ(d.total(), 5u);
+  EXPECT_NEAR(k.at<double>(0, 0), cam.fx_px, 1e-12);
+  EXPECT_NEAR(k.at<double>(1, 1), cam.fy_px(), 1e-12);
+  EXPECT_NEAR(k.at<double>(0, 2), cam.cx_px, 1e-12);
+  EXPECT_NEAR(k.at<double>(1, 2), cam.cy_px, 1e-12);
+  EXPECT_EQ(k.at<double>(0, 1), 0.0);
+  const double expected[5] = {cam.k1, cam.k2, cam.p1, cam.p2, cam.k3};
+  for (int i = 0; i < 5; ++i) EXPECT_NEAR(d.at<double>(i), expected[i], 1e-12) << i;
+  Result<CameraIntrinsics> back = LoadCameraFile(path);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  ExpectSameCamera(cam, *back);
+  EXPECT_TRUE(SameBits(back->fx_px, cam.fx_px));
+}
+
+TEST(CameraFile, VispFileWrittenBySelfcalIsReadByVisp) {
+  TempDir dir;
+  CameraIntrinsics cam = Lens();
+  cam.k2 = cam.p1 = cam.p2 = cam.k3 = 0;
+  const std::string path = dir.File("camera.xml");
+  ASSERT_TRUE(SaveCameraVisp(cam, path, "D435").ok());
+  vpCameraParameters visp;
+  vpXmlParserCamera parser;
+  ASSERT_EQ(VispParse(path, "D435", vpCameraParameters::perspectiveProjWithDistortion, &visp, &parser),
+            vpXmlParserCamera::SEQUENCE_OK);
+  EXPECT_EQ(parser.getWidth(), 1280u);
+  EXPECT_EQ(parser.getHeight(), 720u);
+  EXPECT_NEAR(visp.get_px(), cam.fx_px, 1e-12);
+  EXPECT_NEAR(visp.get_py(), cam.fy_px(), 1e-12);
+  EXPECT_NEAR(visp.get_u0(), cam.cx_px, 1e-12);
+  EXPECT_NEAR(visp.get_v0(), cam.cy_px, 1e-12);
+  EXPECT_NEAR(visp.get_kud(), cam.k1, 1e-12);
+  // kdu: ViSP's approximate inverse, fitted; it undoes the distortion to well below a pixel at the corner.
+  EXPECT_EQ(visp.get_kdu(), FitVispKdu(cam));
+  const Eigen::Vector2d corner(-0.5, -0.5);
+  const Eigen::Vector2d exact = PixelToNormalized(cam, cam.fx_px, corner);
+  const Eigen::Vector2d xd = CenteredPixel(cam, corner) / cam.fx_px;
+  const Eigen::Vector2d approx = xd * (1 + visp.get_kdu() * xd.squaredNorm());
+  EXPECT_LT((approx - exact).norm() * cam.fx_px, 5.0);
+  Result<CameraIntrinsics> back = LoadCameraFile(path, "D435");
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  ExpectSameCamera(cam, *back);
+  // Without distortion: ViSP's other model, read back by ViSP too.
+  cam.k1 = 0;
+  const std::string plain = dir.File("plain.xml");
+  ASSERT_TRUE(SaveCameraVisp(cam, plain).ok());
+  vpXmlParserCamera parser2;
+  ASSERT_EQ(VispParse(plain, "Camera", vpCameraParameters::perspectiveProjWithoutDistortion, &visp, &parser2),
+            vpXmlParserCamera::SEQUENCE_OK);
+  EXPECT_NEAR(visp.get_px(), cam.fx_px, 1e-12);
+  EXPECT_NEAR(visp.get_py(), cam.fy_px(), 1e-12);
+  back = LoadCameraFile(plain);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  ExpectSameCamera(cam, *back);
+}
+
+TEST(CameraFile, TheFrankaSetsVispFileReadsAsVispReadsIt) {
+  const std::string path = SourcePath("test/data/visp-franka-eye-in-hand/franka_camera.xml");
+  Result<CameraIntrinsics> cam = LoadCameraFile(path);
+  ASSERT_TRUE(cam.ok()) << cam.status().ToString();
+  vpCameraParameters visp;
+  vpXmlParserCamera parser;
+  ASSERT_EQ(VispParse(path, "Camera", vpCameraParameters::perspectiveProjWithDistortion, &visp, &parser),
+            vpXmlParserCamera::SEQUENCE_OK);
+  EXPECT_EQ(cam->width_px, 640);
+  EXPECT_EQ(cam->height_px, 480);
+  EXPECT_EQ(cam->fx_px, visp.get_px());
+  EXPECT_EQ(cam->fx_px, 607.5931396484375);
+  EXPECT_NEAR(cam->fy_px(), visp.get_py(), 1e-12);
+  EXPECT_EQ(cam->cx_px, visp.get_u0());
+  EXPECT_EQ(cam->cy_px, visp.get_v0());
+  EXPECT_EQ(cam->k1, 0.0);
+  EXPECT_FALSE(cam->HasDistortion());
+  EXPECT_TRUE(LoadCameraFile(path, "Camera").ok());
+}
+
+TEST(CameraFile, CalibrateCameraStyleFileWithItsExtraKeysLoads) {
+  TempDir dir;
+  const std::string path = dir.File("out_camera_data.yml");
+  {
+    cv::FileStorage fs(path, cv::FileStorage::WRITE);
+    fs << "calibration_time" << "Thu 01 Jan" << "nr_of_frames" << 25 << "image_width" << 640 << "image_height" << 480
+       << "board_width" << 9 << "board_height" << 6 << "square_size" << 0.025 << "flags" << 0;
+    fs << "camera_matrix" << (cv::Mat_<double>(3, 3) << 598.2, 0, 322.7, 0, 606.4, 235.9, 0, 0, 1);
+    fs << "distortion_coefficients" << (cv::Mat_<double>(5, 1) << -0.37, 0.18, -0.0013, 0.0021, -0.045);
+    fs << "avg_reprojection_error" << 0.21;
+  }
+  Result<CameraIntrinsics> cam = LoadCameraFile(path);
+  ASSERT_TRUE(cam.ok()) << cam.status().ToString();
+  EXPECT_EQ(cam->fx_px, 598.2);
+  EXPECT_NEAR(cam->fy_px(), 606.4, 1e-12);
+  EXPECT_EQ(cam->p2, 0.0021);
+  EXPECT_EQ(cam->k3, -0.045);
+}
+
+// Each bad file: refused with ErrorCode::kInvalidInput, the file and the reason named.
+class BadCameraFiles : public ::testing::Test {
+ protected:
+  ::testing::AssertionResult Refused(const std::string& name, const std::string& text, const std::string& why,
+                                     const std::string& camera_name = "") {
+    const std::string path = dir_.File(name);
+    WriteFile(path, text);
+    const Result<CameraIntrinsics> cam = LoadCameraFile(path, camera_name);
+    if (cam.ok()) return ::testing::AssertionFailure() << "accepted";
+    const Status& s = cam.status();
+    if (s.code() != ErrorCode::kInvalidInput || s.message().find(why) == std::string::npos ||
+        s.message().find(path) == std::string::npos) {
+      return ::testing::AssertionFailure() << "expected \"" << why << "\" and the path in: " << s.ToString();
+    }
+    return ::testing::AssertionSuccess();
+  }
+  std::string OpenCv(const std::string& extra, const std::string& matrix = "3, cols: 3, dt: d, data: [600, 0, 320, 0, 600, 240, 0, 0, 1]") {
+    return "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n  {rows: " + matrix +
+           "}\ndistortion_coefficients: !!opencv-matrix\n  {rows: 5, cols: 1, dt: d, data: [0.1, 0, 0, 0, 0]}\n" + extra;
+  }
+  std::string Visp(const std::string& model) {
+    return "<?xml version=\"1.0\"?>\n<root>\n  <camera>\n    <name>A</name>\n    <image_width>640</image_width>\n"
+           "    <image_height>480</image_height>\n    <model>\n" + model + "    </model>\n  </camera>\n</root>\n";
+  }
+  TempDir dir_;
+};
+
+TEST_F(BadCameraFiles, OpenCv) {
+  ASSERT_TRUE(LoadCameraFile((WriteFile(dir_.File("good.yaml"), OpenCv("")), dir_.File("good.yaml"))).ok());
+  EXPECT_TRUE(Refused("unknown.yaml", OpenCv("distortion_coeffs: 3\n"), "unknown key `distortion_coeffs`"));
+  EXPECT_TRUE(Refused("unknown.yaml", OpenCv("distortion_coeffs: 3\n"), "did you mean `distortion_coefficients`?"));
+  std::string missing = OpenCv("");
+  missing.replace(missing.find("image_height: 480\n"), 18, "");
+  EXPECT_TRUE(Refused("missing.yaml", missing, "missing key `image_height`"));
+  EXPECT_TRUE(Refused("size.yaml", OpenCv("", "2, cols: 3, dt: d, data: [600, 0, 320, 0, 600, 240]"),
+                      "`camera_matrix` in " + dir_.File("size.yaml") + " is 2x3, must be 3x3"));
+  EXPECT_TRUE(Refused("skew.yaml", OpenCv("", "3, cols: 3, dt: d, data: [600, 0.5, 320, 0, 600, 240, 0, 0, 1]"),
+                      "has skew 0.5"));
+  std::string rational = OpenCv("");
+  const std::string five = "{rows: 5, cols: 1, dt: d, data: [0.1, 0, 0, 0, 0]}";
+  rational.replace(rational.find(five), five.size(), "{rows: 8, cols: 1, dt: d, data: [0.1, 0, 0, 0, 0, 0.2, 0, 0]}");
+  EXPECT_TRUE(Refused("rational.yaml", rational, "OpenCV's rational (k4, k5, k6) model"));
+  EXPECT_TRUE(Refused("fisheye.yaml", OpenCv("fisheye_model: 1\n"), "fisheye"));
+  EXPECT_TRUE(Refused("garbage.yaml", "%YAML:1.0\n---\n{ [ :\n", "cannot read"));
+  EXPECT_TRUE(Refused("named.yaml", OpenCv(""), "a camera name (`A`) is for ViSP files", "A"));
+  EXPECT_TRUE(Refused("camera.txt", OpenCv(""), "unknown format"));
+  const Result<CameraIntrinsics> none = LoadCameraFile(dir_.File("absent.yaml"));
+  ASSERT_FALSE(none.ok());
+  EXPECT_EQ(none.status().code(), ErrorCode::kInvalidInput);
+  EXPECT_NE(none.status().message().find(dir_.File("absent.yaml")), std::string::npos) << none.status().ToString();
+}
+
+TEST_F(BadCameraFiles, Visp) {
+  const std::string model = "      <type>perspectiveProjWithoutDistortion</type>\n      <px>600</px>\n      <py>601</py>\n"
+                            "      <u0>320</u0>\n      <v0>240</v0>\n";
+  ASSERT_TRUE(LoadCameraFile((WriteFile(dir_.File("good.xml"), Visp(model)), dir_.File("good.xml"))).ok());
+  EXPECT_TRUE(Refused("name.xml", Visp(model), "no camera named `B` in " + dir_.File("name.xml") + " (cameras: `A`)", "B"));
+  std::string typo = model;
+  typo.replace(typo.find("<py>601</py>"), 12, "<pyy>601</pyy>");
+  EXPECT_TRUE(Refused("typo.xml", Visp(typo), "unknown element <pyy> in <model> at " + dir_.File("typo.xml") + ":10; did you mean <py>?"));
+  EXPECT_TRUE(Refused("typo.xml", Visp(typo), "missing element <py> in <model>"));
+  std::string kb = model;
+  kb.replace(kb.find("perspectiveProjWithoutDistortion"), 32, "ProjWithKannalaBrandtDistortion");
+  EXPECT_TRUE(Refused("kb.xml", Visp(kb), "a Kannala-Brandt or other fisheye model is not selfcal's"));
+  std::string text = model;
+  text.replace(text.find("<u0>320</u0>"), 12, "<u0>3x0</u0>");
+  EXPECT_TRUE(Refused("number.xml", Visp(text), "<u0> = `3x0` at " + dir_.File("number.xml") + ":11 is not a finite number"));
+  std::string two = Visp(model);
+  two.replace(two.find("</root>"), 7, "  <camera><name>C</name></camera>\n</root>");
+  EXPECT_TRUE(Refused("two.xml", two, "holds several cameras (`A`, `C`); choose one by name"));
+  const std::string unclosed = Visp(model);
+  EXPECT_TRUE(Refused("broken.xml", unclosed.substr(0, unclosed.find("</root>")), "element <root> opened at line 2 is never closed"));
+  EXPECT_TRUE(Refused("cut.xml", unclosed.substr(0, 64), "unterminated tag"));
+  std::string nosize = Visp(model);
+  nosize.replace(nosize.find("    <image_width>640</image_width>\n"), 35, "");
+  EXPECT_TRUE(Refused("nosize.xml", nosize, "missing element <image_width> in <camera>"));
+}
+
+TEST(CameraFile, VispRefusesWhatItCannotHoldAndWritesNothing) {
+  TempDir dir;
+  const std::string path = dir.File("camera.xml");
+  const Status status = SaveCameraVisp(Lens(), path);
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.code(), ErrorCode::kInvalidInput);
+  EXPECT_NE(status.message().find(path), std::string::npos);
+  EXPECT_NE(status.message().find("ViSP's perspective model has one radial term"), std::string::npos) << status.message();
+  EXPECT_FALSE(std::filesystem::exists(path));
+  EXPECT_TRUE(dir.List().empty());
+}
+
+TEST(CameraFile, ObservationsTakeLensTermsInlineOrACameraFile) {
+  TempDir dir;
+  std::filesystem::create_directory(dir.File("cams"));
+  ASSERT_TRUE(SaveCameraOpenCv(Lens(), dir.File("cams/d435.yaml")).ok());
+  const std::string head = "format: selfcal-observations\nversion: 1.1\n";
+  const std::string tail =
+      "pixel_noise_px: 0.3\nposes:\n  - id: \"1\"\n    base_from_flange: {xyz_m: [0, 0, 0.5], rotvec_rad: [0, 0, 0]}\n"
+      "    dots: [[0, 312.25, 240.5]]\n";
+  WriteFile(dir.File("by_file.yaml"), head + "camera_file: cams/d435.yaml\n" + tail);
+  Result<ObservationSet> by_file = LoadObservations(dir.File("by_file.yaml"));
+  ASSERT_TRUE(by_file.ok()) << by_file.status().ToString();
+  ExpectSameCamera(by_file->camera, Lens());
+  // Saved inline with the lens terms, and loaded back bit-identical.
+  ASSERT_TRUE(SaveObservations(*by_file, dir.File("saved.yaml")).ok());
+  EXPECT_NE(ReadFile(dir.File("saved.yaml")).find(", k2: -0.4667, p1: 0.00061, p2: -0.00042, k3: 0.4103}"), std::string::npos);
+  Result<ObservationSet> saved = LoadObservations(dir.File("saved.yaml"));
+  ASSERT_TRUE(saved.ok()) << saved.status().ToString();
+  const IntrinsicsVector a = IntrinsicsOf(by_file->camera), b = IntrinsicsOf(saved->camera);
+  for (int i = 0; i < kNumIntrinsics; ++i) EXPECT_TRUE(SameBits(a[i], b[i])) << IntrinsicName(i);
+  // A k1-only camera is written as before: no k2, p1, p2, k3 keys.
+  EXPECT_EQ(CameraYaml(CameraIntrinsics()), "{width_px: 640, height_px: 480, fx_px: 1000, mu: 1, cx_px: 319.5, cy_px: 239.5, k1: 0}");
+  // Errors: both forms, a bad camera file (named with the key and line), a lens key misspelt.
+  WriteFile(dir.File("both.yaml"), head + "camera_file: cams/d435.yaml\ncamera: {width_px: 640}\n" + tail);
+  const Status both = LoadObservations(dir.File("both.yaml")).status();
+  EXPECT_NE(both.message().find("give the intrinsics one way, not both"), std::string::npos) << both.ToString();
+  WriteFile(dir.File("missing.yaml"), head + "camera_file: cams/none.yaml\n" + tail);
+  const Status missing = LoadObservations(dir.File("missing.yaml")).status();
+  EXPECT_EQ(missing.code(), ErrorCode::kInvalidInput);
+  EXPECT_NE(missing.message().find("`camera_file` at " + dir.File("missing.yaml") + ":3: cannot read camera file " +
+                                   dir.File("cams/none.yaml")),
+            std::string::npos)
+      << missing.ToString();
+  WriteFile(dir.File("typo.yaml"),
+            head + "camera: {width_px: 640, height_px: 480, fx_px: 600, cx_px: 320, cy_px: 240, k4: 0.1}\n" + tail);
+  const Status typo = LoadObservations(dir.File("typo.yaml")).status();
+  EXPECT_NE(typo.message().find("unknown key `k4` in `camera`"), std::string::npos) << typo.ToString();
+  EXPECT_NE(typo.message().find("did you mean `k"), std::string::npos) << typo.ToString();
+}
+
+}  // namespace
+}  // namespace selfcal::io
