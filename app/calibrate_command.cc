@@ -87,9 +87,9 @@ Result<LoadedInput> LoadInput(const CalibrateRequest& request) {
 Status WriteHandEye(const LoadedInput& loaded, const calibration::CalibrationReport& report, const std::string& out_dir) {
   io::HandEyeResult result;
   result.flange_from_cam = report.model->robot.flange_from_cam;
-  result.fx_px = report.model->fx_px;
+  result.fx_px = report.model->camera.fx_px;
   result.stddev = report.model->flange_from_cam_stddev;
-  result.fx_stddev_px = report.model->fx_stddev_px;
+  result.fx_stddev_px = report.model->intrinsics_stddev[kFx];
   result.source = "selfcal calibrate " + loaded.input.path;
   result.provenance = {{"software_version", SELFCAL_VERSION},
                        {"input_sha256", loaded.input.sha256},
@@ -116,7 +116,7 @@ Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationRep
   if (loaded.observations.UsesFlangePoses()) return WriteHandEye(loaded, report, out_dir);
   io::CalibratedModel model;
   model.model = report.model->robot;
-  model.fx_px = report.model->fx_px;
+  model.fx_px = report.model->camera.fx_px;
   model.parameters = report.model->parameters;
   model.source = "selfcal calibrate " + loaded.input.path;
   model.provenance = {{"software_version", SELFCAL_VERSION},
@@ -139,14 +139,15 @@ void AddMethodOption(CLI::App* cmd, std::string* method) {
 
 void AddParameterMaskOptions(CLI::App* cmd, std::vector<std::string>* fix, std::vector<std::string>* free) {
   const std::string names =
-      "a parameter (j2.beta, cam.tx), a joint (j3), base, camera (or hand_eye), kinematics (base and every joint), fx, k1";
+      "a parameter (j2.beta, cam.tx), a joint (j3), base, camera (or hand_eye), kinematics (base and every joint), an "
+      "intrinsic (fx, mu or fy, cx, cy, k1, k2, p1, p2, k3), lens (k1, k2, p1, p2, k3), intrinsics (all nine)";
   cmd->add_option("--fix", *fix,
                   "Hold these at their nominal values, comma separated: " + names +
                       ". --fix kinematics is the hand-eye-only solve (kinematics trusted)")
       ->delimiter(',');
   cmd->add_option("--free", *free,
-                  "Estimate only these (everything else held), comma separated, same names; naming k1 estimates the "
-                  "radial distortion, and fx must be named to stay estimated")
+                  "Estimate only these (everything else held), comma separated, same names; naming an intrinsic "
+                  "estimates it (fx must be named to stay estimated)")
       ->delimiter(',');
 }
 

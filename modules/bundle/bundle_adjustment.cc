@@ -61,30 +61,58 @@ class PoseCacheSet {
   mutable std::vector<Entry> entries_;
 };
 
-// One observation: blocks the free kinematic parameters, f_x, k1, the dot. Only the free parameters are
-// a block (not rho with a SubsetManifold): Ceres then never multiplies 2 x |rho| Jacobians by the
-// manifold's, which was a fifth of the solve. Analytic Jacobian from the pose cache by the chain rule.
+// The intrinsics of one solve: the held ones' values and which entries the intrinsics block carries.
+struct IntrinsicsLayout {
+  IntrinsicsVector held;     // every intrinsic at the start; the free ones are overwritten per evaluation
+  std::vector<int> free;     // Intrinsic indices in the block, ascending
+};
+
+// One observation: blocks the free kinematic parameters, the free intrinsics (absent when none is free),
+// the dot. Only the free parameters are blocks (not rho or the nine intrinsics with a SubsetManifold):
+// Ceres then never multiplies 2 x |rho| Jacobians by the manifold's, which was a fifth of the solve, and
+// the problem with f_x alone free is the one it was before the full lens, bit for bit. Analytic Jacobian
+// from the pose cache by the chain rule.
 class ReprojectionCost final : public ceres::CostFunction {
  public:
-  ReprojectionCost(std::shared_ptr<const PoseCacheSet> caches, const BundleData* data, int observation)
-      : caches_(std::move(caches)), data_(data), observation_(data->observations[observation]) {
+  ReprojectionCost(std::shared_ptr<const PoseCacheSet> caches, std::shared_ptr<const IntrinsicsLayout> intrinsics,
+                   const BundleData* data, int observation)
+      : caches_(std::move(caches)), intrinsics_(std::move(intrinsics)), data_(data),
+        observation_(data->observations[observation]) {
     set_num_residuals(2);
-    *mutable_parameter_block_sizes() = {caches_->num_free(), 1, 1, 3};
+    *mutable_parameter_block_sizes() = {caches_->num_free()};
+    if (!intrinsics_->free.empty()) mutable_parameter_block_sizes()->push_back(static_cast<int>(intrinsics_->free.size()));
+    mutable_parameter_block_sizes()->push_back(3);
   }
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     const bool kinematic_jacobian = jacobians != nullptr && jacobians[0] != nullptr;
     const internal::PoseCache& cache = caches_->Get(observation_.pose, parameters[0], kinematic_jacobian);
-    const Eigen::Map<const Eigen::Vector3d> dot(parameters[3]);
-    return internal::EvaluateReprojection(data_->camera, data_->sigma_px, cache, parameters[1][0], parameters[2][0], dot,
-                                          observation_.pixel, residuals, kinematic_jacobian ? jacobians[0] : nullptr,
-                                          jacobians != nullptr ? jacobians[1] : nullptr,
-                                          jacobians != nullptr ? jacobians[2] : nullptr,
-                                          jacobians != nullptr ? jacobians[3] : nullptr);
+    const std::vector<int>& free = intrinsics_->free;
+    const int dot_block = free.empty() ? 1 : 2;
+    IntrinsicsVector in = intrinsics_->held;
+    for (size_t k = 0; k < free.size(); ++k) in[free[k]] = parameters[1][k];
+    const Eigen::Map<const Eigen::Vector3d> dot(parameters[dot_block]);
+    double* const d_block = jacobians != nullptr && !free.empty() ? jacobians[1] : nullptr;
+    double d_intrinsics[2 * kNumIntrinsics];
+    if (!internal::EvaluateReprojection(in, data_->sigma_px, cache, dot, observation_.pixel, residuals,
+                                        kinematic_jacobian ? jacobians[0] : nullptr,
+                                        d_block != nullptr ? d_intrinsics : nullptr,
+                                        jacobians != nullptr ? jacobians[dot_block] : nullptr)) {
+      return false;
+    }
+    if (d_block != nullptr) {
+      const size_t m = free.size();
+      for (size_t k = 0; k < m; ++k) {
+        d_block[k] = d_intrinsics[free[k]];
+        d_block[m + k] = d_intrinsics[kNumIntrinsics + free[k]];
+      }
+    }
+    return true;
   }
 
  private:
   std::shared_ptr<const PoseCacheSet> caches_;
+  std::shared_ptr<const IntrinsicsLayout> intrinsics_;
   const BundleData* data_;
   internal::Observation observation_;
 };
@@ -105,32 +133,34 @@ struct YardstickResidual {
 ceres::Solver::Summary Solve(const BundleData& data, const std::vector<int>& free, const BundleOptions& options,
                              bool robust, BundleState* state) {
   auto caches = std::make_shared<const PoseCacheSet>(&data, state->rho, free);
-  // Every parameter block lives in one buffer, in a fixed layout [free rho | f_x | k1 | dots]: Ceres
-  // orders the blocks of an elimination group by address, so blocks scattered over the heap and the
+  auto layout = std::make_shared<IntrinsicsLayout>();
+  layout->held = state->intrinsics;
+  layout->free = EstimatedIntrinsics(options.intrinsics);
+  // Every parameter block lives in one buffer, in a fixed layout [free rho | free intrinsics | dots]:
+  // Ceres orders the blocks of an elimination group by address, so blocks scattered over the heap and the
   // stack would make the arithmetic, and the last bits of the result, depend on the process (P9).
   const size_t n = free.size();
-  std::vector<double> buffer(n + 2 + 3 * state->dots.size());
+  const size_t m = layout->free.size();
+  std::vector<double> buffer(n + m + 3 * state->dots.size());
   double* const x = buffer.data();
-  double* const fx = x + n;
-  double* const k1 = fx + 1;
-  auto dot = [&](int d) { return k1 + 1 + 3 * d; };
+  double* const intrinsics = x + n;
+  auto dot = [&](int d) { return intrinsics + m + 3 * d; };
   for (size_t k = 0; k < n; ++k) x[k] = state->rho[free[k]];
-  *fx = state->fx_px;
-  *k1 = state->k1;
+  for (size_t k = 0; k < m; ++k) intrinsics[k] = state->intrinsics[layout->free[k]];
   for (size_t d = 0; d < state->dots.size(); ++d) Eigen::Map<Eigen::Vector3d>(dot(static_cast<int>(d))) = state->dots[d];
   // Residuals are whitened, so the Huber threshold is huber_px in units of sigma. Declared before the
   // problem, which holds non-owning wrappers of it.
   ceres::HuberLoss huber(options.huber_px / data.sigma_px);
   ceres::Problem problem;
   problem.AddParameterBlock(x, static_cast<int>(n));
-  problem.AddParameterBlock(fx, 1);
-  problem.AddParameterBlock(k1, 1);
-  if (!options.estimate_fx) problem.SetParameterBlockConstant(fx);
-  if (!options.estimate_k1) problem.SetParameterBlockConstant(k1);
+  if (m > 0) problem.AddParameterBlock(intrinsics, static_cast<int>(m));
   for (size_t k = 0; k < data.observations.size(); ++k) {
-    problem.AddResidualBlock(new ReprojectionCost(caches, &data, static_cast<int>(k)),
+    std::vector<double*> blocks = {x};
+    if (m > 0) blocks.push_back(intrinsics);
+    blocks.push_back(dot(data.observations[k].dot));
+    problem.AddResidualBlock(new ReprojectionCost(caches, layout, &data, static_cast<int>(k)),
                              robust ? new ceres::LossFunctionWrapper(&huber, ceres::DO_NOT_TAKE_OWNERSHIP) : nullptr,
-                             x, fx, k1, dot(data.observations[k].dot));
+                             blocks);
   }
   std::vector<bool> in_yardstick(data.dot_ids.size(), false);
   for (const internal::Yardstick& y : data.yardsticks) {
@@ -146,8 +176,7 @@ ceres::Solver::Summary Solve(const BundleData& data, const std::vector<int>& fre
     ordering->AddElementToGroup(dot(static_cast<int>(d)), in_yardstick[d] ? 1 : 0);
   }
   ordering->AddElementToGroup(x, 1);
-  ordering->AddElementToGroup(fx, 1);
-  ordering->AddElementToGroup(k1, 1);
+  if (m > 0) ordering->AddElementToGroup(intrinsics, 1);
 
   ceres::Solver::Options solver_options;
   solver_options.minimizer_type = ceres::TRUST_REGION;
@@ -164,8 +193,7 @@ ceres::Solver::Summary Solve(const BundleData& data, const std::vector<int>& fre
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, &problem, &summary);
   for (size_t k = 0; k < n; ++k) state->rho[free[k]] = x[k];
-  state->fx_px = *fx;
-  state->k1 = *k1;
+  for (size_t k = 0; k < m; ++k) state->intrinsics[layout->free[k]] = intrinsics[k];
   for (size_t d = 0; d < state->dots.size(); ++d) state->dots[d] = Eigen::Map<const Eigen::Vector3d>(dot(static_cast<int>(d)));
   return summary;
 }
@@ -179,8 +207,8 @@ std::vector<double> ReprojectionErrors(const BundleData& data, const BundleState
   std::vector<double> errors;
   for (const internal::Observation& o : data.observations) {
     double r[2];
-    const bool ok = internal::EvaluateReprojection(data.camera, 1.0, caches[o.pose], state.fx_px, state.k1,
-                                                   state.dots[o.dot], o.pixel, r, nullptr, nullptr, nullptr, nullptr);
+    const bool ok = internal::EvaluateReprojection(state.intrinsics, 1.0, caches[o.pose], state.dots[o.dot], o.pixel, r,
+                                                   nullptr, nullptr, nullptr);
     errors.push_back(ok ? std::hypot(r[0], r[1]) : std::numeric_limits<double>::quiet_NaN());
   }
   return errors;
@@ -257,7 +285,7 @@ std::vector<int> DotsSeenOnce(const ObservationSet& observations) {
 
 // Dots from the start model; a dot that cannot be triangulated there (behind a camera, no parallax)
 // is dropped: its id is appended to `dropped`, it and its observations leave `data` and `state`.
-void TriangulateStartDots(const Eigen::VectorXd& rho_start, double fx_start, BundleData* data, BundleState* state,
+void TriangulateStartDots(const Eigen::VectorXd& rho_start, BundleData* data, BundleState* state,
                           std::vector<int>* dropped) {
   std::vector<Rigid3> base_from_cam;
   for (size_t p = 0; p < data->joints.size(); ++p) {
@@ -272,7 +300,8 @@ void TriangulateStartDots(const Eigen::VectorXd& rho_start, double fx_start, Bun
   std::vector<bool> ok(data->dot_ids.size());
   for (size_t d = 0; d < tracks.size(); ++d) {
     const identification::TriangulationResult t =
-        identification::TriangulatePoint(data->camera, fx_start, tracks[d], data->sigma_px);
+        identification::TriangulatePoint(WithIntrinsics(data->camera, state->intrinsics), state->intrinsics[kFx],
+                                         tracks[d], data->sigma_px);
     ok[d] = t.ok && t.point.allFinite();
     state->dots[d] = t.point;
     if (!ok[d]) dropped->push_back(data->dot_ids[d]);
@@ -285,28 +314,21 @@ void TriangulateStartDots(const Eigen::VectorXd& rho_start, double fx_start, Bun
   Subset(all, all_state, keep, data, state, &dot_map);
 }
 
-// The rho indices held by request, and f_x / k1 switched off when held (or left out of a free list).
+// The rho indices held by request, and the intrinsics estimated after the names (EstimatedIntrinsicsOf).
 // Returns the unknown names, one per line.
 std::string HeldParameters(int num_joints, BundleOptions* options, std::vector<int>* held) {
-  bool fx_held = false, k1_held = false, fx_free = false, k1_free = false;
-  std::vector<int> named_free;
-  std::string problems = ResolveParameterNames(options->held_parameters, num_joints, held, &fx_held, &k1_held);
+  std::string problems = ResolveParameterNames(options->held_parameters, num_joints, held);
   if (!options->free_parameters.empty()) {
-    problems += ResolveParameterNames(options->free_parameters, num_joints, &named_free, &fx_free, &k1_free);
+    std::vector<int> named_free;
+    problems += ResolveParameterNames(options->free_parameters, num_joints, &named_free);
     const int n = KinematicParameters(num_joints).size();
     for (int i = 0; i < n; ++i) {
       if (std::find(named_free.begin(), named_free.end(), i) == named_free.end()) held->push_back(i);
     }
     std::sort(held->begin(), held->end());
     held->erase(std::unique(held->begin(), held->end()), held->end());
-    fx_held |= !fx_free;
-    k1_held |= !k1_free;
-    // Naming f_x or k1 in the free list asks for it to be estimated.
-    if (fx_free && !fx_held) options->estimate_fx = true;
-    if (k1_free && !k1_held) options->estimate_k1 = true;
   }
-  if (fx_held) options->estimate_fx = false;
-  if (k1_held) options->estimate_k1 = false;
+  options->intrinsics = EstimatedIntrinsicsOf(*options, num_joints);
   if (!held->empty()) options->require_generic_rank = false;
   return problems;
 }
@@ -319,10 +341,8 @@ bool AnalyzeStartGauge(const BundleData& data, const BundleState& state, const B
                        const std::vector<int>& held, internal::Gauge* gauge, BundleReport* report) {
   BundleState nominal = state;
   nominal.rho = KinematicParameters::Nominal(data.robot);
-  if (!internal::AnalyzeGauge(data, nominal, options.estimate_fx, options.estimate_k1, options.rank_tolerance, gauge,
-                              held) &&
-      !internal::AnalyzeGauge(data, state, options.estimate_fx, options.estimate_k1, options.rank_tolerance, gauge,
-                              held)) {
+  if (!internal::AnalyzeGauge(data, nominal, options.intrinsics, options.rank_tolerance, gauge, held) &&
+      !internal::AnalyzeGauge(data, state, options.intrinsics, options.rank_tolerance, gauge, held)) {
     return false;
   }
   report->free_indices = gauge->free_kinematic;
@@ -343,10 +363,12 @@ bool AnalyzeStartGauge(const BundleData& data, const BundleState& state, const B
 // Why the free set cannot be estimated from these poses (K3), or empty when it can.
 std::string WhyNotIdentifiable(const internal::Gauge& gauge, const BundleOptions& options, int num_poses,
                                int generic_rank) {
-  if (options.estimate_fx && !gauge.fx_identifiable) {
-    return "f_x is not identifiable from these poses (null directions: " + Join(gauge.null_combinations) + ")";
+  // In Intrinsic order, so that f_x is named first when it fails.
+  for (int k : EstimatedIntrinsics(options.intrinsics)) {
+    if (gauge.intrinsics_identifiable[k]) continue;
+    return std::string(k == kFx ? "f_x" : IntrinsicName(k)) + " is not identifiable from these poses (null directions: " +
+           Join(gauge.null_combinations) + "): hold it, or add poses that separate it";
   }
-  if (options.estimate_k1 && !gauge.k1_identifiable) return "k1 is not identifiable from these poses";
   if (gauge.free_kinematic.empty() ||
       (options.require_generic_rank && static_cast<int>(gauge.free_kinematic.size()) < generic_rank)) {
     std::ostringstream msg;
@@ -377,8 +399,7 @@ std::vector<bool> ScreenObservations(const std::vector<double>& errors, double s
 // The globals and the subset's dots of `state` into `full_state` (dot c of the subset is dot_map[c]).
 void WriteBack(const BundleState& state, const std::vector<int>& dot_map, BundleState* full_state) {
   full_state->rho = state.rho;
-  full_state->fx_px = state.fx_px;
-  full_state->k1 = state.k1;
+  full_state->intrinsics = state.intrinsics;
   for (size_t c = 0; c < dot_map.size(); ++c) full_state->dots[dot_map[c]] = state.dots[c];
 }
 
@@ -444,8 +465,7 @@ void EstimateCovariance(const BundleData& data, const BundleState& state, const 
                         const BundleOptions& options, double final_cost, BundleReport* report) {
   internal::GlobalColumns columns;
   columns.kinematic = free;
-  columns.fx = options.estimate_fx;
-  columns.k1 = options.estimate_k1;
+  columns.intrinsics = EstimatedIntrinsics(options.intrinsics);
   const int num_unknowns = columns.size() + 3 * static_cast<int>(data.dot_ids.size());
   const int dof = 2 * report->num_observations + static_cast<int>(data.yardsticks.size()) - num_unknowns;
   Eigen::MatrixXd reduced, covariance;
@@ -472,8 +492,8 @@ void EstimateCovariance(const BundleData& data, const BundleState& state, const 
     }
     const int nk = static_cast<int>(columns.kinematic.size());
     for (int k = 0; k < nk; ++k) report->stddev[columns.kinematic[k]] = sd[k];
-    if (columns.fx) report->fx_stddev = sd[nk];
-    if (columns.k1) report->k1_stddev = sd[nk + (columns.fx ? 1 : 0)];
+    for (size_t k = 0; k < columns.intrinsics.size(); ++k) report->intrinsics_stddev[columns.intrinsics[k]] = sd[nk + k];
+    report->fx_stddev = report->intrinsics_stddev[kFx];
   }
 }
 
@@ -485,10 +505,12 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
   BundleReport report;
   report.rho = rho_start;
   report.fx_px = fx_start;
-  report.k1 = observations.camera.k1;
+  report.intrinsics = IntrinsicsOf(observations.camera);
+  report.intrinsics[kFx] = fx_start;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   report.stddev = Eigen::VectorXd::Constant(std::max<Eigen::Index>(rho_start.size(), 0), nan);
-  report.fx_stddev = report.k1_stddev = nan;
+  report.fx_stddev = nan;
+  report.intrinsics_stddev.fill(nan);
   auto finish = [&](Outcome outcome, const std::string& message) {
     report.outcome = outcome;
     report.message = message;
@@ -501,8 +523,7 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
   std::string problems = CheckInputs(observations, rho_start, fx_start, options);
   problems += HeldParameters(observations.robot.num_joints(), &options, &held);
   if (!problems.empty()) return finish(Outcome::kInvalidInput, "invalid input:\n" + problems);
-  report.fx_estimated = options.estimate_fx;
-  report.k1_estimated = options.estimate_k1;
+  report.intrinsics_estimated = options.intrinsics;
   const int num_poses = static_cast<int>(observations.PosesWithRole(PoseRole::kIdentification).size());
   if (num_poses < options.min_identification_poses) {
     return finish(Outcome::kDegenerate, "only " + std::to_string(num_poses) + " identification poses (need " +
@@ -516,9 +537,8 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
   report.dropped_dots = DotsSeenOnce(observations);
   BundleState state;
   state.rho = rho_start;
-  state.fx_px = fx_start;
-  state.k1 = observations.camera.k1;
-  TriangulateStartDots(rho_start, fx_start, &data, &state, &report.dropped_dots);
+  state.intrinsics = report.intrinsics;
+  TriangulateStartDots(rho_start, &data, &state, &report.dropped_dots);
   if (data.yardsticks.empty() && !flange_poses) {
     return finish(Outcome::kScaleUnresolved,
                   "no yardstick has both ends seen (and triangulable) in two or more identification poses");
@@ -542,8 +562,8 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
     return finish(Outcome::kFailure, "solver failed: " + report.termination);
   }
   report.rho = state.rho;
-  report.fx_px = state.fx_px;
-  report.k1 = state.k1;
+  report.intrinsics = state.intrinsics;
+  report.fx_px = state.intrinsics[kFx];
   for (size_t d = 0; d < data.dot_ids.size(); ++d) report.dots_in_base[data.dot_ids[d]] = state.dots[d];
   report.num_observations = static_cast<int>(data.observations.size());
   {

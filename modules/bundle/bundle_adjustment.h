@@ -3,8 +3,10 @@
 //
 // Residual of dot j seen at identification pose i (pixels, whitened by sigma = pixel_noise_px):
 //
-//   r_ij = ( project(fx, k1, cam_i_from_base * p_j_in_base) - pixel_ij ) / sigma,
+//   r_ij = ( project(intrinsics, cam_i_from_base * p_j_in_base) - pixel_ij ) / sigma,
 //   cam_i_from_base = base_from_cam(q_i; rho)^-1          (kinematics/robot_model.h, camera/camera.h)
+//
+// with OpenCV's radial-tangential lens (intrinsics fx, mu, cx, cy, k1, k2, p1, p2, k3)
 //
 // and, per yardstick (dots a, b, known length L), the length constraint
 //
@@ -15,16 +17,22 @@
 // and its variance is ~1e4 times below what the images alone give for a length (they know it to ~0.1 mm). Its two dots stay out of
 // the Schur-eliminated group (a residual may touch only one eliminated block).
 //
-// Unknowns: the identifiable entries of rho (camera correction included), f_x (and k1 when asked), and
-// every dot seen in at least two identification poses (p_j in the base frame, m). Gauge: with unknown
+// Unknowns: the identifiable entries of rho (camera correction included), the intrinsics asked for (f_x
+// by default; any subset of the nine by name), and every dot seen in at least two identification poses
+// (p_j in the base frame, m). Gauge: with unknown
 // dots a rigid motion of the whole scene is invisible, so the base correction and joint 1's parameters
 // cannot be seen; the yardstick fixes the scale. Nothing is assumed: the rank of the reduced Jacobian
-// (the dots eliminated: J_g^T (I - P_dots) J_g with J_g the columns of rho, f_x, k1) decides, evaluated
+// (the dots eliminated: J_g^T (I - P_dots) J_g with J_g the columns of rho and the estimated
+// intrinsics) decides, evaluated
 // at the nominal model (where nominally parallel axes are exactly parallel; at a perturbed start the d
 // offsets of a parallel pair would look independent, K2) with the dots triangulated from the start.
-// Columns are taken greedily in the order f_x, k1, camera, base, alpha/a/theta/d joint by joint, betas
-// last (the order of identification/identifiability.h, so that the same representative of each
-// dependent set is kept). Everything else is held at its start value and reported by name. For the
+// Columns are taken greedily in the order of the estimated intrinsics (fx, mu, cx, cy, k1, k2, p1, p2,
+// k3), camera, base, alpha/a/theta/d joint by joint, betas last (the order of
+// identification/identifiability.h, so that the same representative of each dependent set is kept).
+// An estimated intrinsic the poses cannot separate from those before it is refused (kDegenerate, named);
+// a principal point traded against the camera rotation keeps both when the perspective of the views
+// separates them, with their correlation in the covariance. Everything else is held at its start value
+// and reported by name. For the
 // PUMA 560 on the arc trajectory this frees 24 kinematic parameters + f_x and fixes the base, joint 1,
 // j2.beta, j3.d, j4-j6.beta, j6.theta and j6.d: the same set as the relative-pose analysis with known
 // scale.
@@ -35,7 +43,7 @@
 // pose's dots). About 20-30 ms for 15 poses x 80 dots.
 //
 // Frames and units: rho in m and rad (robot_model.h); dots in the base frame of the model (the gauge is
-// the start's base and joint-1 parameters); pixels as in camera/camera.h; f_x in px.
+// the start's base and joint-1 parameters); pixels as in camera/camera.h; f_x, c_x, c_y in px.
 #pragma once
 
 #include <cmath>
@@ -45,14 +53,16 @@
 
 #include <Eigen/Core>
 
+#include "camera/camera.h"
 #include "kinematics/robot_model.h"
 #include "observations/observation_set.h"
 
 namespace selfcal::bundle {
 
 struct BundleOptions {
-  bool estimate_fx = true;
-  bool estimate_k1 = false;   // false: k1 held at observations.camera.k1
+  // The intrinsics estimated (camera/camera.h's Intrinsic order); the others are held at
+  // observations.camera's values (f_x at fx_start). Names in held_parameters / free_parameters override.
+  IntrinsicsMask intrinsics = kFocalLengthOnly;
   // Huber loss on each observation's 2-D reprojection error, in pixels (the loss acts on the whitened
   // residual at huber_px / pixel_noise_px standard deviations). Used while outliers are screened; the
   // final fit is plain least squares on the kept observations.
@@ -77,9 +87,10 @@ struct BundleOptions {
   // Parameters held at their start values by request (e.g. a hand-eye-only solve with kinematics
   // trusted: {"kinematics"}), and, when not empty, the only ones that may be estimated (everything else
   // held). Names: a parameter (`j2.beta`, `cam.tx`), a joint (`j3`), a group (`base`, `camera` or
-  // `hand_eye`, `kinematics` = base and every joint), `fx`, `k1`. A held f_x or k1 is as estimate_fx or
-  // estimate_k1 false; `fx` or `k1` in free_parameters turns its estimation on, and a non-empty free
-  // list without them holds them. The rank analysis still decides among the rest.
+  // `hand_eye`, `kinematics` = base and every joint), an intrinsic (`fx`, `mu` or its alias `fy`, `cx`,
+  // `cy`, `k1`, `k2`, `p1`, `p2`, `k3`), `lens` (k1 k2 p1 p2 k3), `intrinsics` (all nine). A held
+  // intrinsic is as false in `intrinsics`; one named in free_parameters is estimated, and a non-empty
+  // free list holds every intrinsic it does not name. The rank analysis still decides among the rest.
   // With anything held, the generic-rank check (require_generic_rank) does not apply.
   std::vector<std::string> held_parameters;
   std::vector<std::string> free_parameters;
@@ -108,10 +119,11 @@ struct BundleReport {
   Outcome outcome = Outcome::kNotRun;
   std::string message;
   Eigen::VectorXd rho;                        // full; fixed entries keep their start values
-  double fx_px = 0;
-  double k1 = 0;
-  // What was estimated: BundleOptions::estimate_fx / estimate_k1, unless held by name.
-  bool fx_estimated = false, k1_estimated = false;
+  double fx_px = 0;                           // = intrinsics[kFx], for its many readers
+  // Every intrinsic (Intrinsic order), held ones at their start; what was estimated (BundleOptions::
+  // intrinsics after the names of held_parameters / free_parameters).
+  IntrinsicsVector intrinsics{};
+  IntrinsicsMask intrinsics_estimated{};
   std::map<int, Eigen::Vector3d> dots_in_base;  // every dot that entered the solve
   std::vector<int> free_indices;              // kinematic, in rho order
   std::vector<std::string> free_names, fixed_names;  // fixed: by the rank analysis and by request
@@ -122,10 +134,11 @@ struct BundleReport {
   // Marginal standard deviations, dots as nuisance: s^2 (J_g^T (I - P_dots) J_g)^-1 over the free
   // columns, s^2 = 2 final_cost / (residuals - unknowns). NaN for fixed entries or when unavailable (K8).
   Eigen::VectorXd stddev;                     // rho size
-  double fx_stddev = 0, k1_stddev = 0;        // NaN when not estimated or unavailable
+  double fx_stddev = 0;                       // = intrinsics_stddev[kFx]
+  IntrinsicsVector intrinsics_stddev{};       // NaN when not estimated or unavailable
   bool covariance_available = false;
   std::string covariance_message;
-  // Order: free_indices, then f_x, then k1 (each when estimated).
+  // Order: free_indices, then the estimated intrinsics in Intrinsic order (EstimatedIntrinsics).
   Eigen::MatrixXd covariance_free, correlation_free;
   std::vector<RemovedObservation> removed;    // by the screen
   std::vector<int> dropped_dots;              // seen fewer than twice, or not triangulable at the start
@@ -143,15 +156,20 @@ struct BundleReport {
 
 // Runs the bundle adjustment on the identification poses of `observations`. The start: rho_start on the
 // model observations.robot (e.g. the nominal rho, or the paper pipeline's result via ExpressOnModel) and
-// fx_start; k1 starts at observations.camera.k1; the dots are triangulated from the start model
+// fx_start; the other intrinsics start at observations.camera's; the dots are triangulated from the start model
 // (identification/triangulation.h). Single-threaded and deterministic.
 BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen::VectorXd& rho_start,
                                  double fx_start, const BundleOptions& options);
 
-// rho indices named by `names` (see BundleOptions::held_parameters; `fx` and `k1` are set in *fx, *k1 and
-// not returned). Returns the unknown names, one per line with the valid forms, or empty.
+// rho indices named by `names` (see BundleOptions::held_parameters; intrinsics and their groups are set
+// true in *intrinsics, when given, and not returned). Returns the unknown names, one per line with the
+// valid forms, or empty.
 std::string ResolveParameterNames(const std::vector<std::string>& names, int num_joints, std::vector<int>* indices,
-                                  bool* fx = nullptr, bool* k1 = nullptr);
+                                  IntrinsicsMask* intrinsics = nullptr);
+
+// The intrinsics a bundle with these options estimates: options.intrinsics after the names of
+// held_parameters and free_parameters (unknown names are ignored here; RunBundleAdjustment refuses them).
+IntrinsicsMask EstimatedIntrinsicsOf(const BundleOptions& options, int num_joints);
 
 // The rho on `target` (same joint count) that gives the same base_from_cam(q) for every q as `source_rho`
 // on `source`: joint parameters copied, base and camera corrections re-expressed against target's
@@ -161,8 +179,7 @@ Eigen::VectorXd ExpressOnModel(const RobotModel& target, const RobotModel& sourc
 // The truth (or any point) of the bundle problem, for the bound.
 struct BundleTruth {
   Eigen::VectorXd rho;                          // on observations.robot
-  double fx_px = 0;
-  double k1 = 0;
+  CameraIntrinsics camera;                      // every intrinsic (the image size is the geometry's)
   std::map<int, Eigen::Vector3d> dots_in_base;  // at least every dot seen twice in identification poses
 };
 
@@ -175,7 +192,8 @@ struct CramerRaoReport {
   // BundleReport::covariance_free.
   Eigen::MatrixXd covariance_free;
   Eigen::VectorXd stddev;         // rho size, NaN for fixed
-  double fx_stddev = 0, k1_stddev = 0;
+  double fx_stddev = 0;           // = intrinsics_stddev[kFx]
+  IntrinsicsVector intrinsics_stddev{};  // NaN for held
   // Propagated to the predicted relative pose cam_ref_from_cam_v (ref = first identification pose) of
   // every verification pose: RMS position error bound sqrt(trace cov_t) (m) and orientation bound
   // sqrt(trace cov_w) (rad, small-angle vector).

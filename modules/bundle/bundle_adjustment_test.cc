@@ -93,11 +93,11 @@ TEST(BundleAdjustment, NoiseFreeFromAPerturbedStartWithTheGaugeOfTheNominalModel
 TEST(BundleAdjustment, EstimatesK1WhenAsked) {
   const sim::SimResult world = World(0.0, 3, 3);
   BundleOptions options;
-  options.estimate_k1 = true;
+  options.intrinsics[kK1] = true;
   const ObservationSet& obs = world.observations;
   const BundleReport r = RunBundleAdjustment(obs, KinematicParameters::Nominal(obs.robot), obs.camera.fx_px, options);
   ExpectExact(r, world, "noise 0, k1 estimated");
-  EXPECT_NEAR(r.k1, world.truth.camera_true.k1, kExact);
+  EXPECT_NEAR(r.intrinsics[kK1], world.truth.camera_true.k1, kExact);
   EXPECT_EQ(r.covariance_free.rows(), 26);
 }
 
@@ -117,43 +117,58 @@ TEST(BundleAdjustment, ExpressOnModelReproducesTheCameraPoses) {
   }
 }
 
-// The analytic chain rule (pose cache + projection) against central differences, with k1 != 0.
+// The analytic chain rule (pose cache + projection) against central differences, with every lens term
+// non-zero and mu != 1: rho, all nine intrinsics, the dot.
 TEST(BundleAdjustment, ReprojectionJacobianMatchesNumericDifferentiation) {
   const RobotModel robot = selfcal::testing::Puma560();
-  CameraIntrinsics camera;
-  camera.mu = 1.02;
   const int n = robot.num_parameters();
   std::vector<int> columns(n);
   for (int i = 0; i < n; ++i) columns[i] = i;
   Eigen::VectorXd q(6);
   q << 0.1, 0.4, 2.6, 0.2, 0.7, -0.3;
-  Eigen::VectorXd x(n + 5);  // rho, f_x, k1, dot
+  Eigen::VectorXd x(n + kNumIntrinsics + 3);  // rho, intrinsics, dot
   x.head(n) = KinematicParameters::Nominal(robot);
   const Rigid3 base_from_cam = BaseFromCam(robot, Eigen::VectorXd(x.head(n)), q);
-  x.tail(5) << 1000.0, -0.08, 0, 0, 0;
+  x.segment<kNumIntrinsics>(n) << 1000.0, 1.02, 322.5, 236.0, -0.08, 0.05, 0.002, -0.003, -0.01;
   x.tail(3) = base_from_cam * Eigen::Vector3d(0.1, -0.05, 0.6);
   const Eigen::Vector2d pixel(300, 250);
   internal::BundleData one;
   one.robot = robot;
   one.joints = {q};
+  auto intrinsics_of = [&](const double* v) {
+    IntrinsicsVector in;
+    for (int k = 0; k < kNumIntrinsics; ++k) in[k] = v[n + k];
+    return in;
+  };
   auto f = [&](const double* v, double* out) {
     internal::PoseCache cache;
     internal::ComputePoseCache(one, 0, v, {}, false, &cache);
-    internal::EvaluateReprojection(camera, 0.5, cache, v[n], v[n + 1], Eigen::Vector3d(v[n + 2], v[n + 3], v[n + 4]),
-                                   pixel, out, nullptr, nullptr, nullptr, nullptr);
+    const double* d = v + n + kNumIntrinsics;
+    internal::EvaluateReprojection(intrinsics_of(v), 0.5, cache, Eigen::Vector3d(d[0], d[1], d[2]), pixel, out,
+                                   nullptr, nullptr, nullptr);
   };
   const Eigen::MatrixXd numeric = NumericJacobian(f, x, 2, 1e-7);
   internal::PoseCache cache;
   internal::ComputePoseCache(one, 0, x.data(), columns, true, &cache);
-  double residual[2], d_fx[2], d_k1[2], d_dot[6];
+  double residual[2], d_intrinsics[2 * kNumIntrinsics], d_dot[6];
   std::vector<double> d_columns(2 * n);
-  ASSERT_TRUE(internal::EvaluateReprojection(camera, 0.5, cache, x[n], x[n + 1], x.tail<3>(), pixel, residual,
-                                             d_columns.data(), d_fx, d_k1, d_dot));
+  ASSERT_TRUE(internal::EvaluateReprojection(intrinsics_of(x.data()), 0.5, cache, x.tail<3>(), pixel, residual,
+                                             d_columns.data(), d_intrinsics, d_dot));
+  // The residual is camera.h's projection, bit for bit.
+  double u = 0, v = 0;
+  ASSERT_TRUE(ProjectWithIntrinsics<double>(x.data() + n, cache.rotation * x.tail<3>() + cache.translation, &u, &v));
+  EXPECT_EQ(residual[0], (u - pixel.x()) * (1.0 / 0.5));
+  EXPECT_EQ(residual[1], (v - pixel.y()) * (1.0 / 0.5));
   for (int r = 0; r < 2; ++r) {
     for (int c = 0; c < n; ++c) EXPECT_NEAR(d_columns[r * n + c], numeric(r, c), 1e-5 * (1 + std::abs(numeric(r, c)))) << c;
-    EXPECT_NEAR(d_fx[r], numeric(r, n), 1e-6);
-    EXPECT_NEAR(d_k1[r], numeric(r, n + 1), 1e-4);
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(d_dot[3 * r + c], numeric(r, n + 2 + c), 1e-4 * (1 + std::abs(numeric(r, n + 2 + c))));
+    for (int k = 0; k < kNumIntrinsics; ++k) {
+      const double expected = numeric(r, n + k);
+      EXPECT_NEAR(d_intrinsics[r * kNumIntrinsics + k], expected, 1e-5 * (1 + std::abs(expected))) << IntrinsicName(k);
+    }
+    for (int c = 0; c < 3; ++c) {
+      const double expected = numeric(r, n + kNumIntrinsics + c);
+      EXPECT_NEAR(d_dot[3 * r + c], expected, 1e-4 * (1 + std::abs(expected)));
+    }
   }
 }
 
@@ -167,11 +182,11 @@ TEST(BundleAdjustment, ReducedJacobianIsTheSchurComplementOfTheDots) {
   }
   const internal::BundleData data = internal::MakeBundleData(obs, 1e-3);
   ASSERT_EQ(data.yardsticks.size(), 1u);
-  internal::BundleState state{world.truth.rho_true, world.truth.camera_true.fx_px, 0.0, {}};
+  internal::BundleState state{world.truth.rho_true, IntrinsicsOf(world.truth.camera_true), {}};
   for (int id : data.dot_ids) state.dots.push_back(world.truth.dots_in_base[id]);
   internal::GlobalColumns columns;
   columns.kinematic = world.truth.perturbed_indices;
-  columns.fx = true;
+  columns.intrinsics = {kFx};
   const int ng = columns.size(), nx = 3 * static_cast<int>(data.dot_ids.size());
   Eigen::MatrixXd reduced;
   ASSERT_TRUE(internal::ReducedJacobian(data, state, columns, &reduced));
@@ -179,15 +194,15 @@ TEST(BundleAdjustment, ReducedJacobianIsTheSchurComplementOfTheDots) {
   auto residuals = [&](const Eigen::VectorXd& x) {
     internal::BundleState s = state;
     for (size_t k = 0; k < columns.kinematic.size(); ++k) s.rho[columns.kinematic[k]] = x[k];
-    s.fx_px = x[ng - 1];
+    s.intrinsics[kFx] = x[ng - 1];
     for (size_t d = 0; d < s.dots.size(); ++d) s.dots[d] = x.segment<3>(ng + 3 * d);
     Eigen::VectorXd out(2 * data.observations.size() + 1);
     for (size_t k = 0; k < data.observations.size(); ++k) {
       const internal::Observation& o = data.observations[k];
       internal::PoseCache cache;
       internal::ComputePoseCache(data, o.pose, s.rho.data(), {}, false, &cache);
-      internal::EvaluateReprojection(data.camera, data.sigma_px, cache, s.fx_px, s.k1, s.dots[o.dot], o.pixel,
-                                     out.data() + 2 * k, nullptr, nullptr, nullptr, nullptr);
+      internal::EvaluateReprojection(s.intrinsics, data.sigma_px, cache, s.dots[o.dot], o.pixel, out.data() + 2 * k,
+                                     nullptr, nullptr, nullptr);
     }
     const auto& y = data.yardsticks[0];
     out[out.size() - 1] = ((s.dots[y.dot_a] - s.dots[y.dot_b]).norm() - y.length_m) / data.yardstick_sigma_m;
@@ -195,7 +210,7 @@ TEST(BundleAdjustment, ReducedJacobianIsTheSchurComplementOfTheDots) {
   };
   Eigen::VectorXd x(ng + nx);
   for (size_t k = 0; k < columns.kinematic.size(); ++k) x[k] = state.rho[columns.kinematic[k]];
-  x[ng - 1] = state.fx_px;
+  x[ng - 1] = state.intrinsics[kFx];
   for (size_t d = 0; d < state.dots.size(); ++d) x.segment<3>(ng + 3 * d) = state.dots[d];
   Eigen::MatrixXd j(residuals(x).size(), x.size());
   for (int c = 0; c < x.size(); ++c) {
@@ -260,19 +275,19 @@ TEST(BundleAdjustment, OutliersAreRemovedByPoseAndDotAndTheResultHolds) {
 TEST(BundleAdjustment, GaugeIsTheSameAtEveryStatedPixelNoise) {
   const sim::SimResult world = World(0.0);
   const ObservationSet& obs = world.observations;
-  internal::BundleState state{KinematicParameters::Nominal(obs.robot), obs.camera.fx_px, 0.0, {}};
+  internal::BundleState state{KinematicParameters::Nominal(obs.robot), IntrinsicsOf(obs.camera), {}};
   internal::BundleData data = internal::MakeBundleData(obs, 1e-6);
   for (int id : data.dot_ids) state.dots.push_back(world.truth.dots_in_base[id]);
   internal::Gauge reference;
-  ASSERT_TRUE(internal::AnalyzeGauge(data, state, true, false, BundleOptions().rank_tolerance, &reference));
+  ASSERT_TRUE(internal::AnalyzeGauge(data, state, kFocalLengthOnly, BundleOptions().rank_tolerance, &reference));
   EXPECT_EQ(reference.free_kinematic, world.truth.perturbed_indices);
   for (double sigma_px : {1e-150, 1e-100, 1e-10, 1e-6, 0.02, 1.0, 100.0}) {
     data.sigma_px = sigma_px;
     internal::Gauge gauge;
-    ASSERT_TRUE(internal::AnalyzeGauge(data, state, true, false, BundleOptions().rank_tolerance, &gauge)) << sigma_px;
+    ASSERT_TRUE(internal::AnalyzeGauge(data, state, kFocalLengthOnly, BundleOptions().rank_tolerance, &gauge)) << sigma_px;
     EXPECT_EQ(gauge.free_kinematic, reference.free_kinematic) << sigma_px;
     EXPECT_EQ(gauge.fixed_names, reference.fixed_names) << sigma_px;
-    EXPECT_TRUE(gauge.fx_identifiable) << sigma_px;
+    EXPECT_TRUE(gauge.intrinsics_identifiable[kFx]) << sigma_px;
   }
 }
 

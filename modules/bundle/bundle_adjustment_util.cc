@@ -28,18 +28,39 @@ std::string BundleOptions::Validate() const {
   return out.str();
 }
 
+namespace {
+
+// An intrinsic by name (fy: the ratio mu = f_y / f_x, the one focal length selfcal keeps beside f_x) or
+// one of the groups `lens` and `intrinsics`; false when `name` is none of them.
+bool AddIntrinsics(const std::string& name, IntrinsicsMask* mask) {
+  if (name == "intrinsics") {
+    mask->fill(true);
+    return true;
+  }
+  if (name == "lens") {
+    for (int k : {kK1, kK2, kP1, kP2, kK3}) (*mask)[k] = true;
+    return true;
+  }
+  const int index = name == "fy" ? static_cast<int>(kMu) : IntrinsicIndex(name);
+  if (index < 0) return false;
+  (*mask)[index] = true;
+  return true;
+}
+
+}  // namespace
+
 std::string ResolveParameterNames(const std::vector<std::string>& names, int num_joints, std::vector<int>* indices,
-                                  bool* fx, bool* k1) {
+                                  IntrinsicsMask* intrinsics) {
   const KinematicParameters params(num_joints);
   std::set<int> chosen;
   std::ostringstream unknown;
   auto add_range = [&](int begin, int count) {
     for (int i = begin; i < begin + count; ++i) chosen.insert(i);
   };
+  IntrinsicsMask named{};
   for (const std::string& name : names) {
-    if (name == "fx" || name == "k1") {
-      if (name == "fx" && fx != nullptr) *fx = true;
-      if (name == "k1" && k1 != nullptr) *k1 = true;
+    if (AddIntrinsics(name, &named)) {
+      continue;
     } else if (name == "kinematics") {
       add_range(0, params.CamOffset());
     } else if (name == "base") {
@@ -53,11 +74,28 @@ std::string ResolveParameterNames(const std::vector<std::string>& names, int num
       chosen.insert(index);
     } else {
       unknown << "unknown parameter `" << name << "`: give a parameter (e.g. j2.beta, cam.tx), a joint j1..j"
-              << num_joints << ", base, camera (or hand_eye), kinematics, fx or k1\n";
+              << num_joints << ", base, camera (or hand_eye), kinematics, an intrinsic (fx, mu or fy, cx, cy, k1, k2, "
+              << "p1, p2, k3), lens (k1, k2, p1, p2, k3) or intrinsics (all nine)\n";
     }
+  }
+  if (intrinsics != nullptr) {
+    for (int k = 0; k < kNumIntrinsics; ++k) (*intrinsics)[k] = (*intrinsics)[k] || named[k];
   }
   indices->assign(chosen.begin(), chosen.end());
   return unknown.str();
+}
+
+IntrinsicsMask EstimatedIntrinsicsOf(const BundleOptions& options, int num_joints) {
+  IntrinsicsMask held{}, free{};
+  std::vector<int> ignored;
+  ResolveParameterNames(options.held_parameters, num_joints, &ignored, &held);
+  IntrinsicsMask out = options.intrinsics;
+  if (!options.free_parameters.empty()) {
+    ResolveParameterNames(options.free_parameters, num_joints, &ignored, &free);
+    out = free;
+  }
+  for (int k = 0; k < kNumIntrinsics; ++k) out[k] = out[k] && !held[k];
+  return out;
 }
 
 const char* OutcomeName(Outcome outcome) {

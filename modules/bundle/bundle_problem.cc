@@ -68,35 +68,57 @@ void ComputePoseCache(const BundleData& data, int pose, const double* rho, const
   }
 }
 
-bool EvaluateReprojection(const CameraIntrinsics& camera, double sigma_px, const PoseCache& cache, double fx,
-                          double k1, const Eigen::Vector3d& dot, const Eigen::Vector2d& pixel, double* residual,
-                          double* d_columns, double* d_fx, double* d_k1, double* d_dot) {
+bool EvaluateReprojection(const IntrinsicsVector& in, double sigma_px, const PoseCache& cache, const Eigen::Vector3d& dot,
+                          const Eigen::Vector2d& pixel, double* residual, double* d_columns, double* d_intrinsics,
+                          double* d_dot) {
   const Eigen::Vector3d p = cache.rotation * dot + cache.translation;
   if (!(p.z() > 0) || !p.allFinite()) return false;
   const double inv_z = 1.0 / p.z();
   const double x = p.x() * inv_z, y = p.y() * inv_z;
+  const double fx = in[kFx], mu = in[kMu];
+  const double k1 = in[kK1], k2 = in[kK2], p1 = in[kP1], p2 = in[kP2], k3 = in[kK3];
+  // camera.h's DistortNormalized and ProjectWithIntrinsics term for term, so that zero coefficients add
+  // exact zeros: a k1-only camera gives the bits of fx x (1 + k1 r^2) + c_x, as before the full lens.
   const double r2 = x * x + y * y;
-  const double radial = 1.0 + k1 * r2;
-  const double mu = camera.mu;
+  const double radial = 1.0 + k1 * r2 + k2 * r2 * r2 + k3 * r2 * r2 * r2;
+  const double tx = 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
+  const double ty = p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
   const double inv_sigma = 1.0 / sigma_px;
-  const double u = fx * x * radial + camera.cx_px;
-  const double v = fx * mu * y * radial + camera.cy_px;
+  const double u = fx * x * radial + fx * tx + in[kCx];
+  const double v = fx * mu * y * radial + fx * mu * ty + in[kCy];
   const double r0 = (u - pixel.x()) * inv_sigma, r1 = (v - pixel.y()) * inv_sigma;
   if (!std::isfinite(r0) || !std::isfinite(r1)) return false;
   residual[0] = r0;
   residual[1] = r1;
-  if (d_fx != nullptr) {
-    d_fx[0] = x * radial * inv_sigma;
-    d_fx[1] = mu * y * radial * inv_sigma;
-  }
-  if (d_k1 != nullptr) {
-    d_k1[0] = fx * x * r2 * inv_sigma;
-    d_k1[1] = fx * mu * y * r2 * inv_sigma;
+  if (d_intrinsics != nullptr) {
+    double* du = d_intrinsics;
+    double* dv = d_intrinsics + kNumIntrinsics;
+    du[kFx] = (x * radial + tx) * inv_sigma;
+    dv[kFx] = (mu * y * radial + mu * ty) * inv_sigma;
+    du[kMu] = 0.0;
+    dv[kMu] = fx * (y * radial + ty) * inv_sigma;
+    du[kCx] = inv_sigma;
+    dv[kCx] = 0.0;
+    du[kCy] = 0.0;
+    dv[kCy] = inv_sigma;
+    du[kK1] = fx * x * r2 * inv_sigma;
+    dv[kK1] = fx * mu * y * r2 * inv_sigma;
+    du[kK2] = fx * x * r2 * r2 * inv_sigma;
+    dv[kK2] = fx * mu * y * r2 * r2 * inv_sigma;
+    du[kK3] = fx * x * r2 * r2 * r2 * inv_sigma;
+    dv[kK3] = fx * mu * y * r2 * r2 * r2 * inv_sigma;
+    du[kP1] = fx * 2.0 * x * y * inv_sigma;
+    dv[kP1] = fx * mu * (r2 + 2.0 * y * y) * inv_sigma;
+    du[kP2] = fx * (r2 + 2.0 * x * x) * inv_sigma;
+    dv[kP2] = fx * mu * 2.0 * x * y * inv_sigma;
   }
   if (d_columns == nullptr && d_dot == nullptr) return true;
+  const double dr = k1 + 2.0 * k2 * r2 + 3.0 * k3 * r2 * r2;  // d radial / d r^2
+  const double dtx_dx = 2.0 * p1 * y + 6.0 * p2 * x, dtx_dy = 2.0 * p1 * x + 2.0 * p2 * y;
+  const double dty_dx = 2.0 * p1 * x + 2.0 * p2 * y, dty_dy = 6.0 * p1 * y + 2.0 * p2 * x;
   Eigen::Matrix2d d_uv_d_xy;
-  d_uv_d_xy << fx * (radial + 2 * k1 * x * x), fx * 2 * k1 * x * y, fx * mu * 2 * k1 * x * y,
-      fx * mu * (radial + 2 * k1 * y * y);
+  d_uv_d_xy << fx * (radial + 2 * dr * x * x + dtx_dx), fx * 2 * dr * x * y + fx * dtx_dy,
+      fx * mu * 2 * dr * x * y + fx * mu * dty_dx, fx * mu * (radial + 2 * dr * y * y + dty_dy);
   Eigen::Matrix<double, 2, 3> d_xy_d_p;
   d_xy_d_p << inv_z, 0, -x * inv_z, 0, inv_z, -y * inv_z;
   const Eigen::Matrix<double, 2, 3> d_p = inv_sigma * d_uv_d_xy * d_xy_d_p;
@@ -168,16 +190,15 @@ bool ReducedJacobian(const BundleData& data, const BundleState& state, const Glo
     int row = 0;
     for (int k : group_observations[g]) {
       const Observation& o = data.observations[k];
-      double residual[2], d_fx[2], d_k1[2], d_dot[6];
-      if (!EvaluateReprojection(data.camera, data.sigma_px, caches[o.pose], state.fx_px, state.k1, state.dots[o.dot],
-                                o.pixel, residual, d_columns.data(), d_fx, d_k1, d_dot)) {
+      double residual[2], d_intrinsics[2 * kNumIntrinsics], d_dot[6];
+      if (!EvaluateReprojection(state.intrinsics, data.sigma_px, caches[o.pose], state.dots[o.dot], o.pixel, residual,
+                                d_columns.data(), d_intrinsics, d_dot)) {
         return false;
       }
       for (int r = 0; r < 2; ++r) {
         for (int c = 0; c < num_kinematic; ++c) b(row + r, c) = d_columns[r * num_kinematic + c];
         int col = num_kinematic;
-        if (columns.fx) b(row + r, col++) = d_fx[r];
-        if (columns.k1) b(row + r, col++) = d_k1[r];
+        for (int i : columns.intrinsics) b(row + r, col++) = d_intrinsics[r * kNumIntrinsics + i];
         for (int c = 0; c < 3; ++c) a(row + r, 3 * slot_of[o.dot] + c) = d_dot[3 * r + c];
       }
       row += 2;
@@ -220,16 +241,14 @@ std::vector<std::string> GlobalNames(const GlobalColumns& columns, int num_joint
   const KinematicParameters params(num_joints);
   std::vector<std::string> names;
   for (int i : columns.kinematic) names.push_back(params.name(i));
-  if (columns.fx) names.push_back("fx");
-  if (columns.k1) names.push_back("k1");
+  for (int i : columns.intrinsics) names.push_back(IntrinsicName(i));
   return names;
 }
 
-std::vector<int> SelectionOrder(int num_joints, bool fx, bool k1) {
+std::vector<int> SelectionOrder(int num_joints, int num_intrinsics) {
   const int n = KinematicParameters(num_joints).size();
   std::vector<int> order;
-  if (fx) order.push_back(n);
-  if (k1) order.push_back(n + (fx ? 1 : 0));
+  for (int k = 0; k < num_intrinsics; ++k) order.push_back(n + k);
   for (int c : identification::PreferredParameterOrder(num_joints)) order.push_back(c);
   return order;
 }
@@ -310,15 +329,14 @@ BundleData MakeBundleData(const ObservationSet& observations, double yardstick_s
   return data;
 }
 
-bool AnalyzeGauge(const BundleData& data, const BundleState& state, bool estimate_fx, bool estimate_k1,
+bool AnalyzeGauge(const BundleData& data, const BundleState& state, const IntrinsicsMask& estimate,
                   double rank_tolerance, Gauge* gauge, const std::vector<int>& held) {
   const int num_joints = data.robot.num_joints();
   const int n = data.robot.num_parameters();
   GlobalColumns columns;
   columns.kinematic.resize(n);
   std::iota(columns.kinematic.begin(), columns.kinematic.end(), 0);
-  columns.fx = estimate_fx;
-  columns.k1 = estimate_k1;
+  columns.intrinsics = EstimatedIntrinsics(estimate);
   // The gauge is a property of the poses, the dots and the yardsticks, not of the stated pixel noise: the
   // pixel rows are weighted as at 1 px, so that a noise of 1e-150 px neither overflows the Jacobian (a
   // crash in the QR) nor makes the yardstick's rows vanish below the rank tolerance (scale then looked
@@ -329,7 +347,7 @@ bool AnalyzeGauge(const BundleData& data, const BundleState& state, bool estimat
   if (!ReducedJacobian(unit_weights, state, columns, &reduced)) return false;
   const std::vector<std::string> names = GlobalNames(columns, num_joints);
   std::vector<int> order;
-  for (int c : SelectionOrder(num_joints, estimate_fx, estimate_k1)) {
+  for (int c : SelectionOrder(num_joints, static_cast<int>(columns.intrinsics.size()))) {
     if (std::find(held.begin(), held.end(), c) == held.end()) order.push_back(c);
   }
   const identification::RankSelection selection = identification::SelectColumns(reduced, order, rank_tolerance, names);
@@ -339,10 +357,8 @@ bool AnalyzeGauge(const BundleData& data, const BundleState& state, bool estimat
     if (c < n) {
       gauge->free_kinematic.push_back(c);
       gauge->free_names.push_back(names[c]);
-    } else if (names[c] == "fx") {
-      gauge->fx_identifiable = true;
     } else {
-      gauge->k1_identifiable = true;
+      gauge->intrinsics_identifiable[columns.intrinsics[c - n]] = true;
     }
   }
   for (int c : selection.dependent) {

@@ -2,8 +2,9 @@
 // (dots-eliminated) Jacobian, and the rank selection. Shared by the solver, the covariance, the
 // Cramer-Rao bound and the tests; Ceres stays out of this header.
 //
-// Global columns: entries of rho (a chosen subset), then f_x and k1 when present. Rows are whitened:
-// pixel residuals divided by sigma_px, yardstick residuals by yardstick_sigma_m.
+// Global columns: entries of rho (a chosen subset), then the estimated intrinsics (camera/camera.h's
+// Intrinsic order: fx, mu, cx, cy, k1, k2, p1, p2, k3). Rows are whitened: pixel residuals divided by
+// sigma_px, yardstick residuals by yardstick_sigma_m.
 #pragma once
 
 #include <string>
@@ -32,7 +33,7 @@ struct Yardstick {
 // The fixed inputs of one problem, poses and dots by index.
 struct BundleData {
   RobotModel robot;
-  CameraIntrinsics camera;
+  CameraIntrinsics camera;  // the prior (image size, the start's triangulation); the solve's values: BundleState
   double sigma_px = 1;
   double yardstick_sigma_m = 1e-6;
   std::vector<std::string> pose_ids;
@@ -48,16 +49,14 @@ struct BundleData {
 // A point of the problem.
 struct BundleState {
   Eigen::VectorXd rho;
-  double fx_px = 0;
-  double k1 = 0;
+  IntrinsicsVector intrinsics{};      // every intrinsic, estimated or held
   std::vector<Eigen::Vector3d> dots;  // by dot index, base frame
 };
 
 struct GlobalColumns {
-  std::vector<int> kinematic;  // rho indices
-  bool fx = false;
-  bool k1 = false;
-  int size() const { return static_cast<int>(kinematic.size()) + (fx ? 1 : 0) + (k1 ? 1 : 0); }
+  std::vector<int> kinematic;   // rho indices
+  std::vector<int> intrinsics;  // Intrinsic indices, ascending
+  int size() const { return static_cast<int>(kinematic.size() + intrinsics.size()); }
 };
 
 // cam_from_base of one pose and its derivative with respect to rho[columns[c]] (forward-mode autodiff
@@ -72,12 +71,13 @@ Rigid3 BaseFromCamOfPose(const BundleData& data, int pose, const Eigen::VectorXd
 void ComputePoseCache(const BundleData& data, int pose, const double* rho, const std::vector<int>& columns,
                       bool derivatives, PoseCache* out);
 
-// Whitened residual (project(fx, k1, R p + t) - pixel) / sigma of one observation. Derivatives (each
-// optional, row-major): d_columns 2 x cache.d_rotation.size(), d_fx 2, d_k1 2, d_dot 2 x 3. Returns false
+// Whitened residual (project(intrinsics, R p + t) - pixel) / sigma of one observation, the projection of
+// camera/camera.h (ProjectWithIntrinsics, the same bits). Derivatives (each optional, row-major):
+// d_columns 2 x cache.d_rotation.size(), d_intrinsics 2 x kNumIntrinsics, d_dot 2 x 3. Returns false
 // (outputs untouched) when the point is not in front of the camera or anything is non-finite.
-bool EvaluateReprojection(const CameraIntrinsics& camera, double sigma_px, const PoseCache& cache, double fx,
-                          double k1, const Eigen::Vector3d& dot, const Eigen::Vector2d& pixel, double* residual,
-                          double* d_columns, double* d_fx, double* d_k1, double* d_dot);
+bool EvaluateReprojection(const IntrinsicsVector& intrinsics, double sigma_px, const PoseCache& cache,
+                          const Eigen::Vector3d& dot, const Eigen::Vector2d& pixel, double* residual, double* d_columns,
+                          double* d_intrinsics, double* d_dot);
 
 // Compressed reduced Jacobian: a matrix Rd with gc.size() columns and Rd^T Rd = J_g^T (I - P_dots) J_g,
 // the Schur complement of the dots in the whitened normal matrix (J_g: global columns, P_dots: projection
@@ -86,12 +86,13 @@ bool EvaluateReprojection(const CameraIntrinsics& camera, double sigma_px, const
 bool ReducedJacobian(const BundleData& data, const BundleState& state, const GlobalColumns& columns,
                      Eigen::MatrixXd* reduced);
 
-// Names of the global columns when kinematic = all of rho: rho names, then "fx", then "k1".
+// Names of the global columns: rho names, then the intrinsics' ("fx", "cx", ...).
 std::vector<std::string> GlobalNames(const GlobalColumns& columns, int num_joints);
 
-// Greedy column order over all global columns (rho entries 0..n-1, f_x at n, k1 after it): f_x, k1,
-// camera, base, alpha/a/theta/d joint by joint, betas last (as identification/identifiability.cc).
-std::vector<int> SelectionOrder(int num_joints, bool fx, bool k1);
+// Greedy column order over all global columns (rho entries 0..n-1, then `num_intrinsics` intrinsic
+// columns): the intrinsics in their order, then camera, base, alpha/a/theta/d joint by joint, betas last
+// (as identification/identifiability.cc).
+std::vector<int> SelectionOrder(int num_joints, int num_intrinsics);
 
 // Inverse of jacobian^T jacobian through the SVD of the column-normalised matrix. Returns false, with a
 // message naming the columns involved in the null space (K8), when it is rank deficient.
@@ -104,16 +105,16 @@ bool CovarianceFromJacobian(const Eigen::MatrixXd& jacobian, const std::vector<s
 BundleData MakeBundleData(const ObservationSet& observations, double yardstick_sigma_m);
 
 // The gauge and the free set of the problem at `state` (DESIGN.md section 4): SelectColumns on the
-// reduced Jacobian of every rho entry plus f_x / k1 when estimated.
+// reduced Jacobian of every rho entry plus the estimated intrinsics.
 struct Gauge {
   std::vector<int> free_kinematic;  // rho indices, ascending
   std::vector<std::string> free_names, fixed_names, null_combinations;
   std::vector<std::string> held_names;  // held at their start by request (BundleOptions::held_parameters)
-  bool fx_identifiable = false, k1_identifiable = false;
+  IntrinsicsMask intrinsics_identifiable{};  // of the estimated ones, those the selection kept
   double condition_number = 0;
 };
 // `held`: rho indices held at their start by request; they take no part in the selection.
-bool AnalyzeGauge(const BundleData& data, const BundleState& state, bool estimate_fx, bool estimate_k1,
+bool AnalyzeGauge(const BundleData& data, const BundleState& state, const IntrinsicsMask& estimate,
                   double rank_tolerance, Gauge* gauge, const std::vector<int>& held = {});
 
 }  // namespace selfcal::bundle::internal

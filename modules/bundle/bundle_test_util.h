@@ -27,8 +27,7 @@ inline sim::SimResult World(double noise_px, uint64_t world_seed = 1, uint64_t n
 inline BundleTruth Truth(const sim::SimResult& world) {
   BundleTruth truth;
   truth.rho = world.truth.rho_true;
-  truth.fx_px = world.truth.camera_true.fx_px;
-  truth.k1 = world.truth.camera_true.k1;
+  truth.camera = world.truth.camera_true;
   for (size_t d = 0; d < world.truth.dots_in_base.size(); ++d) truth.dots_in_base[static_cast<int>(d)] = world.truth.dots_in_base[d];
   return truth;
 }

@@ -57,20 +57,20 @@ CramerRaoReport BundleCramerRao(const ObservationSet& geometry, const BundleTrut
   CramerRaoReport report;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   report.stddev = Eigen::VectorXd::Constant(std::max<Eigen::Index>(truth.rho.size(), 0), nan);
-  report.fx_stddev = report.k1_stddev = nan;
+  report.fx_stddev = nan;
+  report.intrinsics_stddev.fill(nan);
   std::ostringstream problems;
   problems << options.Validate();
   if (truth.rho.size() != geometry.robot.num_parameters() || !truth.rho.allFinite()) {
     problems << "truth.rho must be finite with " << geometry.robot.num_parameters() << " entries\n";
   }
-  if (!(truth.fx_px > 0) || !std::isfinite(truth.k1)) problems << "truth f_x / k1 invalid\n";
+  if (const std::string invalid = truth.camera.Validate(); !invalid.empty()) problems << "truth camera: " << invalid;
   if (!(sigma_px > 0) || !std::isfinite(sigma_px)) problems << "sigma_px = " << sigma_px << " must be > 0\n";
   internal::BundleData data = internal::MakeBundleData(geometry, options.yardstick_sigma_m);
   data.sigma_px = sigma_px;
   internal::BundleState state;
   state.rho = truth.rho;
-  state.fx_px = truth.fx_px;
-  state.k1 = truth.k1;
+  state.intrinsics = IntrinsicsOf(truth.camera);
   for (int id : data.dot_ids) {
     auto it = truth.dots_in_base.find(id);
     if (it == truth.dots_in_base.end()) {
@@ -86,23 +86,24 @@ CramerRaoReport BundleCramerRao(const ObservationSet& geometry, const BundleTrut
   }
 
   // The free set as the solve chooses it: at the nominal model (bundle_adjustment.cc says why).
+  const IntrinsicsMask estimated = EstimatedIntrinsicsOf(options, data.robot.num_joints());
   internal::Gauge gauge;
   internal::BundleState nominal = state;
   nominal.rho = KinematicParameters::Nominal(data.robot);
-  if (!internal::AnalyzeGauge(data, nominal, options.estimate_fx, options.estimate_k1, options.rank_tolerance, &gauge)) {
+  if (!internal::AnalyzeGauge(data, nominal, estimated, options.rank_tolerance, &gauge)) {
     report.message = "a dot is behind a camera";
     return report;
   }
   report.free_indices = gauge.free_kinematic;
   report.fixed_names = gauge.fixed_names;
-  if ((options.estimate_fx && !gauge.fx_identifiable) || (options.estimate_k1 && !gauge.k1_identifiable)) {
-    report.message = "f_x or k1 is not identifiable: the information is singular";
-    return report;
-  }
   internal::GlobalColumns columns;
   columns.kinematic = gauge.free_kinematic;
-  columns.fx = options.estimate_fx;
-  columns.k1 = options.estimate_k1;
+  columns.intrinsics = EstimatedIntrinsics(estimated);
+  for (int k : columns.intrinsics) {
+    if (gauge.intrinsics_identifiable[k]) continue;
+    report.message = std::string(IntrinsicName(k)) + " is not identifiable: the information is singular";
+    return report;
+  }
   Eigen::MatrixXd reduced;
   if (!internal::ReducedJacobian(data, state, columns, &reduced) ||
       !internal::CovarianceFromJacobian(reduced, internal::GlobalNames(columns, data.robot.num_joints()),
@@ -112,11 +113,11 @@ CramerRaoReport BundleCramerRao(const ObservationSet& geometry, const BundleTrut
   }
   const int nk = static_cast<int>(columns.kinematic.size());
   for (int k = 0; k < nk; ++k) report.stddev[columns.kinematic[k]] = std::sqrt(report.covariance_free(k, k));
-  if (columns.fx) report.fx_stddev = std::sqrt(report.covariance_free(nk, nk));
-  if (columns.k1) {
-    const int i = nk + (columns.fx ? 1 : 0);
-    report.k1_stddev = std::sqrt(report.covariance_free(i, i));
+  for (size_t k = 0; k < columns.intrinsics.size(); ++k) {
+    const int i = nk + static_cast<int>(k);
+    report.intrinsics_stddev[columns.intrinsics[k]] = std::sqrt(report.covariance_free(i, i));
   }
+  report.fx_stddev = report.intrinsics_stddev[kFx];
 
   // Propagation to the held-out poses.
   const std::vector<int> id_poses = geometry.PosesWithRole(PoseRole::kIdentification);

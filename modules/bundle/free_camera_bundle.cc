@@ -15,16 +15,14 @@ namespace selfcal::bundle {
 namespace {
 
 struct Reprojection {
-  Reprojection(const CameraIntrinsics* camera, Eigen::Vector2d pixel, double sigma)
-      : camera(camera), pixel(std::move(pixel)), inv_sigma(1.0 / sigma) {}
+  Reprojection(Eigen::Vector2d pixel, double sigma) : pixel(std::move(pixel)), inv_sigma(1.0 / sigma) {}
   template <typename T>
-  bool operator()(const T* cam, const T* dot, const T* fx, const T* k1, T* residual) const {
+  bool operator()(const T* cam, const T* dot, const T* intrinsics, T* residual) const {
     T p[3];
     ceres::AngleAxisRotatePoint(cam, dot, p);
     const Vec3T<T> in_cam(p[0] + cam[3], p[1] + cam[4], p[2] + cam[5]);
-    return internal::WhitenedReprojection<T>(*camera, fx[0], k1[0], in_cam, pixel, inv_sigma, residual);
+    return internal::WhitenedReprojection<T>(intrinsics, in_cam, pixel, inv_sigma, residual);
   }
-  const CameraIntrinsics* camera;
   Eigen::Vector2d pixel;
   double inv_sigma;
 };
@@ -67,11 +65,11 @@ Rigid3 FromBlock(const std::array<double, 6>& block) {
 }
 
 // Reprojection error |r| (px) of one observation at the current blocks; NaN behind the camera.
-double ErrorPx(const CameraIntrinsics& camera, const std::array<double, 6>& cam, const Eigen::Vector3d& dot, double fx,
-               double k1, const Eigen::Vector2d& pixel) {
-  Reprojection f(&camera, pixel, 1.0);
+double ErrorPx(const std::array<double, 6>& cam, const Eigen::Vector3d& dot, const IntrinsicsVector& intrinsics,
+               const Eigen::Vector2d& pixel) {
+  Reprojection f(pixel, 1.0);
   double r[2];
-  if (!f(cam.data(), dot.data(), &fx, &k1, r)) return NAN;
+  if (!f(cam.data(), dot.data(), intrinsics.data(), r)) return NAN;
   return std::hypot(r[0], r[1]);
 }
 
@@ -79,7 +77,7 @@ double ErrorPx(const CameraIntrinsics& camera, const std::array<double, 6>& cam,
 
 FreeCameraReport RunFreeCameraBundle(const ObservationSet& obs, const std::vector<Rigid3>& base_from_cam_start,
                                      const std::vector<bool>& use, const std::map<int, Eigen::Vector3d>& dots_start,
-                                     double fx_start, double k1_start, const FreeCameraOptions& options) {
+                                     const FreeCameraOptions& options) {
   FreeCameraReport report;
   std::vector<std::array<double, 6>> cams;
   for (size_t p = 0; p < obs.poses.size() && p < use.size() && p < base_from_cam_start.size(); ++p) {
@@ -105,7 +103,7 @@ FreeCameraReport RunFreeCameraBundle(const ObservationSet& obs, const std::vecto
     if (n >= 2) dots[id] = dots_start.at(id);
   }
   const double sigma = obs.pixel_noise_px;
-  double fx = fx_start, k1 = k1_start;
+  IntrinsicsVector intrinsics = IntrinsicsOf(obs.camera);
   const double centre_distance = (base_from_cam_start[report.poses[0]].translation -
                                   base_from_cam_start[report.poses[1]].translation).norm();
   std::vector<bool> keep(all.size(), true);
@@ -115,10 +113,10 @@ FreeCameraReport RunFreeCameraBundle(const ObservationSet& obs, const std::vecto
     ceres::Problem problem;
     for (size_t k = 0; k < all.size(); ++k) {
       if (!keep[k] || !dots.count(all[k].dot)) continue;
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Reprojection, 2, 6, 3, 1, 1>(
-                                   new Reprojection(&obs.camera, all[k].pixel, sigma)),
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Reprojection, 2, 6, 3, kNumIntrinsics>(
+                                   new Reprojection(all[k].pixel, sigma)),
                                round == 0 ? new ceres::LossFunctionWrapper(&huber, ceres::DO_NOT_TAKE_OWNERSHIP) : nullptr,
-                               cams[all[k].camera].data(), dots[all[k].dot].data(), &fx, &k1);
+                               cams[all[k].camera].data(), dots[all[k].dot].data(), intrinsics.data());
     }
     if (!problem.HasParameterBlock(cams[0].data()) || !problem.HasParameterBlock(cams[1].data())) {
       report.message = "the first two poses share no dot with the others";
@@ -128,13 +126,12 @@ FreeCameraReport RunFreeCameraBundle(const ObservationSet& obs, const std::vecto
                                  new CentreDistance(centre_distance, 1e-6 * std::max(centre_distance, 1e-3))),
                              nullptr, cams[0].data(), cams[1].data());
     problem.SetParameterBlockConstant(cams[0].data());
-    summary = internal::SolveWithIntrinsics(&problem, &fx, &k1, options.estimate_fx, options.estimate_k1,
-                                            options.max_iterations);
+    summary = internal::SolveWithIntrinsics(&problem, intrinsics.data(), options.intrinsics, options.max_iterations);
     if (internal::SolverFailed(summary, &report.message)) return report;
     // Screen against the robust solution: |r| beyond screen_sigma robust sigmas (never below the noise).
     std::vector<double> errors;
     for (const Obs& o : all) {
-      errors.push_back(dots.count(o.dot) ? ErrorPx(obs.camera, cams[o.camera], dots[o.dot], fx, k1, o.pixel) : NAN);
+      errors.push_back(dots.count(o.dot) ? ErrorPx(cams[o.camera], dots[o.dot], intrinsics, o.pixel) : NAN);
     }
     const double limit = internal::ScreenLimit(errors, sigma, options.screen_sigma);
     if (!std::isfinite(limit)) break;
@@ -153,8 +150,7 @@ FreeCameraReport RunFreeCameraBundle(const ObservationSet& obs, const std::vecto
   }
   report.num_removed = static_cast<int>(std::count(keep.begin(), keep.end(), false));
   for (const auto& block : cams) report.base_from_cam.push_back(FromBlock(block));
-  report.fx_px = fx;
-  report.k1 = k1;
+  report.intrinsics = intrinsics;
   report.ok = summary.termination_type == ceres::CONVERGENCE || summary.termination_type == ceres::NO_CONVERGENCE;
   std::ostringstream msg;
   msg << ceres::TerminationTypeToString(summary.termination_type) << ": " << report.num_observations

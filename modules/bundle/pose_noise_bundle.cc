@@ -14,17 +14,15 @@ namespace selfcal::bundle {
 namespace {
 
 struct Reprojection {
-  Reprojection(const CameraIntrinsics* camera, const Rigid3* base_from_flange, const Rigid3* x0, Eigen::Vector2d pixel,
-               double sigma)
-      : camera(camera), base_from_flange(base_from_flange), x0(x0), pixel(std::move(pixel)), inv_sigma(1.0 / sigma) {}
+  Reprojection(const Rigid3* base_from_flange, const Rigid3* x0, Eigen::Vector2d pixel, double sigma)
+      : base_from_flange(base_from_flange), x0(x0), pixel(std::move(pixel)), inv_sigma(1.0 / sigma) {}
   template <typename T>
-  bool operator()(const T* delta, const T* c, const T* dot, const T* fx, const T* k1, T* residual) const {
+  bool operator()(const T* delta, const T* c, const T* dot, const T* intrinsics, T* residual) const {
     const Rigid3T<T> base_from_cam = base_from_flange->Cast<T>() * RigidFromTranslationRotvec(delta) *
                                      x0->Cast<T>() * RigidFromTranslationRotvec(c);
     const Vec3T<T> in_cam = base_from_cam.Inverse() * Vec3T<T>(dot[0], dot[1], dot[2]);
-    return internal::WhitenedReprojection<T>(*camera, fx[0], k1[0], in_cam, pixel, inv_sigma, residual);
+    return internal::WhitenedReprojection<T>(intrinsics, in_cam, pixel, inv_sigma, residual);
   }
-  const CameraIntrinsics* camera;
   const Rigid3* base_from_flange;
   const Rigid3* x0;
   Eigen::Vector2d pixel;
@@ -68,11 +66,29 @@ struct Obs {
   Eigen::Vector2d pixel;
 };
 
+// The standard deviations of the hand-eye correction `c` and of the estimated entries of the intrinsics block,
+// the covariance scaled by the residual variance s2; left NaN when the covariance is unavailable.
+void StandardDeviations(ceres::Problem* problem, const double* c, const double* intrinsics, const IntrinsicsMask& estimated,
+                        double s2, PoseNoiseReport* report) {
+  const std::vector<int> free = EstimatedIntrinsics(estimated);
+  ceres::Covariance::Options cov_options;
+  cov_options.algorithm_type = ceres::DENSE_SVD;
+  ceres::Covariance covariance(cov_options);
+  std::vector<std::pair<const double*, const double*>> blocks = {{c, c}};
+  if (!free.empty()) blocks.push_back({intrinsics, intrinsics});
+  if (!covariance.Compute(blocks, problem)) return;
+  double cc[36], ii[kNumIntrinsics * kNumIntrinsics];
+  covariance.GetCovarianceBlock(c, c, cc);
+  for (int k = 0; k < 6; ++k) report->stddev[k] = std::sqrt(s2 * cc[7 * k]);
+  if (free.empty()) return;
+  covariance.GetCovarianceBlock(intrinsics, intrinsics, ii);  // ambient: zero where held
+  for (int k : free) report->intrinsics_stddev[k] = std::sqrt(s2 * ii[(kNumIntrinsics + 1) * k]);
+}
+
 }  // namespace
 
 PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
-                                   const std::map<int, Eigen::Vector3d>& dots_start, double fx_start, double k1_start,
-                                   const PoseNoiseOptions& options) {
+                                   const std::map<int, Eigen::Vector3d>& dots_start, const PoseNoiseOptions& options) {
   PoseNoiseReport report;
   if (!obs.UsesFlangePoses() || !(options.translation_sigma_m > 0) || !(options.rotation_sigma_rad > 0)) {
     report.message = "needs a flange-pose set and a positive pose noise";
@@ -99,7 +115,8 @@ PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
   const std::vector<KnownDistance> lengths = LengthsAmong(obs.yardsticks, dots);
   std::vector<std::array<double, 6>> deltas(poses.size(), std::array<double, 6>{0, 0, 0, 0, 0, 0});
   std::array<double, 6> c{0, 0, 0, 0, 0, 0};
-  double fx = fx_start, k1 = k1_start;
+  IntrinsicsVector intrinsics = IntrinsicsOf(obs.camera);
+  const int num_estimated = static_cast<int>(EstimatedIntrinsics(options.intrinsics).size());
   const double sigma = obs.pixel_noise_px;
   ceres::HuberLoss huber(options.huber_px / sigma);
   std::vector<bool> keep(all.size(), true);
@@ -108,10 +125,10 @@ PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
     ceres::Problem problem;
     for (size_t k = 0; k < all.size(); ++k) {
       if (!keep[k] || !dots.count(all[k].dot)) continue;
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Reprojection, 2, 6, 6, 3, 1, 1>(new Reprojection(
-                                   &obs.camera, &flanges[all[k].pose], &x0, all[k].pixel, sigma)),
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Reprojection, 2, 6, 6, 3, kNumIntrinsics>(
+                                   new Reprojection(&flanges[all[k].pose], &x0, all[k].pixel, sigma)),
                                round == 0 ? new ceres::LossFunctionWrapper(&huber, ceres::DO_NOT_TAKE_OWNERSHIP) : nullptr,
-                               deltas[all[k].pose].data(), c.data(), dots[all[k].dot].data(), &fx, &k1);
+                               deltas[all[k].pose].data(), c.data(), dots[all[k].dot].data(), intrinsics.data());
     }
     for (auto& delta : deltas) {
       if (!problem.HasParameterBlock(delta.data())) continue;
@@ -124,15 +141,14 @@ PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
                                    new Length(y.length_m, options.yardstick_sigma_m)),
                                nullptr, dots[y.dot_a].data(), dots[y.dot_b].data());
     }
-    summary = internal::SolveWithIntrinsics(&problem, &fx, &k1, options.estimate_fx, options.estimate_k1,
-                                            options.max_iterations);
+    summary = internal::SolveWithIntrinsics(&problem, intrinsics.data(), options.intrinsics, options.max_iterations);
     if (internal::SolverFailed(summary, &report.message)) return report;
     std::vector<double> errors;
     for (const Obs& o : all) {
       double r[2] = {NAN, NAN};
       if (dots.count(o.dot)) {
-        Reprojection f(&obs.camera, &flanges[o.pose], &x0, o.pixel, 1.0);
-        if (!f(deltas[o.pose].data(), c.data(), dots[o.dot].data(), &fx, &k1, r)) r[0] = NAN;
+        Reprojection f(&flanges[o.pose], &x0, o.pixel, 1.0);
+        if (!f(deltas[o.pose].data(), c.data(), dots[o.dot].data(), intrinsics.data(), r)) r[0] = NAN;
       }
       errors.push_back(std::hypot(r[0], r[1]));
     }
@@ -149,23 +165,14 @@ PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
       ++report.num_observations;
     }
     report.rms_reprojection_px = report.num_observations > 0 ? std::sqrt(sum2 / report.num_observations) : 0.0;
-    // Covariance of the hand-eye correction and f_x, scaled by the residual variance.
-    const int unknowns = 6 + (options.estimate_fx ? 1 : 0) + (options.estimate_k1 ? 1 : 0) +
-                         3 * static_cast<int>(dots.size()) + 6 * static_cast<int>(deltas.size());
+    // Covariance of the hand-eye correction and the estimated intrinsics, scaled by the residual variance.
+    const int unknowns = 6 + num_estimated + 3 * static_cast<int>(dots.size()) + 6 * static_cast<int>(deltas.size());
     const int residuals =
         2 * report.num_observations + 6 * static_cast<int>(deltas.size()) + static_cast<int>(lengths.size());
     const int dof = residuals - unknowns;
-    ceres::Covariance::Options cov_options;
-    cov_options.algorithm_type = ceres::DENSE_SVD;
-    ceres::Covariance covariance(cov_options);
-    std::vector<std::pair<const double*, const double*>> blocks = {{c.data(), c.data()}, {&fx, &fx}};
-    if (dof > 0 && covariance.Compute(blocks, &problem)) {
-      const double s2 = 2.0 * summary.final_cost / dof;
-      double cc[36], ff = 0;
-      covariance.GetCovarianceBlock(c.data(), c.data(), cc);
-      covariance.GetCovarianceBlock(&fx, &fx, &ff);
-      for (int k = 0; k < 6; ++k) report.stddev[k] = std::sqrt(s2 * cc[7 * k]);
-      report.fx_stddev = options.estimate_fx ? std::sqrt(s2 * ff) : NAN;
+    if (dof > 0) {
+      StandardDeviations(&problem, c.data(), intrinsics.data(), options.intrinsics, 2.0 * summary.final_cost / dof,
+                         &report);
     }
   }
   report.num_removed = static_cast<int>(std::count(keep.begin(), keep.end(), false));
@@ -173,8 +180,7 @@ PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
     report.yardstick_lengths_m.push_back((dots[y.dot_a] - dots[y.dot_b]).norm());
   }
   report.flange_from_cam = x0 * RigidFromTranslationRotvec(c.data());
-  report.fx_px = fx;
-  report.k1 = k1;
+  report.intrinsics = intrinsics;
   for (const auto& delta : deltas) {
     report.correction_translation_m.push_back(Eigen::Vector3d(delta[0], delta[1], delta[2]).norm());
     report.correction_rotation_rad.push_back(Eigen::Vector3d(delta[3], delta[4], delta[5]).norm());

@@ -3,7 +3,8 @@
 //
 //   base_from_cam_i = base_from_flange_i * Exp(delta_i) * flange_from_cam,   delta_i ~ N(0, diag(s_t, s_r)),
 //
-// and the hand-eye transform, f_x (k1 when asked), the dots and every delta_i are estimated together
+// and the hand-eye transform, the intrinsics asked for (f_x by default), the dots and every delta_i are
+// estimated together
 // (autodiff, Huber while outliers are screened at 4 robust sigmas, then plain least squares). Started
 // from the exact-pose solution (bundle_adjustment.h on the same set). The prior fixes the gauge and the
 // scale: the scene's size comes from the flange translations, weighted by their stated noise, and from
@@ -16,6 +17,7 @@
 
 #include <Eigen/Core>
 
+#include "camera/camera.h"
 #include "geometry/rigid3.h"
 #include "observations/observation_set.h"
 
@@ -24,8 +26,7 @@ namespace selfcal::bundle {
 struct PoseNoiseOptions {
   double translation_sigma_m = 0;  // per axis, of each recorded flange pose
   double rotation_sigma_rad = 0;   // per axis (rotation vector)
-  bool estimate_fx = true;
-  bool estimate_k1 = false;
+  IntrinsicsMask intrinsics = kFocalLengthOnly;  // estimated; the others held at observations.camera's
   double huber_px = 2.0;
   // Std of a yardstick's length (observations.yardsticks with both ends among the dots: length
   // constraints beside the flange translations; the caller leaves none when the flanges alone scale).
@@ -38,11 +39,11 @@ struct PoseNoiseReport {
   bool ok = false;
   std::string message;
   Rigid3 flange_from_cam;
-  double fx_px = 0, k1 = 0;
+  IntrinsicsVector intrinsics{};  // every intrinsic, held ones at the start
   // Standard deviations of a correction flange_from_cam * Exp(c) (translation m, rotation vector rad,
-  // camera frame) and of f_x, scaled by the residual variance; NaN when unavailable.
+  // camera frame) and of the intrinsics, scaled by the residual variance; NaN when unavailable or held.
   Eigen::Matrix<double, 6, 1> stddev = Eigen::Matrix<double, 6, 1>::Constant(NAN);
-  double fx_stddev = NAN;
+  IntrinsicsVector intrinsics_stddev = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
   std::vector<std::string> pose_ids;                  // identification poses, in order
   std::vector<double> correction_translation_m;       // |delta_i| translation per pose
   std::vector<double> correction_rotation_rad;        // |delta_i| rotation per pose
@@ -51,8 +52,8 @@ struct PoseNoiseReport {
   double rms_reprojection_px = 0;
 };
 
+// The intrinsics start at observations.camera's.
 PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& observations, const Rigid3& flange_from_cam_start,
-                                   const std::map<int, Eigen::Vector3d>& dots_start, double fx_start, double k1_start,
-                                   const PoseNoiseOptions& options);
+                                   const std::map<int, Eigen::Vector3d>& dots_start, const PoseNoiseOptions& options);
 
 }  // namespace selfcal::bundle

@@ -1,6 +1,7 @@
-// Internal to the bundle module: the residual, the solve and the screen shared by the free-camera and the pose-noise bundles
-// (autodiff problems with f_x and k1 as single blocks): f_x and k1 held unless estimated, sparse Schur,
-// one thread (deterministic), silent.
+// Internal to the bundle module: the residual, the solve and the screen shared by the free-camera and the
+// pose-noise bundles (autodiff problems with the nine intrinsics as one block, camera/camera.h's order): the
+// held entries of that block fixed by a SubsetManifold (the whole block constant when none is estimated),
+// sparse Schur, one thread (deterministic), silent.
 #pragma once
 
 #include <algorithm>
@@ -14,10 +15,23 @@
 
 namespace selfcal::bundle::internal {
 
-inline ceres::Solver::Summary SolveWithIntrinsics(ceres::Problem* problem, double* fx, double* k1, bool estimate_fx,
-                                                  bool estimate_k1, int max_iterations) {
-  if (!estimate_fx) problem->SetParameterBlockConstant(fx);
-  if (!estimate_k1) problem->SetParameterBlockConstant(k1);
+// Holds the entries of the intrinsics block `intrinsics` (kNumIntrinsics values, already in `problem`)
+// that `estimate` does not set.
+inline void HoldIntrinsics(ceres::Problem* problem, double* intrinsics, const IntrinsicsMask& estimate) {
+  std::vector<int> held;
+  for (int k = 0; k < kNumIntrinsics; ++k) {
+    if (!estimate[k]) held.push_back(k);
+  }
+  if (static_cast<int>(held.size()) == kNumIntrinsics) {
+    problem->SetParameterBlockConstant(intrinsics);
+  } else if (!held.empty()) {
+    problem->SetManifold(intrinsics, new ceres::SubsetManifold(kNumIntrinsics, held));
+  }
+}
+
+inline ceres::Solver::Summary SolveWithIntrinsics(ceres::Problem* problem, double* intrinsics,
+                                                  const IntrinsicsMask& estimate, int max_iterations) {
+  HoldIntrinsics(problem, intrinsics, estimate);
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::SPARSE_SCHUR;
   solver.num_threads = 1;
@@ -28,13 +42,13 @@ inline ceres::Solver::Summary SolveWithIntrinsics(ceres::Problem* problem, doubl
   return summary;
 }
 
-// The whitened reprojection residual (project(p_in_cam) - pixel) / sigma of one observation, autodiff-ready;
-// false when the point is not in front of the camera.
+// The whitened reprojection residual (project(p_in_cam) - pixel) / sigma of one observation with the nine
+// intrinsics `intrinsics`, autodiff-ready; false when the point is not in front of the camera.
 template <typename T>
-bool WhitenedReprojection(const CameraIntrinsics& camera, const T& fx, const T& k1, const Vec3T<T>& p_in_cam,
-                          const Eigen::Vector2d& pixel, double inv_sigma, T* residual) {
+bool WhitenedReprojection(const T* intrinsics, const Vec3T<T>& p_in_cam, const Eigen::Vector2d& pixel, double inv_sigma,
+                          T* residual) {
   T u, v;
-  if (!ProjectPoint<T>(camera, fx, k1, p_in_cam, &u, &v)) return false;
+  if (!ProjectWithIntrinsics<T>(intrinsics, p_in_cam, &u, &v)) return false;
   residual[0] = (u - T(pixel.x())) * T(inv_sigma);
   residual[1] = (v - T(pixel.y())) * T(inv_sigma);
   return true;

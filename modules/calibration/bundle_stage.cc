@@ -46,7 +46,8 @@ Eigen::VectorXd BundleStartFromPaper(const ObservationSet& obs, const PaperPipel
 
 namespace {
 
-// The held-out reprojection figures of the calibrated and the nominal model (see bundle_stage.h).
+// The held-out reprojection figures of the calibrated and the nominal model (see bundle_stage.h), every
+// estimated intrinsic's uncertainty in the calibrated model's prediction.
 void VerifyHeldOutReprojection(const ObservationSet& obs, BundleStageReport* report) {
   const bundle::BundleReport& b = report->bundle;
   const bool estimated = std::isfinite(b.pixel_noise_estimate_px) && b.pixel_noise_estimate_px > 0;
@@ -54,12 +55,9 @@ void VerifyHeldOutReprojection(const ObservationSet& obs, BundleStageReport* rep
   PredictionModel calibrated;
   calibrated.robot = obs.robot;
   calibrated.rho = b.rho;
-  calibrated.camera = obs.camera;
-  calibrated.camera.fx_px = b.fx_px;
-  if (b.k1_estimated) calibrated.camera.k1 = b.k1;
+  calibrated.camera = report->calibrated_camera;
   calibrated.free_indices = b.free_indices;
-  calibrated.fx_estimated = b.fx_estimated;
-  calibrated.k1_estimated = b.k1_estimated;
+  calibrated.intrinsics_estimated = b.intrinsics_estimated;
   if (b.covariance_available) calibrated.covariance = b.covariance_free;
   ExcludedObservations excluded;
   for (const bundle::RemovedObservation& o : b.removed) excluded.insert({o.pose_id, o.dot_id});
@@ -110,29 +108,21 @@ BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineR
   if (b.rho.size() == obs.robot.num_parameters() && b.rho.allFinite() && std::isfinite(b.fx_px) && b.fx_px > 0) {
     report.calibrated_robot = ApplyParameters(obs.robot, b.rho);
     report.calibrated_rho = KinematicParameters::Nominal(report.calibrated_robot);
+    report.calibrated_camera = WithIntrinsics(obs.camera, b.intrinsics);
     if (valid) VerifyHeldOutReprojection(obs, &report);
     if (verify) {
-      if (b.k1_estimated) {
-        ObservationSet with_k1 = obs;
-        with_k1.camera.k1 = b.k1;
-        report.verification = VerifyDistances(with_k1, verification_poses, obs.robot, b.rho, b.fx_px, obs.check_distances);
-      } else {
-        report.verification = VerifyDistances(obs, verification_poses, obs.robot, b.rho, b.fx_px, obs.check_distances);
-      }
+      ObservationSet calibrated = obs;
+      calibrated.camera = report.calibrated_camera;
+      report.verification = VerifyDistances(calibrated, verification_poses, obs.robot, b.rho, b.fx_px, obs.check_distances);
       if (b.covariance_available) {
-        // Order free, f_x (when estimated), k1 (when estimated; not propagated). A held f_x: zero variance.
+        // Order free, then the estimated intrinsics, f_x first when estimated (the others not propagated).
+        // A held f_x: zero variance.
         const int nf = static_cast<int>(b.free_indices.size());
         Eigen::MatrixXd sigma = Eigen::MatrixXd::Zero(nf + 1, nf + 1);
         sigma.topLeftCorner(nf, nf) = b.covariance_free.topLeftCorner(nf, nf);
-        if (b.fx_estimated) sigma = b.covariance_free.topLeftCorner(nf + 1, nf + 1);
-        ObservationSet with_k1;
-        if (b.k1_estimated) {
-          with_k1 = obs;
-          with_k1.camera.k1 = b.k1;
-        }
-        report.predicted_error = PredictDistanceErrors(b.k1_estimated ? with_k1 : obs, verification_poses, obs.robot,
-                                                       b.rho, b.fx_px, b.free_indices, sigma, obs.pixel_noise_px,
-                                                       obs.check_distances);
+        if (b.intrinsics_estimated[kFx]) sigma = b.covariance_free.topLeftCorner(nf + 1, nf + 1);
+        report.predicted_error = PredictDistanceErrors(calibrated, verification_poses, obs.robot, b.rho, b.fx_px,
+                                                       b.free_indices, sigma, obs.pixel_noise_px, obs.check_distances);
       } else {
         report.predicted_error.message = "covariance unavailable: " + b.covariance_message;
       }

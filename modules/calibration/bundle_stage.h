@@ -43,13 +43,15 @@ struct BundleStageReport {
   // rho (= Nominal(calibrated_robot), zero corrections). Empty unless the bundle produced a full rho.
   RobotModel calibrated_robot;
   Eigen::VectorXd calibrated_rho;
-  // Section 4.1 step 5 with the bundle's model and f_x (k1 as estimated when it was): 3-D error of the
-  // check distances triangulated from the verification poses.
+  // observations.camera with the bundle's intrinsics (every estimated one; the held ones as they were).
+  CameraIntrinsics calibrated_camera;
+  // Section 4.1 step 5 with the bundle's model and calibrated camera: 3-D error of the check distances
+  // triangulated from the verification poses.
   VerificationSummary verification;
   VerificationSummary verification_nominal;  // the same with the nominal model and the prior f_x (before)
   // The predicted std of that 3-D error (calibration/predicted_error.h): the bundle's covariance of the free
-  // parameters and f_x, and the stated pixel noise (observations.pixel_noise_px) of the verification
-  // images. ok = false when the covariance was unavailable.
+  // parameters and f_x (the other intrinsics' uncertainty is not propagated), and the stated pixel noise
+  // (observations.pixel_noise_px) of the verification images. ok = false when the covariance was unavailable.
   PredictedDistanceErrors predicted_error;
   // Held-out reprojection (heldout_reprojection.h), with no check distance needed: the bundle's dots and
   // model (its covariance in the normalisation), and the nominal model with the prior f_x and the dots it

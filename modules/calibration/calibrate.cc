@@ -80,6 +80,33 @@ ObservationSet PrepareFlangePoseSet(const ObservationSet& observations, const Ca
   return prepared;
 }
 
+// A flange-pose set after its bundle: the images' own camera motions against the flange motions, and with a
+// stated flange pose noise the pose-noise bundle; both start from the bundle's hand-eye transform, dots and
+// calibrated camera, and estimate the intrinsics the bundle estimated.
+void CheckFlangePoses(const ObservationSet& observations, const ObservationSet& prepared, const CalibrateOptions& options,
+                      CalibrationReport* report) {
+  const BundleStageReport& stage = *report->bundle;
+  const bundle::BundleReport& b = stage.bundle;
+  if (!stage.calibrated_robot.flange_from_cam.rotation.allFinite() || b.dots_in_base.empty()) return;
+  ObservationSet calibrated = prepared;
+  calibrated.camera = stage.calibrated_camera;
+  bundle::FreeCameraOptions check_options = options.motion_check;
+  check_options.intrinsics = b.intrinsics_estimated;
+  report->motion_check = CheckImageMotions(calibrated, stage.calibrated_robot.flange_from_cam, b.dots_in_base, check_options);
+  if (!(observations.flange_translation_sigma_m > 0)) return;
+  bundle::PoseNoiseOptions noise;
+  noise.translation_sigma_m = observations.flange_translation_sigma_m;
+  noise.rotation_sigma_rad = observations.flange_rotation_sigma_rad;
+  noise.intrinsics = b.intrinsics_estimated;
+  noise.yardstick_sigma_m = options.bundle.bundle.yardstick_sigma_m;
+  if (options.flange_scale_from_yardsticks) {
+    calibrated.yardsticks = observations.yardsticks;
+    calibrated.check_distances = observations.check_distances;
+  }
+  report->pose_noise = bundle::RunPoseNoiseBundle(calibrated, stage.calibrated_robot.flange_from_cam, b.dots_in_base, noise);
+  report->flange_scale_yardsticks = static_cast<int>(report->pose_noise->yardstick_lengths_m.size());
+}
+
 }  // namespace
 
 CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateOptions& options) {
@@ -124,59 +151,34 @@ CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateO
     report.verdict = VerdictFor(report.bundle->bundle.outcome);
     report.message = report.bundle->bundle.message;
   }
-  if (flange_poses && report.bundle && report.bundle->calibrated_robot.flange_from_cam.rotation.allFinite() &&
-      !report.bundle->bundle.dots_in_base.empty()) {
-    bundle::FreeCameraOptions check_options = options.motion_check;
-    check_options.estimate_k1 = report.bundle->bundle.k1_estimated;
-    ObservationSet with_k1 = obs;
-    with_k1.camera.k1 = report.bundle->bundle.k1;
-    report.motion_check = CheckImageMotions(with_k1, report.bundle->calibrated_robot.flange_from_cam,
-                                            report.bundle->bundle.dots_in_base, report.bundle->bundle.fx_px,
-                                            report.bundle->bundle.k1, check_options);
-  }
-  if (flange_poses && report.bundle && observations.flange_translation_sigma_m > 0 &&
-      !report.bundle->bundle.dots_in_base.empty()) {
-    bundle::PoseNoiseOptions noise;
-    noise.translation_sigma_m = observations.flange_translation_sigma_m;
-    noise.rotation_sigma_rad = observations.flange_rotation_sigma_rad;
-    noise.estimate_fx = report.bundle->bundle.fx_estimated;
-    noise.estimate_k1 = report.bundle->bundle.k1_estimated;
-    noise.yardstick_sigma_m = options.bundle.bundle.yardstick_sigma_m;
-    ObservationSet with_k1 = obs;
-    with_k1.camera.k1 = report.bundle->bundle.k1;
-    if (options.flange_scale_from_yardsticks) {
-      with_k1.yardsticks = observations.yardsticks;
-      with_k1.check_distances = observations.check_distances;
-    }
-    report.pose_noise = bundle::RunPoseNoiseBundle(with_k1, report.bundle->calibrated_robot.flange_from_cam,
-                                                   report.bundle->bundle.dots_in_base, report.bundle->bundle.fx_px,
-                                                   report.bundle->bundle.k1, noise);
-    report.flange_scale_yardsticks = static_cast<int>(report.pose_noise->yardstick_lengths_m.size());
-  }
+  if (flange_poses && report.bundle) CheckFlangePoses(observations, obs, options, &report);
   if (!report.accepted()) return report;  // K4: no model for a result that is not to be applied
   CalibratedModel model;
   if (report.bundle) {
+    const bundle::BundleReport& b = report.bundle->bundle;
     model.robot = report.bundle->calibrated_robot;
-    model.fx_px = report.bundle->bundle.fx_px;
-    model.parameters = report.bundle->bundle.rho;
+    model.camera = report.bundle->calibrated_camera;
+    model.intrinsics_estimated = b.intrinsics_estimated;
+    if (b.covariance_available) model.intrinsics_stddev = b.intrinsics_stddev;
+    model.parameters = b.rho;
     model.method_description = flange_poses ? "hand-eye bundle adjustment on recorded flange poses"
                                             : "kinematic bundle adjustment";
-    const bundle::BundleReport& b = report.bundle->bundle;
     const int cam = KinematicParameters(0).CamOffset();
     if (flange_poses && b.covariance_available && b.stddev.size() >= cam + 6) {
       model.flange_from_cam_stddev = b.stddev.segment<6>(cam);
-      model.fx_stddev_px = b.fx_stddev;
     }
   } else {
     model.robot = report.paper.calibrated_robot;
-    model.fx_px = report.paper.fx_px;
+    model.camera = observations.camera;
+    model.camera.fx_px = report.paper.fx_px;
+    model.intrinsics_estimated = kFocalLengthOnly;
     model.method_description = "paper pipeline";
   }
   if (report.pose_noise && report.pose_noise->ok) {
     model.robot.flange_from_cam = report.pose_noise->flange_from_cam;
-    model.fx_px = report.pose_noise->fx_px;
+    model.camera = WithIntrinsics(model.camera, report.pose_noise->intrinsics);
     model.flange_from_cam_stddev = report.pose_noise->stddev;
-    model.fx_stddev_px = report.pose_noise->fx_stddev;
+    model.intrinsics_stddev = report.pose_noise->intrinsics_stddev;
     model.method_description += ", flange poses with their stated noise";
   }
   report.model = std::move(model);

@@ -65,16 +65,21 @@ struct CalibrateOptions {
 // The chosen method's calibrated model, ready for writing.
 struct CalibratedModel {
   RobotModel robot;            // nominal values replaced by the calibrated ones, metric
-  double fx_px = 0;
+  // The calibrated camera: the observations' with every intrinsic the method estimated replaced (the
+  // paper pipeline: f_x), the image size and the held intrinsics as observed.
+  CameraIntrinsics camera;
+  IntrinsicsMask intrinsics_estimated{};
+  // Standard deviations of the estimated intrinsics from the solve that gave them (NaN: held, or
+  // unavailable); flange-pose sets: the pose-noise bundle's when it ran.
+  IntrinsicsVector intrinsics_stddev = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
   // The calibrated parameter vector on the observations' nominal model (corrections for base and
   // camera), when the method estimates one (the bundle adjustment); empty otherwise.
   Eigen::VectorXd parameters;
   std::string method_description;  // e.g. "kinematic bundle adjustment"
   // A flange-pose set: the standard deviations of a correction flange_from_cam * Exp(c) (translation m,
-  // rotation vector rad, camera frame) and of f_x, from the solve that gave robot.flange_from_cam and
-  // fx_px (the pose-noise bundle when it ran, else the exact-pose bundle); NaN when unavailable.
+  // rotation vector rad, camera frame), from the solve that gave robot.flange_from_cam and the camera
+  // (the pose-noise bundle when it ran, else the exact-pose bundle); NaN when unavailable.
   Eigen::Matrix<double, 6, 1> flange_from_cam_stddev = Eigen::Matrix<double, 6, 1>::Constant(NAN);
-  double fx_stddev_px = NAN;
 };
 
 struct CalibrationReport {

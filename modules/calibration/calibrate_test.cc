@@ -19,13 +19,13 @@ TEST(Calibrate, BundleMethodReturnsTheBundleStagesModel) {
   const PaperPipelineReport paper = RunPaperPipeline(obs, PaperPipelineOptions());
   const BundleStageReport stage = RunBundleStage(obs, paper, BundleStageOptions());
   EXPECT_EQ(report.model->parameters, stage.bundle.rho);
-  EXPECT_EQ(report.model->fx_px, stage.bundle.fx_px);
+  EXPECT_EQ(report.model->camera.fx_px, stage.bundle.fx_px);
   EXPECT_EQ(report.model->method_description, "kinematic bundle adjustment");
   // The chosen method's held-out figures are the bundle's, and they beat the nominal model.
   EXPECT_EQ(report.verification_calibrated().rms_error_m, stage.verification.rms_error_m);
   EXPECT_LT(report.verification_calibrated().rms_error_m, report.verification_nominal().rms_error_m);
   // Against the hidden truth, within the noise: f_x within 5 sigma of the bundle's own std.
-  EXPECT_NEAR(report.model->fx_px, world.truth.camera_true.fx_px, 5 * stage.bundle.fx_stddev);
+  EXPECT_NEAR(report.model->camera.fx_px, world.truth.camera_true.fx_px, 5 * stage.bundle.fx_stddev);
 }
 
 TEST(Calibrate, PaperMethodRunsNoBundleAndWritesThePapersModel) {
@@ -36,7 +36,7 @@ TEST(Calibrate, PaperMethodRunsNoBundleAndWritesThePapersModel) {
   EXPECT_FALSE(report.bundle.has_value());
   ASSERT_TRUE(report.accepted()) << report.message;
   ASSERT_TRUE(report.model.has_value());
-  EXPECT_EQ(report.model->fx_px, report.paper.fx_px);
+  EXPECT_EQ(report.model->camera.fx_px, report.paper.fx_px);
   EXPECT_EQ(report.model->parameters.size(), 0);
   EXPECT_EQ(report.model->method_description, "paper pipeline");
 }

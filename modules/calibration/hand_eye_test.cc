@@ -170,6 +170,55 @@ TEST(HandEye, StatedFlangePoseNoiseIsModelled) {
   for (int k = 0; k < 3; ++k) EXPECT_LT(std::abs(rotation_error[k]), 4 * report.pose_noise->stddev[3 + k]) << k;
 }
 
+// A prior principal point 3 px off and k1 unknown: freeing them with the hand-eye transform (--free
+// camera,fx,cx,cy,k1), the exact-pose bundle, the image-motion check and, with a stated flange pose noise,
+// the pose-noise bundle (one intrinsics block with the held entries fixed) all estimate them; the model's
+// camera is the pose-noise bundle's, every estimated intrinsic within 3 of its sigma of the truth.
+TEST(HandEye, FreedIntrinsicsAreEstimatedByEveryBundleOfAFlangePoseSet) {
+  FlangeWorld w = MakeFlangeWorld(0.2);
+  const CameraIntrinsics truth = w.observations.camera;  // the simulator's camera but for f_x
+  w.observations.camera.cx_px += 3.0;
+  w.observations.camera.cy_px -= 2.0;
+  w.observations.flange_translation_sigma_m = 1e-4;
+  w.observations.flange_rotation_sigma_rad = 1e-4;
+  CalibrateOptions options;
+  options.bundle.bundle.free_parameters = {"camera", "fx", "cx", "cy", "k1"};
+  const CalibrationReport report = Calibrate(w.observations, options);
+  ASSERT_TRUE(report.accepted()) << report.message;
+  const bundle::BundleReport& b = report.bundle->bundle;
+  const IntrinsicsMask expected = {true, false, true, true, true, false, false, false, false};
+  EXPECT_EQ(b.intrinsics_estimated, expected);
+  ASSERT_TRUE(report.pose_noise.has_value() && report.pose_noise->ok) << report.pose_noise->message;
+  ASSERT_TRUE(report.motion_check.has_value() && report.motion_check->ok) << report.motion_check->message;
+  const IntrinsicsVector t = IntrinsicsOf(truth);
+  const IntrinsicsVector& noise = report.pose_noise->intrinsics;
+  for (int k = 0; k < kNumIntrinsics; ++k) {
+    const double sd = report.pose_noise->intrinsics_stddev[k];
+    if (!expected[k]) {
+      EXPECT_EQ(noise[k], IntrinsicsOf(w.observations.camera)[k]) << IntrinsicName(k);  // held
+      EXPECT_TRUE(std::isnan(sd)) << IntrinsicName(k);
+      continue;
+    }
+    const double truth_k = k == kFx ? w.fx_true : t[k];
+    ASSERT_TRUE(sd > 0 && std::isfinite(sd)) << IntrinsicName(k);
+    EXPECT_LT(std::abs(noise[k] - truth_k), 3 * sd) << IntrinsicName(k) << " " << noise[k] << " +- " << sd;
+    EXPECT_LT(std::abs(b.intrinsics[k] - truth_k), 3 * b.intrinsics_stddev[k]) << IntrinsicName(k);
+    // The images' own bundle (every camera free, all poses) starts at the calibrated camera and estimates
+    // the same intrinsics again.
+    EXPECT_NE(report.motion_check->images.intrinsics[k], b.intrinsics[k]) << IntrinsicName(k);
+  }
+  for (int k = 0; k < kNumIntrinsics; ++k) {
+    if (!expected[k]) {
+      EXPECT_EQ(report.motion_check->images.intrinsics[k], b.intrinsics[k]) << IntrinsicName(k);
+    }
+  }
+  EXPECT_EQ(IntrinsicsOf(report.model->camera), noise);
+  for (int k = 0; k < kNumIntrinsics; ++k) {
+    const double m = report.model->intrinsics_stddev[k], n = report.pose_noise->intrinsics_stddev[k];
+    EXPECT_TRUE(m == n || (std::isnan(m) && std::isnan(n))) << IntrinsicName(k);
+  }
+}
+
 // The paper's method needs joints: refused by name, not run on flange poses.
 TEST(HandEye, PaperMethodRefusesFlangePoses) {
   const FlangeWorld w = MakeFlangeWorld(0.2);

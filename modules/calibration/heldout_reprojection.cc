@@ -13,8 +13,8 @@ namespace {
 
 constexpr double kStepRho = 1e-6;  // m or rad
 constexpr double kStepDot = 1e-6;  // m
-constexpr double kStepFx = 1e-3;   // px
-constexpr double kStepK1 = 1e-6;
+// Per intrinsic (fx, mu, cx, cy, k1, k2, p1, p2, k3): 1e-3 px for the pixel-valued ones, 1e-6 otherwise.
+constexpr double kStepIntrinsic[kNumIntrinsics] = {1e-3, 1e-6, 1e-3, 1e-3, 1e-6, 1e-6, 1e-6, 1e-6, 1e-6};
 
 using Matrix23 = Eigen::Matrix<double, 2, 3>;
 
@@ -27,8 +27,9 @@ struct PoseFrames {
 // Projections of the model and their derivatives by central differences.
 class Projector {
  public:
-  explicit Projector(const PredictionModel& model) : model_(model) {
-    const int n = static_cast<int>(model.free_indices.size()) + (model.fx_estimated ? 1 : 0) + (model.k1_estimated ? 1 : 0);
+  explicit Projector(const PredictionModel& model)
+      : model_(model), intrinsics_(IntrinsicsOf(model.camera)), estimated_(EstimatedIntrinsics(model.intrinsics_estimated)) {
+    const int n = static_cast<int>(model.free_indices.size() + estimated_.size());
     with_parameters_ = model.covariance.size() > 0 && model.covariance.rows() == n && model.covariance.cols() == n;
     num_theta_ = with_parameters_ ? n : 0;
   }
@@ -52,38 +53,40 @@ class Projector {
   // The pixel of p_in_base, d(pixel)/d(p) and d(pixel)/d(theta); false when behind the camera at any step.
   bool Project(const PoseFrames& f, const Eigen::Vector3d& p, Eigen::Vector2d* uv, Matrix23* jd,
                Eigen::MatrixXd* jt) const {
-    const double fx = model_.camera.fx_px, k1 = model_.camera.k1;
-    if (!Pixel(f.cam_from_base, fx, k1, p, uv)) return false;
+    const IntrinsicsVector& in = intrinsics_;
+    if (!Pixel(f.cam_from_base, in, p, uv)) return false;
     Eigen::Vector2d a, b;
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d h = Eigen::Vector3d::Unit(k) * kStepDot;
-      if (!Pixel(f.cam_from_base, fx, k1, p + h, &a) || !Pixel(f.cam_from_base, fx, k1, p - h, &b)) return false;
+      if (!Pixel(f.cam_from_base, in, p + h, &a) || !Pixel(f.cam_from_base, in, p - h, &b)) return false;
       jd->col(k) = (a - b) / (2 * kStepDot);
     }
     jt->resize(2, num_theta_);
     if (!with_parameters_) return true;
     int column = 0;
     for (size_t k = 0; k < f.plus.size(); ++k, ++column) {
-      if (!Pixel(f.plus[k], fx, k1, p, &a) || !Pixel(f.minus[k], fx, k1, p, &b)) return false;
+      if (!Pixel(f.plus[k], in, p, &a) || !Pixel(f.minus[k], in, p, &b)) return false;
       jt->col(column) = (a - b) / (2 * kStepRho);
     }
-    if (model_.fx_estimated) {
-      if (!Pixel(f.cam_from_base, fx + kStepFx, k1, p, &a) || !Pixel(f.cam_from_base, fx - kStepFx, k1, p, &b)) return false;
-      jt->col(column++) = (a - b) / (2 * kStepFx);
-    }
-    if (model_.k1_estimated) {
-      if (!Pixel(f.cam_from_base, fx, k1 + kStepK1, p, &a) || !Pixel(f.cam_from_base, fx, k1 - kStepK1, p, &b)) return false;
-      jt->col(column++) = (a - b) / (2 * kStepK1);
+    for (int i : estimated_) {
+      IntrinsicsVector plus = in, minus = in;
+      plus[i] += kStepIntrinsic[i];
+      minus[i] -= kStepIntrinsic[i];
+      if (!Pixel(f.cam_from_base, plus, p, &a) || !Pixel(f.cam_from_base, minus, p, &b)) return false;
+      jt->col(column++) = (a - b) / (2 * kStepIntrinsic[i]);
     }
     return true;
   }
 
  private:
-  bool Pixel(const Rigid3& cam_from_base, double fx, double k1, const Eigen::Vector3d& p, Eigen::Vector2d* uv) const {
-    return ProjectPoint<double>(model_.camera, fx, k1, cam_from_base * p, &uv->x(), &uv->y());
+  static bool Pixel(const Rigid3& cam_from_base, const IntrinsicsVector& in, const Eigen::Vector3d& p,
+                    Eigen::Vector2d* uv) {
+    return ProjectWithIntrinsics<double>(in.data(), cam_from_base * p, &uv->x(), &uv->y());
   }
 
   const PredictionModel& model_;
+  IntrinsicsVector intrinsics_;
+  std::vector<int> estimated_;
   bool with_parameters_ = false;
   int num_theta_ = 0;
 };

@@ -13,7 +13,8 @@
 // given the parameters (H_dd = sum over its identification views of J^T J / sigma^2, the same dot seen in
 // several verification images correlates them); G Sigma G^T: the parameters' error (Sigma: the bundle's
 // covariance of the free parameters, f_x, k1, dots marginalised) including the dot's correlated response
-// to it (H_dtheta: the identification views' cross term). This is the bundle's own joint covariance of
+// to it (H_dtheta: the identification views' cross term; theta: the free rho entries and the estimated
+// intrinsics, whatever subset of the nine). This is the bundle's own joint covariance of
 // (dots, parameters), to first order, except that the yardstick's coupling of its two dots is left out
 // (those two dots' positions are taken as slightly less certain than they are). For the nominal model the
 // parameters are taken as exact (no Sigma). The statistic is r^T C^-1 r over the residuals of a pose
@@ -26,8 +27,9 @@
 // or more degrees of freedom), Paulson's cube-root approximation for F (which is Wilson-Hilferty's when
 // noise_dof is infinite).
 //
-// Jacobians: central differences of the projection (steps 1e-6 m or rad for rho and the dots, 1e-3 px for
-// f_x, 1e-6 for k1). Frames and units as in bundle/bundle_adjustment.h; pixels in px.
+// Jacobians: central differences of the projection with the full lens (steps 1e-6 m or rad for rho and
+// the dots, 1e-3 px for f_x, c_x, c_y, 1e-6 for mu and the lens coefficients). Frames and units as in
+// bundle/bundle_adjustment.h; pixels in px.
 #pragma once
 
 #include <cmath>
@@ -49,11 +51,11 @@ namespace selfcal::calibration {
 struct PredictionModel {
   RobotModel robot;           // the rho below is on this model
   Eigen::VectorXd rho;
-  CameraIntrinsics camera;    // f_x and k1 as the model has them
-  // The covariance of the estimated entries in the order free_indices, then f_x (when fx_estimated), then
-  // k1 (when k1_estimated); empty: the model is taken as exact.
+  CameraIntrinsics camera;    // every intrinsic as the model has it (the calibrated lens)
+  // The covariance of the estimated entries in the order free_indices, then the estimated intrinsics in
+  // camera/camera.h's Intrinsic order; empty: the model is taken as exact.
   std::vector<int> free_indices;
-  bool fx_estimated = false, k1_estimated = false;
+  IntrinsicsMask intrinsics_estimated{};
   Eigen::MatrixXd covariance;
 };
 

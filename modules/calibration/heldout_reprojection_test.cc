@@ -108,7 +108,7 @@ TEST(HeldOutReprojection, CorrectModelPassesAtTheSimulatedNoise) {
   EXPECT_GE(passed, 9);
 }
 
-// (b) A wrong model: f_x held 2 % off the truth (estimate_fx = false, prior 1.02 f_x, the bundle started from
+// (b) A wrong model: f_x held 2 % off the truth (fx held, prior 1.02 f_x, the bundle started from
 // the nominal model so that the paper's f_x does not come in), the arc's last 10 poses held out. The
 // held-out RMS is far above the noise (more than 10 times; the correct model's stays below 5 times in (a))
 // and the test at the stated (true) noise fails. With the estimated noise the test is weaker (the
@@ -116,7 +116,7 @@ TEST(HeldOutReprojection, CorrectModelPassesAtTheSimulatedNoise) {
 TEST(HeldOutReprojection, FxHeldTwoPercentOffFails) {
   const double noise = 0.3;
   BundleStageOptions options;
-  options.bundle.estimate_fx = false;
+  options.bundle.intrinsics[kFx] = false;
   int failed = 0;
   for (uint64_t seed = 21; seed < 24; ++seed) {
     const CalibratedCell run = Calibrated(Cell(noise, seed), options, false, /*from_paper=*/false, 1.02);
@@ -131,6 +131,40 @@ TEST(HeldOutReprojection, FxHeldTwoPercentOffFails) {
     failed += f.test_passed ? 0 : 1;
   }
   EXPECT_GE(failed, 2);
+}
+
+// (c) A lens the prior gets wrong (truth: principal point (328, 233) px, k2 = 0.4; prior: the image centre,
+// k2 = 0), the arc's last 10 poses held out. With cx, cy and k2 freed, the predictions use the
+// calibrated lens and the covariance of all four estimated intrinsics: the statistic at the stated (true)
+// noise is within 4 of its standard deviations of dof, as for a correct model. With them held at the
+// wrong prior the same test fails.
+TEST(HeldOutReprojection, FreedLensIsPredictedWithItsUncertainty) {
+  sim::SimOptions sim_options = Cell(0.3, 31);
+  sim_options.camera.cx_px = 328.0;
+  sim_options.camera.cy_px = 233.0;
+  sim_options.camera.k2 = 0.4;
+  sim::SimResult world = testing::PumaArcWorld(sim_options);
+  ObservationSet& obs = world.observations;
+  obs.camera.cx_px = 319.5;
+  obs.camera.cy_px = 239.5;
+  obs.camera.k2 = 0;
+  BundleStageOptions options;
+  options.bundle.intrinsics = {true, false, true, true, false, true, false, false, false};
+  const BundleStageReport freed = RunBundleStage(obs, PaperPipelineReport(), options);
+  ASSERT_EQ(freed.bundle.outcome, bundle::Outcome::kConverged) << freed.bundle.message;
+  ASSERT_TRUE(freed.heldout.ok) << freed.heldout.message;
+  EXPECT_TRUE(freed.heldout.prediction_uncertainty);
+  EXPECT_EQ(freed.bundle.covariance_free.rows(), static_cast<int>(freed.bundle.free_indices.size()) + 4);
+  EXPECT_EQ(freed.calibrated_camera.k2, freed.bundle.intrinsics[kK2]);
+  const HeldOutFigure& stated = freed.heldout_at_stated_noise;
+  EXPECT_NEAR(stated.chi_square, stated.dof, 4 * std::sqrt(2.0 * stated.dof));
+  const BundleStageReport held = RunBundleStage(obs, PaperPipelineReport(), BundleStageOptions());
+  ASSERT_TRUE(held.heldout.ok) << held.heldout.message;
+  std::cout << "[ figure ] lens freed: held-out RMS " << freed.heldout.overall.rms_px << " px, statistic "
+            << stated.chi_square << " / dof " << stated.dof << "; held at the prior: RMS " << held.heldout.overall.rms_px
+            << " px, statistic " << held.heldout_at_stated_noise.chi_square << "\n";
+  EXPECT_FALSE(held.heldout_at_stated_noise.test_passed);
+  EXPECT_GT(held.heldout.overall.rms_px, freed.heldout.overall.rms_px);
 }
 
 }  // namespace

@@ -20,8 +20,7 @@ double Quantile(std::vector<double> values, double q) {
 }  // namespace
 
 MotionCheck CheckImageMotions(const ObservationSet& obs, const Rigid3& flange_from_cam,
-                              const std::map<int, Eigen::Vector3d>& dots_in_base, double fx_px, double k1,
-                              const bundle::FreeCameraOptions& options) {
+                              const std::map<int, Eigen::Vector3d>& dots_in_base, const bundle::FreeCameraOptions& options) {
   MotionCheck check;
   if (!obs.UsesFlangePoses()) {
     check.message = "needs a flange pose in every pose";
@@ -29,8 +28,7 @@ MotionCheck CheckImageMotions(const ObservationSet& obs, const Rigid3& flange_fr
   }
   std::vector<Rigid3> start;
   for (const PoseObservation& pose : obs.poses) start.push_back(*pose.base_from_flange * flange_from_cam);
-  check.images = bundle::RunFreeCameraBundle(obs, start, std::vector<bool>(obs.poses.size(), true), dots_in_base, fx_px,
-                                             k1, options);
+  check.images = bundle::RunFreeCameraBundle(obs, start, std::vector<bool>(obs.poses.size(), true), dots_in_base, options);
   if (!check.images.ok) {
     check.message = "the free-camera bundle did not solve: " + check.images.message;
     return check;

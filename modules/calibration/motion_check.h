@@ -35,9 +35,9 @@ struct MotionCheck {
 };
 
 // Every pose of the flange-pose set `obs` (identification and verification), started at
-// base_from_flange * flange_from_cam with the dots and f_x, k1 given (e.g. the hand-eye bundle's).
+// base_from_flange * flange_from_cam with the dots given and the intrinsics of obs.camera (e.g. the
+// hand-eye bundle's dots and calibrated camera).
 MotionCheck CheckImageMotions(const ObservationSet& obs, const Rigid3& flange_from_cam,
-                              const std::map<int, Eigen::Vector3d>& dots_in_base, double fx_px, double k1,
-                              const bundle::FreeCameraOptions& options);
+                              const std::map<int, Eigen::Vector3d>& dots_in_base, const bundle::FreeCameraOptions& options);
 
 }  // namespace selfcal::calibration

@@ -45,6 +45,14 @@ IntrinsicsVector IntrinsicsOf(const CameraIntrinsics& cam) {
   return {cam.fx_px, cam.mu, cam.cx_px, cam.cy_px, cam.k1, cam.k2, cam.p1, cam.p2, cam.k3};
 }
 
+std::vector<int> EstimatedIntrinsics(const IntrinsicsMask& mask) {
+  std::vector<int> out;
+  for (int i = 0; i < kNumIntrinsics; ++i) {
+    if (mask[i]) out.push_back(i);
+  }
+  return out;
+}
+
 CameraIntrinsics WithIntrinsics(const CameraIntrinsics& cam, const IntrinsicsVector& values) {
   CameraIntrinsics out = cam;
   out.fx_px = values[kFx];

@@ -15,6 +15,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -49,6 +50,12 @@ const char* IntrinsicName(int intrinsic);
 // The index of a name above, or -1.
 int IntrinsicIndex(const std::string& name);
 IntrinsicsVector IntrinsicsOf(const CameraIntrinsics& cam);
+// Which intrinsics an estimator moves (true) or holds (false), in the order of Intrinsic.
+using IntrinsicsMask = std::array<bool, kNumIntrinsics>;
+// f_x estimated, everything else held: the default of every bundle.
+inline constexpr IntrinsicsMask kFocalLengthOnly = {true, false, false, false, false, false, false, false, false};
+// The indices set in `mask`, ascending (the order of the estimated intrinsics in covariances).
+std::vector<int> EstimatedIntrinsics(const IntrinsicsMask& mask);
 // `cam` with the values of `values` (image size kept).
 CameraIntrinsics WithIntrinsics(const CameraIntrinsics& cam, const IntrinsicsVector& values);
 

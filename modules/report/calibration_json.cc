@@ -189,6 +189,19 @@ json PaperSectionJson(const ObservationSet& obs, const calibration::PaperPipelin
       {"predicted_3d_error", nullptr}};
 }
 
+// Every intrinsic by name (camera/camera.h): its value (px for f_x, c_x, c_y), whether it was estimated,
+// and its standard deviation (null when held or unavailable).
+json IntrinsicsJson(const IntrinsicsVector& values, const IntrinsicsMask& estimated, const IntrinsicsVector& stddev) {
+  json out = json::object();
+  for (int k = 0; k < kNumIntrinsics; ++k) {
+    const std::string unit = k == kFx || k == kCx || k == kCy ? "_px" : "";
+    out[IntrinsicName(k)] = {{"value" + unit, values[k]},
+                             {"estimated", estimated[k]},
+                             {"stddev" + unit, estimated[k] ? Finite(stddev[k]) : json()}};
+  }
+  return out;
+}
+
 json BundleSectionJson(const ObservationSet& obs, const calibration::BundleStageReport& stage) {
   const bundle::BundleReport& b = stage.bundle;
   json removed = json::array();
@@ -203,8 +216,9 @@ json BundleSectionJson(const ObservationSet& obs, const calibration::BundleStage
           {"message", b.message},
           {"fx_px", b.fx_px},
           {"fx_stddev_px", Finite(b.fx_stddev)},
-          {"k1", b.k1},
-          {"k1_stddev", Finite(b.k1_stddev)},
+          {"k1", b.intrinsics[kK1]},
+          {"k1_stddev", Finite(b.intrinsics_stddev[kK1])},
+          {"intrinsics", IntrinsicsJson(b.intrinsics, b.intrinsics_estimated, b.intrinsics_stddev)},
           {"start", calibration::BundleStartName(stage.start)},
           {"start_note", stage.start_note},
           {"fx_start_px", stage.fx_start_px},
@@ -296,7 +310,7 @@ json HandEyeJson(const calibration::CalibrationReport& report) {
     j["image_motions"] = {{"ok", m.ok},
                           {"message", m.message},
                           {"images_rms_reprojection_px", m.images.rms_reprojection_px},
-                          {"images_fx_px", m.images.fx_px},
+                          {"images_fx_px", m.images.intrinsics[kFx]},
                           {"median_error_rad", m.median_error_rad},
                           {"p90_error_rad", m.p90_error_rad},
                           {"max_error_rad", m.max_error_rad},
@@ -345,7 +359,13 @@ json CalibrationReportJson(const ObservationSet& obs, const calibration::Calibra
   j["format"] = kCalibrationReportFormat;
   j["version"] = kCalibrationReportVersion;
   j["software_version"] = SELFCAL_VERSION;
-  j["input"] = {{"kind", context.input.kind}, {"path", context.input.path}, {"sha256", context.input.sha256}};
+  j["input"] = {{"kind", context.input.kind}, {"path", context.input.path}, {"sha256", context.input.sha256},
+                {"camera_file", json()}};
+  if (!context.input.camera_file.empty()) {
+    j["input"]["camera_file"] = {{"path", context.input.camera_file},
+                                 {"sha256", context.input.camera_file_sha256},
+                                 {"camera_name", context.input.camera_name}};
+  }
   j["method"] = calibration::MethodName(report.method);
   j["verdict"] = calibration::VerdictName(report.verdict);
   j["accepted"] = report.accepted();

@@ -25,6 +25,9 @@ struct ReportInput {
   std::string kind;    // "observations" or "session"
   std::string path;
   std::string sha256;  // of the observations file, or of the session's session.json
+  // A camera file that replaced the observations' camera (empty: none), its SHA-256 and the camera name
+  // chosen in it (empty: the file's only camera).
+  std::string camera_file{}, camera_file_sha256{}, camera_name{};
 };
 
 // What a session input adds to the report: the journal's counts and what a resume would repair.

@@ -1,4 +1,6 @@
 #include <iomanip>
+#include <sstream>
+#include <string>
 
 #include "report/calibration_report.h"
 
@@ -65,6 +67,27 @@ void PrintHeldOut(const calibration::BundleStageReport& stage, std::ostream& out
   out.unsetf(std::ios::floatfield);
 }
 
+// " + f_x + k1 + ...": the estimated intrinsics after the free kinematic count.
+std::string EstimatedIntrinsicsText(const IntrinsicsMask& estimated) {
+  std::string out;
+  for (int k : EstimatedIntrinsics(estimated)) out += std::string(" + ") + (k == kFx ? "f_x" : IntrinsicName(k));
+  return out;
+}
+
+// The estimated intrinsics other than f_x with their standard deviations, one line; nothing when none.
+void PrintLensSummary(const bundle::BundleReport& b, std::ostream& out) {
+  std::string line;
+  for (int k : EstimatedIntrinsics(b.intrinsics_estimated)) {
+    if (k == kFx) continue;
+    const bool px = k == kCx || k == kCy;
+    std::ostringstream term;
+    term << std::setprecision(px ? 5 : 4) << IntrinsicName(k) << " = " << b.intrinsics[k] << " +- "
+         << std::setprecision(2) << b.intrinsics_stddev[k] << (px ? " px" : "");
+    line += (line.empty() ? "" : ", ") + term.str();
+  }
+  if (!line.empty()) out << "  intrinsics: " << line << "\n";
+}
+
 void PrintBundleSummary(const calibration::BundleStageReport& stage, bool flange_poses, std::ostream& out) {
   const bundle::BundleReport& b = stage.bundle;
   out << (flange_poses ? "hand-eye bundle adjustment (recorded flange poses): " : "kinematic bundle adjustment: ")
@@ -73,7 +96,7 @@ void PrintBundleSummary(const calibration::BundleStageReport& stage, bool flange
   out << "\n  start: " << stage.start_note << "\n";
   if (b.rho.size() == 0) return;
   out << "  " << b.free_names.size() << (flange_poses ? " free hand-eye parameters" : " free kinematic parameters")
-      << (b.fx_estimated ? " + f_x, " : ", ") << b.fixed_names.size() << " fixed";
+      << EstimatedIntrinsicsText(b.intrinsics_estimated) << ", " << b.fixed_names.size() << " fixed";
   if (!b.held_names.empty()) out << " (" << b.held_names.size() << " held by request)";
   out << "; " << b.num_observations << " observations, " << b.removed.size() << " removed by the screen, "
       << b.dropped_dots.size() << " dots dropped\n";
@@ -81,6 +104,7 @@ void PrintBundleSummary(const calibration::BundleStageReport& stage, bool flange
       << b.rms_reprojection_px << " px; f_x = " << std::fixed << std::setprecision(3) << b.fx_px << " +- "
       << b.fx_stddev << " px\n";
   out.unsetf(std::ios::floatfield);
+  PrintLensSummary(b, out);
   if (stage.verification.num_ok > 0) {
     out << "  3-D error on " << stage.verification.num_ok << " held-out distances: nominal model " << std::fixed
         << std::setprecision(3) << stage.verification_nominal.rms_error_m * kMm << " mm RMS, bundle "

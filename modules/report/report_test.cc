@@ -45,7 +45,7 @@ calibration::CalibrationReport* CalibrationReportTest::report_ = nullptr;
 
 TEST_F(CalibrationReportTest, TopLevelCarriesTheChosenMethodsFigures) {
   ASSERT_TRUE(report_->accepted()) << report_->message;
-  const nlohmann::json j = CalibrationReportJson(world_->observations, *report_, {{"observations", "o.yaml", "ab"}, 0, {}});
+  const nlohmann::json j = CalibrationReportJson(world_->observations, *report_, {{"observations", "o.yaml", "ab", "", "", ""}, 0, {}});
   EXPECT_EQ(j["format"], kCalibrationReportFormat);
   EXPECT_EQ(j["version"], 2);
   EXPECT_EQ(j["method"], "bundle");
@@ -58,6 +58,47 @@ TEST_F(CalibrationReportTest, TopLevelCarriesTheChosenMethodsFigures) {
   EXPECT_NE(j["verification"], j["methods"]["paper"]["verification"]);
   EXPECT_EQ(j["input"]["sha256"], "ab");
   EXPECT_TRUE(j["session"].is_null());
+}
+
+// methods.bundle.intrinsics: every intrinsic by name with its value, whether it was estimated (the default:
+// f_x alone) and its std, null when held; the values are the bundle's, the f_x std its covariance's.
+TEST_F(CalibrationReportTest, BundleIntrinsicsNameEveryIntrinsicWithItsEstimateFlagAndStd) {
+  const nlohmann::json j = CalibrationReportJson(world_->observations, *report_, {});
+  const nlohmann::json& in = j["methods"]["bundle"]["intrinsics"];
+  const bundle::BundleReport& b = report_->bundle->bundle;
+  ASSERT_EQ(in.size(), static_cast<size_t>(kNumIntrinsics)) << in.dump();
+  for (int k = 0; k < kNumIntrinsics; ++k) {
+    const std::string unit = k == kFx || k == kCx || k == kCy ? "_px" : "";
+    const nlohmann::json& e = in.at(IntrinsicName(k));
+    EXPECT_EQ(e.at("estimated").get<bool>(), k == kFx) << IntrinsicName(k);
+    EXPECT_EQ(e.at("value" + unit).get<double>(), b.intrinsics[k]) << IntrinsicName(k);
+    EXPECT_EQ(e.at("stddev" + unit).is_null(), k != kFx) << IntrinsicName(k);
+  }
+  EXPECT_EQ(in["fx"]["value_px"].get<double>(), j["fx_px"].get<double>());
+  EXPECT_EQ(in["fx"]["stddev_px"].get<double>(), b.fx_stddev);
+  EXPECT_EQ(in["cx"]["value_px"].get<double>(), world_->observations.camera.cx_px);  // held: as observed
+  EXPECT_TRUE(j["input"]["camera_file"].is_null());
+  const nlohmann::json named = CalibrationReportJson(world_->observations, *report_,
+                                                     {{"observations", "o.yaml", "ab", "cam.xml", "cd", "Camera"}, 0, {}});
+  EXPECT_EQ(named["input"]["camera_file"]["path"], "cam.xml");
+  EXPECT_EQ(named["input"]["camera_file"]["sha256"], "cd");
+  EXPECT_EQ(named["input"]["camera_file"]["camera_name"], "Camera");
+}
+
+// The summary names the estimated intrinsics and gives each one beside f_x with its std.
+TEST(CalibrationReport, SummaryNamesTheEstimatedIntrinsics) {
+  const sim::SimResult world = testing::PumaArcWorld(0.2, 2, 2);
+  calibration::CalibrateOptions options;
+  options.bundle.bundle.intrinsics[kCx] = options.bundle.bundle.intrinsics[kCy] = true;
+  const calibration::CalibrationReport report = calibration::Calibrate(world.observations, options);
+  ASSERT_TRUE(report.accepted()) << report.message;
+  std::ostringstream text;
+  PrintCalibrationSummary(report, text);
+  EXPECT_NE(text.str().find("free kinematic parameters + f_x + cx + cy,"), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("  intrinsics: cx = "), std::string::npos) << text.str();
+  const nlohmann::json j = CalibrationReportJson(world.observations, report, {});
+  EXPECT_TRUE(j["methods"]["bundle"]["intrinsics"]["cy"]["estimated"].get<bool>());
+  EXPECT_GT(j["methods"]["bundle"]["intrinsics"]["cy"]["stddev_px"].get<double>(), 0);
 }
 
 // One key style: SI values with the unit in the key; no mm or degree keys anywhere in report.json.

@@ -162,8 +162,7 @@ bundle::CramerRaoReport BundleBound(const sim::SimResult& world, const Observati
   }
   bundle::BundleTruth truth;
   truth.rho = world.truth.rho_true;
-  truth.fx_px = world.truth.camera_true.fx_px;
-  truth.k1 = world.truth.camera_true.k1;
+  truth.camera = world.truth.camera_true;
   for (size_t d = 0; d < world.truth.dots_in_base.size(); ++d) {
     truth.dots_in_base[static_cast<int>(d)] = world.truth.dots_in_base[d];
   }
@@ -235,7 +234,7 @@ void ScoreBundle(const sim::SimResult& world, const ObservationSet& obs, const c
       ++cell->bundle_intervals;
       cell->bundle_covered += std::abs(b.rho[i] - truth.rho_true[i]) <= 2 * b.stddev[i] ? 1 : 0;
     }
-    if (options.bundle.bundle.estimate_fx) {
+    if (b.intrinsics_estimated[kFx]) {
       ++cell->bundle_intervals;
       cell->bundle_covered += std::abs(b.fx_px - truth.camera_true.fx_px) <= 2 * b.fx_stddev ? 1 : 0;
     }
@@ -264,7 +263,9 @@ void ScoreBundle(const sim::SimResult& world, const ObservationSet& obs, const c
   if (bound.covariance_free.rows() >= nf) {
     Eigen::MatrixXd sigma = Eigen::MatrixXd::Zero(nf + 1, nf + 1);
     sigma.topLeftCorner(nf, nf) = bound.covariance_free.topLeftCorner(nf, nf);
-    if (options.bundle.bundle.estimate_fx) sigma = bound.covariance_free.topLeftCorner(nf + 1, nf + 1);
+    if (bundle::EstimatedIntrinsicsOf(options.bundle.bundle, robot.num_joints())[kFx]) {
+      sigma = bound.covariance_free.topLeftCorner(nf + 1, nf + 1);
+    }
     const calibration::PredictedDistanceErrors b3d =
         calibration::PredictDistanceErrors(obs, obs.PosesWithRole(PoseRole::kVerification), obs.robot, truth.rho_true,
                               truth.camera_true.fx_px, bound.free_indices, sigma, cell->noise_px, obs.check_distances);

@@ -24,10 +24,10 @@ TEST(Planning, FisherDesignMatchesTheBundleCramerRaoBound) {
   sim::SimResult nominal_world = w.sim;
   bundle::BundleTruth truth;
   truth.rho = KinematicParameters::Nominal(w.problem.robot);
-  truth.fx_px = w.problem.camera.fx_px;
   for (size_t j = 0; j < w.sim.truth.dots_in_base.size(); ++j) truth.dots_in_base[j] = w.sim.truth.dots_in_base[j];
   ObservationSet geometry = w.sim.observations;
-  geometry.camera.fx_px = truth.fx_px;
+  geometry.camera.fx_px = w.problem.camera.fx_px;
+  truth.camera = geometry.camera;
   // Every dot seen in every identification pose, as the design assumes (the simulator keeps them in view).
   bundle::BundleOptions bundle_options;
   bundle_options.yardstick_sigma_m = 1e-6;
