@@ -7,6 +7,7 @@
 
 #include "app/cli_util.h"
 #include "app/commands.h"
+#include "io/camera_file.h"
 #include "io/hand_eye_file.h"
 #include "io/observations_file.h"
 #include "io/report_json.h"
@@ -60,6 +61,35 @@ void PrintSummary(const session::JournalSummary& s) {
   std::cout << "\n";
 }
 
+// --camera-file: the file's intrinsics replace the observations' camera; the image size must agree (the
+// pixels were measured in that image). Says so on stdout.
+Status ReplaceCamera(const CalibrateRequest& request, LoadedInput* loaded) {
+  if (request.camera_file.empty()) {
+    if (!request.camera_name.empty()) {
+      return Status::Error(ErrorCode::kInvalidInput, "--camera-name " + request.camera_name +
+                                                         " selects a camera of a --camera-file; none was given");
+    }
+    return Status::Ok();
+  }
+  Result<CameraIntrinsics> camera = io::LoadCameraFile(request.camera_file, request.camera_name);
+  if (!camera.ok()) return camera.status();
+  const CameraIntrinsics& old = loaded->observations.camera;
+  if (camera->width_px != old.width_px || camera->height_px != old.height_px) {
+    return Status::Error(ErrorCode::kInvalidInput,
+                         "camera file " + request.camera_file + " is for " + std::to_string(camera->width_px) + "x" +
+                             std::to_string(camera->height_px) + " images, the observations of " + request.input +
+                             " were measured in " + std::to_string(old.width_px) + "x" + std::to_string(old.height_px));
+  }
+  std::cout << "camera: the intrinsics of " << request.camera_file
+            << (request.camera_name.empty() ? "" : " (camera " + request.camera_name + ")")
+            << " replace the observations' camera (f_x " << old.fx_px << " -> " << camera->fx_px << " px)\n";
+  loaded->observations.camera = *camera;
+  loaded->input.camera_file = request.camera_file;
+  loaded->input.camera_file_sha256 = FileSha256(request.camera_file);
+  loaded->input.camera_name = request.camera_name;
+  return Status::Ok();
+}
+
 Result<LoadedInput> LoadInput(const CalibrateRequest& request) {
   LoadedInput loaded;
   if (session::IsSessionDirectory(request.input)) {
@@ -74,13 +104,43 @@ Result<LoadedInput> LoadInput(const CalibrateRequest& request) {
     loaded.session = report::SessionContext{session->summary, session->findings};
     loaded.input = {"session", request.input, session->manifest_sha256};
     loaded.observations = std::move(session).value().observations;
-    return loaded;
+  } else {
+    Result<ObservationSet> obs = io::LoadObservations(request.input);
+    if (!obs.ok()) return obs.status();
+    loaded.observations = std::move(obs).value();
+    loaded.input = {"observations", request.input, FileSha256(request.input)};
   }
-  Result<ObservationSet> obs = io::LoadObservations(request.input);
-  if (!obs.ok()) return obs.status();
-  loaded.observations = std::move(obs).value();
-  loaded.input = {"observations", request.input, FileSha256(request.input)};
+  if (Status s = ReplaceCamera(request, &loaded); !s.ok()) return s;
   return loaded;
+}
+
+// --write-camera-visp of an accepted model whose lens ViSP cannot hold: refused before anything is written.
+Status CheckCameraOutputs(const CalibrateRequest& request, const calibration::CalibrationReport& report) {
+  if (request.write_camera_visp.empty() || !report.model) return Status::Ok();
+  const std::string problems = io::VispCameraProblems(report.model->camera);
+  if (problems.empty()) return Status::Ok();
+  return Status::Error(ErrorCode::kInvalidInput, "--write-camera-visp " + request.write_camera_visp +
+                                                     ": the calibrated camera cannot be written as a ViSP file:\n" +
+                                                     problems + "nothing was written");
+}
+
+// The calibrated intrinsics as OpenCV and ViSP camera files, when asked and accepted.
+Status WriteCameraFiles(const CalibrateRequest& request, const calibration::CalibrationReport& report) {
+  if (request.write_camera_opencv.empty() && request.write_camera_visp.empty()) return Status::Ok();
+  if (!report.model) {
+    std::cout << "camera files: not written (no calibrated model)\n";
+    return Status::Ok();
+  }
+  if (!request.write_camera_opencv.empty()) {
+    if (Status s = io::SaveCameraOpenCv(report.model->camera, request.write_camera_opencv); !s.ok()) return s;
+    std::cout << "camera (OpenCV): " << request.write_camera_opencv << "\n";
+  }
+  if (!request.write_camera_visp.empty()) {
+    const std::string name = request.camera_name.empty() ? "Camera" : request.camera_name;
+    if (Status s = io::SaveCameraVisp(report.model->camera, request.write_camera_visp, name); !s.ok()) return s;
+    std::cout << "camera (ViSP, camera " << name << "): " << request.write_camera_visp << "\n";
+  }
+  return Status::Ok();
 }
 
 // A flange-pose set's result: the hand-eye transform and f_x with their standard deviations.
@@ -90,6 +150,8 @@ Status WriteHandEye(const LoadedInput& loaded, const calibration::CalibrationRep
   result.fx_px = report.model->camera.fx_px;
   result.stddev = report.model->flange_from_cam_stddev;
   result.fx_stddev_px = report.model->intrinsics_stddev[kFx];
+  result.camera = report.model->camera;
+  result.intrinsics_stddev = report.model->intrinsics_stddev;
   result.source = "selfcal calibrate " + loaded.input.path;
   result.provenance = {{"software_version", SELFCAL_VERSION},
                        {"input_sha256", loaded.input.sha256},
@@ -117,6 +179,8 @@ Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationRep
   io::CalibratedModel model;
   model.model = report.model->robot;
   model.fx_px = report.model->camera.fx_px;
+  model.camera = report.model->camera;
+  model.intrinsics_stddev = report.model->intrinsics_stddev;
   model.parameters = report.model->parameters;
   model.source = "selfcal calibrate " + loaded.input.path;
   model.provenance = {{"software_version", SELFCAL_VERSION},
@@ -154,12 +218,8 @@ void AddParameterMaskOptions(CLI::App* cmd, std::vector<std::string>* fix, std::
 int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   Result<LoadedInput> loaded = LoadInput(request);
   if (!loaded.ok()) return Fail(loaded.status());
-  if (Status s = EnsureDirectory(request.out_dir); !s.ok()) return Fail(s);
   const bool from_session = loaded->session.has_value();
   if (from_session) {
-    // The session's observations as a file, for other tools and for re-solving without the images.
-    const std::string derived = (std::filesystem::path(request.out_dir) / "observations.yaml").string();
-    if (Status s = io::SaveObservations(loaded->observations, derived); !s.ok()) return Fail(s);
     std::cout << "session " << request.input << ": " << loaded->observations.poses.size() << " accepted samples\n";
   }
   calibration::CalibrateOptions options;
@@ -170,8 +230,16 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   options.flange_scale_from_yardsticks = request.scale_from == "yardstick";
   calibration::CalibrationReport report = calibration::Calibrate(loaded->observations, options);
   report::PrintCalibrationSummary(report, std::cout);
+  if (Status s = CheckCameraOutputs(request, report); !s.ok()) return Fail(s);
+  if (Status s = EnsureDirectory(request.out_dir); !s.ok()) return Fail(s);
+  if (from_session) {
+    // The session's observations as a file, for other tools and for re-solving without the images.
+    const std::string derived = (std::filesystem::path(request.out_dir) / "observations.yaml").string();
+    if (Status s = io::SaveObservations(loaded->observations, derived); !s.ok()) return Fail(s);
+  }
   const ExitCode code = ExitCodeFor(report.verdict);
   if (Status s = WriteOutputs(*loaded, report, code, request.out_dir); !s.ok()) return Fail(s);
+  if (Status s = WriteCameraFiles(request, report); !s.ok()) return Fail(s);
   if (!report.accepted()) {
     std::cerr << "selfcal: " << ExitCodeName(code) << ": " << report.message << " (no calibrated model written)\n";
   }
@@ -199,6 +267,17 @@ Command AddCalibrateCommand(CLI::App& app) {
                   "Flange poses: what fixes the metric scale. flange: the flange translations (yardsticks are checks); "
                   "yardstick: the yardsticks as length constraints beside them")
       ->check(CLI::IsMember({"flange", "yardstick"}));
+  cmd->add_option("--camera-file", request->camera_file,
+                  "Camera intrinsics file (OpenCV FileStorage YAML/XML or ViSP XML, docs/camera-files.md) replacing the "
+                  "observations' camera; same image size");
+  cmd->add_option("--camera-name", request->camera_name,
+                  "The camera of a ViSP --camera-file holding several; also the name --write-camera-visp writes "
+                  "(default Camera)");
+  cmd->add_option("--write-camera-opencv", request->write_camera_opencv,
+                  "Also write the calibrated intrinsics as an OpenCV FileStorage YAML file (when accepted)");
+  cmd->add_option("--write-camera-visp", request->write_camera_visp,
+                  "Also write the calibrated intrinsics as a ViSP XML file (when accepted; refused, before anything is "
+                  "written, for a lens with k2, p1, p2 or k3)");
   return [request, method]() {
     request->method = MethodFromName(*method);
     return CalibrateAndWrite(*request);

@@ -32,6 +32,11 @@ struct CalibrateRequest {
   calibration::Method method = calibration::Method::kBundle;
   std::vector<std::string> fix, free;  // parameter names and groups (bundle::BundleOptions::held_parameters)
   std::string scale_from = "flange";   // flange-pose sets: "flange" or "yardstick" (CalibrateOptions)
+  // A camera file (io/camera_file.h) whose intrinsics replace the observations' camera, and the camera
+  // chosen in a ViSP file (empty: its only one; also the name written to write_camera_visp).
+  std::string camera_file{}, camera_name{};
+  // Where to write the calibrated intrinsics (empty: not written), only when accepted.
+  std::string write_camera_opencv{}, write_camera_visp{};
 };
 
 // What a calibration read and returned, for callers that compare it with a truth (`simulate`).

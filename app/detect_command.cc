@@ -14,6 +14,7 @@
 #include "base/atomic_file.h"
 #include "detection/contact_sheet.h"
 #include "detection/detect_points.h"
+#include "io/camera_file.h"
 #include "io/file_lists.h"
 #include "io/hand_eye_file.h"
 #include "io/image_files.h"
@@ -30,6 +31,8 @@ struct DetectSettings {
   std::string detector = "dots", identity = "grid", grid;
   std::string robot, hand_eye;
   double fx_px = 0, cx_px = NAN, cy_px = NAN, mu = 1.0, k1 = 0.0;
+  std::string camera_file, camera_name;  // instead of the --camera-* values
+  bool camera_values_given = false;      // any --camera-fx-px, -cx-px, -cy-px, -mu, -k1
   double pixel_noise_px = 0.5;
   std::vector<double> yardstick;  // A, B, length_mm
   double tag_side_mm = 0;
@@ -84,15 +87,27 @@ Result<detection::ObservationSetup> ToSetup(const DetectSettings& a, const vpIma
                                             const RobotModel* robot) {
   detection::ObservationSetup setup;
   if (robot != nullptr) setup.robot = *robot;
-  setup.camera.width_px = static_cast<int>(first.getWidth());
-  setup.camera.height_px = static_cast<int>(first.getHeight());
-  setup.camera.fx_px = a.fx_px;
-  setup.camera.cx_px = std::isnan(a.cx_px) ? 0.5 * (setup.camera.width_px - 1) : a.cx_px;
-  setup.camera.cy_px = std::isnan(a.cy_px) ? 0.5 * (setup.camera.height_px - 1) : a.cy_px;
-  setup.camera.mu = a.mu;
-  setup.camera.k1 = a.k1;
-  if (const std::string problems = setup.camera.Validate(); !problems.empty()) {
-    return Usage("--camera-* options:\n" + problems);
+  const int width = static_cast<int>(first.getWidth()), height = static_cast<int>(first.getHeight());
+  if (!a.camera_file.empty()) {
+    Result<CameraIntrinsics> camera = io::LoadCameraFile(a.camera_file, a.camera_name);
+    if (!camera.ok()) return camera.status();
+    if (camera->width_px != width || camera->height_px != height) {
+      return Usage("camera file " + a.camera_file + " is for " + std::to_string(camera->width_px) + "x" +
+                   std::to_string(camera->height_px) + " images, the images are " + std::to_string(width) + "x" +
+                   std::to_string(height));
+    }
+    setup.camera = *camera;
+  } else {
+    setup.camera.width_px = width;
+    setup.camera.height_px = height;
+    setup.camera.fx_px = a.fx_px;
+    setup.camera.cx_px = std::isnan(a.cx_px) ? 0.5 * (width - 1) : a.cx_px;
+    setup.camera.cy_px = std::isnan(a.cy_px) ? 0.5 * (height - 1) : a.cy_px;
+    setup.camera.mu = a.mu;
+    setup.camera.k1 = a.k1;
+    if (const std::string problems = setup.camera.Validate(); !problems.empty()) {
+      return Usage("--camera-* options:\n" + problems);
+    }
   }
   setup.pixel_noise_px = a.pixel_noise_px;
   if (!a.yardstick.empty()) {
@@ -120,7 +135,16 @@ int DetectFromSettings(const DetectSettings& a) {
   const auto start = std::chrono::steady_clock::now();
   Result<detection::DetectionOptions> options = ToDetectionOptions(a);
   if (!options.ok()) return Fail(options.status());
-  if (!(a.fx_px > 0)) return Fail(Usage("--camera-fx-px: the camera's nominal focal length (px) is required"));
+  if (!a.camera_file.empty() && a.camera_values_given) {
+    return Fail(Usage("--camera-file " + a.camera_file + " gives the intrinsics: leave out --camera-fx-px, --camera-cx-px, "
+                      "--camera-cy-px, --camera-mu and --camera-k1"));
+  }
+  if (a.camera_file.empty() && !a.camera_name.empty()) {
+    return Fail(Usage("--camera-name " + a.camera_name + " selects a camera of a --camera-file; none was given"));
+  }
+  if (a.camera_file.empty() && !(a.fx_px > 0)) {
+    return Fail(Usage("--camera-fx-px (the camera's nominal focal length, px) or --camera-file is required"));
+  }
   std::unique_ptr<RobotModel> robot;
   if (!a.robot.empty()) {
     Result<RobotModel> loaded = io::LoadRobotModel(ResolveDataPath(a.robot));
@@ -207,18 +231,26 @@ Command AddDetectCommand(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--robot", a->robot, "Robot config (config/robots/*.yaml): needed for joint-angle poses");
   cmd->add_option("--hand-eye", a->hand_eye, "Flange poses: a nominal hand-eye transform (selfcal-hand-eye file)");
-  cmd->add_option("--camera-fx-px", a->fx_px, "The camera's nominal focal length, px")->check(CLI::PositiveNumber);
-  cmd->add_option("--camera-cx-px", a->cx_px, "Principal point u, px (default: the image centre)");
-  cmd->add_option("--camera-cy-px", a->cy_px, "Principal point v, px (default: the image centre)");
-  cmd->add_option("--camera-mu", a->mu, "f_y / f_x (default 1)")->check(CLI::PositiveNumber);
-  cmd->add_option("--camera-k1", a->k1, "Radial distortion k1 (default 0)");
+  cmd->add_option("--camera-file", a->camera_file,
+                  "The camera's intrinsics from an OpenCV FileStorage or ViSP XML file (docs/camera-files.md), instead "
+                  "of the --camera-* values");
+  cmd->add_option("--camera-name", a->camera_name, "The camera of a ViSP --camera-file holding several");
+  std::vector<CLI::Option*> values = {
+      cmd->add_option("--camera-fx-px", a->fx_px, "The camera's nominal focal length, px")->check(CLI::PositiveNumber),
+      cmd->add_option("--camera-cx-px", a->cx_px, "Principal point u, px (default: the image centre)"),
+      cmd->add_option("--camera-cy-px", a->cy_px, "Principal point v, px (default: the image centre)"),
+      cmd->add_option("--camera-mu", a->mu, "f_y / f_x (default 1)")->check(CLI::PositiveNumber),
+      cmd->add_option("--camera-k1", a->k1, "Radial distortion k1 (default 0)")};
   cmd->add_option("--pixel-noise-px", a->pixel_noise_px, "Standard deviation of a point's pixel, px (default 0.5)")
       ->check(CLI::Range(kMinPixelNoisePx, kMaxPixelNoisePx));
   cmd->add_option("--yardstick", a->yardstick, "A,B,LENGTH_MM: a known distance between points A and B")
       ->delimiter(',')
       ->expected(3);
   cmd->add_flag("--skip-failed", a->skip_failed, "Leave images without points out instead of failing");
-  return [a]() { return DetectFromSettings(*a); };
+  return [a, values]() {
+    for (const CLI::Option* option : values) a->camera_values_given = a->camera_values_given || option->count() > 0;
+    return DetectFromSettings(*a);
+  };
 }
 
 }  // namespace selfcal::app

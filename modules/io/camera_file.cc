@@ -273,13 +273,18 @@ double FitVispKdu(const CameraIntrinsics& camera) {
   return den > 0 ? num / den : 0.0;
 }
 
-Status SaveCameraVisp(const CameraIntrinsics& camera, const std::string& path, const std::string& camera_name) {
+std::string VispCameraProblems(const CameraIntrinsics& camera) {
   std::string problems = camera.Validate();
   if (camera.k2 != 0 || camera.p1 != 0 || camera.p2 != 0 || camera.k3 != 0) {
     problems += "k2 = " + Num(camera.k2) + ", p1 = " + Num(camera.p1) + ", p2 = " + Num(camera.p2) + ", k3 = " +
                 Num(camera.k3) + ": ViSP's perspective model has one radial term (kud = k1) and no tangential "
                 "terms; write these intrinsics as an OpenCV file instead\n";
   }
+  return problems;
+}
+
+Status SaveCameraVisp(const CameraIntrinsics& camera, const std::string& path, const std::string& camera_name) {
+  std::string problems = VispCameraProblems(camera);
   if (camera_name.empty()) problems += "the camera name is empty\n";
   if (!problems.empty()) {
     return Status::Error(ErrorCode::kInvalidInput, "refusing to write " + path + " as a ViSP camera file:\n" + problems);

@@ -31,6 +31,11 @@ Result<CameraIntrinsics> LoadCameraFile(const std::string& path, const std::stri
 // all five coefficients), atomically.
 Status SaveCameraOpenCv(const CameraIntrinsics& camera, const std::string& path);
 
+// Why `camera` cannot be written as a ViSP camera file, one problem per line (invalid intrinsics; k2, p1,
+// p2 or k3 non-zero: ViSP's perspective model has one radial term), or empty when it can: for callers that
+// refuse before writing anything.
+std::string VispCameraProblems(const CameraIntrinsics& camera);
+
 // Writes vpXmlParserCamera XML with one camera `camera_name`, atomically: perspectiveProjWithDistortion
 // when k1 != 0, else perspectiveProjWithoutDistortion. Refuses a camera with k2, p1, p2 or k3.
 Status SaveCameraVisp(const CameraIntrinsics& camera, const std::string& path, const std::string& camera_name = "Camera");

@@ -105,6 +105,14 @@ TEST(HandEyeFile, SaveLoadRoundTripIsExact) {
   result.stddev << 1e-4, 2e-4, 3e-4, 1e-3, 2e-3, 3e-3;
   result.fx_px = 607.59;
   result.fx_stddev_px = 0.7;
+  CameraIntrinsics camera;
+  camera.fx_px = 607.59;
+  camera.cx_px = 323.46;
+  camera.k1 = 0.028;
+  camera.k2 = -0.1 / 3;
+  result.camera = camera;
+  result.intrinsics_stddev[kFx] = 0.7;
+  result.intrinsics_stddev[kK2] = 0.01 / 3;
   result.provenance = {{"method", "test"}};
   TempDir dir;
   const std::string path = dir.File("hand_eye.yaml");
@@ -115,6 +123,10 @@ TEST(HandEyeFile, SaveLoadRoundTripIsExact) {
   EXPECT_EQ(loaded->flange_from_cam.translation, result.flange_from_cam.translation);
   EXPECT_EQ(loaded->fx_px, result.fx_px);
   for (int k = 0; k < 6; ++k) EXPECT_NEAR(loaded->stddev[k], result.stddev[k], 1e-15) << k;
+  ASSERT_TRUE(loaded->camera.has_value());
+  EXPECT_EQ(IntrinsicsOf(*loaded->camera), IntrinsicsOf(camera));
+  EXPECT_EQ(loaded->intrinsics_stddev[kK2], result.intrinsics_stddev[kK2]);
+  EXPECT_TRUE(std::isnan(loaded->intrinsics_stddev[kCx]));
   // A hand-edited rounded transform that no longer matches the exact one is caught.
   std::string text = testing::ReadFile(path);
   const size_t at = text.find("xyz_mm: [57.7");

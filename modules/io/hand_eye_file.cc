@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 
 #include "io/atomic_file.h"
+#include "io/observations_file.h"
 #include "io/transform_yaml.h"
 #include "io/yaml_schema.h"
 #include "io/yaml_writer.h"
@@ -23,6 +24,11 @@ Status SaveHandEye(const HandEyeResult& result, const std::string& path) {
   const Rigid3& x = result.flange_from_cam;
   if (!x.translation.allFinite() || !x.rotation.allFinite() || !std::isfinite(result.fx_px) || result.fx_px <= 0) {
     return Status::Error(ErrorCode::kInvalidInput, "refusing to write a non-finite hand-eye result to " + path);
+  }
+  if (result.camera) {
+    if (const std::string invalid = result.camera->Validate(); !invalid.empty()) {
+      return Status::Error(ErrorCode::kInvalidInput, "refusing to write invalid intrinsics to " + path + ":\n" + invalid);
+    }
   }
   const Eigen::Quaterniond q(x.rotation);
   std::ostringstream out;
@@ -43,6 +49,10 @@ Status SaveHandEye(const HandEyeResult& result, const std::string& path) {
   }
   out << "fx_px: " << YamlNumber(result.fx_px) << "\n";
   if (std::isfinite(result.fx_stddev_px)) out << "fx_stddev_px: " << MaybeNumber(result.fx_stddev_px) << "\n";
+  if (result.camera) out << "camera: " << CameraYaml(*result.camera) << "  # the calibrated intrinsics\n";
+  if (const std::string sd = IntrinsicsStddevYaml(result.intrinsics_stddev); !sd.empty()) {
+    out << "intrinsics_stddev: " << sd << "  # of the estimated intrinsics\n";
+  }
   if (!result.provenance.empty()) {
     out << "provenance:\n";
     for (const auto& [key, value] : result.provenance) out << "  " << YamlQuoted(key) << ": " << YamlQuoted(value) << "\n";
@@ -76,6 +86,8 @@ Result<HandEyeResult> LoadHandEye(const std::string& path) {
   root.Optional("provenance");
   root.Double("fx_px", Range::Positive(1e6), &result.fx_px);
   root.OptionalDouble("fx_stddev_px", Range::Closed(0, 1e6), &result.fx_stddev_px);
+  ReadOptionalCamera(&root, &problems, &result.camera);
+  ReadIntrinsicsStddev(&root, &result.intrinsics_stddev);
   root.Finish();
   if (problems.empty() && ((rounded.translation - result.flange_from_cam.translation).norm() > 1e-6 ||
                            (rounded.rotation - result.flange_from_cam.rotation).norm() > 1e-6)) {

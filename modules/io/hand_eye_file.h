@@ -9,8 +9,12 @@
 //   flange_from_cam_stddev: {xyz_mm: [...], rotvec_deg: [...]}    # of the correction in the camera frame
 //   fx_px: 607.2
 //   fx_stddev_px: 0.4
+//   camera: {width_px: 640, height_px: 480, fx_px: 607.2, mu: 1, cx_px: ..., cy_px: ..., k1: ...}
+//   intrinsics_stddev: {fx_px: 0.4, k1: 0.002}                   # of the estimated intrinsics
 #pragma once
 
+#include <cmath>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -18,6 +22,7 @@
 #include <Eigen/Core>
 
 #include "base/status.h"
+#include "camera/camera.h"
 #include "geometry/rigid3.h"
 
 namespace selfcal::io {
@@ -31,6 +36,10 @@ struct HandEyeResult {
   Eigen::Matrix<double, 6, 1> stddev = Eigen::Matrix<double, 6, 1>::Constant(NAN);
   double fx_px = 0;
   double fx_stddev_px = NAN;
+  // The calibrated camera (every intrinsic) and the standard deviations of the estimated intrinsics (NaN:
+  // held or unknown); optional.
+  std::optional<CameraIntrinsics> camera;
+  IntrinsicsVector intrinsics_stddev = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
   std::string source;
   std::vector<std::pair<std::string, std::string>> provenance;
 };

@@ -116,6 +116,40 @@ std::string CameraYaml(const CameraIntrinsics& c) {
   return out.str();
 }
 
+const char* IntrinsicYamlKey(int intrinsic) {
+  static constexpr const char* kKeys[kNumIntrinsics] = {"fx_px", "mu", "cx_px", "cy_px", "k1", "k2", "p1", "p2", "k3"};
+  return intrinsic >= 0 && intrinsic < kNumIntrinsics ? kKeys[intrinsic] : "?";
+}
+
+std::string IntrinsicsStddevYaml(const IntrinsicsVector& stddev) {
+  std::string out;
+  for (int k = 0; k < kNumIntrinsics; ++k) {
+    if (!std::isfinite(stddev[k])) continue;
+    out += (out.empty() ? "{" : ", ") + std::string(IntrinsicYamlKey(k)) + ": " + YamlNumber(stddev[k]);
+  }
+  return out.empty() ? out : out + "}";
+}
+
+bool ReadIntrinsicsStddev(MapReader* root, IntrinsicsVector* stddev) {
+  stddev->fill(NAN);
+  const yaml::YamlNode* node = root->Optional("intrinsics_stddev");
+  if (node == nullptr) return true;
+  MapReader map(*node, root->Path("intrinsics_stddev"), root->problems());
+  if (!map.ok()) return false;
+  bool ok = true;
+  for (int k = 0; k < kNumIntrinsics; ++k) ok &= map.OptionalDouble(IntrinsicYamlKey(k), Range::Closed(0, 1e6), &(*stddev)[k]);
+  map.Finish();
+  return ok;
+}
+
+bool ReadOptionalCamera(MapReader* root, Problems* problems, std::optional<CameraIntrinsics>* camera) {
+  if (root->Optional("camera") == nullptr) return true;
+  CameraIntrinsics read;
+  if (!ReadCamera(root, problems, &read)) return false;
+  *camera = read;
+  return true;
+}
+
 namespace {
 
 bool ReadDistances(MapReader* root, const std::string& key, bool required, Problems* problems,

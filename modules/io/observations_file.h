@@ -18,6 +18,7 @@
 // Pixels: origin at the centre of the top-left pixel, u right, v down.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "base/status.h"
@@ -51,5 +52,20 @@ bool ReadCamera(MapReader* root, Problems* problems, CameraIntrinsics* camera);
 
 // The `camera` map as SaveObservations writes it, one line: k2, p1, p2, k3 only when non-zero.
 std::string CameraYaml(const CameraIntrinsics& camera);
+
+// The key of an intrinsic in a `camera` map: fx_px, mu, cx_px, cy_px, k1, k2, p1, p2, k3.
+const char* IntrinsicYamlKey(int intrinsic);
+
+// The standard deviations of the intrinsics as one line `{fx_px: 3.7, k1: 0.012}`, by the keys above, only
+// the finite ones (held intrinsics have none); "" when none is finite.
+std::string IntrinsicsStddevYaml(const IntrinsicsVector& stddev);
+
+// The optional `intrinsics_stddev` map of *root (the keys above, each optional, >= 0) into *stddev (NaN
+// where absent). Returns false when it is present and wrong (the problems recorded).
+bool ReadIntrinsicsStddev(MapReader* root, IntrinsicsVector* stddev);
+
+// The optional `camera` map of *root (a `camera_file` is not taken: files selfcal writes hold their
+// camera), read as ReadCamera does; *camera untouched when absent. Returns false when present and wrong.
+bool ReadOptionalCamera(MapReader* root, Problems* problems, std::optional<CameraIntrinsics>* camera);
 
 }  // namespace selfcal::io

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "io/atomic_file.h"
+#include "io/observations_file.h"
 #include "yaml/yaml_reader.h"
 #include "io/yaml_writer.h"
 
@@ -154,10 +155,12 @@ CalibratedModel Parse(const yaml::YamlNode& node, const std::string& name, Probl
   }
   if (calibrated) {
     ok &= map.OptionalDouble("fx_px", Range::Positive(1e6), &out.fx_px);
+    ok &= ReadOptionalCamera(&map, problems, &out.camera);
+    ok &= ReadIntrinsicsStddev(&map, &out.intrinsics_stddev);
     ReadParameters(&map, static_cast<int>(rows.size()), &out.parameters);
     ReadProvenance(&map, &out.provenance);
   } else {
-    for (const char* key : {"fx_px", "parameters", "provenance"}) {
+    for (const char* key : {"fx_px", "camera", "intrinsics_stddev", "parameters", "provenance"}) {
       map.Disallow(key, std::string("only in a `format: ") + kCalibratedModelFormat + "` file");
     }
   }
@@ -259,6 +262,9 @@ Status SaveCalibratedModel(const CalibratedModel& calibrated, const std::string&
                 std::to_string(model.num_parameters()) + "\n";
   }
   if (!calibrated.parameters.allFinite()) problems += "the parameter vector is not finite\n";
+  if (calibrated.camera) {
+    if (const std::string invalid = calibrated.camera->Validate(); !invalid.empty()) problems += "camera: " + invalid;
+  }
   for (const auto& [key, value] : calibrated.provenance) {
     if (key.empty()) problems += "empty provenance key\n";
   }
@@ -273,6 +279,10 @@ Status SaveCalibratedModel(const CalibratedModel& calibrated, const std::string&
   if (!calibrated.source.empty()) out << "source: " << YamlQuoted(calibrated.source) << "\n";
   out << RobotModelYaml(model, TransformStyle::kMillimetreDegree, 0);
   if (calibrated.fx_px > 0) out << "fx_px: " << YamlNumber(calibrated.fx_px) << "\n";
+  if (calibrated.camera) out << "camera: " << CameraYaml(*calibrated.camera) << "  # the calibrated intrinsics\n";
+  if (const std::string sd = IntrinsicsStddevYaml(calibrated.intrinsics_stddev); !sd.empty()) {
+    out << "intrinsics_stddev: " << sd << "  # of the estimated intrinsics\n";
+  }
   if (calibrated.parameters.size() > 0) {
     out << "parameters:  # rho of kinematics/robot_model.h (base and camera corrections, link values)\n";
     const KinematicParameters names(model.num_joints());

@@ -18,10 +18,13 @@
 // Transforms and rpy: io/transform_yaml.h. Every problem of the file is reported together (C1-C3).
 //
 // A calibrated model (SaveCalibratedModel) is a robot config with dh_convention: modified_hayati plus
-// `format: selfcal-calibrated-model`, `version: 1`, and the optional keys `fx_px`, `parameters` and
-// `provenance`; LoadRobotModel reads it too. docs/calibrated-model-format.md describes both.
+// `format: selfcal-calibrated-model`, `version: 1`, and the optional keys `fx_px`, `camera`,
+// `intrinsics_stddev`, `parameters` and `provenance`; LoadRobotModel reads it too.
+// docs/calibrated-model-format.md describes both.
 #pragma once
 
+#include <cmath>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -29,6 +32,7 @@
 #include <Eigen/Core>
 
 #include "base/status.h"
+#include "camera/camera.h"
 #include "io/transform_yaml.h"
 #include "io/yaml_schema.h"
 #include "kinematics/robot_model.h"
@@ -43,6 +47,10 @@ struct CalibratedModel {
   RobotModel model;            // calibrated (e.g. ApplyParameters(nominal, rho)); SI
   std::string source;          // free text, e.g. which session produced it; optional
   double fx_px = 0;            // identified focal length; 0 = not stored
+  // The calibrated camera (every intrinsic, the `camera:` block of an observations file) and the standard
+  // deviations of the estimated intrinsics (NaN: held or unknown); not stored when empty / all NaN.
+  std::optional<CameraIntrinsics> camera;
+  IntrinsicsVector intrinsics_stddev = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
   Eigen::VectorXd parameters;  // rho (SI) in KinematicParameters order; empty = not stored
   std::vector<std::pair<std::string, std::string>> provenance;  // P7: software, hashes, session id ...
 };

@@ -1,5 +1,6 @@
 // Robot configs and calibrated models: the shipped configs match the robots of the test support, and a
 // calibrated model survives a save / load.
+#include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -140,6 +141,15 @@ CalibratedModel PerturbedPuma(std::mt19937_64* rng, Eigen::VectorXd* rho_out) {
   calibrated.model = ApplyParameters(nominal, rho);
   calibrated.source = "unit test \"perturbed\" puma";
   calibrated.fx_px = 1000.0 / 3.0;
+  CameraIntrinsics camera;
+  camera.fx_px = calibrated.fx_px;
+  camera.mu = 1.0 + 1e-4 / 3;
+  camera.cx_px = 321.1 / 3;
+  camera.k1 = -0.1 / 7;
+  camera.p2 = 1e-3 / 3;
+  calibrated.camera = camera;
+  calibrated.intrinsics_stddev[kFx] = 0.3;
+  calibrated.intrinsics_stddev[kP2] = 1e-4 / 3;
   calibrated.parameters = rho;
   calibrated.provenance = {{"software", "selfcal 0.1.0"}, {"session", "s-0007"}, {"odd key: #1", "tab\there"}};
   *rho_out = rho;
@@ -160,6 +170,14 @@ TEST(CalibratedModel, SaveLoadRoundTripKeepsBetasOffsetsAndKinematics) {
   EXPECT_EQ(loaded->source, saved.source);
   EXPECT_EQ(loaded->fx_px, saved.fx_px);
   EXPECT_EQ(loaded->provenance, saved.provenance);
+  // The camera and the intrinsics' sigmas come back bit for bit; the held ones' sigmas stay absent.
+  ASSERT_TRUE(loaded->camera.has_value()) << ReadFile(path);
+  EXPECT_EQ(IntrinsicsOf(*loaded->camera), IntrinsicsOf(*saved.camera));
+  EXPECT_EQ(loaded->camera->width_px, saved.camera->width_px);
+  for (int k = 0; k < kNumIntrinsics; ++k) {
+    const double a = saved.intrinsics_stddev[k], b = loaded->intrinsics_stddev[k];
+    EXPECT_TRUE(a == b || (std::isnan(a) && std::isnan(b))) << IntrinsicName(k) << " " << a << " " << b;
+  }
   ASSERT_EQ(loaded->parameters.size(), rho.size());
   EXPECT_LT((loaded->parameters - rho).cwiseAbs().maxCoeff(), 1e-14);
   for (int i = 0; i < saved.model.num_joints(); ++i) {
@@ -189,7 +207,8 @@ TEST(CalibratedModel, WrittenInMillimetresAndDegreesWithSchema) {
   for (const char* expected : {"format: selfcal-calibrated-model\n", "version: 1\n", "dh_convention: modified_hayati\n",
                                "alpha_deg: ", "a_mm: ", "beta_deg: ", "theta_offset_deg: ", "d_mm: ",
                                "link_n_from_flange: {xyz_mm: ", "flange_from_cam: {xyz_mm: ", "fx_px: 333.3333333333333\n",
-                               "  j2.a_mm: ", "  cam.rz_deg: "}) {
+                               "  j2.a_mm: ", "  cam.rz_deg: ", "camera: {width_px: 640, height_px: 480, fx_px: 333.3333333333333",
+                               "intrinsics_stddev: {fx_px: 0.3, p2: "}) {
     EXPECT_NE(text.find(expected), std::string::npos) << expected << "\n" << text;
   }
 }
@@ -219,6 +238,18 @@ TEST(CalibratedModel, PlainRobotConfigIsNotACalibratedModel) {
   const std::string path = SourcePath("config/robots/puma560.yaml");
   const Status status = LoadCalibratedModel(path).status();
   EXPECT_NE(status.message().find("is a robot config, not a calibrated model"), std::string::npos) << status.message();
+}
+
+// A robot config is the manufacturer's data: the calibrated keys, the camera among them, are refused there.
+TEST(CalibratedModel, ARobotConfigHoldsNoCamera) {
+  TempDir dir;
+  const std::string path = dir.File("robot.yaml");
+  WriteFile(path, ReadFile(SourcePath("config/robots/puma560.yaml")) +
+                      "camera: {width_px: 640, height_px: 480, fx_px: 1000, cx_px: 319.5, cy_px: 239.5}\n");
+  const Status status = LoadRobotModel(path).status();
+  EXPECT_EQ(status.code(), ErrorCode::kInvalidInput);
+  EXPECT_NE(status.message().find("camera"), std::string::npos) << status.message();
+  EXPECT_NE(status.message().find("only in a `format: selfcal-calibrated-model` file"), std::string::npos) << status.message();
 }
 
 TEST(CalibratedModel, InvalidModelIsNotWritten) {

@@ -2,8 +2,8 @@
 """report.json against its documented schema (docs/report.schema.json, docs/report-format.md).
 
 Runs the selfcal binary as a user would: `simulate --points` (bundle, accepted), `calibrate --method paper`
-on its observations (paper, accepted), and `calibrate` on a file with too few poses (exit 3, not
-accepted, no model), then validates every report.json with python3-jsonschema and checks the rules the
+on its observations (paper, accepted), `calibrate --camera-file` with the principal point and the lens freed
+(bundle, accepted), and `calibrate` on a file with too few poses (exit 3, not accepted, no model), then validates every report.json with python3-jsonschema and checks the rules the
 schema cannot state: the top level repeats the chosen method's figures, and no key carries mm or degrees.
 
   report_schema_test.py SELFCAL_BINARY SOURCE_DIR
@@ -73,6 +73,30 @@ def main():
             if code != 0:
                 failures.append(f"calibrate --method paper exited {code}: {out[-2000:]}")
             check(os.path.join(paper, "report.json"), schema, "paper", True, failures)
+            # The camera from an OpenCV file, the principal point and the lens estimated.
+            with open(os.path.join(sim, "observations.yaml")) as f:
+                camera = yaml.safe_load(f)["camera"]
+            camera_file = os.path.join(tmp, "camera.yaml")
+            with open(camera_file, "w") as f:
+                fx, fy = camera["fx_px"], camera["fx_px"] * camera.get("mu", 1.0)
+                f.write("%YAML:1.0\n---\n"
+                        f"image_width: {camera['width_px']}\nimage_height: {camera['height_px']}\n"
+                        "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+                        f"   data: [ {fx}, 0., {camera['cx_px']}, 0., {fy}, {camera['cy_px']}, 0., 0., 1. ]\n"
+                        "distortion_coefficients: !!opencv-matrix\n   rows: 5\n   cols: 1\n   dt: d\n"
+                        f"   data: [ {camera.get('k1', 0.0)}, 0., 0., 0., 0. ]\n")
+            lens = os.path.join(tmp, "lens")
+            code, out = run(binary, ["calibrate", os.path.join(sim, "observations.yaml"), "--camera-file", camera_file,
+                                     "--free", "kinematics,camera,fx,cx,cy,lens", "--out", lens], source)
+            if code != 0:
+                failures.append(f"calibrate --camera-file exited {code}: {out[-2000:]}")
+            report = check(os.path.join(lens, "report.json"), schema, "bundle", True, failures)
+            estimated = [k for k, v in report.get("methods", {}).get("bundle", {}).get("intrinsics", {}).items()
+                         if v.get("estimated")]
+            if sorted(estimated) != sorted(["fx", "cx", "cy", "k1", "k2", "p1", "p2", "k3"]):
+                failures.append(f"lens report: estimated intrinsics {estimated}")
+            if (report.get("input", {}).get("camera_file") or {}).get("path") != camera_file:
+                failures.append("lens report: input.camera_file does not name the camera file")
             # Too few poses: exit 3, a report that says why, no model.
             with open(os.path.join(sim, "observations.yaml")) as f:
                 observations = yaml.safe_load(f)
@@ -91,7 +115,7 @@ def main():
                 failures.append("a model was written for a result that was not accepted")
     for f in failures:
         print("FAIL:", f)
-    print(f"report schema: {len(failures)} problem(s) in 3 reports" if failures else "report schema: 3 reports valid")
+    print(f"report schema: {len(failures)} problem(s) in 4 reports" if failures else "report schema: 4 reports valid")
     return 1 if failures else 0
 
 

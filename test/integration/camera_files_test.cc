@@ -1,0 +1,204 @@
+// Camera files on the command line (docs/camera-files.md): `detect --camera-file`, `calibrate --camera-file`
+// replacing the observations' camera, `--write-camera-opencv` / `--write-camera-visp` of the calibrated
+// intrinsics, every written file read back; bad files refused naming the file, with nothing written.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "io/camera_file.h"
+#include "io/hand_eye_file.h"
+#include "io/observations_file.h"
+#include "io/robot_config.h"
+#include "support/cli.h"
+#include "support/sim_worlds.h"
+
+namespace selfcal {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::FreshDir;
+using testing::RunSelfcal;
+using testing::RunSelfcalInSource;
+
+const std::string kFrankaCamera = "test/data/visp-franka-eye-in-hand/franka_camera.xml";
+const std::string kFrankaDetect =
+    "detect --images 'test/data/visp-franka-eye-in-hand/franka_image-*.png' --poses "
+    "'test/data/visp-franka-eye-in-hand/franka_pose_rPe_*.yaml' --detector chessboard --grid 9x6 ";
+
+nlohmann::json ReadJson(const fs::path& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+// Every intrinsic of `camera` against the report's methods.bundle.intrinsics, to `relative` (0: exact).
+void ExpectReportCamera(const nlohmann::json& intrinsics, const CameraIntrinsics& camera, double relative,
+                        const std::string& what) {
+  const IntrinsicsVector values = IntrinsicsOf(camera);
+  for (int k = 0; k < kNumIntrinsics; ++k) {
+    const std::string unit = k == kFx || k == kCx || k == kCy ? "_px" : "";
+    const double expected = intrinsics.at(IntrinsicName(k)).at("value" + unit).get<double>();
+    EXPECT_NEAR(values[k], expected, relative * std::abs(expected)) << what << " " << IntrinsicName(k);
+  }
+}
+
+// The ViSP Franka set as a user runs it with the data's own camera file: detect takes it instead of the
+// --camera-* values, calibrate replaces the observations' camera with it again (saying so), estimates f_x
+// and k1 with the hand-eye transform, and writes both camera formats, which read back as the report's
+// calibrated intrinsics (the OpenCV file to the rounding of f_y = mu f_x, the ViSP file to its 1e-12). Freeing p1 and p2 as well
+// gives a lens ViSP cannot hold: refused with exit 2 before anything is written, the OpenCV file included.
+TEST(CameraFilesCli, FrankaCameraFileInCalibratedCameraOutInBothFormats) {
+  const fs::path dir = FreshDir("camera_files", "franka");
+  const std::string obs = (dir / "franka.yaml").string();
+  std::string output;
+  ASSERT_EQ(RunSelfcalInSource(kFrankaDetect + "--camera-file " + kFrankaCamera + " --out " + obs, &output), 0) << output;
+  Result<ObservationSet> set = io::LoadObservations(obs);
+  ASSERT_TRUE(set.ok()) << set.status().ToString();
+  Result<CameraIntrinsics> file = io::LoadCameraFile(fs::path(SELFCAL_SOURCE_DIR) / kFrankaCamera);
+  ASSERT_TRUE(file.ok()) << file.status().ToString();
+  EXPECT_EQ(IntrinsicsOf(set->camera), IntrinsicsOf(*file));
+
+  const fs::path out = dir / "calibration";
+  const std::string opencv = (dir / "franka_opencv.yaml").string(), visp = (dir / "franka_visp.xml").string();
+  ASSERT_EQ(RunSelfcalInSource("calibrate " + obs + " --camera-file " + kFrankaCamera + " --free camera,fx,k1 --out " +
+                                   out.string() + " --write-camera-opencv " + opencv + " --write-camera-visp " + visp,
+                               &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("camera: the intrinsics of " + kFrankaCamera + " replace the observations' camera"),
+            std::string::npos)
+      << output;
+  EXPECT_NE(output.find("free hand-eye parameters + f_x + k1,"), std::string::npos) << output;
+  const nlohmann::json report = ReadJson(out / "report.json");
+  EXPECT_EQ(report.at("input").at("camera_file").at("path"), kFrankaCamera);
+  const nlohmann::json& intrinsics = report.at("methods").at("bundle").at("intrinsics");
+  EXPECT_TRUE(intrinsics.at("k1").at("estimated").get<bool>());
+  EXPECT_FALSE(intrinsics.at("cx").at("estimated").get<bool>());
+  EXPECT_EQ(intrinsics.at("cx").at("value_px").get<double>(), file->cx_px);  // held: the file's, unchanged
+  Result<CameraIntrinsics> written_opencv = io::LoadCameraFile(opencv);
+  ASSERT_TRUE(written_opencv.ok()) << written_opencv.status().ToString();
+  Result<CameraIntrinsics> written_visp = io::LoadCameraFile(visp);
+  ASSERT_TRUE(written_visp.ok()) << written_visp.status().ToString();
+  Result<io::HandEyeResult> hand_eye = io::LoadHandEye((out / "hand_eye.yaml").string());
+  ASSERT_TRUE(hand_eye.ok()) << hand_eye.status().ToString();
+  ASSERT_TRUE(hand_eye->camera.has_value());
+  // The model's camera is the bundle's here (no stated flange pose noise): all three equal the report.
+  ExpectReportCamera(intrinsics, *written_opencv, 1e-15, "OpenCV file");  // mu: f_y / f_x rounded once
+  ExpectReportCamera(intrinsics, *written_visp, 1e-12, "ViSP file");
+  ExpectReportCamera(intrinsics, *hand_eye->camera, 0.0, "hand_eye.yaml");
+  EXPECT_EQ(hand_eye->intrinsics_stddev[kK1], intrinsics.at("k1").at("stddev").get<double>());
+  EXPECT_TRUE(std::isnan(hand_eye->intrinsics_stddev[kCx]));
+
+  const fs::path refused = dir / "refused";
+  const std::string opencv2 = (dir / "lens_opencv.yaml").string(), visp2 = (dir / "lens_visp.xml").string();
+  EXPECT_EQ(RunSelfcalInSource("calibrate " + obs + " --free camera,fx,k1,k2,p1,p2 --out " + refused.string() +
+                                   " --write-camera-opencv " + opencv2 + " --write-camera-visp " + visp2,
+                               &output),
+            2)
+      << output;
+  EXPECT_NE(output.find("--write-camera-visp " + visp2), std::string::npos) << output;
+  EXPECT_NE(output.find("ViSP's perspective model has one radial term"), std::string::npos) << output;
+  EXPECT_NE(output.find("nothing was written"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(refused));
+  EXPECT_FALSE(fs::exists(opencv2));
+  EXPECT_FALSE(fs::exists(visp2));
+  // The same lens written as OpenCV alone is fine, and its p1, p2 are the report's.
+  ASSERT_EQ(RunSelfcalInSource("calibrate " + obs + " --free camera,fx,k1,k2,p1,p2 --out " + refused.string() +
+                                   " --write-camera-opencv " + opencv2,
+                               &output),
+            0)
+      << output;
+  Result<CameraIntrinsics> lens = io::LoadCameraFile(opencv2);
+  ASSERT_TRUE(lens.ok()) << lens.status().ToString();
+  ExpectReportCamera(ReadJson(refused / "report.json").at("methods").at("bundle").at("intrinsics"), *lens, 1e-15, "lens");
+  EXPECT_NE(lens->p1, 0.0);
+}
+
+// A joint-angle set whose file states a wrong camera (principal point 4 px off, no k2): --camera-file with
+// the true lens replaces it, the held intrinsics are the file's exactly, and calibrated_model.yaml carries
+// the calibrated camera and f_x's sigma as the report has them.
+TEST(CameraFilesCli, CameraFileReplacesTheObservationsCameraOfAJointAngleSet) {
+  const fs::path dir = FreshDir("camera_files", "puma");
+  sim::SimOptions options;
+  options.camera.k1 = -0.1;
+  options.camera.k2 = 0.08;
+  options.camera.p1 = 0.001;
+  const sim::SimResult world = testing::PumaArcWorld(options);
+  ObservationSet obs = world.observations;
+  CameraIntrinsics truth = world.truth.camera_true;
+  truth.fx_px = obs.camera.fx_px;  // the file holds the prior f_x; the bundle estimates it
+  obs.camera.cx_px += 4.0;
+  obs.camera.k2 = 0.0;
+  const std::string obs_path = (dir / "obs.yaml").string(), camera_path = (dir / "camera.yaml").string();
+  ASSERT_TRUE(io::SaveObservations(obs, obs_path).ok());
+  ASSERT_TRUE(io::SaveCameraOpenCv(truth, camera_path).ok());
+  const fs::path out = dir / "out";
+  std::string output;
+  ASSERT_EQ(RunSelfcal("calibrate " + obs_path + " --camera-file " + camera_path + " --out " + out.string(), &output), 0)
+      << output;
+  const nlohmann::json report = ReadJson(out / "report.json");
+  const nlohmann::json& intrinsics = report.at("methods").at("bundle").at("intrinsics");
+  CameraIntrinsics expected = truth;
+  expected.fx_px = report.at("fx_px").get<double>();
+  ExpectReportCamera(intrinsics, expected, 0.0, "report");
+  EXPECT_NEAR(expected.fx_px, world.truth.camera_true.fx_px, 4 * report.at("methods").at("bundle").at("fx_stddev_px").get<double>());
+  Result<io::CalibratedModel> model = io::LoadCalibratedModel((out / "calibrated_model.yaml").string());
+  ASSERT_TRUE(model.ok()) << model.status().ToString();
+  ASSERT_TRUE(model->camera.has_value());
+  EXPECT_EQ(IntrinsicsOf(*model->camera), IntrinsicsOf(expected));
+  EXPECT_EQ(model->intrinsics_stddev[kFx], intrinsics.at("fx").at("stddev_px").get<double>());
+  EXPECT_TRUE(std::isnan(model->intrinsics_stddev[kK2]));
+  EXPECT_EQ(report.at("input").at("camera_file").at("sha256").get<std::string>().size(), 64u);
+}
+
+// Bad camera files and options: exit 2, the message names the file (and what is wrong), nothing written.
+TEST(CameraFilesCli, BadCameraFilesAreRefusedNamingTheFileAndNothingIsWritten) {
+  const fs::path dir = FreshDir("camera_files", "bad");
+  const sim::SimResult world = testing::PumaArcWorld(0.2);
+  const std::string obs_path = (dir / "obs.yaml").string();
+  ASSERT_TRUE(io::SaveObservations(world.observations, obs_path).ok());
+  CameraIntrinsics other_size = world.observations.camera;
+  other_size.width_px = 800;
+  const std::string sized = (dir / "size.yaml").string(), unknown = (dir / "unknown.yaml").string();
+  ASSERT_TRUE(io::SaveCameraOpenCv(other_size, sized).ok());
+  ASSERT_TRUE(io::SaveCameraOpenCv(world.observations.camera, unknown).ok());
+  std::ofstream(unknown, std::ios::app) << "focal_lenght: 1000.\n";
+  const fs::path out = dir / "out";
+  struct Case {
+    std::string arguments, expected;
+  };
+  const Case cases[] = {
+      {"calibrate " + obs_path + " --camera-file " + (dir / "missing.xml").string(), (dir / "missing.xml").string()},
+      {"calibrate " + obs_path + " --camera-file " + unknown, "focal_lenght"},
+      {"calibrate " + obs_path + " --camera-file " + sized, "camera file " + sized + " is for 800x480 images"},
+      {"calibrate " + obs_path + " --camera-file " + unknown + " --camera-name Camera", "is an OpenCV file"},
+      {"calibrate " + obs_path + " --camera-name Camera", "--camera-name Camera selects a camera of a --camera-file"},
+  };
+  std::string output;
+  for (const Case& c : cases) {
+    EXPECT_EQ(RunSelfcal(c.arguments + " --out " + out.string() + " --write-camera-opencv " + (dir / "w.yaml").string(),
+                         &output),
+              2)
+        << c.arguments << "\n" << output;
+    EXPECT_NE(output.find(c.expected), std::string::npos) << c.arguments << "\n" << output;
+    EXPECT_FALSE(fs::exists(out)) << c.arguments;
+    EXPECT_FALSE(fs::exists(dir / "w.yaml")) << c.arguments;
+  }
+  // detect: the file is refused before any image is read into a result, and the --camera-* values are
+  // not taken beside it.
+  const std::string detect = kFrankaDetect + "--out " + (dir / "franka.yaml").string() + " --camera-file ";
+  EXPECT_EQ(RunSelfcalInSource(detect + unknown, &output), 2) << output;
+  EXPECT_NE(output.find(unknown), std::string::npos) << output;
+  EXPECT_EQ(RunSelfcalInSource(detect + kFrankaCamera + " --camera-fx-px 600", &output), 2) << output;
+  EXPECT_NE(output.find("leave out --camera-fx-px"), std::string::npos) << output;
+  EXPECT_EQ(RunSelfcalInSource(detect + sized, &output), 2) << output;
+  EXPECT_NE(output.find("camera file " + sized + " is for 800x480 images, the images are 640x480"), std::string::npos)
+      << output;
+  EXPECT_FALSE(fs::exists(dir / "franka.yaml"));
+}
+
+}  // namespace
+}  // namespace selfcal
