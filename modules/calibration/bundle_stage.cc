@@ -111,6 +111,7 @@ BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineR
     report.calibrated_robot = ApplyParameters(obs.robot, b.rho);
     report.calibrated_rho = KinematicParameters::Nominal(report.calibrated_robot);
     if (valid) VerifyHeldOutReprojection(obs, &report);
+    report.fit_geometry = FitGeometryOf(obs, b);
     if (verify) {
       if (b.k1_estimated) {
         ObservationSet with_k1 = obs;

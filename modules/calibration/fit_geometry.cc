@@ -1,0 +1,38 @@
+#include "calibration/fit_geometry.h"
+
+#include <cmath>
+#include <set>
+#include <utility>
+
+#include "camera/camera.h"
+
+namespace selfcal::calibration {
+
+FitGeometry FitGeometryOf(const ObservationSet& obs, const bundle::BundleReport& b) {
+  FitGeometry geometry;
+  if (b.rho.size() != obs.robot.num_parameters() || !b.rho.allFinite() || !(std::isfinite(b.fx_px) && b.fx_px > 0)) {
+    return geometry;
+  }
+  // The bundle's camera: k1 is the observations' own when it was not estimated (its start value).
+  CameraIntrinsics camera = obs.camera;
+  camera.fx_px = b.fx_px;
+  camera.k1 = b.k1;
+  std::set<std::pair<std::string, int>> removed;
+  for (const bundle::RemovedObservation& o : b.removed) removed.insert({o.pose_id, o.dot_id});
+  for (const PoseObservation& pose : obs.poses) {
+    const Rigid3 base_from_cam = BaseFromCamAt(obs.robot, b.rho, pose);
+    geometry.camera_poses.push_back({pose.id, pose.role, base_from_cam});
+    if (pose.role != PoseRole::kIdentification) continue;
+    const Rigid3 cam_from_base = base_from_cam.Inverse();
+    for (const auto& [id, pixel] : pose.dots_px) {
+      const auto dot = b.dots_in_base.find(id);
+      if (dot == b.dots_in_base.end() || removed.count({pose.id, id}) > 0) continue;
+      const std::optional<Eigen::Vector2d> uv = Project(camera, cam_from_base * dot->second);
+      if (!uv) continue;
+      geometry.identification_residuals.push_back({pose.id, id, pixel, pixel - *uv});
+    }
+  }
+  return geometry;
+}
+
+}  // namespace selfcal::calibration
