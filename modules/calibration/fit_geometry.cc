@@ -10,7 +10,9 @@ namespace selfcal::calibration {
 
 FitGeometry FitGeometryOf(const ObservationSet& obs, const bundle::BundleReport& b) {
   FitGeometry geometry;
-  if (b.rho.size() != obs.robot.num_parameters() || !b.rho.allFinite() || !(std::isfinite(b.fx_px) && b.fx_px > 0)) {
+  // No dots: the bundle stopped before its solve (degenerate, no scale), and rho is only its start.
+  if (b.dots_in_base.empty() || b.rho.size() != obs.robot.num_parameters() || !b.rho.allFinite() ||
+      !(std::isfinite(b.fx_px) && b.fx_px > 0)) {
     return geometry;
   }
   // The bundle's camera: k1 is the observations' own when it was not estimated (its start value).

@@ -32,7 +32,8 @@ struct FitGeometry {
   std::vector<ObservedResidual> identification_residuals;  // the final fit's observations, pose by pose
 };
 
-// Empty when the bundle gave no full rho or no positive f_x.
+// Empty when the bundle did not solve (no dots: it stopped before, e.g. kDegenerate, and its rho is its
+// start), or gave no full rho or no positive f_x. An unconverged solve has its geometry (where it stopped).
 FitGeometry FitGeometryOf(const ObservationSet& observations, const bundle::BundleReport& bundle);
 
 }  // namespace selfcal::calibration

@@ -76,12 +76,17 @@ TEST(FitGeometry, ResidualsAreTheFinalFitsAndTheHeldOutFigures) {
   EXPECT_NEAR(Rms(h.residuals) / std::sqrt(2.0), h.overall.rms_px, 1e-9 * h.overall.rms_px);
 }
 
-TEST(FitGeometry, EmptyWithoutAModel) {
-  const sim::SimResult world = testing::PumaArcWorld(0.2, 3, 3);
-  bundle::BundleReport failed;  // kNotRun: no rho
-  const FitGeometry g = FitGeometryOf(world.observations, failed);
-  EXPECT_TRUE(g.camera_poses.empty());
-  EXPECT_TRUE(g.identification_residuals.empty());
+// No geometry from a bundle that did not solve: not run, or stopped as degenerate with its start's rho.
+TEST(FitGeometry, EmptyWithoutASolve) {
+  sim::SimResult world = testing::PumaArcWorld(0.2, 3, 3);
+  bundle::BundleReport not_run;  // kNotRun: no rho
+  EXPECT_TRUE(FitGeometryOf(world.observations, not_run).camera_poses.empty());
+  world.observations.poses.resize(3);  // too few poses to identify the generic set
+  const CalibrationReport report = Calibrate(world.observations, {});
+  ASSERT_EQ(report.bundle->bundle.outcome, bundle::Outcome::kDegenerate) << report.bundle->bundle.message;
+  ASSERT_EQ(report.bundle->bundle.rho.size(), world.observations.robot.num_parameters());
+  EXPECT_TRUE(report.bundle->fit_geometry.camera_poses.empty());
+  EXPECT_TRUE(report.bundle->fit_geometry.identification_residuals.empty());
 }
 
 }  // namespace

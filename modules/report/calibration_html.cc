@@ -71,9 +71,11 @@ void VerdictSection(const json& r, Page* page) {
 
   const json& heldout = At(r, {"heldout_reprojection"});
   const json& verification = At(r, {"verification"});
-  Table t({"figure", "calibrated model", "nominal model"});
+  Table t({"figure", accepted ? "calibrated model" : "result (not accepted)", "nominal model"});
   t.Row({"f_x (px)", Text(At(r, {"fx_px"}), 7), ""});
-  t.Row({"fit: reprojection RMS (px)", Text(At(r, {"methods", "bundle", "rms_reprojection_px"})), ""});
+  const json& bundle = At(r, {"methods", "bundle"});
+  t.Row({"fit: reprojection RMS (px)",
+         Number(At(bundle, {"num_observations"})) > 0 ? Text(At(bundle, {"rms_reprojection_px"})) : "\u2014", ""});
   t.Row({"held-out reprojection RMS (px)", Text(At(heldout, {"calibrated_model", "overall", "rms_px"})),
          Text(At(heldout, {"nominal_model", "overall", "rms_px"}))});
   t.Row({"held-out chi-square test at 99 % passed", Yes(At(heldout, {"calibrated_model", "overall", "test_passed"})),
@@ -146,6 +148,10 @@ void ParameterSection(const json& r, Page* page) {
   const std::string method = Text(At(r, {"method"}));
   const json& section = At(r, {"methods", method.c_str()});
   const json& parameters = At(section, {"parameters"});
+  if (At(r, {"accepted"}) != true) {
+    page->Paragraph("Not accepted: these values are where the solve stopped (or its start), not a model to apply.",
+                    "note");
+  }
   if (method == "bundle") html::CorrectionFigure(parameters, page);
   Table intrinsics({"intrinsic", "value", "sigma"});
   intrinsics.Row({"f_x (px)", Text(At(section, {"fx_px"}), 7), Text(At(section, {"fx_stddev_px"}), 3)});
@@ -304,7 +310,13 @@ std::string CalibrationReportHtml(const json& r, const std::string& plotly_js) {
                  "meta");
   VerdictSection(r, &page);
   page.Heading(2, "Cameras and dots in 3-D", "scene");
-  html::SceneFigure(At(r, {"methods", "bundle", "plot_data"}), At(r, {"verification"}), &page);
+  if (At(r, {"methods", "bundle"}).is_null()) {
+    page.Paragraph("The bundle adjustment did not run (method " + Text(At(r, {"method"})) +
+                       "): no camera poses or dots to show.",
+                   "note");
+  } else {
+    html::SceneFigure(At(r, {"methods", "bundle", "plot_data"}), At(r, {"verification"}), &page);
+  }
   ResidualSection(r, &page);
   ParameterSection(r, &page);
   IdentifiabilitySection(r, &page);

@@ -107,7 +107,8 @@ void SceneFigure(const json& plot_data, const json& verification, Page* page) {
     hi = hi.cwiseMax(t);
   }
   if (cameras.empty()) {
-    page->Paragraph("No camera poses in this report (the bundle adjustment gave no model): no 3-D view.", "note");
+    page->Paragraph("No camera poses in this report (the bundle adjustment stopped before solving): no 3-D view.",
+                    "note");
     return;
   }
   const double axis_m = std::max(0.12 * (hi - lo).maxCoeff(), 0.01);
@@ -165,7 +166,8 @@ void ResidualFigures(const json& plot_data, double noise_px, Page* page) {
   const std::vector<Residual> fit = Residuals(At(plot_data, {"identification_residuals"}));
   const std::vector<Residual> heldout = Residuals(At(plot_data, {"heldout_residuals"}));
   if (fit.empty() && heldout.empty()) {
-    page->Paragraph("No per-observation residuals in this report (the bundle adjustment gave no model).", "note");
+    page->Paragraph("No per-observation residuals in this report (the bundle adjustment stopped before solving).",
+                    "note");
     return;
   }
   struct Set {

@@ -150,7 +150,7 @@ TEST(HtmlReport, SparseReportRendersWithNotes) {
   EXPECT_NE(page->find("Not accepted (invalid_input)"), std::string::npos);
   EXPECT_NE(page->find("<li>the first reason</li>"), std::string::npos);
   EXPECT_NE(page->find("<li>held_out: the second &lt;reason&gt;</li>"), std::string::npos);
-  EXPECT_NE(page->find("no 3-D view"), std::string::npos);
+  EXPECT_NE(page->find("no camera poses or dots to show"), std::string::npos);
   EXPECT_EQ(Figures(*page).size(), 0u);
 }
 
