@@ -245,16 +245,21 @@ void ResidualFigures(const json& plot_data, double noise_px, Page* page) {
     image.push_back(points);
   }
   json xaxis = Axis("u (px)"), yaxis = Axis("v (px)");
+  json layout = {{"title", {{"text", "Residuals over the image"}}}, {"height", 560}};
   if (width > 0 && height > 0) {
     xaxis["range"] = {0, width};
     yaxis["range"] = {height, 0};  // v down, as in the image
+    // Square pixels: the plot area shrinks to the image's aspect rather than the ranges growing.
+    xaxis["constrain"] = yaxis["constrain"] = "domain";
+    layout["shapes"] = json::array({{{"type", "rect"}, {"x0", 0}, {"x1", width}, {"y0", 0}, {"y1", height},
+                                     {"line", {{"color", "#555555"}, {"width", 1}}}}});
   } else {
     yaxis["autorange"] = "reversed";
   }
   yaxis["scaleanchor"] = "x";
-  page->Figure(image,
-               {{"title", {{"text", "Residuals over the image"}}}, {"height", 560}, {"xaxis", xaxis},
-                {"yaxis", yaxis}},
+  layout["xaxis"] = xaxis;
+  layout["yaxis"] = yaxis;
+  page->Figure(image, layout,
                "Each detection (dot) and, from it, the prediction's offset (prediction - detection) magnified " +
                    Format(scale, 3) + " times; all poses superimposed in the image's own coordinates.");
 }
