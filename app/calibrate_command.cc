@@ -7,6 +7,7 @@
 
 #include "app/cli_util.h"
 #include "app/commands.h"
+#include "app/report_command.h"
 #include "io/camera_file.h"
 #include "io/hand_eye_file.h"
 #include "io/observations_file.h"
@@ -169,11 +170,10 @@ Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationRep
   const std::filesystem::path out(out_dir);
   const report::ReportContext context{loaded.input, static_cast<int>(code), loaded.session};
   const std::string report_path = (out / "report.json").string();
-  if (Status s = io::WriteJsonFile(report::CalibrationReportJson(loaded.observations, report, context), report_path);
-      !s.ok()) {
-    return s;
-  }
+  const nlohmann::json document = report::CalibrationReportJson(loaded.observations, report, context);
+  if (Status s = io::WriteJsonFile(document, report_path); !s.ok()) return s;
   std::cout << "report: " << report_path << "\n";
+  WriteHtmlBeside(document, (out / "report.html").string());
   if (!report.model) return Status::Ok();
   if (loaded.observations.UsesFlangePoses()) return WriteHandEye(loaded, report, out_dir);
   io::CalibratedModel model;

@@ -22,5 +22,6 @@ Command AddAuditCommand(CLI::App& app);
 Command AddNameDotsCommand(CLI::App& app);
 Command AddSessionCommand(CLI::App& app);
 Command AddDetectCommand(CLI::App& app);
+Command AddReportCommand(CLI::App& app);
 
 }  // namespace selfcal::app

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   const selfcal::app::Command name_dots = selfcal::app::AddNameDotsCommand(app);
   const selfcal::app::Command session = selfcal::app::AddSessionCommand(app);
   const selfcal::app::Command detect = selfcal::app::AddDetectCommand(app);
+  const selfcal::app::Command report = selfcal::app::AddReportCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -33,7 +34,8 @@ int main(int argc, char** argv) {
     for (const auto& [name, command] :
          {std::pair{"calibrate", calibrate}, {"simulate", simulate}, {"study", study},
           {"identifiability", identifiability}, {"make-trajectory", make_trajectory}, {"identify-tracker", identify_tracker}, {"plan", plan},
-          {"run", run}, {"audit", audit}, {"name-dots", name_dots}, {"session", session}, {"detect", detect}}) {
+          {"run", run}, {"audit", audit}, {"name-dots", name_dots}, {"session", session}, {"detect", detect},
+          {"report", report}}) {
       if (app.got_subcommand(name)) return command();
     }
   } catch (const std::exception& e) {

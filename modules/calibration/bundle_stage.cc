@@ -110,6 +110,7 @@ BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineR
     report.calibrated_rho = KinematicParameters::Nominal(report.calibrated_robot);
     report.calibrated_camera = WithIntrinsics(obs.camera, b.intrinsics);
     if (valid) VerifyHeldOutReprojection(obs, &report);
+    report.fit_geometry = FitGeometryOf(obs, b);
     if (verify) {
       ObservationSet calibrated = obs;
       calibrated.camera = report.calibrated_camera;

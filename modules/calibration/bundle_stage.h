@@ -20,6 +20,7 @@
 
 #include "bundle/bundle_adjustment.h"
 #include "observations/observation_set.h"
+#include "calibration/fit_geometry.h"
 #include "calibration/heldout_reprojection.h"
 #include "calibration/paper_pipeline.h"
 #include "calibration/predicted_error.h"
@@ -60,6 +61,9 @@ struct BundleStageReport {
   // heldout_at_stated_noise is the calibrated overall figure normalised with observations.pixel_noise_px.
   HeldOutReprojection heldout, heldout_nominal;
   HeldOutFigure heldout_at_stated_noise;
+  // The camera poses and the identification residuals at the bundle's solution (fit_geometry.h), for the
+  // report's plots; empty when the bundle gave no model.
+  FitGeometry fit_geometry;
   double seconds_total = 0;
 };
 

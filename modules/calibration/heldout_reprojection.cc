@@ -226,6 +226,7 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
       block.middleCols<3>(d->second.column) = jd * d->second.sqrt_inverse * noise_px;
       rows.push_back(static_cast<int>(residuals.size()));
       residuals.push_back({static_cast<int>(rows_of_pose.size()), pixel - uv});
+      report.residuals.push_back({pose.id, id, pixel, pixel - uv});
       rows_of_u.push_back(std::move(block));
     }
     if (!rows.empty()) {

@@ -59,6 +59,14 @@ struct PredictionModel {
   Eigen::MatrixXd covariance;
 };
 
+// One detection beside the model's prediction of it (for plots of the residuals over the image).
+struct ObservedResidual {
+  std::string pose_id;
+  int dot_id = -1;
+  Eigen::Vector2d pixel_px = Eigen::Vector2d::Zero();     // the detection
+  Eigen::Vector2d residual_px = Eigen::Vector2d::Zero();  // detection - prediction
+};
+
 // One verification pose, or all of them.
 struct HeldOutFigure {
   std::string pose_id;        // empty for the overall figure
@@ -82,6 +90,7 @@ struct HeldOutReprojection {
   int num_not_predicted = 0;  // detections of dots that the identification images do not place
   std::vector<HeldOutFigure> poses;   // verification poses in file order (those with a residual)
   HeldOutFigure overall;
+  std::vector<ObservedResidual> residuals;  // every predicted detection, pose by pose (those in `overall`)
 };
 
 // The identification observations (pose id, dot id) that a solve left out, e.g. by its screen.

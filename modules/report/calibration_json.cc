@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "report/calibration_json_plots.h"
 #include "report/calibration_report.h"
 #include "report/json_util.h"
 
@@ -238,7 +239,8 @@ json BundleSectionJson(const ObservationSet& obs, const calibration::BundleStage
           {"parameters", ParametersJson(obs, b.rho, b.stddev, b.free_indices, "value", true)},
           {"verification", VerificationJson(obs, stage.verification_nominal, stage.verification)},
           {"predicted_3d_error", PredictedErrorJson(stage.predicted_error)},
-          {"heldout_reprojection", HeldOutJson(obs, stage)}};
+          {"heldout_reprojection", HeldOutJson(obs, stage)},
+          {"plot_data", BundlePlotDataJson(obs, stage)}};
 }
 
 // The session block: the input's path and manifest hash, the journal's counts, the findings.

@@ -1,0 +1,102 @@
+// selfcal report REPORT_JSON --out FILE.html: the HTML page of an existing report.json or study JSON.
+// Read-only on its input.
+#include "app/report_command.h"
+
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include "app/cli_util.h"
+#include "app/commands.h"
+#include "io/atomic_file.h"
+#include "io/report_json.h"
+#include "report/html_report.h"
+
+namespace selfcal::app {
+
+namespace {
+
+constexpr std::size_t kMaxPlotlyBytes = 64u << 20;  // plotly.js is ~9 MB unminified
+
+// plotly.js's text, from the first source that names a file (see report_command.h).
+Result<std::string> ReadPlotlyJs(const std::string& option) {
+  const char* env = std::getenv("SELFCAL_PLOTLY_JS");
+  std::string path = SELFCAL_PLOTLY_JS, source = "found when selfcal was configured (CMake SELFCAL_PLOTLY_JS)";
+  if (!option.empty()) {
+    path = option;
+    source = "given by --plotly-js";
+  } else if (env != nullptr && *env != '\0') {
+    path = env;
+    source = "named by the environment's SELFCAL_PLOTLY_JS";
+  }
+  bool missing = false;
+  Result<std::string> text = io::ReadFileCapped(path, kMaxPlotlyBytes, &missing);
+  if (text.ok()) return text;
+  return Status::Error(ErrorCode::kInvalidInput,
+                       "plotly.js " + std::string(missing ? "not found" : "not readable") + ": " + path + " (" +
+                           source + "; " + text.status().message() +
+                           "). report.html inlines it: install Debian's python3-plotly (scripts/install-deps, or "
+                           "apt-get install python3-plotly), or name the file with --plotly-js PATH or "
+                           "SELFCAL_PLOTLY_JS=PATH");
+}
+
+bool SameFile(const std::string& a, const std::string& b) {
+  std::error_code error;
+  return std::filesystem::equivalent(a, b, error) && !error;
+}
+
+struct ReportArgs {
+  std::string input;
+  std::string out;
+  std::string plotly_js;
+};
+
+}  // namespace
+
+Status WriteHtmlReport(const nlohmann::json& document, const std::string& html_path, const std::string& plotly_js_path,
+                       const std::string& document_name) {
+  Result<std::string> plotly = ReadPlotlyJs(plotly_js_path);
+  if (!plotly.ok()) return plotly.status();
+  Result<std::string> page = report::ReportHtml(document, *plotly);
+  if (!page.ok()) {
+    return document_name.empty() ? page.status()
+                                 : Status::Error(page.status().code(), document_name + ": " + page.status().message());
+  }
+  return io::WriteFileAtomically(html_path, *page);
+}
+
+void WriteHtmlBeside(const nlohmann::json& document, const std::string& html_path) {
+  if (Status s = WriteHtmlReport(document, html_path); !s.ok()) {
+    std::cerr << "selfcal: warning: " << html_path << " not written (report.json and the model are): " << s.message()
+              << "\n";
+    return;
+  }
+  std::cout << "HTML report: " << html_path << "\n";
+}
+
+Command AddReportCommand(CLI::App& app) {
+  auto args = std::make_shared<ReportArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "report", "Write the self-contained HTML report (plots inlined, opens offline) of a report.json (calibrate) or a "
+                "study's JSON output; reads its input only");
+  cmd->add_option("input", args->input, "report.json of calibrate or simulate, or the JSON file of study --out")
+      ->required();
+  cmd->add_option("--out", args->out, "HTML file to write (replaced atomically)")->required();
+  cmd->add_option("--plotly-js", args->plotly_js,
+                  "plotly.js to inline (default: $SELFCAL_PLOTLY_JS, else the one found at configure time: " +
+                      std::string(SELFCAL_PLOTLY_JS) + ")");
+  return [args]() {
+    if (SameFile(args->input, args->out)) {
+      return Fail(Status::Error(ErrorCode::kInvalidInput, "--out " + args->out + " is the input " + args->input +
+                                                              ": report never writes over its input"));
+    }
+    Result<nlohmann::json> document = io::ReadJsonFile(args->input);
+    if (!document.ok()) return Fail(document.status());
+    if (Status s = WriteHtmlReport(*document, args->out, args->plotly_js, args->input); !s.ok()) return Fail(s);
+    std::cout << "HTML report: " << args->out << "\n";
+    return 0;
+  };
+}
+
+}  // namespace selfcal::app

@@ -1,0 +1,69 @@
+#include "report/calibration_json_plots.h"
+
+#include "geometry/rigid3.h"
+#include "kinematics/robot_model.h"
+#include "report/json_util.h"
+
+namespace selfcal::report {
+
+namespace {
+
+using nlohmann::json;
+
+json Vector(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+json ResidualsJson(const std::vector<calibration::ObservedResidual>& residuals) {
+  json rows = json::array();
+  for (const calibration::ObservedResidual& r : residuals) {
+    rows.push_back({{"pose", r.pose_id},
+                    {"dot", r.dot_id},
+                    {"pixel_px", {r.pixel_px.x(), r.pixel_px.y()}},
+                    {"residual_px", {r.residual_px.x(), r.residual_px.y()}}});
+  }
+  return rows;
+}
+
+// The correlations of the estimated entries, named (order: free parameters, then the estimated intrinsics).
+json CorrelationJson(const ObservationSet& obs, const bundle::BundleReport& b) {
+  if (!b.covariance_available || b.correlation_free.rows() == 0) return nullptr;
+  const KinematicParameters params(obs.robot.num_joints());
+  json names = json::array();
+  for (int i : b.free_indices) names.push_back(params.name(i));
+  for (int i : EstimatedIntrinsics(b.intrinsics_estimated)) names.push_back(IntrinsicName(i));
+  if (static_cast<int>(names.size()) != b.correlation_free.rows()) return nullptr;
+  json matrix = json::array();
+  for (int r = 0; r < b.correlation_free.rows(); ++r) {
+    json row = json::array();
+    for (int c = 0; c < b.correlation_free.cols(); ++c) row.push_back(Finite(b.correlation_free(r, c)));
+    matrix.push_back(row);
+  }
+  return {{"names", names}, {"matrix", matrix}};
+}
+
+}  // namespace
+
+json BundlePlotDataJson(const ObservationSet& obs, const calibration::BundleStageReport& stage) {
+  const calibration::FitGeometry& g = stage.fit_geometry;
+  if (g.camera_poses.empty()) return nullptr;
+  json cameras = json::array();
+  for (const calibration::CameraPose& c : g.camera_poses) {
+    cameras.push_back({{"pose", c.pose_id},
+                       {"role", PoseRoleName(c.role)},
+                       {"xyz_m", Vector(c.base_from_cam.translation)},
+                       {"rotvec_rad", Vector(LogSO3(c.base_from_cam.rotation))}});
+  }
+  json dots = json::array();
+  for (const auto& [id, p] : stage.bundle.dots_in_base) dots.push_back({{"dot", id}, {"xyz_m", Vector(p)}});
+  return {{"description", "for report.html's figures: the calibrated model's base_from_cam at every pose (translation and "
+                          "rotation vector, in the base frame of the bundle's gauge), the bundle's dots in that frame, "
+                          "every identification detection of the final fit and every held-out detection with its "
+                          "residual (detection - prediction, px), and the correlations of the estimated entries"},
+          {"image", {{"width_px", obs.camera.width_px}, {"height_px", obs.camera.height_px}}},
+          {"camera_poses", cameras},
+          {"dots_in_base", dots},
+          {"identification_residuals", ResidualsJson(g.identification_residuals)},
+          {"heldout_residuals", ResidualsJson(stage.heldout.residuals)},
+          {"correlation", CorrelationJson(obs, stage.bundle)}};
+}
+
+}  // namespace selfcal::report

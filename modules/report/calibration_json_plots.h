@@ -1,0 +1,16 @@
+// report.json's `methods.bundle.plot_data`: what report.html draws and the figures do not hold (the
+// camera poses, the bundle's dots, every residual with its pixel, the correlations of the free
+// parameters). Internal to the report module; docs/report-format.md describes it.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "calibration/bundle_stage.h"
+#include "observations/observation_set.h"
+
+namespace selfcal::report {
+
+// null when the bundle gave no model (its fit geometry is empty).
+nlohmann::json BundlePlotDataJson(const ObservationSet& observations, const calibration::BundleStageReport& stage);
+
+}  // namespace selfcal::report
