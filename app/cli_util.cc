@@ -31,6 +31,7 @@ ExitCode ExitCodeFor(calibration::Verdict verdict) {
     case calibration::Verdict::kScaleUnresolved: return ExitCode::kDegenerateData;
     case calibration::Verdict::kUnconverged:
     case calibration::Verdict::kSolverFailure: return ExitCode::kSolverFailure;
+    case calibration::Verdict::kRejected: return ExitCode::kModelRejected;
   }
   return ExitCode::kSolverFailure;
 }

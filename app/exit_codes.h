@@ -12,6 +12,7 @@ enum class ExitCode : int {
   kDegenerateData = 3,  // insufficient or degenerate data
   kHardware = 4,        // robot or camera fault (the session halted)
   kSolverFailure = 5,   // the solver did not converge or failed
+  kModelRejected = 6,   // converged, but the model fails its held-out checks (no model written)
   kInternal = 70,       // a bug in selfcal (sysexits.h EX_SOFTWARE): please report it
   kInterrupted = 130,   // Ctrl-C: the robot was stopped, the session is resumable
 };
@@ -36,6 +37,7 @@ inline const char* ExitCodeName(ExitCode code) {
     case ExitCode::kDegenerateData: return "degenerate_data";
     case ExitCode::kHardware: return "hardware_fault";
     case ExitCode::kSolverFailure: return "solver_failure";
+    case ExitCode::kModelRejected: return "model_rejected";
     case ExitCode::kInternal: return "internal_error";
     case ExitCode::kInterrupted: return "interrupted";
   }

@@ -83,6 +83,11 @@ BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineR
   BundleStageReport report;
   const Eigen::VectorXd rho_start =
       BundleStartFromPaper(obs, paper, &report.fx_start_px, &report.start, &report.start_note);
+  // A held f_x is the one the user stated (the observations' camera), not the paper's estimate.
+  if (!bundle::EstimatedIntrinsicsOf(options.bundle, obs.robot.num_joints())[kFx]) {
+    report.fx_start_px = obs.camera.fx_px;
+    report.start_note += "; f_x held at the stated value";
+  }
   report.bundle = bundle::RunBundleAdjustment(obs, rho_start, report.fx_start_px, options.bundle);
   const bool retry = options.retry_from_nominal && report.start == BundleStart::kPaperPipeline &&
                      (report.bundle.outcome == bundle::Outcome::kNoConvergence ||

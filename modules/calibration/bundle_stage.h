@@ -8,7 +8,8 @@
 // bundle then fixes its own gauge at the nominal values, as "identify corrections from the nominal model"
 // asks, and the result is comparable entry by entry with a simulator's truth. When the paper pipeline
 // failed (e.g. kDegenerate on a flat dot sheet, where the factor method has no unique solution): the
-// nominal model with the prior f_x. A start from the paper's result that does not converge is retried
+// nominal model with the prior f_x. A held f_x (not estimated) is always the stated prior. A start
+// from the paper's result that does not converge is retried
 // once from the nominal model (the report says so).
 //
 // Works on an ObservationSet only: no files, no hardware, no truth.

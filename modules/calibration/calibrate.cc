@@ -18,6 +18,7 @@ const char* VerdictName(Verdict verdict) {
     case Verdict::kScaleUnresolved: return "scale_unresolved";
     case Verdict::kUnconverged: return "unconverged";
     case Verdict::kSolverFailure: return "solver_failure";
+    case Verdict::kRejected: return "rejected";
   }
   return "solver_failure";
 }
@@ -107,6 +108,48 @@ void CheckFlangePoses(const ObservationSet& observations, const ObservationSet& 
   report->flange_scale_yardsticks = static_cast<int>(report->pose_noise->yardstick_lengths_m.size());
 }
 
+// The acceptance checks of the chosen method's converged model; a failed one turns the verdict to
+// kRejected, its sentences the message.
+void CheckAcceptance(const ObservationSet& obs, const ObservationSet& original, CalibrationReport* report) {
+  AcceptanceInputs in;
+  in.stated_noise_px = obs.pixel_noise_px;
+  if (report->bundle) {
+    const BundleStageReport& stage = *report->bundle;
+    in.calibrated = &stage.heldout;
+    in.nominal = &stage.heldout_nominal;
+    in.test_at_stated_noise = &stage.heldout_at_stated_noise;
+    if (original.flange_translation_sigma_m > 0) {
+      in.test_at_stated_noise = nullptr;
+      in.no_test_reason = "the flange poses have a stated noise, which the test does not model";
+    }
+    in.distances_calibrated = &stage.verification;
+    in.distances_nominal = &stage.verification_nominal;
+    in.distances_decisive = false;
+    if (stage.bundle.rho.size() == obs.robot.num_parameters()) {
+      in.robot = &obs.robot;
+      in.corrections = stage.bundle.rho - KinematicParameters::Nominal(obs.robot);
+      // A flange-pose set's nominal hand-eye transform is a guess (or the start from the images): a large
+      // correction of it is the calibration's answer, not a wrong description.
+      if (original.UsesFlangePoses()) {
+        in.corrections.segment<6>(KinematicParameters(obs.robot.num_joints()).CamOffset()).setZero();
+      }
+    }
+  } else {
+    report->paper_heldout = PaperHeldOutOf(obs, report->paper);
+    in.calibrated = &report->paper_heldout->calibrated;
+    in.nominal = &report->paper_heldout->nominal;
+    in.no_test_reason = "the paper's method gives no parameter covariance to predict with (its model is compared "
+                        "with the nominal one only)";
+    in.distances_calibrated = &report->paper.verification_calibrated;
+    in.distances_nominal = &report->paper.verification_nominal;
+  }
+  report->acceptance = AcceptanceOf(in);
+  if (report->acceptance.Passed()) return;
+  report->verdict = Verdict::kRejected;
+  report->message = "the calibrated model is refused";
+  for (const std::string& reason : report->acceptance.Reasons()) report->message += "; " + reason;
+}
+
 }  // namespace
 
 CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateOptions& options) {
@@ -152,7 +195,8 @@ CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateO
     report.message = report.bundle->bundle.message;
   }
   if (flange_poses && report.bundle) CheckFlangePoses(observations, obs, options, &report);
-  if (!report.accepted()) return report;  // K4: no model for a result that is not to be applied
+  if (report.accepted()) CheckAcceptance(obs, observations, &report);
+  if (!report.accepted()) return report;  // no model for a result that is not to be applied
   CalibratedModel model;
   if (report.bundle) {
     const bundle::BundleReport& b = report.bundle->bundle;

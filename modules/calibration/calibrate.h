@@ -7,6 +7,8 @@
 //                                          yardsticks become checks, the flange translations are metric)
 //     -> RunBundleStage                   (Method::kBundle, the default: the product's answer)
 //     -> verdict of the chosen method     (one vocabulary for every method: Verdict)
+//     -> acceptance checks                (acceptance.h: a converged model that fails its held-out test
+//                                          or predicts worse than the nominal model is kRejected)
 //     -> the chosen method's model        (only when accepted)
 //
 // Commands call this and nothing below it: they parse, load, call Calibrate, and write what it returns
@@ -21,6 +23,7 @@
 
 #include <Eigen/Core>
 
+#include "calibration/acceptance.h"
 #include "calibration/bundle_stage.h"
 #include "calibration/hand_eye_start.h"
 #include "bundle/pose_noise_bundle.h"
@@ -46,6 +49,7 @@ enum class Verdict {
   kScaleUnresolved,  // no usable yardstick: no metric scale
   kUnconverged,      // the solver stopped without converging: the result is not to be applied
   kSolverFailure,    // the solver failed (non-finite start, internal failure)
+  kRejected,         // converged, but refused by its acceptance checks (acceptance.h): not to be applied
 };
 const char* VerdictName(Verdict verdict);  // "accepted", "invalid_input", ...
 
@@ -101,6 +105,10 @@ struct CalibrationReport {
   int flange_scale_yardsticks = 0;
   std::optional<BundleStageReport> bundle;  // when method == kBundle
   std::optional<CalibratedModel> model;    // the chosen method's model, only when accepted
+  // The acceptance checks of the chosen method's converged model (empty when it did not converge).
+  Acceptance acceptance;
+  // Method::kPaper on joint angles, converged: the held-out figures of its model and of the nominal one.
+  std::optional<PaperHeldOut> paper_heldout;
 
   bool accepted() const { return verdict == Verdict::kAccepted; }
   // The chosen method's held-out verification (3-D error of the check distances), before and after.

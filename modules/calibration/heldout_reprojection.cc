@@ -173,7 +173,7 @@ HeldOutFigure FigureOf(const std::string& pose_id, const std::vector<int>& rows,
   f.rms_px = std::sqrt(sum2 / f.dof);
   f.max_px = worst;
   f.chi_square = ChiSquareOf(rows, residuals, u, sigma);
-  f.chi_square_limit = ChiSquareQuantile(0.99, f.dof, noise_dof);
+  f.chi_square_limit = ChiSquareQuantile(kHeldOutTestLevel, f.dof, noise_dof);
   f.p_value = ChiSquareUpperTail(f.chi_square, f.dof, noise_dof);
   f.test_passed = f.chi_square <= f.chi_square_limit;
   return f;
@@ -255,7 +255,7 @@ HeldOutFigure Renormalised(const HeldOutFigure& figure, double from_noise_px, do
   if (f.dof == 0) return f;
   f.chi_square = figure.chi_square * (from_noise_px * from_noise_px) / (to_noise_px * to_noise_px);
   f.noise_dof = 0;
-  f.chi_square_limit = ChiSquareQuantile(0.99, f.dof);
+  f.chi_square_limit = ChiSquareQuantile(kHeldOutTestLevel, f.dof);
   f.p_value = ChiSquareUpperTail(f.chi_square, f.dof);
   f.test_passed = f.chi_square <= f.chi_square_limit;
   return f;

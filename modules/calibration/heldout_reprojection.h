@@ -23,7 +23,7 @@
 // noise estimated from the identification residuals (noise_dof of them), statistic / dof is
 // F(dof, noise_dof) instead (the estimate's own scatter, ~3 % in variance for 2000 residuals, would
 // otherwise fail a correct model far more often than 1 %). The test passes when the statistic is at or
-// below its 99 % quantile: Wilson-Hilferty for chi-square (relative error of the quantile below 1e-3 for 4
+// below its 95 % quantile (kHeldOutTestLevel): Wilson-Hilferty for chi-square (relative error of the quantile below 1e-3 for 4
 // or more degrees of freedom), Paulson's cube-root approximation for F (which is Wilson-Hilferty's when
 // noise_dof is infinite).
 //
@@ -46,6 +46,10 @@
 #include "observations/observation_set.h"
 
 namespace selfcal::calibration {
+
+// The probability at which the held-out test's limit is the statistic's quantile: a correct model with
+// the right noise passes it in 95 % of calibrations (the verdict's false refusal rate is 5 %).
+inline constexpr double kHeldOutTestLevel = 0.95;
 
 // The model whose predictions are checked.
 struct PredictionModel {
@@ -76,7 +80,7 @@ struct HeldOutFigure {
   double max_px = NAN;        // largest 2-D error
   double chi_square = NAN;    // r^T C^-1 r
   int noise_dof = 0;          // the noise's degrees of freedom when it was estimated, 0 when taken as known
-  double chi_square_limit = NAN;  // 99 % quantile of the statistic (chi-square, or dof F(dof, noise_dof))
+  double chi_square_limit = NAN;  // kHeldOutTestLevel quantile of the statistic (chi-square, or dof F(dof, noise_dof))
   double p_value = NAN;       // probability of a larger statistic with a correct model
   bool test_passed = false;   // chi_square <= chi_square_limit
 };

@@ -105,7 +105,8 @@ TEST(HeldOutReprojection, CorrectModelPassesAtTheSimulatedNoise) {
       passed += f.test_passed ? 1 : 0;
     }
   }
-  EXPECT_GE(passed, 9);
+  // At the 95 % level, 7 or more of 10 pass with probability 0.999 (binomial).
+  EXPECT_GE(passed, 7);
 }
 
 // (b) A wrong model: f_x held 2 % off the truth (fx held, prior 1.02 f_x, the bundle started from

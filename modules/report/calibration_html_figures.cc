@@ -326,7 +326,7 @@ void CorrelationFigure(const json& plot_data, Page* page) {
 
 void HeldOutFigure(const json& heldout, Page* page) {
   json traces = json::array();
-  json ratio = {{"type", "bar"}, {"name", "calibrated: chi-square / 99 % limit"}, {"x", json::array()},
+  json ratio = {{"type", "bar"}, {"name", "calibrated: chi-square / 95 % limit"}, {"x", json::array()},
                 {"y", json::array()}, {"marker", {{"color", kHeldOutColour}}}};
   for (const auto& [key, name, colour] : {std::tuple{"calibrated_model", "calibrated model", kHeldOutColour},
                                           {"nominal_model", "nominal model", kNominalColour}}) {
@@ -336,7 +336,7 @@ void HeldOutFigure(const json& heldout, Page* page) {
       bars["x"].push_back(PlotText(Text(At(pose, {"pose"}))));
       bars["y"].push_back(At(pose, {"rms_px"}));
       if (std::string(key) == "calibrated_model") {
-        const double limit = Number(At(pose, {"chi_square_limit_99"}));
+        const double limit = Number(At(pose, {"chi_square_limit"}));
         ratio["x"].push_back(PlotText(Text(At(pose, {"pose"}))));
         ratio["y"].push_back(limit > 0 ? json(Number(At(pose, {"chi_square"})) / limit) : json(nullptr));
       }
@@ -371,10 +371,10 @@ void HeldOutFigure(const json& heldout, Page* page) {
                "own uncertainty.");
   json ratio_layout = {{"title", {{"text", "Held-out test per verification pose (calibrated model)"}}},
                        {"height", 360}, {"xaxis", {{"title", {{"text", "verification pose"}}}, {"type", "category"}}},
-                       {"yaxis", Axis("chi-square / 99 % limit")},
+                       {"yaxis", Axis("chi-square / 95 % limit")},
                        {"shapes", json::array({{{"type", "line"}, {"xref", "paper"}, {"x0", 0}, {"x1", 1}, {"y0", 1},
                                                 {"y1", 1}, {"line", {{"color", "#c62828"}, {"dash", "dash"}}}}})}};
-  page->Figure(json::array({ratio}), ratio_layout, "Above the dashed line at 1: that pose fails its own test at 99 %.");
+  page->Figure(json::array({ratio}), ratio_layout, "Above the dashed line at 1: that pose fails its own test at 95 %.");
 }
 
 void CheckDistanceFigure(const json& verification, const json& predicted, Page* page) {

@@ -28,7 +28,7 @@ void CorrectionFigure(const nlohmann::json& parameters, Page* page);
 void CorrelationFigure(const nlohmann::json& plot_data, Page* page);
 
 // Held-out reprojection per verification pose: RMS of both models against the noise, and each pose's
-// chi-square over its 99 % limit. `heldout`: the top level's heldout_reprojection.
+// chi-square over its 95 % limit. `heldout`: the top level's heldout_reprojection.
 void HeldOutFigure(const nlohmann::json& heldout, Page* page);
 
 // The 3-D error of each check distance, both models, with the predicted std as the calibrated bar's

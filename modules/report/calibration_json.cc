@@ -66,7 +66,7 @@ json HeldOutFigureJson(const calibration::HeldOutFigure& f) {
             {"max_px", any ? Finite(f.max_px) : json()},
             {"chi_square", any ? Finite(f.chi_square) : json()},
             {"noise_dof", f.noise_dof},
-            {"chi_square_limit_99", any ? Finite(f.chi_square_limit) : json()},
+            {"chi_square_limit", any ? Finite(f.chi_square_limit) : json()},
             {"p_value", any ? Finite(f.p_value) : json()},
             {"test_passed", any ? json(f.test_passed) : json()}};
   if (!f.pose_id.empty()) j["pose"] = f.pose_id;
@@ -95,13 +95,13 @@ json HeldOutJson(const ObservationSet& obs, const calibration::BundleStageReport
   return {{"description", "the dots placed from the identification images (the bundle's, or triangulated with the nominal "
                           "model) projected into every verification image with the same model and compared with the "
                           "detections; chi-square of the residuals normalised by the detection noise and the "
-                          "prediction's own first-order uncertainty, 2 degrees of freedom per dot, tested at 99 %: "
+                          "prediction's own first-order uncertainty, 2 degrees of freedom per dot, tested at 95 %: "
                           "chi-square (Wilson-Hilferty) when the noise is taken as known, dof x F(dof, noise_dof) "
                           "(Paulson) when it is the bundle's estimate from noise_dof residual degrees of freedom"},
           {"noise_px", Finite(c.noise_px)},
           {"noise_source", c.noise_source},
           {"stated_noise_px", obs.pixel_noise_px},
-          {"test_passed", c.ok ? json(c.overall.test_passed) : json()},
+          {"test_passed", c.ok ? json(stage.heldout_at_stated_noise.test_passed) : json()},
           {"beats_nominal", compare ? json(c.overall.rms_px < n.overall.rms_px) : json()},
           {"calibrated_model", calibrated},
           {"nominal_model", HeldOutModelJson(n)}};
@@ -356,6 +356,10 @@ json CalibrationReportJson(const ObservationSet& obs, const calibration::Calibra
                            const ReportContext& context) {
   json methods = {{"paper", PaperSectionJson(obs, report.paper)}};
   if (report.bundle) methods["bundle"] = BundleSectionJson(obs, *report.bundle);
+  if (report.paper_heldout) {
+    methods["paper"]["heldout_models"] = {{"calibrated_model", HeldOutModelJson(report.paper_heldout->calibrated)},
+                                          {"nominal_model", HeldOutModelJson(report.paper_heldout->nominal)}};
+  }
   const json& chosen = methods[calibration::MethodName(report.method)];
   json j;
   j["format"] = kCalibrationReportFormat;
@@ -372,6 +376,13 @@ json CalibrationReportJson(const ObservationSet& obs, const calibration::Calibra
   j["verdict"] = calibration::VerdictName(report.verdict);
   j["accepted"] = report.accepted();
   j["message"] = report.message;
+  j["reasons"] = report.acceptance.Reasons();
+  json checks = json::array();
+  for (const calibration::AcceptanceCheck& c : report.acceptance.checks) {
+    checks.push_back({{"check", c.name}, {"status", calibration::CheckStatusName(c.status)}, {"decisive", c.decisive},
+                      {"sentence", c.sentence}});
+  }
+  j["acceptance"] = checks;
   j["exit_code"] = context.exit_code;
   j["pixel_noise_px"] = obs.pixel_noise_px;
   j["pixel_noise_note"] = "standard deviation per coordinate (the paper's N(0, s) read as a std)";

@@ -50,7 +50,7 @@ void PrintHeldOut(const calibration::BundleStageReport& stage, std::ostream& out
   out << std::fixed << std::setprecision(3) << "  held-out reprojection on " << c.poses.size() << " verification poses, "
       << f.num_residuals << " dots: RMS " << f.rms_px << " px per coordinate (noise " << c.noise_px << " px, "
       << c.noise_source << "); chi-square " << std::setprecision(1) << f.chi_square << " for " << f.dof
-      << " degrees of freedom, 99 % limit " << f.chi_square_limit << (f.noise_dof > 0 ? " (F test)" : "") << ": "
+      << " degrees of freedom, 95 % limit " << f.chi_square_limit << (f.noise_dof > 0 ? " (F test)" : "") << ": "
       << (f.test_passed ? "passed" : "failed") << "\n";
   if (!c.prediction_uncertainty) out << "    (the parameters' uncertainty is not in the test: " << c.message << ")\n";
   const calibration::HeldOutReprojection& n = stage.heldout_nominal;
@@ -167,6 +167,14 @@ void PrintCalibrationSummary(const calibration::CalibrationReport& report, std::
   if (report.bundle) {
     out << "\n";
     PrintBundleSummary(*report.bundle, report.hand_eye_start.has_value(), out);
+  }
+  if (!report.acceptance.checks.empty()) {
+    out << "\nacceptance of the " << calibration::MethodName(report.method) << " model:\n";
+    for (const calibration::AcceptanceCheck& c : report.acceptance.checks) {
+      out << "  " << calibration::CheckStatusName(c.status) << (c.decisive ? "" : " (figure only)") << ": " << c.sentence
+          << "\n";
+    }
+    if (!report.acceptance.Verified()) out << "  (not verified: nothing held out could test it)\n";
   }
 }
 

@@ -109,11 +109,16 @@ TEST(Cli, SimulateWithTheBundleMethodReportsTheBundleAndWritesItsModel) {
   EXPECT_NEAR(model->fx_px, b["fx_px"].get<double>(), 1e-6);
   // The baseline alone on the same file: no bundle section, the paper's outcome.
   const fs::path paper = dir / "paper";
+  // It measures the check distances worse than the nominal model (at 0.2 px the factor method's model is
+  // the weaker one), so the verdict refuses it, saying why, and writes no model.
   ASSERT_EQ(RunSelfcal("calibrate " + (dir / "observations.yaml").string() + " --method paper --out " + paper.string(),
-                       &output), 0) << output;
+                       &output), 6) << output;
   const nlohmann::json baseline = ReadJson(paper / "report.json");
   EXPECT_EQ(baseline["method"], "paper");
-  EXPECT_EQ(baseline["verdict"], "accepted");
+  EXPECT_EQ(baseline["verdict"], "rejected");
+  ASSERT_EQ(baseline["reasons"].size(), 1u) << baseline["reasons"].dump();
+  EXPECT_NE(baseline["reasons"][0].get<std::string>().find("worse than the robot it started from"), std::string::npos);
+  EXPECT_FALSE(fs::exists(paper / "calibrated_model.yaml"));
   EXPECT_EQ(baseline["methods"]["paper"]["outcome"], "success");
   EXPECT_FALSE(baseline["methods"].contains("bundle"));
   EXPECT_EQ(baseline["verification"], baseline["methods"]["paper"]["verification"]);

@@ -50,12 +50,15 @@ TEST(HostileInput, TinyPixelNoiseIsRefusedByLineOrCalibratesLikeTheStatedNoise) 
         << output;
     EXPECT_FALSE(fs::exists(out)) << value;
   }
+  // A tiny but valid noise: the solve is unchanged (no false insufficient excitation), and the verdict
+  // refuses the model because its held-out residuals are far above that noise, saying so.
   for (const std::string value : {"1e-6", "1e-3"}) {
     const fs::path file = dir / ("obs_" + value + ".yaml");
     std::ofstream(file) << std::string(original).replace(at, key.size(), "pixel_noise_px: " + value + "\n");
-    EXPECT_EQ(RunSelfcal("calibrate " + file.string() + " --out " + (dir / ("out_" + value)).string(), &output), 0)
+    EXPECT_EQ(RunSelfcal("calibrate " + file.string() + " --out " + (dir / ("out_" + value)).string(), &output), 6)
         << value << ": " << output;
     EXPECT_FALSE(Has(output, "insufficient excitation")) << output;
+    EXPECT_TRUE(Has(output, "a pixel noise stated too small")) << output;
   }
 }
 

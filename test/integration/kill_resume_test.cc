@@ -113,8 +113,10 @@ TEST(KillResume, RandomKillsLoseNothingAndTheResultIsIdentical) {
   const auto t0 = std::chrono::steady_clock::now();
   ASSERT_EQ(RunToEnd(run_args(root / "clean", false), log), 0) << ReadFile(log);
   const double full_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  ASSERT_EQ(RunToEnd({"calibrate", (root / "clean").string(), "--out", (root / "clean_cal").string()}, log), 0)
-      << ReadFile(log);
+  // The verdict may refuse the model (exit 6: at supersampling 2 the centroids are noisier than the
+  // simulated cell states); whichever it is, every resumed session must reach the same one.
+  const int clean_code = RunToEnd({"calibrate", (root / "clean").string(), "--out", (root / "clean_cal").string()}, log);
+  ASSERT_TRUE(clean_code == 0 || clean_code == 6) << ReadFile(log);
 
   // The killed one: delays uniform over [0, 2 full / kills + 0.3 s] so that kills land everywhere, from
   // start-up to the last write, and progress needs several lives.
@@ -168,10 +170,13 @@ TEST(KillResume, RandomKillsLoseNothingAndTheResultIsIdentical) {
     ASSERT_EQ(RunToEnd(run_args(dir, true), log), 0) << ReadFile(log);
     EXPECT_EQ(AcceptedSamples(dir, &problem), clean_samples) << problem;
     const fs::path cal = root / ("cal_" + std::to_string(sessions));
-    ASSERT_EQ(RunToEnd({"calibrate", dir.string(), "--out", cal.string()}, log), 0) << ReadFile(log);
-    EXPECT_EQ(without_source(ReadFile(cal / "calibrated_model.yaml")),
-              without_source(ReadFile(root / "clean_cal" / "calibrated_model.yaml")))
-        << "session " << dir;
+    ASSERT_EQ(RunToEnd({"calibrate", dir.string(), "--out", cal.string()}, log), clean_code) << ReadFile(log);
+    ASSERT_EQ(fs::exists(cal / "calibrated_model.yaml"), clean_code == 0);
+    if (clean_code == 0) {
+      EXPECT_EQ(without_source(ReadFile(cal / "calibrated_model.yaml")),
+                without_source(ReadFile(root / "clean_cal" / "calibrated_model.yaml")))
+          << "session " << dir;
+    }
     EXPECT_EQ(ReadFile(cal / "observations.yaml"), ReadFile(root / "clean_cal" / "observations.yaml"));
   }
   std::printf("%d kills over %d sessions (%d after the run had journaled something, %d runs finished before "
