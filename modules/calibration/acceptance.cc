@@ -1,5 +1,6 @@
 #include "calibration/acceptance.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -113,25 +114,40 @@ AcceptanceCheck PlausibleCorrections(const AcceptanceInputs& in) {
                         "no kinematic corrections to check (the paper's method re-identifies the model)"};
   if (in.robot == nullptr || in.corrections.size() != in.robot->num_parameters()) return check;
   const KinematicParameters params(in.robot->num_joints());
-  std::string worst;
-  double worst_rad = 0;
+  // The largest correction relative to its bound, and the largest of each kind.
+  int worst = -1;
+  double worst_ratio = 0, largest_deg = 0, largest_mm = 0;
   for (int i = 0; i < params.size(); ++i) {
-    if (params.kind(i) == ParameterKind::kLength || !(std::abs(in.corrections[i]) > worst_rad)) continue;
-    worst_rad = std::abs(in.corrections[i]);
-    worst = params.name(i);
+    const bool length = params.kind(i) == ParameterKind::kLength;
+    const double size = std::abs(in.corrections[i]);
+    if (!std::isfinite(size)) {
+      worst = i;
+      worst_ratio = INFINITY;
+      break;
+    }
+    (length ? largest_mm : largest_deg) = std::max(length ? largest_mm : largest_deg, size * (length ? 1e3 : 180.0 / M_PI));
+    const double ratio = size / (length ? kMaxLengthCorrectionM : kMaxAngularCorrectionRad);
+    if (ratio > worst_ratio) {
+      worst_ratio = ratio;
+      worst = i;
+    }
   }
-  const double worst_deg = worst_rad * 180.0 / M_PI;
-  if (worst_rad <= kMaxAngularCorrectionRad) {
+  if (worst_ratio <= 1) {
     check.status = CheckStatus::kPassed;
-    check.sentence = Format("every angular correction is within 45 deg of the robot description (largest %.3g deg)",
-                            worst_deg);
+    check.sentence = Format("every correction is within 45 deg and 100 mm of the robot description (largest %.3g deg, "
+                            "%.3g mm)",
+                            largest_deg, largest_mm);
     return check;
   }
+  const bool length = params.kind(worst) == ParameterKind::kLength;
   check.status = CheckStatus::kFailed;
-  check.sentence = worst + Format(" is corrected by %.1f deg: a calibration does not turn a joint by more than 45 deg; "
-                                  "the robot description is wrong there (a joint's sign, zero or axis), and the solve "
-                                  "found an equivalent parameterisation instead. Fix the robot description",
-                                  worst_deg);
+  check.sentence =
+      params.name(worst) +
+      Format(length ? " is corrected by %.4g mm: a calibration does not move a link by more than 100 mm"
+                    : " is corrected by %.1f deg: a calibration does not turn a joint by more than 45 deg",
+             std::abs(in.corrections[worst]) * (length ? 1e3 : 180.0 / M_PI)) +
+      "; the robot description is wrong there (a joint's sign, zero, axis or length, or a parameter held at a wrong "
+      "value), and the solve found an equivalent or compensating parameterisation instead. Fix the robot description";
   return check;
 }
 

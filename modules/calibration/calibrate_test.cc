@@ -82,7 +82,7 @@ TEST(Calibrate, AWrongFocalLengthHeldFixedIsRejected) {
 
 // A half-turn in a joint's angle is a wrong description absorbed into an equivalent parameterisation
 // (a negated joint reading fits exactly with j4.alpha and j5.theta turned by multiples of 180 deg): refused,
-// naming the parameter. Corrections within 45 deg pass; lengths are not judged.
+// naming the parameter. Corrections within 45 deg and 100 mm pass.
 TEST(Calibrate, AHalfTurnCorrectionIsImplausible) {
   const sim::SimResult world = testing::PumaArcWorld(0.0, 1, 1);
   const RobotModel& robot = world.observations.robot;
@@ -91,7 +91,7 @@ TEST(Calibrate, AHalfTurnCorrectionIsImplausible) {
   in.robot = &robot;
   in.corrections = Eigen::VectorXd::Zero(robot.num_parameters());
   in.corrections[params.IndexOf("j4.alpha")] = 0.7;   // 40 deg
-  in.corrections[params.IndexOf("j2.a")] = 0.5;       // 0.5 m, a length
+  in.corrections[params.IndexOf("j2.a")] = 0.09;      // 90 mm
   const auto plausible = [](const Acceptance& a) { return a.checks.back(); };
   EXPECT_EQ(plausible(AcceptanceOf(in)).status, CheckStatus::kPassed);
   EXPECT_TRUE(AcceptanceOf(in).Passed());
@@ -102,6 +102,11 @@ TEST(Calibrate, AHalfTurnCorrectionIsImplausible) {
   EXPECT_FALSE(refused.Passed());
   EXPECT_EQ(refused.Reasons().size(), 1u);
   EXPECT_NE(refused.Reasons()[0].find("j5.theta is corrected by 540.0 deg"), std::string::npos) << refused.Reasons()[0];
+  in.corrections[params.IndexOf("j5.theta")] = 0;
+  in.corrections[params.IndexOf("j3.d")] = -12.0;  // metres: lengths traded against angles on parallel axes
+  const Acceptance lengths = AcceptanceOf(in);
+  ASSERT_EQ(lengths.Reasons().size(), 1u);
+  EXPECT_NE(lengths.Reasons()[0].find("j3.d is corrected by 1.2e+04 mm"), std::string::npos) << lengths.Reasons()[0];
 }
 
 TEST(Calibrate, MethodNamesRoundTrip) {
