@@ -56,8 +56,13 @@ void VerdictSection(const json& r, Page* page) {
   box += "<div class=\"word\">" +
          html::EscapeHtml(accepted ? "Accepted" : "Not accepted (" + verdict + ")") + "</div>";
   const std::string message = Text(At(r, {"message"}));
-  if (!message.empty() && message != "\u2014") box += "<p>" + html::EscapeHtml(message) + "</p>";
   const std::vector<std::string> reasons = Reasons(At(r, {"reasons"}));
+  // A refusal's message is its reasons joined: the list says it once.
+  if (!reasons.empty()) {
+    box += "<p>The calibrated model is refused:</p>";
+  } else if (!message.empty() && message != "\u2014") {
+    box += "<p>" + html::EscapeHtml(message) + "</p>";
+  }
   if (!reasons.empty()) {
     box += "<ul>";
     for (const std::string& reason : reasons) box += "<li>" + html::EscapeHtml(reason) + "</li>";
@@ -68,6 +73,16 @@ void VerdictSection(const json& r, Page* page) {
                                             : "; no calibrated model was written")) +
          "</p></div>\n";
   page->Markup(box);
+  const json& checks = At(r, {"acceptance"});
+  if (checks.is_array() && !checks.empty()) {
+    Table a({"acceptance check", "status", "what it found"});
+    for (const json& c : checks) {
+      const std::string status = Text(At(c, {"status"})) + (At(c, {"decisive"}) == false ? " (figure only)" : "");
+      a.Row({Text(At(c, {"check"})), status, Text(At(c, {"sentence"}))},
+            At(c, {"status"}) == "failed" && At(c, {"decisive"}) != false ? "fail" : "");
+    }
+    page->Markup(a.Html());
+  }
 
   const json& heldout = At(r, {"heldout_reprojection"});
   const json& verification = At(r, {"verification"});
@@ -78,7 +93,7 @@ void VerdictSection(const json& r, Page* page) {
          Number(At(bundle, {"num_observations"})) > 0 ? Text(At(bundle, {"rms_reprojection_px"})) : "\u2014", ""});
   t.Row({"held-out reprojection RMS (px)", Text(At(heldout, {"calibrated_model", "overall", "rms_px"})),
          Text(At(heldout, {"nominal_model", "overall", "rms_px"}))});
-  t.Row({"held-out chi-square test at 95 % passed", Yes(At(heldout, {"calibrated_model", "overall", "test_passed"})),
+  t.Row({"held-out chi-square test at 95 % passed (stated noise)", Yes(At(heldout, {"test_passed"})),
          Yes(At(heldout, {"nominal_model", "overall", "test_passed"}))},
         At(heldout, {"test_passed"}) == false ? "fail" : "");
   t.Row({"held-out: calibrated beats nominal", Yes(At(heldout, {"beats_nominal"})), ""},
