@@ -272,7 +272,9 @@ int SimulateSession(const SimulateArgs& args) {
   }
   std::cout << "\nsimulated session " << run_s << " s, with the calibration " << total_s << " s; results in " << args.out
             << "/: " << std::filesystem::path(run.session).filename().string()
-            << "/ (the session), observations.yaml, report.json" << (code == 0 ? ", calibrated_model.yaml" : "")
+            << "/ (the session), observations.yaml, report.json"
+            << (std::filesystem::exists(std::filesystem::path(args.out) / "report.html") ? ", report.html" : "")
+            << (code == 0 ? ", calibrated_model.yaml" : "")
             << ", truth.json, comparison_with_truth.json\n";
   return code;
 }
@@ -344,6 +346,7 @@ Command AddSimulateCommand(CLI::App& app) {
       if (Status s = io::WriteJsonFile(comparison, (out / "comparison_with_truth.json").string()); !s.ok()) return Fail(s);
     }
     std::cout << "results in " << args->out << "/: observations.yaml, truth.json, report.json"
+              << (std::filesystem::exists(out / "report.html") ? ", report.html" : "")
               << (code == 0 ? ", calibrated_model.yaml" : "") << (comparison.empty() ? "" : ", comparison_with_truth.json")
               << "\n";
     return code;
