@@ -170,11 +170,7 @@ PaperHeldOut PaperHeldOutOf(const ObservationSet& obs, const PaperPipelineReport
   out.calibrated = HeldOutReprojectionOf(obs, calibrated, TriangulateIdentificationDots(obs, calibrated), {},
                                          obs.pixel_noise_px, 0);
   out.calibrated.noise_source = "the stated pixel noise";
-  PredictionModel nominal;
-  nominal.robot = obs.robot;
-  nominal.rho = KinematicParameters::Nominal(obs.robot);
-  nominal.camera = obs.camera;
-  out.nominal = HeldOutReprojectionOf(obs, nominal, TriangulateIdentificationDots(obs, nominal), {}, obs.pixel_noise_px, 0);
+  out.nominal = NominalHeldOutReprojection(obs, obs.pixel_noise_px, 0);
   out.nominal.noise_source = out.calibrated.noise_source;
   return out;
 }

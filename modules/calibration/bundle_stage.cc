@@ -67,11 +67,7 @@ void VerifyHeldOutReprojection(const ObservationSet& obs, BundleStageReport* rep
                                            : "the stated pixel noise (the bundle has no redundancy to estimate it)";
   if (!b.covariance_available) report->heldout.message = "prediction uncertainty of the parameters left out: " + b.covariance_message;
   report->heldout_at_stated_noise = Renormalised(report->heldout.overall, noise, obs.pixel_noise_px);
-  PredictionModel nominal;
-  nominal.robot = obs.robot;
-  nominal.rho = KinematicParameters::Nominal(obs.robot);
-  nominal.camera = obs.camera;
-  report->heldout_nominal = HeldOutReprojectionOf(obs, nominal, TriangulateIdentificationDots(obs, nominal), {}, noise, noise_dof);
+  report->heldout_nominal = NominalHeldOutReprojection(obs, noise, noise_dof);
   report->heldout_nominal.noise_source = report->heldout.noise_source;
 }
 

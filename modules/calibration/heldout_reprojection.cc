@@ -250,6 +250,14 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
   return report;
 }
 
+HeldOutReprojection NominalHeldOutReprojection(const ObservationSet& obs, double noise_px, int noise_dof) {
+  PredictionModel nominal;
+  nominal.robot = obs.robot;
+  nominal.rho = KinematicParameters::Nominal(obs.robot);
+  nominal.camera = obs.camera;
+  return HeldOutReprojectionOf(obs, nominal, TriangulateIdentificationDots(obs, nominal), {}, noise_px, noise_dof);
+}
+
 HeldOutFigure Renormalised(const HeldOutFigure& figure, double from_noise_px, double to_noise_px) {
   HeldOutFigure f = figure;
   if (f.dof == 0) return f;

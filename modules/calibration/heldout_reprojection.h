@@ -117,6 +117,10 @@ HeldOutFigure Renormalised(const HeldOutFigure& figure, double from_noise_px, do
 std::map<int, Eigen::Vector3d> TriangulateIdentificationDots(const ObservationSet& observations,
                                                              const PredictionModel& model);
 
+// The nominal model's held-out figures: observations.robot at its nominal values and camera, taken as exact,
+// with the dots it triangulates from the identification images.
+HeldOutReprojection NominalHeldOutReprojection(const ObservationSet& observations, double noise_px, int noise_dof);
+
 // The distribution of the statistic X with `dof` degrees of freedom: chi-square (noise_dof = 0,
 // Wilson-Hilferty) or dof F(dof, noise_dof) (Paulson): the quantile at probability p (0 < p < 1), and the
 // upper tail P(X > x).
