@@ -166,14 +166,14 @@ Status WriteHandEye(const LoadedInput& loaded, const calibration::CalibrationRep
 // Writes report.json, and calibrated_model.yaml (hand_eye.yaml for flange poses) when the verdict is
 // "accepted" (K4).
 Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationReport& report, ExitCode code,
-                    const std::string& out_dir) {
+                    const std::string& out_dir, bool html) {
   const std::filesystem::path out(out_dir);
   const report::ReportContext context{loaded.input, static_cast<int>(code), loaded.session};
   const std::string report_path = (out / "report.json").string();
   const nlohmann::json document = report::CalibrationReportJson(loaded.observations, report, context);
   if (Status s = io::WriteJsonFile(document, report_path); !s.ok()) return s;
   std::cout << "report: " << report_path << "\n";
-  WriteHtmlBeside(document, (out / "report.html").string());
+  if (html) WriteHtmlBeside(document, (out / "report.html").string());
   if (!report.model) return Status::Ok();
   if (loaded.observations.UsesFlangePoses()) return WriteHandEye(loaded, report, out_dir);
   io::CalibratedModel model;
@@ -238,7 +238,7 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
     if (Status s = io::SaveObservations(loaded->observations, derived); !s.ok()) return Fail(s);
   }
   const ExitCode code = ExitCodeFor(report.verdict);
-  if (Status s = WriteOutputs(*loaded, report, code, request.out_dir); !s.ok()) return Fail(s);
+  if (Status s = WriteOutputs(*loaded, report, code, request.out_dir, request.html); !s.ok()) return Fail(s);
   if (Status s = WriteCameraFiles(request, report); !s.ok()) return Fail(s);
   if (!report.accepted()) {
     std::cerr << "selfcal: " << ExitCodeName(code) << ": " << report.message << " (no calibrated model written)\n";
@@ -278,8 +278,11 @@ Command AddCalibrateCommand(CLI::App& app) {
   cmd->add_option("--write-camera-visp", request->write_camera_visp,
                   "Also write the calibrated intrinsics as a ViSP XML file (when accepted; refused, before anything is "
                   "written, for a lens with k2, p1, p2 or k3)");
-  return [request, method]() {
+  auto no_html = std::make_shared<bool>(false);
+  cmd->add_flag("--no-html", *no_html, "Do not write report.html (report.json and the model are written as always)");
+  return [request, method, no_html]() {
     request->method = MethodFromName(*method);
+    request->html = !*no_html;
     return CalibrateAndWrite(*request);
   };
 }

@@ -30,13 +30,14 @@ struct CalibrateRequest {
   std::string out_dir;
   uint64_t seed = 1;  // RANSAC sampling of the two-view step
   calibration::Method method = calibration::Method::kBundle;
-  std::vector<std::string> fix, free;  // parameter names and groups (bundle::BundleOptions::held_parameters)
+  std::vector<std::string> fix{}, free{};  // parameter names and groups (bundle::BundleOptions::held_parameters)
   std::string scale_from = "flange";   // flange-pose sets: "flange" or "yardstick" (CalibrateOptions)
   // A camera file (io/camera_file.h) whose intrinsics replace the observations' camera, and the camera
   // chosen in a ViSP file (empty: its only one; also the name written to write_camera_visp).
   std::string camera_file{}, camera_name{};
   // Where to write the calibrated intrinsics (empty: not written), only when accepted.
   std::string write_camera_opencv{}, write_camera_visp{};
+  bool html = true;  // also write report.html beside report.json (--no-html: not)
 };
 
 // What a calibration read and returned, for callers that compare it with a truth (`simulate`).

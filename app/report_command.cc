@@ -17,7 +17,7 @@ namespace selfcal::app {
 
 namespace {
 
-constexpr std::size_t kMaxPlotlyBytes = 64u << 20;  // plotly.js is ~9 MB unminified
+constexpr std::size_t kMaxPlotlyBytes = 64u << 20;  // plotly.js is 8.6 MB unminified, 3.8 MB minified
 
 // plotly.js's text, from the first source that names a file (see report_command.h).
 Result<std::string> ReadPlotlyJs(const std::string& option) {

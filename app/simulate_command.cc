@@ -38,6 +38,7 @@ struct SimulateArgs {
   double grey_noise = 2.0;  // image mode
   double blur_px = 0.0;
   int supersampling = 4;
+  bool no_html = false;     // --no-html: report.html not written
 };
 
 nlohmann::json TruthJson(const sim::SimResult& world) {
@@ -248,7 +249,9 @@ int SimulateSession(const SimulateArgs& args) {
   const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (run_code != 0) return run_code;
   CalibrationRun calibrated;
-  const int code = CalibrateAndWrite({run.session, args.out, args.seed, MethodFromName(args.method), {}, {}}, &calibrated);
+  CalibrateRequest request{run.session, args.out, args.seed, MethodFromName(args.method)};
+  request.html = !args.no_html;
+  const int code = CalibrateAndWrite(request, &calibrated);
   const ObservationSet& obs = calibrated.observations;
   const calibration::CalibrationReport& result = calibrated.report;
   const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -292,6 +295,7 @@ Command AddSimulateCommand(CLI::App& app) {
   cmd->add_flag("--perturb-gauge", args->perturb_gauge, "Also perturb the parameters the measurements cannot see");
   cmd->add_flag("--flat-sheet", args->flat_sheet,
                 "Put every dot on one plane (the paper's factor method is degenerate there, the bundle is not)");
+  cmd->add_flag("--no-html", args->no_html, "Do not write report.html (report.json is written as always)");
   cmd->add_flag("--points", args->points,
                 "Fast mode: project the dots with Gaussian pixel noise (--noise-px), no images, no session");
   cmd->add_option("--grey-noise", args->grey_noise, "Image mode: pixel noise std, grey levels")
@@ -331,7 +335,9 @@ Command AddSimulateCommand(CLI::App& app) {
     if (Status s = io::WriteJsonFile(TruthJson(world), (out / "truth.json").string()); !s.ok()) return Fail(s);
     // Calibrate from the file, as any user's data would be.
     CalibrationRun calibrated;
-    const int code = CalibrateAndWrite({obs_path, args->out, args->seed, MethodFromName(args->method), {}, {}}, &calibrated);
+    CalibrateRequest request{obs_path, args->out, args->seed, MethodFromName(args->method)};
+    request.html = !args->no_html;
+    const int code = CalibrateAndWrite(request, &calibrated);
     const calibration::CalibrationReport& result = calibrated.report;
     const ObservationSet* obs = &calibrated.observations;
     nlohmann::json comparison = nlohmann::json::object();

@@ -99,6 +99,21 @@ TEST_F(ReportCommand, CalibrateWithoutPlotlyWritesEverythingButThePage) {
   EXPECT_NE(output.find("python3-plotly"), std::string::npos) << output;
 }
 
+// --no-html: everything but the page, and no warning about it; the page written by default inlines a
+// minified plotly.js when the build made one (its licence banner kept on top).
+TEST_F(ReportCommand, NoHtmlWritesEverythingButThePageAndTheDefaultPageKeepsPlotlysLicence) {
+  const fs::path out = *dir_ / "no_html";
+  std::string output;
+  ASSERT_EQ(RunSelfcal("calibrate " + (*dir_ / "observations.yaml").string() + " --seed 4 --no-html --out " +
+                           out.string(), &output), 0) << output;
+  EXPECT_TRUE(fs::exists(out / "report.json"));
+  EXPECT_TRUE(fs::exists(out / "calibrated_model.yaml"));
+  EXPECT_FALSE(fs::exists(out / "report.html"));
+  EXPECT_EQ(output.find("report.html"), std::string::npos) << output;
+  const std::string page = ReadFile(*dir_ / "report.html");
+  EXPECT_NE(page.find("Licensed under the MIT license"), std::string::npos);
+}
+
 // Other JSON, a missing input and an output over the input: refused (exit 2), nothing written.
 TEST_F(ReportCommand, RefusesOtherDocumentsAndWritingOverItsInput) {
   const fs::path out = *dir_ / "refused.html";
