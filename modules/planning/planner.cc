@@ -14,6 +14,7 @@
 #include "identification/identifiability.h"
 #include "planning/candidate_pool.h"
 #include "planning/view_geometry.h"
+#include "planning/visit_order.h"
 
 namespace selfcal::planning {
 
@@ -371,36 +372,14 @@ void PlanExchange(const PlanningProblem& problem, const PlannerOptions& options,
   for (int i = 0; i < m_id; ++i) result->poses[i] = candidates[chosen[i]];
 }
 
-// Visit order of the identification poses after the reference: a short tour in the image, nearest
-// neighbour by the median displacement of the scene's dots (ImageMotionOfMove) among the poses within the
-// joint travel bound of the last one (the nearest in image motion when none is). Kept when the check
-// accepts it or the given order fails too: the session tracks the dots through every move.
+// The visit order that lets the session track the dots through every move (visit_order.h): kept when
+// the check accepts it or the given order fails too.
 void OrderAsTour(const PlanningProblem& problem, std::vector<Eigen::VectorXd>* poses) {
-  const int m_id = problem.num_identification_poses;
-  const double travel_bound = problem.constraints.max_joint_travel_rad;
-  std::vector<Eigen::VectorXd> tour = {(*poses)[0]};
-  std::vector<int> rest;
-  for (int i = 1; i < m_id; ++i) rest.push_back(i);
-  while (!rest.empty()) {
-    const Eigen::VectorXd& last = tour.back();
-    size_t best = 0;
-    double best_key = std::numeric_limits<double>::infinity();
-    for (size_t k = 0; k < rest.size(); ++k) {
-      const Eigen::VectorXd& q = (*poses)[rest[k]];
-      const bool travel_ok = (q - last).lpNorm<Eigen::Infinity>() <= travel_bound;
-      // Moves within the travel bound first (key below 1e12), then by image motion.
-      const double key = (travel_ok ? 0.0 : 1e12) + ImageMotionOfMove(problem, last, q).median_px;
-      if (key < best_key) {
-        best_key = key;
-        best = k;
-      }
-    }
-    tour.push_back((*poses)[rest[best]]);
-    rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(best));
-  }
-  std::vector<Eigen::VectorXd> reordered = *poses;
-  for (int i = 0; i < m_id; ++i) reordered[i] = tour[i];
-  if (CheckPlan(problem, reordered).ok || !CheckPlan(problem, *poses).ok) *poses = reordered;
+  const VisitOrder visit = OrderForTracking(problem, *poses);
+  std::vector<Eigen::VectorXd> reordered;
+  reordered.reserve(poses->size());
+  for (int i : visit.order) reordered.push_back((*poses)[i]);
+  if (CheckPlan(problem, reordered).ok || !CheckPlan(problem, *poses).ok) *poses = std::move(reordered);
 }
 
 }  // namespace

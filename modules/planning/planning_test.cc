@@ -13,6 +13,7 @@
 #include "planning/planner.h"
 #include "planning/planning_test_util.h"
 #include "planning/view_geometry.h"
+#include "planning/visit_order.h"
 
 namespace selfcal::planning {
 namespace {
@@ -300,6 +301,42 @@ TEST(Planning, CheckPlanForNamesTheRobotAndSaysWhatItChecked) {
   ASSERT_TRUE(HasIssue(check, PlanIssue::kJointLimit)) << check.Summary();
   EXPECT_NE(check.Summary().find("pose p02 joint 1"), std::string::npos) << check.Summary();
   EXPECT_NE(check.Summary().find("the controller's limits"), std::string::npos) << check.Summary();
+}
+
+// The shipped arc visited in a scrambled order breaks the image-motion bound (the session would lose its
+// dots); the visit order finds an order within every bound, with pose 0 first and the identification
+// poses before the verification ones, and the reordered plan passes the check.
+TEST(VisitOrder, ScrambledArcIsVisitedWithinTheImageMotionAndTravelBounds) {
+  World w = MakeWorld();
+  w.problem.constraints.max_image_motion_px = 60;
+  std::vector<int> scramble = {0};
+  for (int i = 1; i < 15; i += 2) scramble.push_back(i);   // 1 3 5 ... 13, then 14 12 ... 2
+  for (int i = 14; i > 0; i -= 2) scramble.push_back(i);
+  for (int i = 24; i >= 15; i -= 3) scramble.push_back(i);  // 24 21 18 15, 22 19 16, 23 20 17
+  for (int i = 22; i >= 15; i -= 3) scramble.push_back(i);
+  for (int i = 23; i >= 15; i -= 3) scramble.push_back(i);
+  ASSERT_EQ(scramble.size(), w.start.size());
+  std::vector<Eigen::VectorXd> poses;
+  for (int i : scramble) poses.push_back(w.start[i]);
+  const PlanCheck before = CheckPlan(w.problem, poses);
+  ASSERT_TRUE(HasIssue(before, PlanIssue::kImageMotion)) << before.Summary();
+
+  const VisitOrder visit = OrderForTracking(w.problem, poses);
+  ASSERT_EQ(visit.order.size(), poses.size());
+  EXPECT_EQ(visit.order[0], 0);
+  std::vector<int> id(visit.order.begin() + 1, visit.order.begin() + 15), ver(visit.order.begin() + 15, visit.order.end());
+  std::sort(id.begin(), id.end());
+  std::sort(ver.begin(), ver.end());
+  for (int k = 0; k < 14; ++k) EXPECT_EQ(id[k], k + 1);
+  for (int k = 0; k < 10; ++k) EXPECT_EQ(ver[k], k + 15);
+  EXPECT_EQ(visit.moves_over_bounds, 0);
+  EXPECT_LE(visit.max_image_motion_px, 60.0);
+  std::vector<Eigen::VectorXd> reordered;
+  for (int i : visit.order) reordered.push_back(poses[i]);
+  const PlanCheck after = CheckPlan(w.problem, reordered);
+  EXPECT_FALSE(HasIssue(after, PlanIssue::kImageMotion)) << after.Summary();
+  EXPECT_FALSE(HasIssue(after, PlanIssue::kJointTravel)) << after.Summary();
+  EXPECT_NEAR(after.max_image_motion_px, visit.max_image_motion_px, 1e-9);
 }
 
 }  // namespace
