@@ -3,6 +3,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <sstream>
 
 #include "io/atomic_file.h"
@@ -285,6 +286,42 @@ bool ReadPose(const yaml::YamlNode& node, const std::string& name, const RobotMo
 
 }  // namespace
 
+namespace {
+
+// The file's line of every subject ObservationSet::Validate names: "pose <id>" (the line of the id; of the
+// later one for a repeated id), "yardstick <a>-<b>" and "check distance <a>-<b>" (the entry's line).
+std::map<std::string, int> SubjectLines(const yaml::YamlNode& root, const ObservationSet& set) {
+  std::map<std::string, int> lines;
+  if (const yaml::YamlNode* poses = root.IsMap() ? root.Find("poses") : nullptr; poses && poses->IsSequence()) {
+    for (size_t i = 0; i < poses->items.size() && i < set.poses.size(); ++i) {
+      const yaml::YamlNode* id = poses->items[i].IsMap() ? poses->items[i].Find("id") : nullptr;
+      lines["pose " + set.poses[i].id] = id != nullptr ? id->line : poses->items[i].line;
+    }
+  }
+  auto distances = [&](const char* key, const char* what, const std::vector<KnownDistance>& list) {
+    const yaml::YamlNode* node = root.IsMap() ? root.Find(key) : nullptr;
+    if (node == nullptr || !node->IsSequence()) return;
+    for (size_t k = 0; k < node->items.size() && k < list.size(); ++k) {
+      lines.emplace(std::string(what) + " " + std::to_string(list[k].dot_a) + "-" + std::to_string(list[k].dot_b),
+                    node->items[k].line);
+    }
+  };
+  distances("yardsticks", "yardstick", set.yardsticks);
+  distances("check_distances", "check distance", set.check_distances);
+  return lines;
+}
+
+// The line of the subject a problem of ObservationSet::Validate starts with ("pose p03: ...",
+// "pose p03, dot 7: ...", "yardstick 0-1: ..."), or 0.
+int LineOfSubject(const std::map<std::string, int>& lines, const std::string& problem) {
+  const size_t end = problem.find_first_of(":,");
+  if (end == std::string::npos) return 0;
+  const auto it = lines.find(problem.substr(0, end));
+  return it != lines.end() ? it->second : 0;
+}
+
+}  // namespace
+
 Result<ObservationSet> ParseObservations(const yaml::YamlDocument& doc) {
   Problems problems(doc.path);
   MapReader root(doc.root, "", &problems);
@@ -352,8 +389,12 @@ Result<ObservationSet> ParseObservations(const yaml::YamlDocument& doc) {
   }
   root.Finish();
   if (problems.empty()) {
+    // The set's own checks name a pose or a distance; the file's line of that pose or distance is added.
+    const std::map<std::string, int> lines = SubjectLines(doc.root, set);
     std::istringstream invalid(set.Validate());
-    for (std::string line; std::getline(invalid, line);) problems.Add(doc.path + ": " + line);
+    for (std::string line; std::getline(invalid, line);) {
+      problems.Add((LineOfSubject(lines, line) > 0 ? problems.At(LineOfSubject(lines, line)) : doc.path) + ": " + line);
+    }
   }
   if (!problems.empty()) return problems.ToStatus("observations");
   return set;

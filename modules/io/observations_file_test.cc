@@ -1,6 +1,7 @@
 // Observations, trajectory and JSON files, and atomic writes.
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cstring>
 #include <random>
 
@@ -231,10 +232,19 @@ TEST_F(ObservationsEdits, C3DotsOutsideTheImageOrRepeated) {
   EXPECT_TRUE(Refused(Load("[1, 100.0, 20.0]", "[1, 100.0]"), "must be [dot id, u_px, v_px]"));
 }
 
-TEST_F(ObservationsEdits, SetLevelValidationNamesTheFile) {
+// The set's own checks name the file and the line of the pose or distance they refuse.
+TEST_F(ObservationsEdits, SetLevelValidationNamesTheFileAndLine) {
+  auto line_of = [this](const std::string& text) {
+    const size_t at = example_.find(text);
+    EXPECT_NE(at, std::string::npos) << text;
+    return std::to_string(1 + std::count(example_.begin(), example_.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+  };
+  const std::string yardstick = line_of("{dot_a: 0, dot_b: 2, length_mm: 250.0}");
   EXPECT_TRUE(Refused(Load("{dot_a: 0, dot_b: 2, length_mm: 250.0}", "{dot_a: 0, dot_b: 99, length_mm: 250.0}"),
-                      path_ + ": yardstick 0-99: dot 99 is never observed"));
-  EXPECT_TRUE(Refused(Load("id: v00", "id: p00"), path_ + ": pose p00: duplicate pose id"));
+                      path_ + ":" + yardstick + ": yardstick 0-99: dot 99 is never observed"));
+  EXPECT_TRUE(Refused(Load("{dot_a: 0, dot_b: 2, length_mm: 250.0}", "{dot_a: 2, dot_b: 2, length_mm: 250.0}"),
+                      path_ + ":" + yardstick + ": yardstick 2-2: both ends are the same dot"));
+  EXPECT_TRUE(Refused(Load("id: v00", "id: p00"), path_ + ":" + line_of("id: v00") + ": pose p00: duplicate pose id"));
 }
 
 TEST_F(ObservationsEdits, RobotAndRobotFile) {
