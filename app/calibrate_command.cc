@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "app/cli_output.h"
 #include "app/cli_util.h"
 #include "app/commands.h"
 #include "app/report_command.h"
@@ -13,6 +14,7 @@
 #include "io/observations_file.h"
 #include "io/report_json.h"
 #include "io/robot_config.h"
+#include "base/terminal_text.h"
 #include "report/calibration_report.h"
 #include "session/session_dir.h"
 #include "session/session_observations.h"
@@ -97,7 +99,9 @@ Result<LoadedInput> LoadInput(const CalibrateRequest& request) {
     if (Status s = CheckOutputOutsideSession(request.out_dir, request.input); !s.ok()) return s;
     Result<session::SessionObservations> session = session::LoadSessionObservations(request.input);
     if (!session.ok()) return session.status();
-    for (const std::string& finding : session->findings) std::cerr << "selfcal: warning: " << finding << "\n";
+    for (const std::string& finding : session->findings) {
+      std::cerr << "selfcal: warning: " << TerminalSafe(finding) << "\n";
+    }
     if (!session->findings.empty()) {
       std::cerr << "selfcal: warning: calibrate changed nothing in session " << request.input
                 << " (a resume would repair it)\n";
@@ -135,11 +139,13 @@ Status WriteCameraFiles(const CalibrateRequest& request, const calibration::Cali
   if (!request.write_camera_opencv.empty()) {
     if (Status s = io::SaveCameraOpenCv(report.model->camera, request.write_camera_opencv); !s.ok()) return s;
     std::cout << "camera (OpenCV): " << request.write_camera_opencv << "\n";
+    AddOutputFile("camera_opencv", request.write_camera_opencv);
   }
   if (!request.write_camera_visp.empty()) {
     const std::string name = request.camera_name.empty() ? "Camera" : request.camera_name;
     if (Status s = io::SaveCameraVisp(report.model->camera, request.write_camera_visp, name); !s.ok()) return s;
     std::cout << "camera (ViSP, camera " << name << "): " << request.write_camera_visp << "\n";
+    AddOutputFile("camera_visp", request.write_camera_visp);
   }
   return Status::Ok();
 }
@@ -160,7 +166,19 @@ Status WriteHandEye(const LoadedInput& loaded, const calibration::CalibrationRep
   const std::string path = (std::filesystem::path(out_dir) / "hand_eye.yaml").string();
   if (Status s = io::SaveHandEye(result, path); !s.ok()) return s;
   std::cout << "hand-eye result: " << path << "\n";
+  AddOutputFile("hand_eye", path);
   return Status::Ok();
+}
+
+// --json: the answer at report.json's top level (docs/report-format.md), without its per-method sections.
+void RecordCalibrationFigures(const nlohmann::json& report) {
+  nlohmann::json figures = nlohmann::json::object();
+  for (const char* key : {"method", "verdict", "accepted", "message", "reasons", "acceptance", "pixel_noise_px", "fx_px",
+                          "heldout_reprojection", "verification", "predicted_3d_error", "session"}) {
+    if (report.contains(key)) figures[key] = report[key];
+  }
+  OutputDocument()["calibration"] = figures;
+  SetOutcome(report.value("verdict", std::string()));
 }
 
 // Writes report.json, and calibrated_model.yaml (hand_eye.yaml for flange poses) when the verdict is
@@ -173,7 +191,13 @@ Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationRep
   const nlohmann::json document = report::CalibrationReportJson(loaded.observations, report, context);
   if (Status s = io::WriteJsonFile(document, report_path); !s.ok()) return s;
   std::cout << "report: " << report_path << "\n";
-  if (html) WriteHtmlBeside(document, (out / "report.html").string());
+  AddOutputFile("report", report_path);
+  RecordCalibrationFigures(document);
+  const std::string html_path = (out / "report.html").string();
+  if (html) {
+    WriteHtmlBeside(document, html_path);
+    if (std::filesystem::exists(html_path)) AddOutputFile("report_html", html_path);
+  }
   if (!report.model) return Status::Ok();
   if (loaded.observations.UsesFlangePoses()) return WriteHandEye(loaded, report, out_dir);
   io::CalibratedModel model;
@@ -189,6 +213,7 @@ Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationRep
   const std::string model_path = (out / "calibrated_model.yaml").string();
   if (Status s = io::SaveCalibratedModel(model, model_path); !s.ok()) return s;
   std::cout << "calibrated model (" << calibration::MethodName(report.method) << "): " << model_path << "\n";
+  AddOutputFile("calibrated_model", model_path);
   return Status::Ok();
 }
 
@@ -228,6 +253,7 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   options.bundle.bundle.held_parameters = request.fix;
   options.bundle.bundle.free_parameters = request.free;
   options.flange_scale_from_yardsticks = request.scale_from == "yardstick";
+  options.progress = Progress();
   calibration::CalibrationReport report = calibration::Calibrate(loaded->observations, options);
   report::PrintCalibrationSummary(report, std::cout);
   if (Status s = CheckCameraOutputs(request, report); !s.ok()) return Fail(s);
@@ -236,12 +262,14 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
     // The session's observations as a file, for other tools and for re-solving without the images.
     const std::string derived = (std::filesystem::path(request.out_dir) / "observations.yaml").string();
     if (Status s = io::SaveObservations(loaded->observations, derived); !s.ok()) return Fail(s);
+    AddOutputFile("observations", derived);
   }
   const ExitCode code = ExitCodeFor(report.verdict);
   if (Status s = WriteOutputs(*loaded, report, code, request.out_dir, request.html); !s.ok()) return Fail(s);
   if (Status s = WriteCameraFiles(request, report); !s.ok()) return Fail(s);
   if (!report.accepted()) {
-    std::cerr << "selfcal: " << ExitCodeName(code) << ": " << report.message << " (no calibrated model written)\n";
+    std::cerr << "selfcal: " << ExitCodeName(code) << ": " << TerminalSafe(report.message)
+              << " (no calibrated model written)\n";
   }
   if (from_session) PrintSummary(loaded->session->summary);
   if (run != nullptr) *run = {std::move(loaded).value().observations, std::move(report)};

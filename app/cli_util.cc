@@ -1,5 +1,7 @@
 #include "app/cli_util.h"
 
+#include "app/cli_output.h"
+
 #include <filesystem>
 #include <iostream>
 
@@ -7,6 +9,7 @@
 #include "io/trajectory_file.h"
 
 #include "base/sha256.h"
+#include "base/terminal_text.h"
 
 namespace selfcal::app {
 
@@ -19,7 +22,8 @@ std::string ResolveDataPath(const std::string& path) {
 }
 
 int Fail(const Status& status) {
-  std::cerr << "selfcal: " << status.ToString() << "\n";
+  std::cerr << "selfcal: " << TerminalSafe(status.ToString()) << "\n";
+  RecordError(status.ToString());
   return static_cast<int>(ExitCodeFor(status.code()));
 }
 

@@ -9,6 +9,7 @@
 #include <memory>
 #include <sstream>
 
+#include "app/cli_output.h"
 #include "app/cli_util.h"
 #include "app/commands.h"
 #include "base/atomic_file.h"
@@ -131,6 +132,25 @@ void PrintPerImage(const std::vector<io::NamedImage>& images, const std::vector<
   }
 }
 
+// --json: images and points, per image and in all.
+void RecordDetectFigures(const std::vector<io::NamedImage>& images, const std::vector<detection::ImagePoints>& points,
+                         const ObservationSet& set) {
+  nlohmann::json per_image = nlohmann::json::array();
+  for (size_t i = 0; i < images.size(); ++i) {
+    per_image.push_back({{"image", images[i].path},
+                         {"ok", points[i].ok},
+                         {"points", points[i].ok ? points[i].points_px.size() : 0},
+                         {"message", points[i].message}});
+  }
+  size_t total = 0;
+  for (const PoseObservation& p : set.poses) total += p.dots_px.size();
+  OutputDocument()["detect"] = {{"images", images.size()},
+                                {"images_with_points", set.poses.size()},
+                                {"points", total},
+                                {"poses", set.UsesFlangePoses() ? "flange" : "joint"},
+                                {"per_image", per_image}};
+}
+
 int DetectFromSettings(const DetectSettings& a) {
   const auto start = std::chrono::steady_clock::now();
   Result<detection::DetectionOptions> options = ToDetectionOptions(a);
@@ -170,7 +190,9 @@ int DetectFromSettings(const DetectSettings& a) {
     ids.push_back(io::FileStem((*images)[i].path));
     robot_poses.push_back({(*matched)[i].base_from_flange, (*matched)[i].joints_rad});
   }
-  const std::vector<detection::ImagePoints> points = detection::DetectAllImagePoints(pixels, *options);
+  detection::DetectionOptions detect_options = *options;
+  detect_options.progress = Progress();
+  const std::vector<detection::ImagePoints> points = detection::DetectAllImagePoints(pixels, detect_options);
   PrintPerImage(*images, points);
   Result<ObservationSet> set = detection::BuildObservationSet(ids, points, robot_poses, *setup);
   if (!set.ok()) return Fail(set.status());
@@ -197,6 +219,9 @@ int DetectFromSettings(const DetectSettings& a) {
     most = std::max(most, p.dots_px.size());
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  RecordDetectFigures(*images, points, *set);
+  AddOutputFile("observations", a.out);
+  if (!a.contact_sheet.empty()) AddOutputFile("contact_sheet", a.contact_sheet);
   std::printf("%zu of %zu images with points (%zu to %zu points each), %s poses; wrote %s%s%s (%.2f s)\n",
               set->poses.size(), images->size(), fewest, most, set->UsesFlangePoses() ? "flange" : "joint",
               a.out.c_str(), a.contact_sheet.empty() ? "" : " and ", a.contact_sheet.c_str(), seconds);

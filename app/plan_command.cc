@@ -6,12 +6,14 @@
 #include <optional>
 #include <sstream>
 
+#include "app/cli_output.h"
 #include "app/cli_util.h"
 #include "app/commands.h"
 #include "io/robot_config.h"
 #include "io/trajectory_file.h"
 #include "planning/observability.h"
 #include "planning/planner.h"
+#include "report/plan_json.h"
 #include "sim/sim_world.h"
 
 namespace selfcal::app {
@@ -204,8 +206,13 @@ int CheckOnly(const PlanArgs& args, const RobotModel& robot, const io::Trajector
     problem.constraints = file.planned_for->constraints;
     problem.num_identification_poses = file.num_identification_poses > 0 ? file.num_identification_poses
                                                                          : std::min<int>(15, file.poses.size());
-    PrintObservability(planning::AnalyzeObservability(problem, file.poses, args.noise_px), robot, std::cout);
+    const planning::ObservabilityReport observability = planning::AnalyzeObservability(problem, file.poses, args.noise_px);
+    PrintObservability(observability, robot, std::cout);
+    OutputDocument()["observability"] = report::ObservabilityJson(observability, robot);
   }
+  OutputDocument()["plan_check"] = report::PlanCheckJson(check);
+  OutputDocument()["plan_check"]["plan"] = plan_path;
+  SetOutcome(check.ok ? "plan_ok" : "plan_refused");
   std::cout << (check.ok ? "plan ok\n" : "plan refused: " + std::to_string(check.problems.size()) + " problems\n");
   return check.ok ? 0 : static_cast<int>(ExitCode::kDegenerateData);
 }
@@ -245,6 +252,7 @@ int WritePlan(const PlanArgs& args, planning::Criterion criterion, const plannin
   }
   if (Status s = io::SaveTrajectoryFile(plan, args.out); !s.ok()) return Fail(s);
   std::cout << "wrote " << args.out << "\n";
+  AddOutputFile("plan", args.out);
   return 0;
 }
 
@@ -257,13 +265,17 @@ int PlanAndWrite(const PlanArgs& args, planning::Criterion criterion, const plan
   options.seed = args.seed;
   options.pool_size = args.pool;
   options.fisher.pixel_noise_px = args.noise_px;
+  options.progress = Progress();
   const planning::PlanResult r = planning::PlanMeasurements(problem, file.poses, options);
+  OutputDocument()["plan"] = report::PlanResultJson(r);
   std::cout << "start " << plan_path << ":\n";
   PrintCheck(r.check_start, std::cout);
   if (r.repaired_poses > 0) std::cout << "  repaired: " << r.repaired_poses << " poses replaced from the pool\n";
   if (!r.ok) return Fail(Status::Error(ErrorCode::kDegenerateData, r.message));
   PrintPlanned(args, criterion, r);
-  PrintObservability(planning::AnalyzeObservability(problem, r.poses, args.noise_px), problem.robot, std::cout);
+  const planning::ObservabilityReport observability = planning::AnalyzeObservability(problem, r.poses, args.noise_px);
+  PrintObservability(observability, problem.robot, std::cout);
+  OutputDocument()["observability"] = report::ObservabilityJson(observability, problem.robot);
   return WritePlan(args, criterion, problem, plan_path, r);
 }
 

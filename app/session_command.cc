@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/cli_output.h"
 #include "app/cli_util.h"
 #include "app/commands.h"
 #include "capture/v4l2_camera.h"
@@ -23,6 +24,7 @@
 #include "io/robot_config.h"
 #include "io/trajectory_file.h"
 #include "acquisition/session_runner.h"
+#include "base/terminal_text.h"
 #include "simulation/sim_run_settings.h"
 #include "simulation/sim_session.h"
 #include "robot/manual_robot.h"
@@ -104,19 +106,23 @@ simulation::SimCellOptions SimCellOptionsFor(const RunSettings& a) {
   return simulation::SimCellOptionsFor(RunJson(a)).value();
 }
 
-// Typed confirmation before a real backend moves (R1): the operator types the robot's serial.
+// Typed confirmation before a real backend moves (R1): the operator types the robot's serial. The
+// preview holds the controller's identity text: printed escaped. With --json it goes to stderr, stdout
+// being the document's.
 bool ConfirmOnTerminal(const std::string& preview, const robot::RobotIdentity& identity, bool dry_run) {
-  std::cout << preview;
+  std::ostream& out = JsonMode() ? std::cerr : std::cout;
+  ClearProgressLine();
+  out << TerminalSafe(preview);
   if (dry_run) {
-    std::cout << "dry run: nothing moved, no command was sent to the robot\n";
+    out << "dry run: nothing moved, no command was sent to the robot\n";
     return false;
   }
   if (!identity.real_hardware) {
-    std::cout << "simulated robot: armed without confirmation\n";
+    out << "simulated robot: armed without confirmation\n";
     return true;
   }
-  std::cout << "This moves a REAL robot (" << identity.model << ", serial " << identity.serial
-            << "). Type the serial to arm, anything else to cancel: " << std::flush;
+  out << "This moves a REAL robot (" << TerminalSafe(identity.model) << ", serial " << TerminalSafe(identity.serial)
+      << "). Type the serial to arm, anything else to cancel: " << std::flush;
   std::string answer;
   if (!std::getline(std::cin, answer)) return false;
   return answer == identity.serial;
@@ -291,10 +297,14 @@ Status MakeBackends(const RunSettings& a, RunPlan* run, Backends* b) {
     if (port < 0) return Status::Error(ErrorCode::kInvalidInput, "--address must be HOST:PORT, not \"" + a.address + "\"");
     robot::NetworkRobotOptions options;  // everything checked at connect against the robot config
     options.config_limits = ManualJointLimits(run->nominal);
-    options.log = [](const std::string& line) { std::cout << line << "\n"; };
+    options.log = [](const std::string& line) {
+      ClearProgressLine();
+      std::cout << TerminalSafe(line) << "\n";
+    };
     b->owned_robot = std::make_unique<robot::NetworkRobot>(a.address.substr(0, colon), port, options);
   } else if (a.robot_backend == "manual") {
-    b->owned_robot = std::make_unique<robot::ManualRobot>(std::cin, std::cout, ManualJointLimits(run->nominal), *b->clock);
+    b->owned_robot = std::make_unique<robot::ManualRobot>(std::cin, JsonMode() ? std::cerr : std::cout,
+                                                          ManualJointLimits(run->nominal), *b->clock);
   } else {
     return Status::Error(ErrorCode::kInvalidInput, "--robot must be sim, network or manual");
   }
@@ -354,6 +364,24 @@ Status PrepareSession(const RunSettings& a, RunPlan* run, Backends* backends, Se
   return a.robot_backend == "sim" ? MakeBackends(a, run, backends) : Status::Ok();
 }
 
+// --json: what the session loop did (this run's samples, skips and faults) and the session directory.
+void RecordRunFigures(const RunSettings& a, const acquisition::RunReport& report, bool session_exists) {
+  OutputDocument()["run"] = {{"outcome", acquisition::RunOutcomeName(report.outcome)},
+                             {"message", report.message},
+                             {"session", a.session},
+                             {"first_pose", report.first_pose},
+                             {"samples_accepted", report.accepted},
+                             {"samples_skipped", report.skips},
+                             {"faults", report.faults},
+                             {"frames_grabbed", report.frames_grabbed},
+                             {"frames_tracked", report.frames_tracked},
+                             {"halt_reason", report.halt_reason.empty() ? nlohmann::json() : json(report.halt_reason)},
+                             {"dry_run", a.dry_run}};
+  const bool dry_run = a.dry_run && report.outcome == acquisition::RunOutcome::kRefused;
+  SetOutcome(dry_run ? "dry_run" : acquisition::RunOutcomeName(report.outcome));
+  if (session_exists) AddOutputFile("session", a.session);
+}
+
 // Stage 4: the session loop (acquisition::RunSession) and what it did; returns the exit code.
 // `session` is the session to continue, or null: then `create` makes it once the run can start.
 int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, session::Session* session,
@@ -381,13 +409,18 @@ int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, se
   context.confirm = [dry_run](const std::string& preview, const robot::RobotIdentity& identity) {
     return ConfirmOnTerminal(preview, identity, dry_run);
   };
-  context.log = [](const std::string& line) { std::cout << line << "\n" << std::flush; };
+  context.log = [](const std::string& line) {
+    ClearProgressLine();
+    std::cout << TerminalSafe(line) << "\n" << std::flush;
+  };
+  context.progress = Progress();
   const acquisition::RunReport report = acquisition::RunSession(run.plan, context, options);
+  RecordRunFigures(a, report, session != nullptr || created.has_value());
   if (a.dry_run && report.outcome == acquisition::RunOutcome::kRefused && report.preview.size() > 0 &&
       report.message.rfind("not confirmed", 0) == 0) {
     return 0;
   }
-  std::cout << "run: " << acquisition::RunOutcomeName(report.outcome) << ": " << report.message << "\n";
+  std::cout << "run: " << acquisition::RunOutcomeName(report.outcome) << ": " << TerminalSafe(report.message) << "\n";
   std::cout << "this run: " << report.accepted << " samples accepted from pose " << report.first_pose << ", "
             << report.frames_grabbed << " frames grabbed, " << report.frames_tracked << " tracked";
   for (const auto& [reason, n] : report.skips) std::cout << ", skipped " << reason << " x" << n;

@@ -11,6 +11,7 @@
 
 #include "app/calibrate_command.h"
 #include "app/session_command.h"
+#include "app/cli_output.h"
 #include "app/cli_util.h"
 #include "app/commands.h"
 #include "io/report_json.h"
@@ -256,9 +257,9 @@ int SimulateSession(const SimulateArgs& args) {
   const calibration::CalibrationReport& result = calibrated.report;
   const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const sim::SimResult& world = *hidden;
-  if (Status s = io::WriteJsonFile(TruthJson(world), (std::filesystem::path(args.out) / "truth.json").string()); !s.ok()) {
-    return Fail(s);
-  }
+  const std::string truth_path = (std::filesystem::path(args.out) / "truth.json").string();
+  if (Status s = io::WriteJsonFile(TruthJson(world), truth_path); !s.ok()) return Fail(s);
+  AddOutputFile("truth", truth_path);
   nlohmann::json comparison = nlohmann::json::object();
   if (result.paper.calibrated_rho.size() > 0) {
     std::cout << "\npaper pipeline vs truth:";
@@ -269,10 +270,10 @@ int SimulateSession(const SimulateArgs& args) {
   }
   comparison["seconds"] = {{"session", run_s}, {"session_and_calibration", total_s}};
   if (Status s = AddIdentityAudit(world, run.session, calibrated, &comparison); !s.ok()) return Fail(s);
-  if (Status s = io::WriteJsonFile(comparison, (std::filesystem::path(args.out) / "comparison_with_truth.json").string());
-      !s.ok()) {
-    return Fail(s);
-  }
+  const std::string comparison_path = (std::filesystem::path(args.out) / "comparison_with_truth.json").string();
+  if (Status s = io::WriteJsonFile(comparison, comparison_path); !s.ok()) return Fail(s);
+  AddOutputFile("comparison_with_truth", comparison_path);
+  OutputDocument()["comparison_with_truth"] = comparison;
   std::cout << "\nsimulated session " << run_s << " s, with the calibration " << total_s << " s; results in " << args.out
             << "/: " << std::filesystem::path(run.session).filename().string()
             << "/ (the session), observations.yaml, report.json"
@@ -332,7 +333,9 @@ Command AddSimulateCommand(CLI::App& app) {
     const std::filesystem::path out(args->out);
     const std::string obs_path = (out / "observations.yaml").string();
     if (Status s = io::SaveObservations(world.observations, obs_path); !s.ok()) return Fail(s);
+    AddOutputFile("observations", obs_path);
     if (Status s = io::WriteJsonFile(TruthJson(world), (out / "truth.json").string()); !s.ok()) return Fail(s);
+    AddOutputFile("truth", (out / "truth.json").string());
     // Calibrate from the file, as any user's data would be.
     CalibrationRun calibrated;
     CalibrateRequest request{obs_path, args->out, args->seed, MethodFromName(args->method)};
@@ -350,6 +353,8 @@ Command AddSimulateCommand(CLI::App& app) {
     }
     if (!comparison.empty()) {
       if (Status s = io::WriteJsonFile(comparison, (out / "comparison_with_truth.json").string()); !s.ok()) return Fail(s);
+      AddOutputFile("comparison_with_truth", (out / "comparison_with_truth.json").string());
+      OutputDocument()["comparison_with_truth"] = comparison;
     }
     std::cout << "results in " << args->out << "/: observations.yaml, truth.json, report.json"
               << (std::filesystem::exists(out / "report.html") ? ", report.html" : "")

@@ -2,6 +2,7 @@
 // adjustment beyond it (simulation/study.h).
 #include <iostream>
 
+#include "app/cli_output.h"
 #include "app/cli_util.h"
 #include "app/commands.h"
 #include "report/study_report.h"
@@ -72,6 +73,7 @@ Command AddStudyCommand(CLI::App& app) {
     options.with_bound = !args->no_bound;
     options.with_bundle = !args->no_bundle;
     options.sim.flat_sheet = args->flat_sheet;
+    options.progress = Progress();
     if (args->rendered) {
       options.sim.separation_dot_radius_m = options.rendered.dot_radius_m;
       // Image noise levels (grey levels on a 200/40 paper/ink contrast) and the centroid noise the solvers
@@ -86,13 +88,15 @@ Command AddStudyCommand(CLI::App& app) {
       for (double noise : args->noise) {
         if (noise <= 0) continue;
         const std::vector<simulation::BoundPoint> sweep =
-            simulation::SweepTwoViewBound(simulation::DefaultBoundGrid(noise), args->seed);
+            simulation::SweepTwoViewBound(simulation::DefaultBoundGrid(noise), args->seed, Progress());
         report::PrintBoundSweep(sweep, std::cout);
         json["bound_sweep"].push_back(report::BoundSweepJson(sweep));
       }
     }
     if (Status s = io::WriteJsonFile(json, args->out); !s.ok()) return Fail(s);
     std::cout << "JSON: " << args->out << "\n";
+    AddOutputFile("study", args->out);
+    OutputDocument()["study"] = json;  // the tables' figures, as in the file
     return 0;
   };
 }

@@ -322,7 +322,8 @@ RunReport Runner::Run() {
 
   // R4: where the arm should be before each move: the previous move's target (the reading at the start).
   Eigen::VectorXd expected = robot.joints.position_rad;
-  for (size_t r = 0; r < route.poses.size(); ++r) {
+  ProgressScope progress(c_.progress, static_cast<int64_t>(route.poses.size()), "session poses");
+  for (size_t r = 0; r < route.poses.size(); ++r, progress.Advance()) {
     const bool is_return = route.returning && r == 0;
     const Step step = is_return ? ReturnTo(route.poses[r], route.plan_index[r], &expected)
                                 : VisitPose(route.poses[r], route.plan_index[r], route.pass[r], &expected);

@@ -39,6 +39,7 @@
 #include <string>
 #include <vector>
 
+#include "base/progress.h"
 #include "capture/frame_source.h"
 #include "acquisition/dot_prediction.h"
 #include "acquisition/motion_safety.h"
@@ -168,6 +169,8 @@ struct RunContext {
   std::function<bool(const std::string& preview, const robot::RobotIdentity& robot)> confirm;
   // Progress lines for the operator (optional).
   std::function<void(const std::string& line)> log;
+  // Told the poses of this run's route done (optional), for the operator's progress line.
+  ProgressSink* progress = nullptr;
 };
 
 // Runs (or continues) the session of `plan` (see the header comment). The plan must be the one the

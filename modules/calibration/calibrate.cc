@@ -161,9 +161,14 @@ CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateO
     report.message = "the paper's method needs joint angles; these poses are flange poses (use the bundle method)";
     return report;
   }
+  // Flange poses: the start from the images, the bundle, its checks, the acceptance; joints: the paper's
+  // pipeline, the bundle (when chosen), the acceptance.
+  ProgressScope progress(options.progress, (flange_poses ? 2 : 1) + (options.method == Method::kBundle ? 1 : 0) + 1,
+                         "calibrate");
   ObservationSet prepared;
   if (flange_poses) {
     prepared = PrepareFlangePoseSet(observations, options, &report);
+    progress.Advance();
     if (options.flange_scale_from_yardsticks &&
         (observations.yardsticks.empty() || !(observations.flange_translation_sigma_m > 0))) {
       report.verdict = Verdict::kInvalidInput;
@@ -179,7 +184,10 @@ CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateO
       return report;
     }
   } else {
-    report.paper = RunPaperPipeline(observations, options.paper);
+    PaperPipelineOptions paper = options.paper;
+    paper.progress = progress.sink();
+    report.paper = RunPaperPipeline(observations, paper);
+    progress.Advance();
   }
   const ObservationSet& obs = flange_poses ? prepared : observations;
   report.verdict = VerdictFor(report.paper.outcome);
@@ -193,9 +201,12 @@ CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateO
     }
     report.verdict = VerdictFor(report.bundle->bundle.outcome);
     report.message = report.bundle->bundle.message;
+    progress.Advance();
   }
   if (flange_poses && report.bundle) CheckFlangePoses(observations, obs, options, &report);
+  if (flange_poses) progress.Advance();
   if (report.accepted()) CheckAcceptance(obs, observations, &report);
+  progress.Advance();
   if (!report.accepted()) return report;  // no model for a result that is not to be applied
   CalibratedModel model;
   if (report.bundle) {

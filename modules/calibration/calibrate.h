@@ -64,6 +64,9 @@ struct CalibrateOptions {
   // in the pose-noise bundle (a stated flange pose noise is required: exact poses fix the scale
   // themselves), for controllers whose reported translations are less consistent than a known length.
   bool flange_scale_from_yardsticks = false;
+  // Told the stages (the start, the chosen method, the checks) and, inside the paper's pipeline, its
+  // two-view pairs, for a person watching; null: nothing reported.
+  ProgressSink* progress = nullptr;
 };
 
 // The chosen method's calibrated model, ready for writing.

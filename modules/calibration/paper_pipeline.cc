@@ -122,7 +122,8 @@ void EstimatePairs(const ObservationSet& obs, const std::vector<int>& id_poses, 
   const RobotModel& robot = obs.robot;
   const int ref = id_poses.front();
   double fx_sum = 0;
-  for (size_t k = 1; k < id_poses.size(); ++k) {
+  ProgressScope progress(options.progress, static_cast<int64_t>(id_poses.size()) - 1, "two-view pairs");
+  for (size_t k = 1; k < id_poses.size(); ++k, progress.Advance()) {
     const int i = id_poses[k];
     PoseMeasurement m;
     m.pose_index = i;

@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include "base/progress.h"
 #include "identification/identifiability.h"
 #include "identification/identification.h"
 #include "identification/triangulation.h"
@@ -45,6 +46,7 @@ struct PaperPipelineOptions {
   // factor method's rotations and translations have very different accuracies from one setup to the next,
   // so fixed weights would let the worse kind dominate.
   int reweighting_rounds = 2;  // 6m > n: the paper's section 4.2 count, checked again by the rank
+  ProgressSink* progress = nullptr;  // told each pair (reference, i) of step 2 done; null: nothing reported
 };
 
 // One measured relative pose (reference -> pose), the factor method's output and the eq. (21) scale.

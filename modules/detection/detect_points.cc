@@ -161,9 +161,11 @@ std::vector<ImagePoints> DetectAllImagePoints(const std::vector<const vpImage<un
   std::vector<ImagePoints> out;
   out.reserve(images.size());
   int last_found = -1;
+  ProgressScope progress(options.progress, static_cast<int64_t>(images.size()), "detect images");
   for (const vpImage<unsigned char>* image : images) {
     out.push_back(DetectImagePoints(*image, options, last_found >= 0 ? &out[static_cast<size_t>(last_found)] : nullptr));
     if (out.back().ok) last_found = static_cast<int>(out.size()) - 1;
+    progress.Advance();
   }
   return out;
 }

@@ -26,6 +26,7 @@
 #include <Eigen/Core>
 #include <visp3/core/vpImage.h>
 
+#include "base/progress.h"
 #include "base/status.h"
 #include "detection/chessboard.h"
 #include "geometry/rigid3.h"
@@ -56,6 +57,7 @@ struct DetectionOptions {
   std::vector<Eigen::Vector2d> tag_dots_m;  // apriltag: the layout around every tag, (x, y) in its frame
   double tag_tolerance_px = 3.0;
   ChessboardOptions chessboard;  // rows and cols are taken from above
+  ProgressSink* progress = nullptr;  // DetectAllImagePoints: told each image done; null: nothing reported
 
   // Every problem, one per line (kInvalidInput).
   Status Validate() const;

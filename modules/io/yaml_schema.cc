@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <system_error>
 
+#include "base/terminal_text.h"
 #include "geometry/rigid3.h"
 
 namespace selfcal::io {
@@ -19,11 +20,12 @@ std::string FormatBound(double v) {
   return buffer;
 }
 
-// The value as written, shortened for messages.
+// The value as written, shortened for messages; a double-quoted scalar's escapes ("\e[2J", "\0") may
+// have made control characters, shown escaped (base/terminal_text.h).
 std::string Shown(const yaml::YamlNode& node) {
   if (!node.IsScalar()) return node.KindName();
   std::string text = node.scalar.size() > 40 ? node.scalar.substr(0, 37) + "..." : node.scalar;
-  return "`" + text + "`";
+  return "`" + TerminalSafe(text) + "`";
 }
 
 std::string Where(const std::string& name, const yaml::YamlNode& node, const Problems& problems) {
@@ -193,21 +195,6 @@ bool ReadDoubleList(const yaml::YamlNode& node, const std::string& name, int siz
     for (const yaml::YamlNode& item : node.items) lines->push_back(item.line);
   }
   return true;
-}
-
-int EditDistance(const std::string& a, const std::string& b) {
-  const size_t n = a.size(), m = b.size();
-  std::vector<std::vector<int>> d(n + 1, std::vector<int>(m + 1));
-  for (size_t i = 0; i <= n; ++i) d[i][0] = static_cast<int>(i);
-  for (size_t j = 0; j <= m; ++j) d[0][j] = static_cast<int>(j);
-  for (size_t i = 1; i <= n; ++i) {
-    for (size_t j = 1; j <= m; ++j) {
-      const int cost = a[i - 1] == b[j - 1] ? 0 : 1;
-      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
-      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
-    }
-  }
-  return d[n][m];
 }
 
 MapReader::MapReader(const yaml::YamlNode& node, std::string name, Problems* problems)

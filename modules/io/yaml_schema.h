@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "base/closest_name.h"
 #include "base/status.h"
 #include "yaml/yaml_reader.h"
 
@@ -79,8 +80,7 @@ bool ReadDoubleList(const yaml::YamlNode& node, const std::string& name, int siz
                     Problems* problems, std::vector<double>* out, KeyUnit unit = KeyUnit::kSi,
                     std::vector<int>* lines = nullptr);
 
-// Levenshtein distance with adjacent transpositions (optimal string alignment).
-int EditDistance(const std::string& a, const std::string& b);
+// EditDistance (Levenshtein with adjacent transpositions) is base/closest_name.h's.
 
 // Reads the keys of one map. Every key looked up through the reader is allowed; Finish() (or the
 // destructor) reports the keys nobody asked for, with a did-you-mean suggestion, and every missing

@@ -8,6 +8,7 @@
 
 #include <ceres/gradient_problem.h>
 #include <ceres/gradient_problem_solver.h>
+#include <ceres/iteration_callback.h>
 #include <ceres/jet.h>
 
 #include "base/status.h"
@@ -265,6 +266,26 @@ int RepairStart(const PlanningProblem& problem, const std::vector<Eigen::VectorX
   return replaced;
 }
 
+// One progress unit per L-BFGS iteration, at most `share` (Ceres also reports the start as iteration 0).
+class IterationProgress : public ceres::IterationCallback {
+ public:
+  IterationProgress(ProgressScope* progress, int share) : progress_(progress), share_(share) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& /*summary*/) override {
+    if (iterations_ < share_) {
+      progress_->Advance();
+      ++iterations_;
+    }
+    return ceres::SOLVER_CONTINUE;
+  }
+  // The rest of the share, when the solve stopped early.
+  void Complete() { progress_->Advance(share_ - iterations_); }
+
+ private:
+  ProgressScope* progress_;
+  int share_;
+  int iterations_ = 0;
+};
+
 void PlanEq39(const PlanningProblem& problem, const PlannerOptions& options, PlanResult* result) {
   const int n = problem.robot.num_joints(), m_id = problem.num_identification_poses;
   BarrierObjective* objective = new BarrierObjective(problem, result->poses, result->free_columns, options.lambda);
@@ -284,10 +305,17 @@ void PlanEq39(const PlanningProblem& problem, const PlannerOptions& options, Pla
   solver_options.gradient_tolerance = 1e-10;
   solver_options.parameter_tolerance = 0;
   solver_options.logging_type = ceres::SILENT;
+  // The most iterations the rounds can take; a round that converges early skips the rest of its share.
+  ProgressScope progress(options.progress, static_cast<int64_t>(options.barrier_rounds) * options.max_iterations_per_round,
+                         "planner iterations");
   for (int round = 0; round < options.barrier_rounds; ++round) {
     objective->set_mu(mu);
     ceres::GradientProblemSolver::Summary summary;
+    IterationProgress counter(&progress, options.max_iterations_per_round);
+    solver_options.callbacks = {&counter};
     ceres::Solve(solver_options, gradient_problem, x.data(), &summary);
+    solver_options.callbacks.clear();
+    counter.Complete();
     result->iterations += static_cast<int>(summary.iterations.size());
     result->solver_message = summary.message;
     mu /= options.barrier_decrease;
@@ -348,6 +376,9 @@ void PlanExchange(const PlanningProblem& problem, const PlannerOptions& options,
   };
   double best = DesignScore(options.criterion, design.Evaluate(chosen));
   ++result->evaluations;
+  // One unit per slot of a pass; a design that stops changing ends the step early.
+  ProgressScope progress(options.progress, static_cast<int64_t>(options.max_exchange_sweeps) * std::max(m_id - 1, 0),
+                         "exchange passes");
   for (int sweep = 0; sweep < options.max_exchange_sweeps; ++sweep) {
     ++result->iterations;
     bool changed = false;
@@ -366,6 +397,7 @@ void PlanExchange(const PlanningProblem& problem, const PlannerOptions& options,
       }
       chosen[slot] = best_candidate;
       changed = changed || best_candidate != current;
+      progress.Advance();
     }
     if (!changed) break;
   }

@@ -23,6 +23,7 @@
 
 #include <Eigen/Core>
 
+#include "base/progress.h"
 #include "planning/eq39.h"
 #include "planning/fisher_design.h"
 #include "planning/plan_check.h"
@@ -49,6 +50,9 @@ struct PlannerOptions {
   uint64_t seed = 1;
   int max_exchange_sweeps = 6;
   FisherDesignOptions fisher;
+  // Told the L-BFGS iterations (eq. (39)) or the exchange passes over the slots (D, A), for a person
+  // watching; null: nothing reported.
+  ProgressSink* progress = nullptr;
   std::string Validate() const;
 };
 

@@ -7,6 +7,8 @@
 #include <sstream>
 #include <utility>
 
+#include "base/terminal_text.h"
+
 namespace selfcal::robot {
 namespace {
 
@@ -28,20 +30,9 @@ std::string IdentityDifference(const RobotIdentity& expected, const RobotIdentit
   return difference;
 }
 
-// "\x1b" for ESC: every byte outside ' '..'~' escaped, so that a controller cannot drive the terminal.
-std::string Sanitised(const std::string& text) {
-  std::string out;
-  for (const unsigned char c : text) {
-    if (c >= 0x20 && c <= 0x7e) {
-      out += static_cast<char>(c);
-    } else {
-      char escaped[8];
-      std::snprintf(escaped, sizeof(escaped), "\\x%02x", c);
-      out += escaped;
-    }
-  }
-  return out;
-}
+// "\x1b" for ESC (base/terminal_text.h): control characters and invalid UTF-8 escaped, so that a
+// controller cannot drive the terminal; printable UTF-8 (a model name with accents) kept.
+std::string Sanitised(const std::string& text) { return TerminalSafe(text); }
 
 Status SanitisedStatus(const Status& status) {
   if (status.ok()) return status;

@@ -10,8 +10,9 @@
 //   - a line the protocol does not allow -> kProtocol quoting the line (a line over max_line_bytes also
 //     closes the connection);
 //   - `ERR <code>` replies -> the error the code names (line_protocol.h).
-// Text from the controller (identity, ERR texts, quoted lines) reaches messages sanitised: control bytes,
-// NUL, DEL and bytes above 0x7e (ANSI escapes among them) are written as \xNN.
+// Text from the controller (identity, ERR texts, quoted lines) reaches messages sanitised by
+// base/terminal_text.h's TerminalSafe: control characters (NUL, ESC of the ANSI sequences, CR, BEL, DEL,
+// the C1 controls) and invalid UTF-8 are written as \xNN (\u00NN), printable UTF-8 is kept.
 // A reconnect re-checks the controller's identity against the one seen at the first connection and
 // refuses a different arm with kProtocol (R10, R13), before anything else is sent.
 //

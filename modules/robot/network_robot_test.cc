@@ -419,6 +419,21 @@ TEST(NetworkRobotTest, ControllerTextIsSanitisedBeforeItReachesAMessage) {
   EXPECT_EQ(stop.message().find('\x1b'), std::string::npos);
 }
 
+// End to end through the loopback server: a controller whose identity carries an ANSI clear-screen and
+// a BEL reaches selfcal escaped (the preview prints it), its UTF-8 text unchanged.
+TEST(NetworkRobotTest, AnsiClearScreenFromTheServedControllerComesOutEscaped) {
+  SimulatedRobotOptions options = FastOptions();
+  options.identity.model = "Gr\xc3\xb6\xc3\x9f" "e 5\x1b[2J\x1b[H";
+  options.identity.calibration_id = "cal\x07 2024";
+  ServedRobot served(options);
+  NetworkRobot client("127.0.0.1", served.port(), FastClientOptions());
+  const Status connected = client.Connect();
+  ASSERT_TRUE(connected.ok()) << connected.ToString();
+  EXPECT_EQ(client.Identity()->model, "Gr\xc3\xb6\xc3\x9f" "e 5\\x1b[2J\\x1b[H");
+  EXPECT_EQ(client.Identity()->calibration_id, "cal\\x07 2024");
+  client.Disconnect();
+}
+
 TEST(NetworkRobotTest, MalformedRepliesAreProtocolErrors) {
   FakeServer server([](const std::string& request) -> std::optional<std::string> {
     if (auto handshake = FakeServer::Handshake(request)) return handshake;

@@ -45,8 +45,10 @@ std::vector<BoundSetup> DefaultBoundGrid(double sigma_px) {
   return grid;
 }
 
-std::vector<BoundPoint> SweepTwoViewBound(const std::vector<BoundSetup>& setups, uint64_t seed) {
+std::vector<BoundPoint> SweepTwoViewBound(const std::vector<BoundSetup>& setups, uint64_t seed,
+                                          ProgressSink* progress_sink) {
   std::vector<BoundPoint> out;
+  ProgressScope progress(progress_sink, static_cast<int64_t>(setups.size()), "bound sweep setups");
   for (const BoundSetup& setup : setups) {
     BoundPoint point;
     point.setup = setup;
@@ -87,6 +89,7 @@ std::vector<BoundPoint> SweepTwoViewBound(const std::vector<BoundSetup>& setups,
       point.position_m_fx_known = point.baseline_m * known.translation_dir_rms_rad();
     }
     out.push_back(point);
+    progress.Advance();
   }
   return out;
 }

@@ -11,6 +11,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "base/progress.h"
+
 namespace selfcal::simulation {
 
 struct BoundSetup {
@@ -33,7 +35,9 @@ struct BoundPoint {
   double orientation_rad_fx_known = 0, position_m_fx_known = 0;
 };
 
-std::vector<BoundPoint> SweepTwoViewBound(const std::vector<BoundSetup>& setups, uint64_t seed);
+// `progress` (optional) is told each setup done.
+std::vector<BoundPoint> SweepTwoViewBound(const std::vector<BoundSetup>& setups, uint64_t seed,
+                                          ProgressSink* progress = nullptr);
 
 // The default grid: fx {500, 1000, 2000, 4000} x spread {0.05, 0.3, 0.7} x baseline {0.1, 0.3, 0.6, 1.0},
 // then fx 300 (94 deg) at spread 0.7, baseline 0.3 and 1.0, and 800 and 8000 dots at fx 500, spread 0.7, 0.3.

@@ -284,6 +284,7 @@ StudyReport RunStudy(const RobotModel& nominal, const std::vector<TrajectorySpec
   const auto start = std::chrono::steady_clock::now();
   StudyReport study;
   study.flat_sheet = options.sim.flat_sheet;
+  ProgressScope progress(options.progress, static_cast<int64_t>(trajectories.size()) * options.runs, "study runs");
   for (const TrajectorySpec& trajectory : trajectories) {
     const size_t num_point_cells = options.noise_levels_px.size();
     std::vector<StudyCell> cells(num_point_cells + options.rendered_levels.size());
@@ -342,6 +343,7 @@ StudyReport RunStudy(const RobotModel& nominal, const std::vector<TrajectorySpec
         }
         if (options.with_bundle) ScoreBundle(world, obs, report, options, &cell, &study);
       }
+      progress.Advance();
     }
     study.cells.insert(study.cells.end(), cells.begin(), cells.end());
   }

@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 
+#include "base/progress.h"
 #include "calibration/bundle_stage.h"
 #include "calibration/paper_pipeline.h"
 #include "calibration/predicted_error.h"
@@ -51,6 +52,7 @@ struct StudyOptions {
   // dots that do not touch in any view: set sim.separation_dot_radius_m (the app does) for such rows.
   std::vector<RenderedLevel> rendered_levels;
   RenderedObservationOptions rendered;  // dot radius, detector, match radius (render noise/blur per level)
+  ProgressSink* progress = nullptr;     // the runs (trajectories x runs), for a person watching; null: none
 };
 
 // Running sample statistics.

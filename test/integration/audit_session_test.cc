@@ -21,25 +21,12 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing::ReadFile;
+using testing::WriteShortPlan;
 using testing::WriteFile;
 
 int RunSelfcal(const std::string& arguments, std::string* output) { return testing::RunSelfcal(arguments, output); }
 
 bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
-
-// The first `n` poses of the shipped PUMA arc as a plan file, the first `identify` of them identifying.
-void WriteShortPlan(const fs::path& path, int n, int identify) {
-  std::istringstream in(ReadFile(std::string(SELFCAL_SOURCE_DIR) + "/config/trajectories/initial_puma560.yaml"));
-  std::string text, line;
-  int poses = 0;
-  while (std::getline(in, line)) {
-    const bool pose = line.rfind("  - [", 0) == 0;
-    if (pose && poses++ >= n) continue;
-    if (line.rfind("poses_rad:", 0) == 0) text += "num_identification_poses: " + std::to_string(identify) + "\n";
-    text += line + "\n";
-  }
-  WriteFile(path.string(), text);
-}
 
 // Replaces the recorded input `name` of the session copy at `session` and its size and SHA-256 in
 // session.json, as if it had been recorded so.

@@ -5,9 +5,11 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <sstream>
 #include <string>
 
 #include "support/run_binary.h"
+#include "support/temp_files.h"
 
 namespace selfcal::testing {
 
@@ -24,6 +26,20 @@ inline int RunSelfcalInSource(const std::string& arguments, std::string* output 
   std::string ignored;
   return RunBinary("cd " + std::string(SELFCAL_SOURCE_DIR) + " && " + SELFCAL_BINARY, arguments,
                    output != nullptr ? output : &ignored);
+}
+
+// The first `n` poses of the shipped PUMA arc as a plan file, the first `identify` of them identifying.
+inline void WriteShortPlan(const std::filesystem::path& path, int n, int identify) {
+  std::istringstream in(ReadFile(std::string(SELFCAL_SOURCE_DIR) + "/config/trajectories/initial_puma560.yaml"));
+  std::string text, line;
+  int poses = 0;
+  while (std::getline(in, line)) {
+    const bool pose = line.rfind("  - [", 0) == 0;
+    if (pose && poses++ >= n) continue;
+    if (line.rfind("poses_rad:", 0) == 0) text += "num_identification_poses: " + std::to_string(identify) + "\n";
+    text += line + "\n";
+  }
+  WriteFile(path.string(), text);
 }
 #endif
 
