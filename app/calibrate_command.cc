@@ -61,6 +61,9 @@ void PrintSummary(const session::JournalSummary& s) {
   for (const auto& [name, n] : s.skips_by_reason) std::cout << ", skipped " << name << " x" << n;
   for (const auto& [name, n] : s.faults_by_kind) std::cout << ", fault " << name << " x" << n;
   for (const auto& [name, n] : s.halts_by_reason) std::cout << ", halted " << name << " x" << n;
+  if (s.rejected_frames > 0) {
+    std::cout << ", " << s.rejected_frames << " frames of skipped poses in images/rejected/ (not used)";
+  }
   std::cout << "\n";
 }
 

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <csignal>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <iostream>
@@ -25,6 +26,7 @@
 #include "io/trajectory_file.h"
 #include "acquisition/session_runner.h"
 #include "base/terminal_text.h"
+#include "liveview/live_view.h"
 #include "simulation/sim_run_settings.h"
 #include "simulation/sim_session.h"
 #include "robot/manual_robot.h"
@@ -150,7 +152,25 @@ struct Backends {
   acquisition::DetectionOrderIdentifier order_identifier;
   acquisition::DotIdentifier* identifier = &order_identifier;
   std::unique_ptr<acquisition::DotIdentifier> owned_identifier;  // --identify
+  std::unique_ptr<liveview::LiveView> live_view;                 // --live-view; null when off
 };
+
+// --live-view: a window showing every frame the loop looks at (liveview/live_view.h). `on` without a
+// display is refused here, before any session is touched; `auto` says only why a set $DISPLAY failed.
+Status OpenRunLiveView(const RunSettings& a, Backends* b) {
+  Result<liveview::LiveViewMode> mode = liveview::ParseLiveViewMode(a.live_view);
+  if (!mode.ok()) return mode.status();
+  liveview::LiveViewOptions options;
+  options.title = "selfcal run " + a.session;
+  options.log = [](const std::string& line) { std::cout << line << "\n" << std::flush; };
+  std::string note;
+  Result<std::unique_ptr<liveview::LiveView>> view = liveview::OpenLiveView(*mode, options, &note);
+  if (!view.ok()) return view.status();
+  b->live_view = std::move(view).value();
+  const char* display = std::getenv("DISPLAY");
+  if (!note.empty() && (b->live_view || (display != nullptr && *display != '\0'))) std::cout << note << "\n";
+  return Status::Ok();
+}
 
 // Refuses backend combinations that cannot work and fills in the default velocity scaling.
 Status CheckRunSettings(RunSettings* a) {
@@ -414,6 +434,9 @@ int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, se
     std::cout << TerminalSafe(line) << "\n" << std::flush;
   };
   context.progress = Progress();
+  if (liveview::LiveView* view = b.live_view.get()) {
+    context.observe = [view](const acquisition::FrameView& frame) { view->Show(frame); };
+  }
   const acquisition::RunReport report = acquisition::RunSession(run.plan, context, options);
   RecordRunFigures(a, report, session != nullptr || created.has_value());
   if (a.dry_run && report.outcome == acquisition::RunOutcome::kRefused && report.preview.size() > 0 &&
@@ -428,6 +451,10 @@ int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, se
   std::cout << "\nnamed by prediction: " << report.named_by_prediction << " dots, " << report.dropped_by_prediction
             << " tracked dots dropped, " << report.ambiguous_by_prediction << " ambiguous detections, "
             << report.prediction_uncorrected << " frames uncorrected\n";
+  if (b.live_view) {
+    std::cout << "live view: " << b.live_view->frames_drawn() << " frames drawn, " << b.live_view->frames_throttled()
+              << " frames of moves not redrawn (at most 15 a second)\n";
+  }
   const bool halted =
       report.outcome == acquisition::RunOutcome::kHalted || report.outcome == acquisition::RunOutcome::kInterrupted;
   if (halted && report.halt_reason.empty()) {  // before the first motion command (connect, identity, camera)
@@ -454,6 +481,7 @@ int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
   if (Status s = LoadRunPlan(a, &run); !s.ok()) return Fail(s);
   Backends backends;  // a bad --address is refused before any session is touched
   if (Status s = MakeBackends(a, &run, &backends); !s.ok()) return Fail(s);
+  if (Status s = OpenRunLiveView(a, &backends); !s.ok()) return Fail(s);
   SessionTarget target;
   if (Status s = PrepareSession(a, &run, &backends, &target); !s.ok()) return Fail(s);
   std::optional<session::Session> created;
@@ -479,6 +507,10 @@ Command AddRunCommand(CLI::App& app) {
                 "--resume: take over a lock left by a process that ended without releasing it (you confirm that "
                 "no selfcal on the host it names uses the session)");
   cmd->add_flag("--dry-run", a->dry_run, "Check the plan and print the preview; send no motion command, create nothing");
+  cmd->add_option("--live-view", a->live_view,
+                  "Show the camera image with the tracked dots, their ids and the pose in an X11 window: auto (when "
+                  "$DISPLAY can be opened), on (refused without a display), off")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   cmd->add_option("--revisit-skipped", a->revisit_skipped,
                   "--resume: visit poses skipped for too few dots, not settled, a bad frame or reading again, at "
                   "most N more times each (0: never)")

@@ -34,6 +34,7 @@ struct RunSettings {
   double grey_noise = 2.0;
   double blur_px = 0.0;
   int supersampling = 4;
+  std::string live_view = "auto";  // --live-view auto|on|off (liveview/live_view.h)
   IdentifySettings identify;  // --identify: empty is the simulator's truth, or the detection order
   std::vector<int> fault_reject_moves, fault_pstop_moves, fault_hang_moves, fault_disconnect_moves,
       fault_jog_after_moves, fault_slow_settle_moves, fault_stale_reads, fault_nan_reads, fault_short_reads;

@@ -40,6 +40,7 @@ struct SimulateArgs {
   double blur_px = 0.0;
   int supersampling = 4;
   bool no_html = false;     // --no-html: report.html not written
+  std::string live_view = "auto";  // image mode: --live-view of `selfcal run`
 };
 
 nlohmann::json TruthJson(const sim::SimResult& world) {
@@ -242,6 +243,7 @@ int SimulateSession(const SimulateArgs& args) {
   run.grey_noise = args.grey_noise;
   run.blur_px = args.blur_px;
   run.supersampling = args.supersampling;
+  run.live_view = args.live_view;
   const auto start = std::chrono::steady_clock::now();
   std::cout << "session " << run.session << ": simulated robot and rendered camera (grey noise " << args.grey_noise
             << ", blur " << args.blur_px << " px)\n";
@@ -304,6 +306,10 @@ Command AddSimulateCommand(CLI::App& app) {
   cmd->add_option("--blur-px", args->blur_px, "Image mode: Gaussian blur sigma, px")->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--supersampling", args->supersampling, "Image mode: samples per pixel side")
       ->check(CLI::Range(1, 8));
+  cmd->add_option("--live-view", args->live_view,
+                  "Image mode: show the camera image with the tracked dots, their ids and the pose in an X11 window: "
+                  "auto (when $DISPLAY can be opened), on (refused without a display), off")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   AddMethodOption(cmd, &args->method);
   return [args]() {
     if (!args->points) {
@@ -311,6 +317,10 @@ Command AddSimulateCommand(CLI::App& app) {
         return Fail(Status::Error(ErrorCode::kInvalidInput, "--flat-sheet and --perturb-gauge need --points"));
       }
       return SimulateSession(*args);
+    }
+    if (args->live_view == "on") {
+      return Fail(Status::Error(ErrorCode::kInvalidInput, "--live-view on needs image mode: the fast --points mode "
+                                                          "renders no image"));
     }
     Result<RobotAndTrajectory> loaded = LoadRobotAndTrajectory(args->robot, args->trajectory);
     if (!loaded.ok()) return Fail(loaded.status());

@@ -14,6 +14,7 @@ namespace selfcal::acquisition::internal {
 using nlohmann::json;
 
 Runner::Step Runner::VisitPose(const PlannedPose& target, int pose, bool is_return, Eigen::VectorXd* expected) {
+  StartPoseView();
   robot::JointReading before;
   if (CheckBeforeMove(pose, *expected, &before) == Step::kEnd) return Step::kEnd;
   Log("pose " + target.id + ": moving");
@@ -92,10 +93,16 @@ Runner::Step Runner::CaptureAtPose(int pose, double settle_s, Capture* capture) 
 }
 
 Runner::Step Runner::NameDots(int pose, const Capture& capture) {
+  std::set<int> carried;  // by tracking from the move; the others are named here
+  for (const tracking::PreviousDot& d : tracked_) carried.insert(d.id);
   const Step step = Identify(pose, capture.frame);
   if (step != Step::kOk) return step;
   if (c_.prediction != nullptr) NameByPrediction(capture);
   FindMarkedAgain(capture.frame);
+  for (const tracking::PreviousDot& d : tracked_) {
+    if (carried.count(d.id) == 0) named_ids_.insert(d.id);
+  }
+  if (!tracked_.empty()) Observe(capture.frame, FramePhase::kSettled, pose);
   if (tracked_.empty()) {
     return Halt(RunOutcome::kHalted, ErrorCode::kDegenerateData, "lost_track",
                 c_.prediction != nullptr ? "no dot is tracked or can be named by prediction"
@@ -149,6 +156,7 @@ Runner::Step Runner::RecordSample(int pose, const PlannedPose& target, const Arr
   if (!Record(sample)) return Step::kEnd;
   RememberSample(pose, capture.joints.position_rad, tracked_, candidates);
   ++report_.accepted;
+  Observe(frame, FramePhase::kAccepted, pose);
   Log("pose " + target.id + ": sample accepted, " + std::to_string(tracked_.size()) + " dots");
   return Step::kOk;
 }
@@ -200,7 +208,9 @@ Runner::Step Runner::Grab(int pose, double not_before_s, bool during_move, captu
       c_.clock->SleepUntil(f->exposure_time_s);  // simulated time: the frame's moment has come
       last_frame_s_ = std::max(last_frame_s_, f->exposure_time_s);
       // V5: the freshness invariant, checked, not assumed (1 ns of slack for grid times in floating point).
+      if (!during_move) pose_frames_.push_back({*f, ""});  // rejected with the pose if it is skipped
       if (!(f->exposure_time_s >= not_before - 1e-9)) {
+        if (!during_move) pose_frames_.back().reason = "stale_frame";
         if (Fault("stale_frame", pose, "frame exposed at " + std::to_string(f->exposure_time_s) + " s, before " +
                                            std::to_string(not_before) + " s") == Step::kEnd) {
           return Step::kEnd;
@@ -266,6 +276,9 @@ Runner::Step Runner::Identify(int pose, const capture::Frame& frame) {
     if (d.status == tracking::TrackStatus::kTracked) {
       next.push_back(tracking::MakePreviousDot(d.id, d.measurement));
     } else {
+      for (const tracking::PreviousDot& p : tracked_) {
+        if (p.id == d.id) lost_[d.id] = p.centroid_px;  // shown where it was last seen
+      }
       ++report_.faults[std::string("dot_") + tracking::TrackStatusName(d.status)];  // D1-D4, counted by status
     }
   }
@@ -316,6 +329,7 @@ Runner::Step Runner::Move(int pose, const robot::JointReading& from, const Eigen
     if (grabbed == Step::kEnd) return Step::kEnd;
     if (grabbed == Step::kOk) {
       if (Step s = Identify(pose, frame); s == Step::kEnd) return s;
+      Observe(frame, FramePhase::kMoving, pose);
       if (tracked_.empty() && c_.prediction == nullptr) {  // with prediction: named again once settled
         return Halt(RunOutcome::kHalted, ErrorCode::kDegenerateData, "lost_track",
                     "every dot was lost during the move: identities cannot be carried on", pose);

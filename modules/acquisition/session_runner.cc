@@ -67,7 +67,16 @@ Runner::Step Runner::Fault(const std::string& kind, int pose, const std::string&
 void Runner::Skip(int pose, const std::string& reason, const std::string& detail) {
   ++report_.skips[reason];
   Log("pose " + plan_[pose].id + " skipped: " + reason + ": " + detail);
-  Record({{"type", "sample_skipped"}, {"pose", pose}, {"reason", reason}, {"detail", detail}});
+  const std::vector<std::string> rejected = SaveRejectedFrames(pose, reason);  // their records first (P1)
+  json record = {{"type", "sample_skipped"}, {"pose", pose}, {"reason", reason}, {"detail", detail}};
+  if (!rejected.empty()) {
+    record["rejected_images"] = rejected;
+    Log("pose " + plan_[pose].id + ": " + std::to_string(rejected.size()) + " rejected frame(s) kept, first " +
+        rejected.front());
+  }
+  Record(record);
+  if (!pose_frames_.empty()) Observe(pose_frames_.back().frame, FramePhase::kSkipped, pose, reason);
+  pose_frames_.clear();
 }
 
 Runner::Step Runner::HaltOnRobotError(const Status& status, int pose, const std::string& what) {
@@ -263,6 +272,7 @@ bool Runner::JournalStart(const session::SessionLog& log, const std::vector<int>
     }
   }
   for (const auto& [image, frame] : log.frames) ++frames_written_[frame.pose];
+  for (const auto& [image, frame] : log.rejected) ++rejected_written_[frame.pose];
   return true;
 }
 
@@ -271,6 +281,7 @@ Runner::Step Runner::ReturnTo(const PlannedPose& target, int pose, Eigen::Vector
   // through a move that starts wherever the arm was left (a jog, a restart).
   std::vector<tracking::PreviousDot> at_sample;
   at_sample.swap(tracked_);
+  StartPoseView();
   robot::JointReading before;
   if (CheckBeforeMove(pose, *expected, &before) == Step::kEnd) return Step::kEnd;
   Log("pose " + target.id + ": moving");

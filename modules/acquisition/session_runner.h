@@ -30,6 +30,10 @@
 // RunOptions::revisit_skipped times each over the session: the route then starts at the accepted pose
 // before the first of them and walks the plan, passing the accepted poses on the way without recording
 // them (their moves are the plan's, so the tracker keeps the identities).
+//
+// A skipped pose keeps what it saw: every frame grabbed after settling and rejected there (the capture
+// that had too few dots, a bad reading or a moved arm, a stale frame) is written to images/rejected/ and
+// journaled (frame_rejected), and the sample_skipped record lists them (docs/session-format.md).
 #pragma once
 
 #include <atomic>
@@ -148,6 +152,38 @@ struct RunReport {
   int prediction_uncorrected = 0;  // settled frames where no correction of the predictions was found
 };
 
+// What a live view is shown of the loop (RunContext::observe): one frame, its dots and the pose.
+enum class FramePhase {
+  kMoving,    // a frame tracked during the move
+  kSettled,   // the frame exposed after settling, its dots named
+  kAccepted,  // that frame, recorded as the pose's sample
+  kSkipped,   // the last frame rejected at a pose that was skipped (FrameView::detail: the reason)
+};
+const char* FramePhaseName(FramePhase phase);  // "moving", "settled", "accepted", "skipped"
+
+enum class ViewDotState {
+  kTracked,    // carried by tracking into this frame
+  kNamed,      // named at this settled frame (first identification, prediction, a marked dot found again)
+  kLost,       // lost at this pose: its last tracked position
+  kCandidate,  // a detection on the epipolar segment of a dot seen once (never an observation)
+};
+
+struct ViewDot {
+  int id = 0;
+  Eigen::Vector2d centroid_px = Eigen::Vector2d::Zero();
+  ViewDotState state = ViewDotState::kTracked;
+};
+
+struct FrameView {
+  const capture::Frame* frame = nullptr;  // valid during the call only
+  FramePhase phase = FramePhase::kMoving;
+  int pose = 0;  // plan index
+  std::string pose_id;
+  int num_poses = 0;
+  std::vector<ViewDot> dots;
+  std::string detail;  // kSkipped: the skip reason
+};
+
 struct RunContext {
   robot::Robot* robot = nullptr;
   capture::FrameSource* camera = nullptr;
@@ -171,6 +207,9 @@ struct RunContext {
   std::function<void(const std::string& line)> log;
   // Told the poses of this run's route done (optional), for the operator's progress line.
   ProgressSink* progress = nullptr;
+  // Every frame the loop looks at, with its dots, for a live view (optional). Called on the loop's
+  // thread: it must return quickly (a view throttles its own drawing).
+  std::function<void(const FrameView& view)> observe;
 };
 
 // Runs (or continues) the session of `plan` (see the header comment). The plan must be the one the

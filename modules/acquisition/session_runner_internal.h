@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,13 @@ struct Arrival {
 struct Capture {
   capture::Frame frame;
   robot::JointReading joints;
+};
+
+// A frame grabbed after settling, kept until the pose is recorded or skipped (then written to
+// images/rejected/ with its reason: empty for the capture, which takes the skip's).
+struct RejectedFrame {
+  capture::Frame frame;
+  std::string reason;
 };
 
 // One invocation of the loop: the state shared by its steps.
@@ -128,6 +136,14 @@ class Runner {
   // Marked dots (DotIdentifier::FindMarked) that tracking lost, found again in a settled frame.
   void FindMarkedAgain(const capture::Frame& frame);
 
+  // What the operator sees of a pose (session_view.cc). A new pose: no rejected frame, lost or named dot.
+  void StartPoseView();
+  // RunContext::observe with the frame and the dots of tracked_, lost_, named_ids_ and candidates_.
+  void Observe(const capture::Frame& frame, FramePhase phase, int pose, const std::string& detail = "");
+  // The rejected frames of the pose written to images/rejected/ with their frame_rejected records; their
+  // record paths. A frame that cannot be written is a fault (counted), not a halt: it is not data.
+  std::vector<std::string> SaveRejectedFrames(int pose, const std::string& reason);
+
   const std::vector<PlannedPose>& plan_;
   RunContext c_;  // a copy: c_.session is set when the run creates its session
   const RunOptions& o_;
@@ -138,6 +154,10 @@ class Runner {
   std::optional<std::map<int, ViewedSample>> viewed_;  // AcceptedSamples, once read from the journal
   double last_frame_s_ = -std::numeric_limits<double>::infinity();
   std::map<int, int> frames_written_;  // per pose: frame_written records so far (image names)
+  std::map<int, int> rejected_written_;  // per pose: frame_rejected records so far (their names)
+  std::vector<RejectedFrame> pose_frames_;  // grabbed after settling at this pose (session_view.cc)
+  std::map<int, Eigen::Vector2d> lost_;     // dots lost at this pose: their last tracked position
+  std::set<int> named_ids_;                 // ids named (not tracked) at this pose's settled frame
 };
 
 }  // namespace selfcal::acquisition::internal

@@ -95,11 +95,13 @@ class Fields {
     if (role == "verification") return PoseRole::kVerification;
     Fail("role", "\"" + role + "\" is neither \"identification\" nor \"verification\"");
   }
-  std::string Image() const {
-    const std::string image = String("image");
-    const std::string prefix = std::string(kImagesDirName) + "/";
+  // The "image" field: "images/<name>", or with `rejected` "images/rejected/<name>".
+  std::string Image(bool rejected = false) const { return ImagePath(String("image"), rejected, "image"); }
+  std::string ImagePath(const std::string& image, bool rejected, const std::string& key) const {
+    const std::string prefix =
+        std::string(kImagesDirName) + "/" + (rejected ? std::string(kRejectedDirName) + "/" : "");
     if (image.compare(0, prefix.size(), prefix) != 0 || !internal::SafeFileName(image.substr(prefix.size()))) {
-      Fail("image", "\"" + image + "\" is not \"" + prefix + "<plain file name>\"");
+      Fail(key, "\"" + image + "\" is not \"" + prefix + "<plain file name>\"");
     }
     return image;
   }
@@ -182,11 +184,10 @@ class LogBuilder {
       AddFrame(f, index);
     } else if (type == "sample_accepted") {
       AddAccepted(f, index);
+    } else if (type == "frame_rejected") {
+      AddRejected(f, index);
     } else if (type == "sample_skipped") {
-      const int pose = Pose(f);
-      SkippedSample skip{f.String("reason"), f.OptionalString("detail"), index};
-      ++log_.skips_by_reason[skip.reason];
-      log_.skips[pose].push_back(std::move(skip));
+      AddSkipped(f, index);
     } else if (type == "fault") {
       OptionalPose(f);
       f.OptionalString("detail");
@@ -246,19 +247,58 @@ class LogBuilder {
 
   void AddFrame(const Fields& f, std::size_t index) {
     FrameWritten frame;
-    frame.pose = Pose(f);
-    frame.image = f.Image();
-    frame.crc32 = f.Crc32();
-    frame.bytes = static_cast<std::uint64_t>(f.Integer("bytes", 0, std::int64_t{1} << 40));
-    frame.exposure_time_s = f.Number("exposure_time_s");
-    frame.sequence = f.Integer("sequence", 0, std::int64_t{1} << 62);
-    frame.record = index;
-    const auto [it, inserted] = log_.frames.emplace(frame.image, frame);
+    ReadFrame(f, index, /*rejected=*/false, &frame);
+    Insert(f, frame, &log_.frames);
+  }
+
+  void AddRejected(const Fields& f, std::size_t index) {
+    FrameRejected frame;
+    ReadFrame(f, index, /*rejected=*/true, &frame);
+    frame.reason = f.String("reason");
+    Insert(f, frame, &log_.rejected);
+  }
+
+  // The fields frame_written and frame_rejected share.
+  void ReadFrame(const Fields& f, std::size_t index, bool rejected, FrameWritten* frame) const {
+    frame->pose = Pose(f);
+    frame->image = f.Image(rejected);
+    frame->crc32 = f.Crc32();
+    frame->bytes = static_cast<std::uint64_t>(f.Integer("bytes", 0, std::int64_t{1} << 40));
+    frame->exposure_time_s = f.Number("exposure_time_s");
+    frame->sequence = f.Integer("sequence", 0, std::int64_t{1} << 62);
+    frame->record = index;
+  }
+
+  // A repeat of an image's record must agree with the first.
+  template <typename Frame>
+  static void Insert(const Fields& f, const Frame& frame, std::map<std::string, Frame>* frames) {
+    const auto [it, inserted] = frames->emplace(frame.image, frame);
     if (!inserted &&
         (it->second.pose != frame.pose || it->second.crc32 != frame.crc32 || it->second.bytes != frame.bytes)) {
       f.Fail("image", frame.image + " was recorded by record " + std::to_string(it->second.record + 1) +
                           " with another pose, size or CRC");
     }
+  }
+
+  void AddSkipped(const Fields& f, std::size_t index) {
+    const int pose = Pose(f);
+    SkippedSample skip{f.String("reason"), f.OptionalString("detail"), {}, index};
+    if (f.Has("rejected_images")) {
+      const nlohmann::json& list = f.Get("rejected_images");
+      if (!list.is_array() || list.size() > 1000) f.Fail("rejected_images", "expected an array of at most 1000 images");
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        const std::string key = "rejected_images[" + std::to_string(i) + "]";
+        if (!list[i].is_string()) f.Fail(key, "expected a string");
+        const std::string image = f.ImagePath(list[i].get<std::string>(), /*rejected=*/true, key);
+        const auto frame = log_.rejected.find(image);
+        if (frame == log_.rejected.end() || frame->second.pose != pose) {
+          f.Fail(key, image + " has no earlier frame_rejected record of pose " + std::to_string(pose));
+        }
+        skip.rejected_images.push_back(image);
+      }
+    }
+    ++log_.skips_by_reason[skip.reason];
+    log_.skips[pose].push_back(std::move(skip));
   }
 
   void AddAccepted(const Fields& f, std::size_t index) {

@@ -69,10 +69,20 @@ struct AcceptedSample {
   std::size_t record = 0;
 };
 
+// frame_rejected: a frame grabbed at a pose that was then skipped, kept for the operator in
+// images/rejected/ (never an observation; readers that solve ignore it): the fields of frame_written
+// (image: "images/rejected/<name>") and why the frame was not recorded.
+struct FrameRejected : FrameWritten {
+  std::string reason;  // the pose's skip reason, or e.g. "stale_frame"
+};
+
 // sample_skipped.
 struct SkippedSample {
   std::string reason;  // e.g. "move_failed", "too_few_dots"
   std::string detail;
+  // The frames rejected at the pose before this skip ("images/rejected/<name>", each named by an
+  // earlier frame_rejected record of the same pose); optional, empty when no frame was grabbed.
+  std::vector<std::string> rejected_images;
   std::size_t record = 0;
 };
 
@@ -99,6 +109,7 @@ struct SessionLog {
   std::vector<std::optional<AcceptedSample>> accepted;  // per planned pose: its first accepted sample
   std::vector<std::vector<SkippedSample>> skips;        // per planned pose, in journal order
   std::map<std::string, FrameWritten> frames;           // by image ("images/<name>"): its frame_written
+  std::map<std::string, FrameRejected> rejected;        // by image ("images/rejected/<name>"): frame_rejected
   std::vector<std::size_t> duplicate_accepts;           // records of later sample_accepted of an accepted pose
   std::map<std::string, int> skips_by_reason;
   std::map<std::string, int> faults_by_kind;
@@ -132,7 +143,8 @@ struct SessionLog {
 // only identically; move_started.from_rad and sample_accepted.joints_rad have the plan's joint count;
 // sample_accepted repeats its pose's id and role and names an image an earlier frame_written of the same
 // pose recorded; a second frame_written of an image must agree with the first; dot ids within a sample
-// are distinct. A second sample_accepted of an accepted pose is kept out (the first counts) and listed in
+// are distinct; frame_rejected names an image under images/rejected/ (a repeat must agree), and a
+// sample_skipped's rejected_images name earlier frame_rejected records of its pose. A second sample_accepted of an accepted pose is kept out (the first counts) and listed in
 // duplicate_accepts. kInvalidInput naming the record, its type and field.
 Result<SessionLog> ReadSessionLog(const std::vector<nlohmann::json>& records);
 

@@ -40,14 +40,17 @@ Result<std::vector<fs::directory_entry>> Entries(const std::string& directory) {
   return entries;
 }
 
-// Files in images/ or orphans/ (not the temporaries of an interrupted write); directories there are foreign.
-Status CountImages(const std::string& directory, SessionDirInspection* out) {
+// Files in images/ (and its rejected/) or orphans/ (not the temporaries of an interrupted write); other
+// directories there are foreign.
+Status CountImages(const std::string& directory, SessionDirInspection* out, bool with_rejected = false) {
   if (!fs::is_directory(fs::symlink_status(directory))) return Status::Ok();
   Result<std::vector<fs::directory_entry>> entries = Entries(directory);
   if (!entries.ok()) return entries.status();
   for (const fs::directory_entry& e : *entries) {
     const std::string name = e.path().filename().string();
-    if (fs::is_directory(e.symlink_status())) {
+    if (with_rejected && name == kRejectedDirName && fs::is_directory(e.symlink_status())) {
+      if (Status s = CountImages(e.path().string(), out); !s.ok()) return s;
+    } else if (fs::is_directory(e.symlink_status())) {
       out->foreign.push_back(e.path().string());
     } else if (!IsAtomicTemporary(name)) {
       ++out->images;
@@ -109,7 +112,7 @@ Result<SessionDirInspection> InspectSessionDir(const std::string& path) {
     if (kKnown.count(name) == 0 && !IsAtomicTemporary(name)) out.foreign.push_back(e.path().string());
   }
   for (const char* dir : {kImagesDirName, kOrphansDirName}) {
-    if (Status s = CountImages(Join(path, dir), &out); !s.ok()) return s;
+    if (Status s = CountImages(Join(path, dir), &out, std::string(dir) == kImagesDirName); !s.ok()) return s;
   }
   const std::string journal = Join(path, kJournalFileName);
   if (fs::exists(fs::symlink_status(journal))) {

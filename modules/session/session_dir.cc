@@ -185,11 +185,14 @@ Result<std::vector<std::string>> ListNonDirectories(const std::string& directory
 // Moves images/<name> to orphans/<name> (or <name>.1, .2, ... when taken) without ever replacing a file:
 // link() then unlink(). A crash between the two leaves the image in both places; the next open moves the
 // images/ copy again under a new name. Returns "orphans/<chosen name>".
+// A name of UnrecordedImages: "<name>", or "rejected/<name>", which becomes "rejected_<name>" in orphans/.
 Result<std::string> MoveToOrphans(const std::string& session_path, const std::string& name) {
   const std::string from = Join(Join(session_path, kImagesDirName), name);
   const std::string orphans = Join(session_path, kOrphansDirName);
+  std::string flat = name;
+  std::replace(flat.begin(), flat.end(), '/', '_');
   for (int attempt = 0; attempt < 1000; ++attempt) {
-    const std::string chosen = attempt == 0 ? name : name + "." + std::to_string(attempt);
+    const std::string chosen = attempt == 0 ? flat : flat + "." + std::to_string(attempt);
     if (::link(from.c_str(), Join(orphans, chosen).c_str()) == 0) {
       if (::unlink(from.c_str()) != 0) return SystemError("cannot remove the orphan image", from, errno);
       return std::string(kOrphansDirName) + "/" + chosen;
@@ -216,7 +219,11 @@ Result<std::vector<std::string>> MoveOrphans(const std::string& session_path,
     moved.push_back(*target);
   }
   if (!moved.empty()) {
-    for (const std::string& directory : {images, Join(session_path, kOrphansDirName), session_path}) {
+    std::vector<std::string> touched = {images, Join(session_path, kOrphansDirName), session_path};
+    const std::string rejected = Join(images, kRejectedDirName);
+    std::error_code error;
+    if (std::filesystem::is_directory(rejected, error)) touched.insert(touched.begin(), rejected);
+    for (const std::string& directory : touched) {
       if (!FsyncDirectory(directory)) return SystemError("cannot fsync directory", directory, errno);
     }
   }
@@ -261,12 +268,21 @@ Result<std::vector<std::string>> UnrecordedImages(const std::string& session_pat
     const std::string& value = image->get_ref<const std::string&>();
     if (value.compare(0, prefix.size(), prefix) == 0) referenced.insert(value.substr(prefix.size()));
   }
-  Result<std::vector<std::string>> names = ListNonDirectories(Join(session_path, kImagesDirName));
-  if (!names.ok()) return names.status();
+  Result<std::vector<std::string>> listed = ListNonDirectories(Join(session_path, kImagesDirName));
+  if (!listed.ok()) return listed.status();
+  std::vector<std::string> names = std::move(listed).value();
+  const std::string rejected_dir = Join(Join(session_path, kImagesDirName), kRejectedDirName);
+  std::error_code error;
+  if (std::filesystem::is_directory(rejected_dir, error)) {
+    Result<std::vector<std::string>> rejected = ListNonDirectories(rejected_dir);
+    if (!rejected.ok()) return rejected.status();
+    for (const std::string& name : *rejected) names.push_back(std::string(kRejectedDirName) + "/" + name);
+  }
   std::vector<std::string> unrecorded;
-  for (const std::string& name : *names) {
+  for (const std::string& name : names) {
     if (referenced.count(name) == 0) unrecorded.push_back(name);
   }
+  std::sort(unrecorded.begin(), unrecorded.end());
   return unrecorded;
 }
 
@@ -294,6 +310,10 @@ const InputDigest* SessionManifest::FindInput(const std::string& name) const {
 }
 
 std::string ImageRecordPath(const std::string& name) { return std::string(kImagesDirName) + "/" + name; }
+
+std::string RejectedImageRecordPath(const std::string& name) {
+  return std::string(kImagesDirName) + "/" + kRejectedDirName + "/" + name;
+}
 
 std::string DeriveSessionId(const std::string& path, const std::string& created_utc) {
   std::string stamp;
@@ -455,10 +475,25 @@ Result<Session> OpenSession(const std::string& path, const SessionInputs& expect
 }
 
 Status Session::WriteImage(const std::string& name, const std::string& bytes) {
+  return WriteImageIn(Join(path_, kImagesDirName), name, bytes);
+}
+
+Status Session::WriteRejectedImage(const std::string& name, const std::string& bytes) {
+  const std::string images = Join(path_, kImagesDirName);
+  const std::string rejected = Join(images, kRejectedDirName);
+  if (::mkdir(rejected.c_str(), 0755) == 0) {
+    if (!FsyncDirectory(images)) return SystemError("cannot fsync directory", images, errno);
+  } else if (errno != EEXIST) {
+    return SystemError("cannot create directory", rejected, errno);
+  }
+  return WriteImageIn(rejected, name, bytes);
+}
+
+Status Session::WriteImageIn(const std::string& directory, const std::string& name, const std::string& bytes) {
   if (!SafeFileName(name)) {
     return Usage("session " + path_ + ": image name \"" + name + "\" is not a plain file name");
   }
-  const std::string file = Join(Join(path_, kImagesDirName), name);
+  const std::string file = Join(directory, name);
   struct stat info {};
   if (::lstat(file.c_str(), &info) == 0) {
     Result<std::string> existing = ReadFileCapped(file, bytes.size());

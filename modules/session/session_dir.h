@@ -8,6 +8,7 @@
 //   <session>/journal.log    append-only journal of every event (journal.h; record types: samples.h)
 //   <session>/inputs/<name>  read-only (0444) copies of the config, robot, plan and camera files
 //   <session>/images/<name>  one file per grabbed frame, each written atomically before its journal record
+//   <session>/images/rejected/<name>  the frames of skipped poses (kept for the operator, never observations)
 //   <session>/orphans/<name> images no durable journal record names, moved aside on open (never deleted)
 //
 // Write order of a frame (P1): WriteImage (temporary file -> fsync -> link to images/<name> -> directory
@@ -31,6 +32,7 @@ inline constexpr const char* kManifestFileName = "session.json";
 inline constexpr const char* kInputsDirName = "inputs";
 inline constexpr const char* kImagesDirName = "images";
 inline constexpr const char* kOrphansDirName = "orphans";
+inline constexpr const char* kRejectedDirName = "rejected";  // images/rejected/: frames of skipped poses
 inline constexpr std::size_t kMaxInputBytes = std::size_t{64} << 20;  // per input file
 
 // One input file of a session, e.g. {"config.yaml", <its bytes>}.
@@ -95,6 +97,9 @@ class Session {
   // are never overwritten, so a retaken frame needs a new name (e.g. "<pose id>_<sequence>.png"). kInvalidInput
   // for a name that is not a plain file name; kHardware naming the file for ENOSPC or EIO.
   Status WriteImage(const std::string& name, const std::string& bytes);
+  // The same for images/rejected/<name> (created on first use, with a directory fsync of images/): a frame
+  // grabbed at a pose that was then skipped, named by RejectedImageRecordPath(name) in its record.
+  Status WriteRejectedImage(const std::string& name, const std::string& bytes);
 
   // kHardware when the session's file system has less than `bytes_needed` bytes available to this user
   // (P5: check before each frame, then halt cleanly rather than run into ENOSPC).
@@ -105,6 +110,7 @@ class Session {
   Result<std::string> ReadInput(const std::string& name) const;
 
  private:
+  Status WriteImageIn(const std::string& directory, const std::string& name, const std::string& bytes);
   friend Result<Session> CreateSession(const std::string&, const SessionInputs&, const std::string&,
                                        const CreateOptions&);
   friend Result<Session> OpenSession(const std::string&, const SessionInputs&, bool, const JournalLimits&, bool);
@@ -169,13 +175,17 @@ Status CheckSessionLayout(const std::string& session_path);
 // session.json (recorded ...; found ...)").
 Result<std::string> ReadRecordedInput(const std::string& session_path, const InputDigest& digest);
 
-// The names of the non-directory entries of <session>/images/ that no record names (the "image" field
-// of any record, "images/<name>"), sorted: what OpenSession would move to orphans/. Changes nothing.
+// The names of the non-directory entries of <session>/images/ and <session>/images/rejected/ that no record
+// names (the "image" field of any record, "images/<name>" or "images/rejected/<name>"), as "<name>" or
+// "rejected/<name>", sorted: what OpenSession would move to orphans/ (a rejected one as
+// "orphans/rejected_<name>"). Changes nothing.
 Result<std::vector<std::string>> UnrecordedImages(const std::string& session_path,
                                                   const std::vector<nlohmann::json>& records);
 
 // "images/<name>": how journal records name an image file.
 std::string ImageRecordPath(const std::string& name);
+// "images/rejected/<name>": how journal records name a rejected frame's file.
+std::string RejectedImageRecordPath(const std::string& name);
 
 // "<created_utc without '-', ':' and '.'>-<first 8 hex digits of the SHA-256 of the absolute, normalised
 // path>", e.g. "20250301T120000Z-1a2b3c4d": deterministic, distinct for sessions created at different

@@ -22,6 +22,7 @@ JournalSummary Summarize(const SessionLog& log, const std::string& session_id) {
   summary.skips_by_reason = log.skips_by_reason;
   summary.faults_by_kind = log.faults_by_kind;
   summary.halts_by_reason = log.halts_by_reason;
+  summary.rejected_frames = static_cast<int>(log.rejected.size());
   return summary;
 }
 

@@ -22,6 +22,7 @@ struct JournalSummary {
   std::map<std::string, int> skips_by_reason;
   std::map<std::string, int> faults_by_kind;
   std::map<std::string, int> halts_by_reason;
+  int rejected_frames = 0;  // frame_rejected records: frames of skipped poses in images/rejected/, not used
 };
 
 struct SessionObservations {
