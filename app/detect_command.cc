@@ -188,7 +188,8 @@ int DetectFromSettings(const DetectSettings& a) {
   for (size_t i = 0; i < images->size(); ++i) {
     pixels.push_back(&(*images)[i].image);
     ids.push_back(io::FileStem((*images)[i].path));
-    robot_poses.push_back({(*matched)[i].base_from_flange, (*matched)[i].joints_rad});
+    robot_poses.push_back({(*matched)[i].base_from_flange, (*matched)[i].joints_rad,
+                           (*matched)[i].verification ? PoseRole::kVerification : PoseRole::kIdentification});
   }
   detection::DetectionOptions detect_options = *options;
   detect_options.progress = Progress();

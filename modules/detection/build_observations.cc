@@ -34,7 +34,7 @@ Result<ObservationSet> BuildObservationSet(const std::vector<std::string>& pose_
     }
     PoseObservation pose;
     pose.id = pose_ids[i];
-    pose.role = PoseRole::kIdentification;
+    pose.role = robot_poses[i].role;
     if (flange_set) {
       pose.base_from_flange = robot_poses[i].base_from_flange;
     } else {

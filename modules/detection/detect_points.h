@@ -83,6 +83,7 @@ std::vector<ImagePoints> DetectAllImagePoints(const std::vector<const vpImage<un
 struct ImageRobotPose {
   std::optional<Rigid3> base_from_flange;
   Eigen::VectorXd joints_rad;
+  PoseRole role = PoseRole::kIdentification;  // kVerification: held out from the solve
 };
 
 struct ObservationSetup {
@@ -94,7 +95,7 @@ struct ObservationSetup {
   bool skip_failed = false;            // leave images without points out instead of refusing the set
 };
 
-// One identification pose per image, id `pose_ids[i]`, with the image's points and robot pose: joint
+// One pose per image, id `pose_ids[i]`, role robot_poses[i].role, with the image's points and robot pose: joint
 // angles on setup.robot, or flange poses (every image, or none) on FlangePoseModel(flange_from_cam), with
 // flange_from_cam_known when it was given. An image whose detection failed is refused (kDegenerateData
 // naming the pose id and why) unless skip_failed; so is a set with no points; mixed flange and joint

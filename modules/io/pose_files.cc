@@ -4,12 +4,15 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <sstream>
 #include <system_error>
 
 #include <Eigen/Geometry>
 
+#include "base/atomic_file.h"
 #include "io/transform_yaml.h"
 #include "io/yaml_schema.h"
+#include "io/yaml_writer.h"
 #include "yaml/yaml_reader.h"
 
 namespace selfcal::io {
@@ -109,6 +112,16 @@ bool ReadListEntry(const yaml::YamlNode& node, const std::string& name, const Ro
   }
   pose->key = ImageKey(image);
   pose->source = problems->At(node.line);
+  std::string role = "identification";
+  if (map.OptionalString("role", &role) && role != "identification") {
+    if (role == "verification") {
+      pose->verification = true;
+    } else {
+      problems->Add("`" + map.Path("role") + "` = `" + role + "` at " + problems->At(map.KeyLine("role")) +
+                    " must be identification or verification");
+      ok = false;
+    }
+  }
   const bool has_flange = map.Optional("base_from_flange") != nullptr;
   const bool has_joints = node.Find("joints_deg") != nullptr || node.Find("joints_rad") != nullptr;
   if (has_flange == has_joints) {
@@ -208,6 +221,23 @@ Result<std::vector<ImagePose>> LoadPosesList(const std::string& path, const Robo
   root.Finish();
   if (!problems.empty()) return problems.ToStatus("a poses list");
   return poses;
+}
+
+Status SavePosesList(const std::vector<PosesListEntry>& entries, const std::string& path) {
+  if (entries.empty()) return Status::Error(ErrorCode::kInvalidInput, path + ": a poses list needs at least one pose");
+  std::ostringstream out;
+  out << "# Robot poses of a folder of images (docs/detect.md), for selfcal detect --poses\n"
+      << "format: " << kPosesListFormat << "\nversion: " << kPosesListVersion << "\nposes:\n";
+  for (size_t i = 0; i < entries.size(); ++i) {
+    const PosesListEntry& e = entries[i];
+    if (e.image.empty() || !e.joints_rad.allFinite() || e.joints_rad.size() == 0) {
+      return Status::Error(ErrorCode::kInvalidInput, path + ": pose " + std::to_string(i) +
+                                                         " needs an image name and finite joint angles");
+    }
+    out << "  - {image: " << YamlQuoted(e.image) << ", joints_rad: " << YamlNumberList(e.joints_rad)
+        << (e.verification ? ", role: verification" : "") << "}\n";
+  }
+  return WriteFileAtomically(path, out.str());
 }
 
 Result<std::vector<ImagePose>> LoadImagePoses(const std::string& spec, const RobotModel* robot) {

@@ -15,7 +15,9 @@
 //        poses:
 //          - {image: 0.png, base_from_flange: {xyz_m: [0.7, 0, 0.85], rotation: [[...], [...], [...]]}}
 //          - {image: 1.png, joints_deg: [0, -30, 120, 0, 45, 0]}     # or joints_rad; needs a robot
-//      (base_from_flange in any form of io/transform_yaml.h).
+//          - {image: 2.png, joints_deg: [5, -30, 120, 0, 45, 0], role: verification}
+//      (base_from_flange in any form of io/transform_yaml.h; `role`, optional: identification (default)
+//      or verification, an image held out from the solve to test the calibration).
 //
 // Images and poses are matched by ImageKey (io/file_lists.h) of their names: "franka_image-3.png" and
 // "franka_pose_rPe_3.yaml" both have the key "3". Every problem names the file (and the line and key when
@@ -46,6 +48,7 @@ struct ImagePose {
   std::string source;  // "FILE" or "FILE:LINE", for messages
   std::optional<Rigid3> base_from_flange;
   Eigen::VectorXd joints_rad;  // empty unless a poses list gave joints
+  bool verification = false;   // a poses list's `role: verification`
 };
 
 // One per-image file of form (a) or (b), told apart by its keys (`rows`, `cols` or `data`: ViSP).
@@ -53,6 +56,17 @@ Result<Rigid3> LoadPerImagePoseFile(const std::string& path);
 
 // A poses list (c). Joints are refused without `robot`; with it their count and limits are checked.
 Result<std::vector<ImagePose>> LoadPosesList(const std::string& path, const RobotModel* robot);
+
+// A poses list entry with joint angles, for SavePosesList.
+struct PosesListEntry {
+  std::string image;           // the image's file name
+  Eigen::VectorXd joints_rad;
+  bool verification = false;   // written as `role: verification`
+};
+
+// Writes a poses list (c) of joint angles (joints_rad, numbers that read back bit-identical),
+// atomically. kInvalidInput for an empty list, an empty image name or a non-finite joint.
+Status SavePosesList(const std::vector<PosesListEntry>& entries, const std::string& path);
 
 // `spec` is a directory (every *.yaml / *.yml file in it is a per-image pose file), a glob of per-image
 // pose files (`poses/pose_*.yaml`), or one poses list. Two files with one key are refused.

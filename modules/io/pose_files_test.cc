@@ -137,6 +137,34 @@ TEST(PosesList, FlangePosesAndJoints) {
   EXPECT_TRUE(MessageHas(LoadPosesList(dir.File("joints.yaml"), nullptr).status(), "need the robot's config"));
 }
 
+// SavePosesList writes what LoadPosesList reads back bit-identical, roles included; a bad role is named.
+TEST(PosesList, WrittenJointListsReadBackWithTheirRoles) {
+  TempDir dir;
+  const RobotModel puma = selfcal::testing::Puma560();
+  Eigen::VectorXd q(6);
+  q << 0.1, -0.5235987755982988, -2.0943951023931957, 1e-17, 0.7853981633974483, -0.3;
+  Eigen::VectorXd q2 = q;
+  q2[2] = -3.3;  // both within the PUMA's limits
+  const std::string path = dir.File("poses.yaml");
+  ASSERT_TRUE(SavePosesList({{"frame_000000.png", q, false}, {"frame_000001.png", q2, true}}, path).ok());
+  Result<std::vector<ImagePose>> poses = LoadPosesList(path, &puma);
+  ASSERT_TRUE(poses.ok()) << poses.status().message();
+  ASSERT_EQ(poses->size(), 2u);
+  EXPECT_EQ((*poses)[0].key, "0");
+  EXPECT_EQ((*poses)[1].key, "1");
+  EXPECT_FALSE((*poses)[0].verification);
+  EXPECT_TRUE((*poses)[1].verification);
+  for (int j = 0; j < 6; ++j) {
+    EXPECT_EQ((*poses)[0].joints_rad[j], q[j]);
+    EXPECT_EQ((*poses)[1].joints_rad[j], q2[j]);
+  }
+  EXPECT_TRUE(MessageHas(SavePosesList({}, path), "at least one pose"));
+  WriteFile(path, "format: selfcal-poses\nversion: 1\nposes:\n"
+                  "  - {image: 1.png, joints_deg: [0, -30, -120, 0, 45, 0], role: verify}\n");
+  EXPECT_TRUE(MessageHas(LoadPosesList(path, &puma).status(),
+                         "`poses[0].role` = `verify` at " + path + ":4 must be identification or verification"));
+}
+
 TEST(PosesList, BadListsNameFileLineAndKey) {
   TempDir dir;
   const RobotModel puma = selfcal::testing::Puma560();

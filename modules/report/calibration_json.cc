@@ -13,6 +13,31 @@ using nlohmann::json;
 
 bool Contains(const std::vector<int>& v, int i) { return std::find(v.begin(), v.end(), i) != v.end(); }
 
+json Vector3Json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+// A relative camera motion cam_from_reference_cam: its rotation vector and its translation (a unit
+// direction for a pair, reference plane distances for a planar view) under `translation_key`.
+json MotionJson(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation, const char* translation_key) {
+  return {{"rotvec_rad", Vector3Json(LogSO3(rotation))}, {translation_key, Vector3Json(translation)}};
+}
+
+// A pair's two-view solution, and the rival and the planes that a caller with more evidence can choose
+// between when the pair stays ambiguous (twoview/two_view.h).
+void AddTwoViewSolutions(const twoview::TwoViewReport& tv, json* row) {
+  const bool posed = tv.outcome == twoview::Outcome::kSuccess || tv.outcome == twoview::Outcome::kNoConvergence ||
+                     tv.outcome == twoview::Outcome::kAmbiguousPose || tv.outcome == twoview::Outcome::kPureRotation ||
+                     tv.outcome == twoview::Outcome::kLowDepthVariation;
+  (*row)["cam_from_reference"] = posed ? MotionJson(tv.rotation, tv.translation_direction, "translation_direction")
+                                       : json();
+  (*row)["plane_normal_in_reference_cam"] = tv.has_plane ? Vector3Json(tv.plane_normal) : json();
+  json rival;
+  if (tv.has_rival) {
+    rival = MotionJson(tv.rival_rotation, tv.rival_translation_direction, "translation_direction");
+    rival["plane_normal_in_reference_cam"] = tv.has_rival_plane ? Vector3Json(tv.rival_plane_normal) : json();
+  }
+  (*row)["rival"] = rival;
+}
+
 // A figure over no checks is absent (null), never 0.
 json VerificationSummaryJson(const calibration::VerificationSummary& v) {
   json checks = json::array();
@@ -124,6 +149,7 @@ json PoseMeasurementsJson(const calibration::PaperPipelineReport& r) {
                             {"far_point_fraction", m.two_view.far_point_fraction},
                             {"warnings", m.two_view.warnings},
                             {"refinement", m.two_view.refinement_termination}});
+    AddTwoViewSolutions(m.two_view, &measurements.back());
   }
   return measurements;
 }
@@ -275,10 +301,22 @@ json HandEyeJson(const calibration::CalibrationReport& report) {
   if (start.plane) {
     const twoview::PlanarViewsReport& p = *start.plane;
     json views = json::array();
-    for (const twoview::PlanarView& v : p.views) {
+    for (size_t k = 0; k < p.views.size(); ++k) {
+      const twoview::PlanarView& v = p.views[k];
+      const bool reference = static_cast<int>(k) == p.reference;  // its own normal is the plane's, above
       json view = {{"ok", v.ok}, {"resolved", v.resolved}, {"message", v.message}, {"has_rival", v.has_rival}};
       view["normal_error_rad"] = v.ok ? json(v.normal_error_rad) : json();
       view["rival_normal_error_rad"] = v.has_rival ? json(v.rival_normal_error_rad) : json();
+      view["normal_in_reference_cam"] = v.ok && !reference ? Vector3Json(v.normal_in_ref) : json();
+      view["cam_from_reference"] =
+          v.ok ? MotionJson(v.cam_from_ref.rotation, v.cam_from_ref.translation, "translation_plane_distances") : json();
+      // The rival of a view the plane did not resolve: the other physical decomposition of its homography.
+      view["rival"] = json();
+      if (v.ok && v.has_rival && !v.resolved) {
+        view["rival"] = MotionJson(v.rival_cam_from_ref.rotation, v.rival_cam_from_ref.translation,
+                                   "translation_plane_distances");
+        view["rival"]["normal_in_reference_cam"] = Vector3Json(v.rival_normal_in_ref);
+      }
       views.push_back(view);
     }
     const Eigen::Vector3d& n = p.normal_in_ref;

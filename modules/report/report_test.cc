@@ -157,6 +157,52 @@ TEST(CalibrationReport, AbsentFiguresAreNullNotZero) {
   EXPECT_EQ(text.str().find("held-out distances"), std::string::npos) << text.str();
 }
 
+// A flat target recorded with flange poses: the planar start's views carry their plane normal and their
+// motion from the reference camera (against the truth), and a rival exactly when the plane left a view
+// unresolved.
+TEST(CalibrationReport, PlanarViewsCarryTheirNormalMotionAndUnresolvedRival) {
+  const sim::SimResult world = testing::PumaArcWorld(0.2, 3, 3, /*flat_sheet=*/true);
+  ObservationSet obs = world.observations;
+  obs.robot = FlangePoseModel(Rigid3());
+  obs.flange_from_cam_known = false;
+  for (PoseObservation& pose : obs.poses) {
+    pose.base_from_flange = BaseFromFlange(world.truth.nominal, world.truth.rho_true, pose.joints_rad);
+    pose.joints_rad.resize(0);
+  }
+  const calibration::CalibrationReport report = calibration::Calibrate(obs, {});
+  const nlohmann::json j = CalibrationReportJson(obs, report, {});
+  const nlohmann::json& plane = j.at("hand_eye").at("start").at("plane");
+  ASSERT_TRUE(plane.at("ok").get<bool>()) << plane.dump(1);
+  const std::vector<int> poses = obs.PosesWithRole(PoseRole::kIdentification);
+  int reference = -1;
+  for (size_t k = 0; k < poses.size(); ++k) {
+    if (obs.poses[poses[k]].id == plane.at("reference_pose")) reference = poses[k];
+  }
+  ASSERT_GE(reference, 0);
+  const auto vec = [](const nlohmann::json& a) { return Eigen::Vector3d(a[0], a[1], a[2]); };
+  const Eigen::Vector3d consensus = vec(plane.at("normal_in_reference_cam"));
+  const nlohmann::json& views = plane.at("views");
+  ASSERT_EQ(views.size(), poses.size());
+  for (size_t k = 0; k < views.size(); ++k) {
+    const nlohmann::json& v = views[k];
+    if (!v.at("ok").get<bool>()) continue;
+    if (poses[k] == reference) {
+      EXPECT_TRUE(v.at("normal_in_reference_cam").is_null());
+      continue;
+    }
+    EXPECT_LT(std::acos(std::min(1.0, vec(v.at("normal_in_reference_cam")).dot(consensus))), DegToRad(5)) << k;
+    const Eigen::Matrix3d truth =
+        (world.truth.base_from_cam[poses[k]].Inverse() * world.truth.base_from_cam[reference]).rotation;
+    const Eigen::Matrix3d reported = ExpSO3<double>(vec(v.at("cam_from_reference").at("rotvec_rad")));
+    EXPECT_LT(LogSO3(truth.transpose() * reported).norm(), DegToRad(1)) << "view " << k;
+    EXPECT_EQ(v.at("rival").is_null(), v.at("resolved").get<bool>() || !v.at("has_rival").get<bool>()) << k;
+    if (!v.at("rival").is_null()) {
+      EXPECT_EQ(v.at("rival").at("normal_in_reference_cam").size(), 3u);
+      EXPECT_EQ(v.at("rival").at("translation_plane_distances").size(), 3u);
+    }
+  }
+}
+
 // The paper's Table 2 comes from the literature table, as printed there.
 TEST(Literature, Table2RowsAsPrinted) {
   ASSERT_EQ(MengZhuang2001Table2().size(), 4u);

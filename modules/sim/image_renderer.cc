@@ -252,6 +252,11 @@ DotScene MakeDotScene(const SimTruth& truth, double radius_m) {
   DotScene scene;
   scene.radius_m = radius_m;
   scene.centres_in_base = truth.dots_in_base;
+  if (!truth.dot_radius_scale.empty()) {
+    SELFCAL_CHECK(truth.dot_radius_scale.size() == truth.dots_in_base.size(),
+                  truth.dot_radius_scale.size() << " radius scales for " << truth.dots_in_base.size() << " dots");
+    for (double scale : truth.dot_radius_scale) scene.radii_m.push_back(scale * radius_m);
+  }
   for (const Eigen::Vector3d& p : truth.dots_in_base) {
     Eigen::Vector3d towards = Eigen::Vector3d::Zero();
     for (const Rigid3& c : truth.base_from_cam) towards += (c.translation - p).normalized();
@@ -288,10 +293,12 @@ RenderedImage RenderDots(const CameraIntrinsics& camera, const Rigid3& base_from
     SELFCAL_CHECK(scene.normals_in_base.size() == scene.centres_in_base.size(),
                   scene.normals_in_base.size() << " normals for " << scene.centres_in_base.size() << " dots");
     SELFCAL_CHECK(std::isfinite(scene.radius_m) && scene.radius_m > 0, "dot radius " << scene.radius_m);
+    SELFCAL_CHECK(scene.radii_m.empty() || scene.radii_m.size() == scene.centres_in_base.size(),
+                  scene.radii_m.size() << " radii for " << scene.centres_in_base.size() << " dots");
+    for (double r : scene.radii_m) SELFCAL_CHECK(std::isfinite(r) && r > 0, "dot radius " << r);
   }
   const int width = camera.width_px, height = camera.height_px;
   const Rigid3 cam_from_base = base_from_cam.Inverse();
-  const double r = scene.radius_m;
 
   RenderedImage out;
   out.dots.resize(scene.centres_in_base.size());
@@ -301,6 +308,7 @@ RenderedImage RenderDots(const CameraIntrinsics& camera, const Rigid3& base_from
 
   for (size_t d = 0; d < out.dots.size(); ++d) {
     out.dots[d].id = static_cast<int>(d);
+    const double r = scene.RadiusOf(d);
     const Eigen::Vector3d c = cam_from_base * scene.centres_in_base[d];
     const Eigen::Vector3d n = (cam_from_base.rotation * scene.normals_in_base[d]).normalized();
     Eigen::Vector3d e1, e2;

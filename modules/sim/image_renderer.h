@@ -47,11 +47,14 @@ struct DotScene {
   std::vector<Eigen::Vector3d> centres_in_base;  // dot id = index
   std::vector<Eigen::Vector3d> normals_in_base;  // unit, one per dot
   double radius_m = kDefaultDotRadiusM;
+  std::vector<double> radii_m;  // per dot when not empty (a grid's larger origin dot); else radius_m for all
+  double RadiusOf(size_t d) const { return radii_m.empty() ? radius_m : radii_m[d]; }
 };
 
 // The scene of `truth`: every disc's normal is the normalised mean of the unit vectors from the dot to
 // the camera centres of truth.base_from_cam (a dot sticker placed to face the cameras). A flat sheet
-// therefore gets nearly (not exactly) parallel normals.
+// therefore gets nearly (not exactly) parallel normals. With truth.dot_radius_scale, dot d's radius is
+// radius_m times its scale (radii_m).
 DotScene MakeDotScene(const SimTruth& truth, double radius_m = kDefaultDotRadiusM);
 
 struct RenderOptions {

@@ -82,6 +82,24 @@ TEST(ImageRenderer, FrontoParallelDiscCentroidIsTheProjectedCentre) {
   std::printf("fronto-parallel: worst supersample centroid error %.5f px\n", worst_sample);
 }
 
+// Per-dot radii (a grid's larger origin dot): each disc has its own area, exactly.
+TEST(ImageRenderer, PerDotRadiiScaleEachDiscsArea) {
+  const CameraIntrinsics camera;
+  DotScene scene;
+  scene.centres_in_base = {Eigen::Vector3d(-0.05, 0, 0.6), Eigen::Vector3d(0.05, 0, 0.6)};
+  scene.normals_in_base = {-Eigen::Vector3d::UnitZ(), -Eigen::Vector3d::UnitZ()};
+  scene.radius_m = 0.004;
+  scene.radii_m = {1.6 * 0.004, 0.004};
+  const RenderedImage out = RenderDots(camera, Rigid3(), scene, Clean(), 1);
+  for (int d = 0; d < 2; ++d) {
+    const double radius_px = camera.fx_px * scene.radii_m[d] / 0.6;
+    EXPECT_NEAR(out.dots[d].area_px2, kPi * radius_px * radius_px, 1e-9 * out.dots[d].area_px2) << d;
+  }
+  EXPECT_NEAR(out.dots[0].sample_area_px2 / out.dots[1].sample_area_px2, 1.6 * 1.6, 0.02);
+  scene.radii_m = {0.004};
+  EXPECT_THROW(RenderDots(camera, Rigid3(), scene, Clean(), 1), std::exception);
+}
+
 TEST(ImageRenderer, TiltedDiscShowsThePerspectiveBias) {
   const CameraIntrinsics camera;
   // On the optical axis at z = 0.5 m, tilted by alpha about x: the closed form of image_renderer.h gives

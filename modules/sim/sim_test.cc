@@ -142,12 +142,57 @@ TEST(Sim, FlatSheetPutsEveryDotOnOnePlaneInViewOfEveryPose) {
   EXPECT_GT(std::abs(normal.dot(axis.normalized())), 1 - 1e-9);
 }
 
+// A flat sheet laid out as a modified circle grid: ids row * cols + col on the spacing, seen from the
+// printed side (col x row towards every camera), the origin dot larger, the diagonal the yardstick; a
+// grid too large for the views is refused by name.
+TEST(Sim, FlatSheetGridIsTheModifiedCircleGridSeenFromItsPrintedSide) {
+  const RobotModel puma = testing::Puma560();
+  SimOptions options;
+  options.pixel_noise_px = 0.0;
+  options.flat_sheet = true;
+  options.sheet_grid.rows = 6;
+  options.sheet_grid.cols = 8;
+  options.sheet_grid.spacing_m = 0.02;
+  const SimResult world = Simulate(puma, ArcTrajectory(puma), options);
+  ASSERT_TRUE(world.ok) << world.message;
+  const std::vector<Eigen::Vector3d>& dots = world.truth.dots_in_base;
+  ASSERT_EQ(dots.size(), 48u);
+  const Eigen::Vector3d col = (dots[1] - dots[0]) / 0.02, row = (dots[8] - dots[0]) / 0.02;
+  EXPECT_NEAR(col.norm(), 1, 1e-12);
+  EXPECT_NEAR(row.norm(), 1, 1e-12);
+  EXPECT_NEAR(col.dot(row), 0, 1e-12);
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 8; ++c) {
+      EXPECT_LT((dots[r * 8 + c] - (dots[0] + 0.02 * (c * col + r * row))).norm(), 1e-12) << r << ", " << c;
+    }
+  }
+  for (const Rigid3& cam : world.truth.base_from_cam) {
+    EXPECT_GT(col.cross(row).dot((cam.translation - dots[0]).normalized()), 0.5);  // facing the camera
+  }
+  ASSERT_EQ(world.truth.dot_radius_scale.size(), 48u);
+  EXPECT_EQ(world.truth.dot_radius_scale[0], options.sheet_grid.origin_radius_scale);
+  EXPECT_EQ(world.truth.dot_radius_scale[47], 1.0);
+  ASSERT_EQ(world.observations.yardsticks.size(), 1u);
+  EXPECT_EQ(world.observations.yardsticks[0].dot_b, 47);
+  EXPECT_NEAR(world.observations.yardsticks[0].length_m, 0.02 * std::hypot(7, 5), 1e-12);
+  EXPECT_EQ(world.observations.Validate(), "");
+
+  options.sheet_grid.spacing_m = 0.2;
+  const SimResult too_large = Simulate(puma, ArcTrajectory(puma), options);
+  EXPECT_FALSE(too_large.ok);
+  EXPECT_NE(too_large.message.find("the 6 x 8 grid of 200 mm does not fit in every view"), std::string::npos)
+      << too_large.message;
+}
+
 TEST(Sim, RefusesImpossibleSetups) {
   const RobotModel puma = testing::Puma560();
   std::vector<Eigen::VectorXd> joints = ArcTrajectory(puma);
   SimOptions options;
   options.num_dots = 5;
   EXPECT_FALSE(Simulate(puma, joints, options).ok);
+  options = SimOptions();
+  options.sheet_grid.rows = options.sheet_grid.cols = 4;  // a grid needs flat_sheet
+  EXPECT_NE(Simulate(puma, joints, options).message.find("sheet_grid needs flat_sheet"), std::string::npos);
   options = SimOptions();
   joints[4][1] = DegToRad(-80);  // beyond joint 2's -45 deg limit
   const SimResult r = Simulate(puma, joints, options);

@@ -21,7 +21,18 @@ std::string SimOptions::Validate() const {
   non_negative(fx_relative_error_std, "fx_relative_error_std");
   non_negative(pixel_noise_px, "pixel_noise_px");
   if (!(fx_nominal_px > 0)) out << "fx_nominal_px = " << fx_nominal_px << " must be > 0\n";
-  if (num_dots < 8) out << "num_dots = " << num_dots << " must be >= 8\n";
+  if (sheet_grid.rows > 0 || sheet_grid.cols > 0) {
+    if (!flat_sheet) out << "sheet_grid needs flat_sheet\n";
+    if (sheet_grid.rows < 2 || sheet_grid.cols < 2 || sheet_grid.rows * sheet_grid.cols < 8) {
+      out << "sheet_grid " << sheet_grid.rows << " x " << sheet_grid.cols << " must have rows, cols >= 2 and >= 8 dots\n";
+    }
+    if (!(sheet_grid.spacing_m > 0) || !std::isfinite(sheet_grid.spacing_m)) out << "sheet_grid.spacing_m must be > 0\n";
+    if (!(sheet_grid.origin_radius_scale >= 1) || !std::isfinite(sheet_grid.origin_radius_scale)) {
+      out << "sheet_grid.origin_radius_scale must be finite and >= 1\n";
+    }
+  } else if (num_dots < 8) {
+    out << "num_dots = " << num_dots << " must be >= 8\n";
+  }
   if (!(yardstick_length_m > 0)) out << "yardstick_length_m must be > 0\n";
   if (num_identification_poses < 2) out << "num_identification_poses must be >= 2\n";
   non_negative(separation_dot_radius_m, "separation_dot_radius_m");
@@ -119,7 +130,9 @@ class ScenePlacer {
   }
 
   void Place(const Eigen::Vector3d& centre) {
-    if (options_.flat_sheet) {
+    if (options_.HasSheetGrid()) {
+      PlaceGrid(centre);
+    } else if (options_.flat_sheet) {
       PlaceOnSheet(centre);
     } else {
       PlaceInVolume(centre);
@@ -176,16 +189,43 @@ class ScenePlacer {
     for (auto& view : placed_) view.clear();
   }
 
-  void PlaceOnSheet(const Eigen::Vector3d& centre) {
-    std::uniform_real_distribution<double> uniform(-kHalfSize, kHalfSize);
-    int tries = 0;
-    // The sheet's in-plane axes e1, e2 (orthonormal, perpendicular to the mean optical axis n).
+  // The sheet's in-plane axes e1, e2: orthonormal, perpendicular to the mean optical axis n, e1 x e2 = n.
+  void SheetAxes(Eigen::Vector3d* e1, Eigen::Vector3d* e2) const {
     Eigen::Vector3d n = Eigen::Vector3d::Zero();
     for (const Rigid3& c : truth_.base_from_cam) n += c.rotation.col(2);
     n.normalize();
     const Eigen::Vector3d helper = std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-    const Eigen::Vector3d e1 = n.cross(helper).normalized();
-    const Eigen::Vector3d e2 = n.cross(e1);
+    *e1 = n.cross(helper).normalized();
+    *e2 = n.cross(*e1);
+  }
+
+  // The grid centred on `centre`: +col along e1, +row along -e2, so that col x row = -n points from the
+  // sheet towards the cameras (the printed face's normal). All or nothing: a dot out of any view clears it.
+  void PlaceGrid(const Eigen::Vector3d& centre) {
+    Eigen::Vector3d e1, e2;
+    SheetAxes(&e1, &e2);
+    const SimOptions::SheetGrid& g = options_.sheet_grid;
+    const Eigen::Vector3d col_step = g.spacing_m * e1, row_step = -g.spacing_m * e2;
+    const Eigen::Vector3d origin = centre - 0.5 * (g.cols - 1) * col_step - 0.5 * (g.rows - 1) * row_step;
+    for (int row = 0; row < g.rows; ++row) {
+      for (int col = 0; col < g.cols; ++col) {
+        const Eigen::Vector3d p = origin + col * col_step + row * row_step;
+        if (!VisibleEverywhere(p)) {
+          truth_.dots_in_base.clear();
+          return;
+        }
+        Record(p);
+      }
+    }
+    truth_.dot_radius_scale.assign(truth_.dots_in_base.size(), 1.0);
+    truth_.dot_radius_scale[0] = g.origin_radius_scale;
+  }
+
+  void PlaceOnSheet(const Eigen::Vector3d& centre) {
+    std::uniform_real_distribution<double> uniform(-kHalfSize, kHalfSize);
+    int tries = 0;
+    Eigen::Vector3d e1, e2;
+    SheetAxes(&e1, &e2);
     auto on_sheet = [&](double u, double v) { return Eigen::Vector3d(centre + u * e1 + v * e2); };
     std::mt19937_64& rng = rng_;
     std::normal_distribution<double>& gauss = gauss_;
@@ -272,15 +312,26 @@ SimResult Simulate(const RobotModel& nominal, const std::vector<Eigen::VectorXd>
   for (const Eigen::VectorXd& q : trajectory) truth.base_from_cam.push_back(BaseFromCam(nominal, truth.rho_true, q));
 
   ScenePlacer(options, &truth, &rng, &gauss).Place(ConvergencePoint(truth.base_from_cam));
-  if (static_cast<int>(truth.dots_in_base.size()) < options.num_dots) {
-    result.message = "could not place " + std::to_string(options.num_dots) +
-                     " dots in view of every pose: the views share too little of the scene";
+  const bool grid = options.HasSheetGrid();
+  const int num_dots = grid ? options.sheet_grid.rows * options.sheet_grid.cols : options.num_dots;
+  if (static_cast<int>(truth.dots_in_base.size()) < num_dots) {
+    std::ostringstream m;
+    if (grid) {
+      m << "the " << options.sheet_grid.rows << " x " << options.sheet_grid.cols << " grid of "
+        << 1e3 * options.sheet_grid.spacing_m << " mm does not fit in every view (margin " << options.image_margin_px
+        << " px): choose fewer dots or a smaller spacing";
+    } else {
+      m << "could not place " << num_dots << " dots in view of every pose: the views share too little of the scene";
+    }
+    result.message = m.str();
     return result;
   }
 
   result.observations.camera = truth.camera_true;
   result.observations.camera.fx_px = options.fx_nominal_px;
-  result.observations.yardsticks = {{0, 1, options.yardstick_length_m}};
+  const int far_end = grid ? num_dots - 1 : 1;
+  result.observations.yardsticks = {
+      {0, far_end, grid ? (truth.dots_in_base[0] - truth.dots_in_base[far_end]).norm() : options.yardstick_length_m}};
   result.observations.check_distances = CheckPairs(truth.dots_in_base);
   result.observations = Observe(result, trajectory, options.pixel_noise_px, options.noise_seed,
                                 options.num_identification_poses);

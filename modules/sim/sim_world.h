@@ -42,6 +42,21 @@ struct SimOptions {
   // look at, facing the mean viewing direction (normal = mean optical axis), still in view of every
   // pose. The paper's factor method is degenerate there; the kinematic bundle adjustment is not.
   bool flat_sheet = false;
+  // With flat_sheet and rows, cols > 0: the dots on a rows x cols grid of `spacing_m` instead of at
+  // random (num_dots is ignored: rows * cols dots), centred where the cameras look, dot (row, col) with
+  // id row * cols + col as tracking/grid_identity.h names a modified circle grid seen from its printed
+  // side (+col, +row and the face towards the cameras a right-handed frame); the origin dot 0 is drawn
+  // origin_radius_scale times larger (SimTruth::dot_radius_scale), the grid's orientation marker. The
+  // yardstick is then dots 0 and rows * cols - 1 (the diagonal). Fails when the grid does not fit in
+  // every view.
+  struct SheetGrid {
+    int rows = 0;
+    int cols = 0;
+    double spacing_m = 0.015;
+    double origin_radius_scale = 1.6;  // area x 2.56: above grid_identity's min_origin_area_ratio of 2
+  };
+  SheetGrid sheet_grid;
+  bool HasSheetGrid() const { return flat_sheet && sheet_grid.rows > 0 && sheet_grid.cols > 0; }
   // Rendered sessions: the dots are discs of this radius (m), and in every view the rims of any two
   // projected discs (radius fx * r / depth) stay at least min_rim_gap_diameters of the larger projected
   // diameter apart, so that a blob detector and a tracker can keep them apart (0 = no spacing rule,
@@ -60,6 +75,7 @@ struct SimTruth {
   CameraIntrinsics camera_true;             // hidden f_x
   std::vector<Eigen::Vector3d> dots_in_base;  // dot id = index
   std::vector<Rigid3> base_from_cam;        // true camera pose per pose
+  std::vector<double> dot_radius_scale;     // per dot, of the rendered radius; empty: 1 for every dot
 };
 
 struct SimResult {

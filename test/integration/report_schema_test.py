@@ -3,12 +3,14 @@
 
 Runs the selfcal binary as a user would: `simulate --points` (bundle, accepted), `calibrate --method paper`
 on its observations (paper, accepted), `calibrate --camera-file` with the principal point and the lens freed
-(bundle, accepted), and `calibrate` on a file with too few poses (exit 3, not accepted, no model), then validates every report.json with python3-jsonschema and checks the rules the
+(bundle, accepted), `simulate --points --flat-sheet` (bundle, accepted; the ambiguous planar pairs' rival
+solutions and plane normals reported, one of each pair's two normals the resolved pairs' plane), and `calibrate` on a file with too few poses (exit 3, not accepted, no model), then validates every report.json with python3-jsonschema and checks the rules the
 schema cannot state: the top level repeats the chosen method's figures, and no key carries mm or degrees.
 
   report_schema_test.py SELFCAL_BINARY SOURCE_DIR
 """
 import json
+import math
 import os
 import subprocess
 import sys
@@ -51,6 +53,28 @@ def check(report_path, schema, expect_method, expect_accepted, failures):
         if k.endswith(("_mm", "_deg")):
             failures.append(f"{report_path}: key {k} is not SI")
     return report
+
+
+def angle(a, b):
+    dot = sum(x * y for x, y in zip(a, b)) / math.sqrt(sum(x * x for x in a) * sum(y * y for y in b))
+    return math.degrees(math.acos(max(-1.0, min(1.0, dot))))
+
+
+def check_flat_pairs(report, failures):
+    pairs = report.get("methods", {}).get("paper", {}).get("pose_measurements", [])
+    ambiguous = [m for m in pairs if m.get("outcome") == "ambiguous_pose"]
+    resolved = [m["plane_normal_in_reference_cam"] for m in pairs
+                if m.get("outcome") == "success" and m.get("plane_normal_in_reference_cam")]
+    if not ambiguous or not resolved:
+        failures.append(f"flat sheet: {len(ambiguous)} ambiguous and {len(resolved)} resolved planar pairs, expected both")
+        return
+    for m in ambiguous:
+        rival = m.get("rival") or {}
+        normals = [m.get("plane_normal_in_reference_cam"), rival.get("plane_normal_in_reference_cam")]
+        if None in normals or not rival.get("rotvec_rad") or not rival.get("translation_direction"):
+            failures.append(f"flat sheet: ambiguous pair {m.get('pose')} lacks its rival or a plane normal")
+        elif min(angle(n, resolved[0]) for n in normals) > 2.0:
+            failures.append(f"flat sheet: neither plane of pair {m.get('pose')} is the resolved pairs' plane")
 
 
 def main():
@@ -98,6 +122,14 @@ def main():
                 failures.append(f"lens report: estimated intrinsics {estimated}")
             if (report.get("input", {}).get("camera_file") or {}).get("path") != camera_file:
                 failures.append("lens report: input.camera_file does not name the camera file")
+            # A flat dot sheet: the paper pipeline's planar pairs stay ambiguous; each reports both solutions'
+            # plane normals in the reference camera, and one of the two is the plane every pair sees.
+            flat = os.path.join(tmp, "flat")
+            code, out = run(binary, ["simulate", "--points", "--flat-sheet", "--seed", "2", "--out", flat], source)
+            if code != 0:
+                failures.append(f"simulate --flat-sheet exited {code}: {out[-2000:]}")
+            else:
+                check_flat_pairs(check(os.path.join(flat, "report.json"), schema, "bundle", True, failures), failures)
             # Too few poses: exit 3, a report that says why, no model.
             with open(os.path.join(sim, "observations.yaml")) as f:
                 observations = yaml.safe_load(f)
@@ -116,7 +148,7 @@ def main():
                 failures.append("a model was written for a result that was not accepted")
     for f in failures:
         print("FAIL:", f)
-    print(f"report schema: {len(failures)} problem(s) in 4 reports" if failures else "report schema: 4 reports valid")
+    print(f"report schema: {len(failures)} problem(s) in 5 reports" if failures else "report schema: 5 reports valid")
     return 1 if failures else 0
 
 
