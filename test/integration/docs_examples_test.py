@@ -222,7 +222,7 @@ def command_lines():
                 continue
             joined = re.sub(r"\\\n\s*", " ", text)
             for k, l in enumerate(joined.splitlines()):
-                m = re.search(r"(?:^|[\s/])selfcal\s+([a-z].*)$", l)
+                m = re.match(r"^\s*(?:\$\s+)?(?:\S*/)?selfcal\s+([a-z].*)$", l)
                 if m:
                     found.append((f"{rel}:{line}", m.group(1).split("#")[0].split()))
         with open(path, encoding="utf-8") as f:
@@ -232,8 +232,17 @@ def command_lines():
     return found
 
 
+def subcommands(args):
+    """The subcommand names a --help lists under "Subcommands:"."""
+    text = run(args + ["--help"]).stdout
+    listed = text.split("Subcommands:", 1)[1] if "Subcommands:" in text else ""
+    return {m.group(1) for m in re.finditer(r"^  ([a-z][a-z-]*)\s", listed, re.M)}
+
+
 def check_command_lines():
     helps = {}
+    commands = subcommands([])
+    commands |= {"session " + c for c in subcommands(["session"])}
     lines = command_lines()
     print(f"{len(lines)} selfcal command lines in the docs")
     for where, tokens in lines:
@@ -242,6 +251,9 @@ def check_command_lines():
             continue
         command = words[:2] if words[0] == "session" and len(words) > 1 else words[:1]
         key = " ".join(command)
+        if key not in commands:
+            problem(f"{where}: `selfcal {key}` is not a command")
+            continue
         if key not in helps:
             result = run(command + ["--help"])
             helps[key] = result.stdout if result.returncode == 0 else None
