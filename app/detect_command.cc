@@ -35,6 +35,7 @@ struct DetectSettings {
   std::string camera_file, camera_name;  // instead of the --camera-* values
   bool camera_values_given = false;      // any --camera-fx-px, -cx-px, -cy-px, -mu, -k1
   double pixel_noise_px = 0.5;
+  double flange_noise_mm = 0, flange_noise_deg = 0;  // --flange-pose-noise-mm / -deg (0: exact poses)
   std::vector<double> yardstick;  // A, B, length_mm
   double tag_side_mm = 0;
   std::vector<double> tag_dots_mm;
@@ -111,6 +112,12 @@ Result<detection::ObservationSetup> ToSetup(const DetectSettings& a, const vpIma
     }
   }
   setup.pixel_noise_px = a.pixel_noise_px;
+  if ((a.flange_noise_mm > 0) != (a.flange_noise_deg > 0)) {
+    return Usage("--flange-pose-noise-mm and --flange-pose-noise-deg: give both (the flange poses' stated noise) or "
+                 "neither (exact poses)");
+  }
+  setup.flange_translation_sigma_m = a.flange_noise_mm * 1e-3;
+  setup.flange_rotation_sigma_rad = DegToRad(a.flange_noise_deg);
   if (!a.yardstick.empty()) {
     const bool ints = a.yardstick.size() == 3 && a.yardstick[0] >= 0 && a.yardstick[1] >= 0 &&
                       a.yardstick[0] == std::floor(a.yardstick[0]) && a.yardstick[1] == std::floor(a.yardstick[1]);
@@ -269,6 +276,12 @@ Command AddDetectCommand(CLI::App& app) {
       cmd->add_option("--camera-k1", a->k1, "Radial distortion k1 (default 0)")};
   cmd->add_option("--pixel-noise-px", a->pixel_noise_px, "Standard deviation of a point's pixel, px (default 0.5)")
       ->check(CLI::Range(kMinPixelNoisePx, kMaxPixelNoisePx));
+  cmd->add_option("--flange-pose-noise-mm", a->flange_noise_mm,
+                  "Flange poses: the stated noise of each recorded flange position, mm (with -deg; 0: exact)")
+      ->check(CLI::Range(0.0, 100.0));
+  cmd->add_option("--flange-pose-noise-deg", a->flange_noise_deg,
+                  "Flange poses: the stated noise of each recorded flange rotation, deg (with -mm; 0: exact)")
+      ->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--yardstick", a->yardstick, "A,B,LENGTH_MM: a known distance between points A and B")
       ->delimiter(',')
       ->expected(3);

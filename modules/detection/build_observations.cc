@@ -25,6 +25,8 @@ Result<ObservationSet> BuildObservationSet(const std::vector<std::string>& pose_
   set.flange_from_cam_known = !flange_set || setup.flange_from_cam.has_value();
   set.camera = setup.camera;
   set.pixel_noise_px = setup.pixel_noise_px;
+  set.flange_translation_sigma_m = setup.flange_translation_sigma_m;
+  set.flange_rotation_sigma_rad = setup.flange_rotation_sigma_rad;
   set.yardsticks = setup.yardsticks;
   std::string failed;
   for (size_t i = 0; i < points.size(); ++i) {

@@ -91,6 +91,8 @@ struct ObservationSetup {
   std::optional<Rigid3> flange_from_cam;  // flange poses: the nominal hand-eye transform, when known
   CameraIntrinsics camera;             // nominal (width and height are the images')
   double pixel_noise_px = 0.5;
+  // Flange poses: the stated noise of the recorded poses (0: exact); both or neither (ObservationSet).
+  double flange_translation_sigma_m = 0, flange_rotation_sigma_rad = 0;
   std::vector<KnownDistance> yardsticks;
   bool skip_failed = false;            // leave images without points out instead of refusing the set
 };

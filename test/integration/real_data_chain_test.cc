@@ -6,6 +6,7 @@
 // OpenCV's PnP, 0.58 deg max); selfcal, without the board's geometry and with one radial term, must not be worse.
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -72,9 +73,15 @@ TEST(RealDataChain, FrankaHandEyeWithOneYardstickMatchesViSP) {
             2)
       << output;
   EXPECT_NE(output.find("needs a stated flange pose noise"), std::string::npos) << output;
-  std::ofstream(obs, std::ios::app) << "flange_pose_noise: {translation_mm: 2.0, rotation_deg: 0.1}\n";
+  // The pose noise stated to detect, which writes it into the observations file.
+  const std::string noisy = (dir / "franka-noise.yaml").string();
+  ASSERT_TRUE(RunCli(kFrankaDetect + "--yardstick 0,53,222.64 --flange-pose-noise-mm 2 --flange-pose-noise-deg 0.1 "
+                     "--out " + noisy));
+  std::ifstream written(noisy);
+  const std::string text((std::istreambuf_iterator<char>(written)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("flange_pose_noise: {translation_m: 0.002, rotation_rad: 0.0017453292519943"), std::string::npos);
   const auto out = dir / "calibration";
-  ASSERT_TRUE(RunCli("calibrate " + obs + " --free camera,fx,k1 --scale-from yardstick --out " + out.string()));
+  ASSERT_TRUE(RunCli("calibrate " + noisy + " --free camera,fx,k1 --scale-from yardstick --out " + out.string()));
   const nlohmann::json report = ReadReport(out);
   EXPECT_EQ(report.at("hand_eye").at("scale_yardsticks").get<int>(), 1);
   const nlohmann::json& plane = report.at("hand_eye").at("start").at("plane");
