@@ -6,6 +6,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -62,6 +63,10 @@ class XvfbServer {
       ::waitpid(pid_, &status, 0);
       pid_ = -1;
     }
+    if (lock_fd_ >= 0) {
+      ::close(lock_fd_);  // releases the flock
+      lock_fd_ = -1;
+    }
   }
   XvfbServer(const XvfbServer&) = delete;
   XvfbServer& operator=(const XvfbServer&) = delete;
@@ -81,6 +86,15 @@ class XvfbServer {
       *why = "Xvfb is not installed (Debian: apt-get install xvfb, or scripts/install-deps)";
       return false;
     }
+    // -noreset: without it the server resets when its last client leaves, and a connection opened during
+    // the reset fails (a probe that opens and closes the display, then the view, saw that under load).
+    // One test server at a time on this machine: Xvfb servers started at the same moment (ctest -j) race
+    // for display numbers, and one of them then reports a display its clients cannot open.
+    lock_fd_ = ::open("/tmp/selfcal-test-xvfb.lock", O_CREAT | O_RDWR | O_CLOEXEC, 0666);
+    if (lock_fd_ < 0 || ::flock(lock_fd_, LOCK_EX) != 0) {
+      *why = "cannot take /tmp/selfcal-test-xvfb.lock";
+      return false;
+    }
     int fds[2];
     if (::pipe(fds) != 0) {
       *why = "pipe failed";
@@ -92,7 +106,7 @@ class XvfbServer {
       const int null = ::open("/dev/null", O_WRONLY);
       ::dup2(null, 1);
       ::dup2(null, 2);
-      ::execl(binary.c_str(), "Xvfb", "-displayfd", "3", "-screen", "0", "1280x1024x24", "-nolisten", "tcp",
+      ::execl(binary.c_str(), "Xvfb", "-displayfd", "3", "-screen", "0", "1280x1024x24", "-nolisten", "tcp", "-noreset",
               static_cast<char*>(nullptr));
       ::_exit(127);
     }
@@ -116,6 +130,7 @@ class XvfbServer {
 
  private:
   pid_t pid_ = -1;
+  int lock_fd_ = -1;
   std::string display_;
 };
 
