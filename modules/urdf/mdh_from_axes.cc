@@ -11,8 +11,10 @@
 namespace selfcal::urdf {
 namespace {
 
-// Axes whose directions differ by less than this sine take Hayati's beta instead of a common normal.
-constexpr double kParallelSine = 1e-2;
+// Axes whose directions differ by less than this sine (about 5.7 deg) take Hayati's beta instead of a
+// common normal: for a tilt eps towards the normal, the common normal's foot moves by about a / eps along
+// the axis (43 m for the PUMA's a2 at 0.01 rad), the offsets the beta is there to avoid.
+constexpr double kParallelSine = 0.1;
 
 struct Frame {
   Eigen::Vector3d origin, x, z;

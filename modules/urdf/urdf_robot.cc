@@ -11,6 +11,7 @@
 
 #include "base/atomic_file.h"
 #include "urdf/urdf_chain.h"
+#include "urdf/urdf_writer.h"
 
 namespace selfcal::urdf {
 namespace {
@@ -41,8 +42,9 @@ std::string JointsDeg(const Eigen::VectorXd& q) {
   return "[" + out + "] deg";
 }
 
-// The model's base_from_flange (and base_from_cam with a camera link) against KDL's at random joints.
-Result<FkCheck> CheckAgainstKdl(const std::string& text, const std::string& name, const UrdfChainSpec& spec,
+}  // namespace
+
+Result<FkCheck> CompareWithKdl(const std::string& text, const std::string& name, const UrdfChainSpec& spec,
                                 const RobotModel& model, const FkCheckOptions& options) {
   const std::vector<Eigen::VectorXd> joints = RandomJointsWithinLimits(model, options.samples, options.seed);
   Result<std::vector<Rigid3>> tips = KdlChainPoses(text, name, spec.base_link, spec.tip_link, joints);
@@ -80,8 +82,6 @@ Result<FkCheck> CheckAgainstKdl(const std::string& text, const std::string& name
   }
   return check;
 }
-
-}  // namespace
 
 std::vector<Eigen::VectorXd> RandomJointsWithinLimits(const RobotModel& model, int count, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
@@ -144,7 +144,7 @@ Result<UrdfRobot> ParseUrdfRobot(const std::string& text, const std::string& nam
   for (const AxisLine& axis : chain->axes) robot.joint_names.push_back(axis.name);
   const std::string invalid = robot.model.Validate();
   if (!invalid.empty()) return Status::Error(ErrorCode::kInvalidInput, name + ": the converted model: " + invalid);
-  Result<FkCheck> check = CheckAgainstKdl(text, name, spec, robot.model, options);
+  Result<FkCheck> check = CompareWithKdl(text, name, spec, robot.model, options);
   if (!check.ok()) return check.status();
   robot.check = *check;
   return robot;

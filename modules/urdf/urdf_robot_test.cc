@@ -65,21 +65,22 @@ TEST(UrdfRobot, ParallelAxesTakeHayatiBetaNotHugeOffsets) {
   ASSERT_TRUE(robot.ok()) << robot.status().message();
   EXPECT_EQ(ParallelAxisPairs(robot->model), (std::vector<int>{2, 3}));  // pairs (2,3) and (3,4)
   for (const LinkParameters& link : robot->model.links) EXPECT_LT(std::abs(link.d), 0.2);
-  // The elbow axis tilted by 1e-4 rad towards the common normal (about y, where plain DH would need
-  // an offset d of about a / 1e-4): a beta of that size, offsets still small.
-  std::string text = testing::ReadFile(DataFile("ur5e.urdf"));
-  const std::string joint3 = "<joint name=\"joint3\"";
-  const size_t at = text.find("<axis xyz=\"0 0 1\"/>", text.find(joint3));
-  ASSERT_NE(at, std::string::npos);
-  text.replace(at, 19, "<axis xyz=\"0.0001 0 1\"/>");  // about the normal's perpendicular: beta
-  Result<UrdfRobot> tilted = ParseUrdfRobot(text, "tilted.urdf", kWithCamera, std::nullopt);
-  ASSERT_TRUE(tilted.ok()) << tilted.status().message();
-  double max_beta = 0;
-  for (const LinkParameters& link : tilted->model.links) {
-    max_beta = std::max(max_beta, std::abs(link.beta));
-    EXPECT_LT(std::abs(link.d), 0.2);
+  // The elbow axis tilted by 1e-4 and 0.05 rad towards the common normal (about y, where plain DH would
+  // need an offset d of about a / tilt): a beta of that size, offsets still small.
+  for (const double tilt : {1e-4, 0.05}) {
+    std::string text = testing::ReadFile(DataFile("ur5e.urdf"));
+    const size_t at = text.find("<axis xyz=\"0 0 1\"/>", text.find("<joint name=\"joint3\""));
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, 19, "<axis xyz=\"" + std::to_string(std::tan(tilt)) + " 0 1\"/>");
+    Result<UrdfRobot> tilted = ParseUrdfRobot(text, "tilted.urdf", kWithCamera, std::nullopt);
+    ASSERT_TRUE(tilted.ok()) << tilted.status().message();
+    double max_beta = 0;
+    for (const LinkParameters& link : tilted->model.links) {
+      max_beta = std::max(max_beta, std::abs(link.beta));
+      EXPECT_LT(std::abs(link.d), 0.2) << tilt;
+    }
+    EXPECT_NEAR(max_beta, tilt, 2e-6) << tilt;
   }
-  EXPECT_NEAR(max_beta, 1e-4, 2e-6);
 }
 
 TEST(UrdfRobot, FlangeFromCamGivenWhenNoCameraLink) {
