@@ -65,7 +65,8 @@ void ParseUrdfRobotConfig(MapReader* map, Problems* problems, CalibratedModel* o
 
 Result<std::string> RobotConfigTextForSession(const std::string& path) {
   Result<std::string> text = ReadFileCapped(path, kMaxRobotConfigBytes);
-  if (!text.ok()) return Status::Error(ErrorCode::kInvalidInput, "cannot read " + path + ": " + text.status().message());
+  if (!text.ok())
+    return Status::Error(ErrorCode::kInvalidInput, "cannot read " + path + ": " + text.status().message());
   Result<yaml::YamlDocument> doc = yaml::ParseYamlText(*text, path);
   if (!doc.ok() || !NamesUrdf(doc->root)) return text;
   Result<RobotModel> model = LoadRobotModel(path);

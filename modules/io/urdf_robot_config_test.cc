@@ -72,13 +72,15 @@ TEST(UrdfRobotConfig, RefusesContradictionsAndNamesTheUrdfProblem) {
   const std::string urdf = SourcePath("test/data/urdf/ur5e.urdf");
   const std::string head = "urdf_file: " + urdf + "\nbase_link: base_link\ntip_link: tool0\n";
   EXPECT_EQ(Refusal(head + "camera_link: camera_optical_frame\n"), "");
-  std::string both = Refusal(head + "camera_link: camera_optical_frame\nflange_from_cam: {xyz_mm: [0, 0, 0], rpy_deg: [0, 0, 0]}\n");
+  std::string both =
+      Refusal(head + "camera_link: camera_optical_frame\nflange_from_cam: {xyz_mm: [0, 0, 0], rpy_deg: [0, 0, 0]}\n");
   EXPECT_NE(both.find("not both"), std::string::npos) << both;
   std::string joints = Refusal(head + "camera_link: camera_optical_frame\ndh_convention: standard\n");
   EXPECT_NE(joints.find("takes the kinematics from the URDF"), std::string::npos) << joints;
   std::string no_cam = Refusal(head);
   EXPECT_NE(no_cam.find("give camera_link"), std::string::npos) << no_cam;
-  std::string bad_tip = Refusal("urdf_file: " + urdf + "\nbase_link: base_link\ntip_link: nowhere\ncamera_link: tool0\n");
+  std::string bad_tip =
+      Refusal("urdf_file: " + urdf + "\nbase_link: base_link\ntip_link: nowhere\ncamera_link: tool0\n");
   EXPECT_NE(bad_tip.find("tip_link `nowhere` is not a link"), std::string::npos) << bad_tip;
   std::string missing = Refusal("urdf_file: absent.urdf\nbase_link: a\ntip_link: b\ncamera_link: c\n");
   EXPECT_NE(missing.find("absent.urdf"), std::string::npos) << missing;

@@ -56,7 +56,8 @@ Frame NormalFrame(const AxisLine& a, const AxisLine& b, const Eigen::Vector3d& f
     hit = b.point + ((e - bb * d) / denom) * b.direction;
   }
   const Eigen::Vector3d normal = hit - f.origin;
-  f.x = normal.norm() > 1e-12 ? Eigen::Vector3d(normal.normalized()) : PerpendicularTo(f.z, c.norm() > 1e-12 ? c : x_hint);
+  f.x = normal.norm() > 1e-12 ? Eigen::Vector3d(normal.normalized())
+                              : PerpendicularTo(f.z, c.norm() > 1e-12 ? c : x_hint);
   *next_foot = hit;
   return f;
 }

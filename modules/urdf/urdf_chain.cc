@@ -14,13 +14,20 @@ Rigid3 RigidOf(const ::urdf::Pose& pose) {
 
 const char* JointTypeName(int type) {
   switch (type) {
-    case ::urdf::Joint::REVOLUTE: return "revolute";
-    case ::urdf::Joint::CONTINUOUS: return "continuous";
-    case ::urdf::Joint::PRISMATIC: return "prismatic";
-    case ::urdf::Joint::FLOATING: return "floating";
-    case ::urdf::Joint::PLANAR: return "planar";
-    case ::urdf::Joint::FIXED: return "fixed";
-    default: return "unknown";
+    case ::urdf::Joint::REVOLUTE:
+      return "revolute";
+    case ::urdf::Joint::CONTINUOUS:
+      return "continuous";
+    case ::urdf::Joint::PRISMATIC:
+      return "prismatic";
+    case ::urdf::Joint::FLOATING:
+      return "floating";
+    case ::urdf::Joint::PLANAR:
+      return "planar";
+    case ::urdf::Joint::FIXED:
+      return "fixed";
+    default:
+      return "unknown";
   }
 }
 
@@ -41,7 +48,8 @@ std::vector<::urdf::JointConstSharedPtr> JointsBetween(const ::urdf::ModelInterf
   return joints;
 }
 
-Status MissingLink(const ::urdf::ModelInterface& model, const std::string& file, const char* key, const std::string& link) {
+Status MissingLink(const ::urdf::ModelInterface& model, const std::string& file, const char* key,
+                   const std::string& link) {
   std::string names;
   for (const auto& entry : model.links_) names += (names.empty() ? "" : ", ") + entry.first;
   return Status::Error(ErrorCode::kInvalidInput, file + ": " + key + " `" + link + "` is not a link of robot `" +
@@ -50,9 +58,11 @@ Status MissingLink(const ::urdf::ModelInterface& model, const std::string& file,
 
 }  // namespace
 
-Result<UrdfChain> ExtractChain(const ::urdf::ModelInterface& model, const std::string& name, const UrdfChainSpec& spec) {
+Result<UrdfChain> ExtractChain(const ::urdf::ModelInterface& model, const std::string& name,
+                               const UrdfChainSpec& spec) {
   for (const auto& [key, link] : {std::pair<const char*, std::string>{"base_link", spec.base_link},
-                                  {"tip_link", spec.tip_link}, {"camera_link", spec.camera_link}}) {
+                                  {"tip_link", spec.tip_link},
+                                  {"camera_link", spec.camera_link}}) {
     if (!link.empty() && !model.getLink(link)) return MissingLink(model, name, key, link);
   }
   std::string error;
@@ -72,15 +82,16 @@ Result<UrdfChain> ExtractChain(const ::urdf::ModelInterface& model, const std::s
     }
     if (joint->mimic) {
       return Status::Error(ErrorCode::kInvalidInput, name + ": joint `" + joint->name + "` mimics `" +
-                                                         joint->mimic->joint_name + "`; mimic joints are not supported");
+                                                         joint->mimic->joint_name +
+                                                         "`; mimic joints are not supported");
     }
     const Eigen::Vector3d axis(joint->axis.x, joint->axis.y, joint->axis.z);
     if (axis.norm() < 1e-9) {
       return Status::Error(ErrorCode::kInvalidInput, name + ": joint `" + joint->name + "` has a zero axis");
     }
     if (!joint->limits || !(joint->limits->lower < joint->limits->upper)) {
-      return Status::Error(ErrorCode::kInvalidInput, name + ": revolute joint `" + joint->name +
-                                                         "` needs a <limit> with lower < upper");
+      return Status::Error(ErrorCode::kInvalidInput,
+                           name + ": revolute joint `" + joint->name + "` needs a <limit> with lower < upper");
     }
     chain.axes.push_back(AxisLine{joint->name, base_from_link.translation, base_from_link.rotation * axis.normalized(),
                                   JointLimits{joint->limits->lower, joint->limits->upper}});
@@ -92,7 +103,8 @@ Result<UrdfChain> ExtractChain(const ::urdf::ModelInterface& model, const std::s
   chain.base_from_tip = base_from_link;
   if (!spec.camera_link.empty()) {
     const auto cam_joints = JointsBetween(model, spec.tip_link, spec.camera_link, &error);
-    if (!error.empty()) return Status::Error(ErrorCode::kInvalidInput, name + ": camera_link: " + error + " (tip_link)");
+    if (!error.empty())
+      return Status::Error(ErrorCode::kInvalidInput, name + ": camera_link: " + error + " (tip_link)");
     Rigid3 tip_from_cam;
     for (const auto& joint : cam_joints) {
       if (joint->type != ::urdf::Joint::FIXED) {

@@ -28,8 +28,8 @@ struct AxisLine {
 
 struct UrdfChain {
   std::string robot_name;
-  std::vector<AxisLine> axes;            // base to tip
-  Rigid3 base_from_tip;                  // at q = 0
+  std::vector<AxisLine> axes;             // base to tip
+  Rigid3 base_from_tip;                   // at q = 0
   std::optional<Rigid3> tip_from_camera;  // when a camera link was named
 };
 

@@ -45,7 +45,7 @@ std::string JointsDeg(const Eigen::VectorXd& q) {
 }  // namespace
 
 Result<FkCheck> CompareWithKdl(const std::string& text, const std::string& name, const UrdfChainSpec& spec,
-                                const RobotModel& model, const FkCheckOptions& options) {
+                               const RobotModel& model, const FkCheckOptions& options) {
   const std::vector<Eigen::VectorXd> joints = RandomJointsWithinLimits(model, options.samples, options.seed);
   Result<std::vector<Rigid3>> tips = KdlChainPoses(text, name, spec.base_link, spec.tip_link, joints);
   if (!tips.ok()) return tips.status();
@@ -97,8 +97,9 @@ std::vector<Eigen::VectorXd> RandomJointsWithinLimits(const RobotModel& model, i
   return out;
 }
 
-Result<std::vector<Rigid3>> KdlChainPoses(const std::string& text, const std::string& name, const std::string& base_link,
-                                          const std::string& tip_link, const std::vector<Eigen::VectorXd>& joints) {
+Result<std::vector<Rigid3>> KdlChainPoses(const std::string& text, const std::string& name,
+                                          const std::string& base_link, const std::string& tip_link,
+                                          const std::vector<Eigen::VectorXd>& joints) {
   KDL::Tree tree;
   if (!kdl_parser::treeFromString(text, tree)) {
     return Status::Error(ErrorCode::kInvalidInput, name + ": kdl_parser could not build a KDL tree from the URDF");
@@ -112,7 +113,8 @@ Result<std::vector<Rigid3>> KdlChainPoses(const std::string& text, const std::st
   std::vector<Rigid3> poses;
   for (const Eigen::VectorXd& q : joints) {
     if (q.size() != static_cast<int>(chain.getNrOfJoints())) {
-      return Status::Error(ErrorCode::kInvalidInput, name + ": " + std::to_string(q.size()) + " joint values for a chain of " +
+      return Status::Error(ErrorCode::kInvalidInput, name + ": " + std::to_string(q.size()) +
+                                                         " joint values for a chain of " +
                                                          std::to_string(chain.getNrOfJoints()) + " joints");
     }
     KDL::JntArray array(chain.getNrOfJoints());
@@ -132,8 +134,9 @@ Result<UrdfRobot> ParseUrdfRobot(const std::string& text, const std::string& nam
     return Status::Error(ErrorCode::kInvalidInput, name + ": a URDF robot needs base_link and tip_link");
   }
   if (spec.camera_link.empty() && !flange_from_cam) {
-    return Status::Error(ErrorCode::kInvalidInput,
-                         name + ": give camera_link (a link of the URDF at the camera's optical frame) or flange_from_cam");
+    return Status::Error(
+        ErrorCode::kInvalidInput,
+        name + ": give camera_link (a link of the URDF at the camera's optical frame) or flange_from_cam");
   }
   const ::urdf::ModelInterfaceSharedPtr parsed = ::urdf::parseURDF(text);
   if (!parsed) return Status::Error(ErrorCode::kInvalidInput, name + ": urdfdom could not parse the URDF");

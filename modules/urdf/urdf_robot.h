@@ -40,8 +40,8 @@ struct FkCheckOptions {
 // The worst difference found between the model and KDL, and where.
 struct FkCheck {
   int samples = 0;
-  int worst_sample = -1;         // 0-based; -1 when no sample
-  Eigen::VectorXd worst_q;       // rad
+  int worst_sample = -1;    // 0-based; -1 when no sample
+  Eigen::VectorXd worst_q;  // rad
   double worst_position_m = 0;
   double worst_rotation_rad = 0;
 };
@@ -63,8 +63,9 @@ Result<UrdfRobot> ParseUrdfRobot(const std::string& text, const std::string& nam
 
 // KDL's forward kinematics of the chain base_link -> tip_link of the URDF `text` at each joint vector of
 // `joints` (rad, one per movable joint of the chain): base_from_tip. For the check and its tests.
-Result<std::vector<Rigid3>> KdlChainPoses(const std::string& text, const std::string& name, const std::string& base_link,
-                                          const std::string& tip_link, const std::vector<Eigen::VectorXd>& joints);
+Result<std::vector<Rigid3>> KdlChainPoses(const std::string& text, const std::string& name,
+                                          const std::string& base_link, const std::string& tip_link,
+                                          const std::vector<Eigen::VectorXd>& joints);
 
 // Seeded random joint vectors, uniform within the model's limits.
 std::vector<Eigen::VectorXd> RandomJointsWithinLimits(const RobotModel& model, int count, std::uint64_t seed);

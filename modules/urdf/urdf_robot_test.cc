@@ -14,7 +14,8 @@ std::string DataFile(const std::string& name) { return std::string(SELFCAL_SOURC
 const UrdfChainSpec kWithCamera{"base_link", "tool0", "camera_optical_frame"};
 
 // Worst position (m) and rotation (rad) difference of base_from_cam between two models at random joints.
-std::pair<double, double> WorstCamDifference(const RobotModel& a, const RobotModel& b, int samples, std::uint64_t seed) {
+std::pair<double, double> WorstCamDifference(const RobotModel& a, const RobotModel& b, int samples,
+                                             std::uint64_t seed) {
   double worst_m = 0, worst_rad = 0;
   for (const Eigen::VectorXd& q : RandomJointsWithinLimits(a, samples, seed)) {
     const PoseDifference d = ComparePoses(BaseFromCam(a, KinematicParameters::Nominal(a), q),
@@ -83,6 +84,22 @@ TEST(UrdfRobot, ParallelAxesTakeHayatiBetaNotHugeOffsets) {
   }
 }
 
+TEST(UrdfRobot, ReversedAndObliqueUnnormalisedAxesMatchKdl) {
+  // Joint 1 turning about -z and joint 4 about an oblique axis of length 2: no longer the DH robot, but
+  // the conversion must still reproduce KDL's forward kinematics (the loader's check, 1e-9).
+  std::string text = testing::ReadFile(DataFile("ur5e.urdf"));
+  for (const auto& [joint, axis] :
+       {std::pair<std::string, std::string>{"joint1", "0 0 -1"}, {"joint4", "0.6 -0.8 1.7320508"}}) {
+    const size_t at = text.find("<axis xyz=\"0 0 1\"/>", text.find("<joint name=\"" + joint + "\""));
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, 19, "<axis xyz=\"" + axis + "\"/>");
+  }
+  Result<UrdfRobot> robot = ParseUrdfRobot(text, "oblique.urdf", kWithCamera, std::nullopt);
+  ASSERT_TRUE(robot.ok()) << robot.status().message();
+  EXPECT_LE(robot->check.worst_position_m, 1e-9);
+  EXPECT_GT(WorstCamDifference(robot->model, testing::Ur5e(), 50, 2).first, 1e-3);  // a different arm indeed
+}
+
 TEST(UrdfRobot, FlangeFromCamGivenWhenNoCameraLink) {
   const Rigid3 cam(RotZ(0.5), Eigen::Vector3d(0.01, 0.02, 0.03));
   Result<UrdfRobot> robot = LoadUrdfRobot(DataFile("ur5e.urdf"), {"base_link", "tool0", ""}, cam);
@@ -103,11 +120,11 @@ void ExpectRefused(const std::string& text, const UrdfChainSpec& spec, const std
 
 TEST(UrdfRobot, RefusesWhatTheModelCannotHold) {
   const std::string ur = testing::ReadFile(DataFile("ur5e.urdf"));
-  const std::string prismatic = std::regex_replace(ur, std::regex("name=\"joint4\" type=\"revolute\""),
-                                                   "name=\"joint4\" type=\"prismatic\"");
+  const std::string prismatic =
+      std::regex_replace(ur, std::regex("name=\"joint4\" type=\"revolute\""), "name=\"joint4\" type=\"prismatic\"");
   ExpectRefused(prismatic, kWithCamera, "joint `joint4` is prismatic");
-  const std::string continuous = std::regex_replace(ur, std::regex("name=\"joint6\" type=\"revolute\""),
-                                                    "name=\"joint6\" type=\"continuous\"");
+  const std::string continuous =
+      std::regex_replace(ur, std::regex("name=\"joint6\" type=\"revolute\""), "name=\"joint6\" type=\"continuous\"");
   ExpectRefused(continuous, kWithCamera, "joint `joint6` is continuous");
   ExpectRefused(ur, {"base_link", "tool9", ""}, "tip_link `tool9` is not a link of robot `ur5e`");
   ExpectRefused(ur, {"tool0", "base_link", ""}, "link `base_link` is not below link `tool0`");

@@ -24,11 +24,20 @@ std::string Xml(const std::string& text) {
   std::string out;
   for (char c : text) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -84,8 +93,8 @@ class UrdfText {
 Result<std::string> UrdfOfModel(const RobotModel& model, const UrdfNames& names, const FkCheckOptions& check) {
   const int n = model.num_joints();
   if (!names.joints.empty() && static_cast<int>(names.joints.size()) != n) {
-    return Status::Error(ErrorCode::kInternal, std::to_string(names.joints.size()) + " joint names for " +
-                                                   std::to_string(n) + " joints");
+    return Status::Error(ErrorCode::kInternal,
+                         std::to_string(names.joints.size()) + " joint names for " + std::to_string(n) + " joints");
   }
   UrdfText text;
   text.Link(names.base_link);
@@ -106,10 +115,11 @@ Result<std::string> UrdfOfModel(const RobotModel& model, const UrdfNames& names,
   text.Joint(names.tip_link + "_to_" + names.camera_link, names.tip_link, names.camera_link, model.flange_from_cam,
              nullptr);
   const std::string robot = names.robot.empty() ? model.name : names.robot;
-  const std::string urdf = "<?xml version=\"1.0\"?>\n<!-- Written by selfcal (docs/urdf.md): modified DH + Hayati, "
-                           "link_i is the model's frame of link i; " +
-                           names.camera_link + " is the camera's optical frame (z forward, x right, y down). -->\n" +
-                           "<robot name=\"" + Xml(robot) + "\">\n" + text.str() + "</robot>\n";
+  const std::string urdf =
+      "<?xml version=\"1.0\"?>\n<!-- Written by selfcal (docs/urdf.md): modified DH + Hayati, "
+      "link_i is the model's frame of link i; " +
+      names.camera_link + " is the camera's optical frame (z forward, x right, y down). -->\n" + "<robot name=\"" +
+      Xml(robot) + "\">\n" + text.str() + "</robot>\n";
   Result<FkCheck> compared =
       CompareWithKdl(urdf, "the written URDF", {names.base_link, names.tip_link, names.camera_link}, model, check);
   if (!compared.ok()) return Status::Error(ErrorCode::kInternal, compared.status().message());

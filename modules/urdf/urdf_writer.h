@@ -16,8 +16,8 @@
 namespace selfcal::urdf {
 
 struct UrdfNames {
-  std::string robot;                     // empty: the model's name
-  std::vector<std::string> joints;       // empty: joint1 .. jointN
+  std::string robot;                // empty: the model's name
+  std::vector<std::string> joints;  // empty: joint1 .. jointN
   std::string base_link = "base_link";
   std::string tip_link = "tool0";
   std::string camera_link = "camera_optical_frame";

@@ -42,8 +42,8 @@ TEST(UrdfWriter, CalibratedModelsKdlForwardKinematicsEqualsTheModel) {
     const std::string text = testing::ReadFile(dir.File("calibrated.urdf"));
     ExpectKdlEqualsModel(text, calibrated);
     // Read back as a robot (urdfdom, the conversion and its own KDL check): the same arm, limits and names.
-    Result<UrdfRobot> back = ParseUrdfRobot(text, "calibrated.urdf", {"base_link", "tool0", "camera_optical_frame"},
-                                            std::nullopt);
+    Result<UrdfRobot> back =
+        ParseUrdfRobot(text, "calibrated.urdf", {"base_link", "tool0", "camera_optical_frame"}, std::nullopt);
     ASSERT_TRUE(back.ok()) << back.status().message();
     EXPECT_EQ(back->joint_names.front(), "joint1");
     for (int j = 0; j < calibrated.num_joints(); ++j) {
@@ -52,7 +52,8 @@ TEST(UrdfWriter, CalibratedModelsKdlForwardKinematicsEqualsTheModel) {
     }
     for (const Eigen::VectorXd& q : RandomJointsWithinLimits(calibrated, 200, 8)) {
       EXPECT_TRUE(testing::RigidNear(BaseFromCam(calibrated, KinematicParameters::Nominal(calibrated), q),
-                                     BaseFromCam(back->model, KinematicParameters::Nominal(back->model), q), 1e-9, 1e-9));
+                                     BaseFromCam(back->model, KinematicParameters::Nominal(back->model), q), 1e-9,
+                                     1e-9));
     }
   }
 }
