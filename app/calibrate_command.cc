@@ -18,6 +18,7 @@
 #include "report/calibration_report.h"
 #include "session/session_dir.h"
 #include "session/session_observations.h"
+#include "urdf/urdf_writer.h"
 
 namespace selfcal::app {
 
@@ -184,7 +185,7 @@ void RecordCalibrationFigures(const nlohmann::json& report) {
   SetOutcome(report.value("verdict", std::string()));
 }
 
-// Writes report.json, and calibrated_model.yaml (hand_eye.yaml for flange poses) when the verdict is
+// Writes report.json, and calibrated_model.yaml and calibrated.urdf (hand_eye.yaml for flange poses) when the verdict is
 // "accepted" (K4).
 Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationReport& report, ExitCode code,
                     const std::string& out_dir, bool html) {
@@ -217,6 +218,10 @@ Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationRep
   if (Status s = io::SaveCalibratedModel(model, model_path); !s.ok()) return s;
   std::cout << "calibrated model (" << calibration::MethodName(report.method) << "): " << model_path << "\n";
   AddOutputFile("calibrated_model", model_path);
+  const std::string urdf_path = (out / "calibrated.urdf").string();  // docs/urdf.md
+  if (Status s = urdf::WriteUrdf(model.model, {}, urdf_path); !s.ok()) return s;
+  std::cout << "calibrated URDF: " << urdf_path << "\n";
+  AddOutputFile("calibrated_urdf", urdf_path);
   return Status::Ok();
 }
 

@@ -24,6 +24,7 @@
 #include "io/report_json.h"
 #include "io/robot_config.h"
 #include "io/trajectory_file.h"
+#include "io/urdf_robot_config.h"
 #include "acquisition/session_runner.h"
 #include "base/terminal_text.h"
 #include "liveview/live_view.h"
@@ -191,8 +192,10 @@ Status CheckRunSettings(RunSettings* a) {
 // Stage 1: the robot config, the plan and the setup (made by the simulated cell, or --setup), as the
 // session's inputs.
 Status LoadRunPlan(const RunSettings& a, RunPlan* run) {
-  Result<session::SessionInput> robot_input = session::ReadInputFile("robot.yaml", ResolveDataPath(a.robot_config));
-  if (!robot_input.ok()) return robot_input.status();
+  // A config naming a URDF is recorded as its converted model, so that the session stands on its own.
+  Result<std::string> robot_text = io::RobotConfigTextForSession(ResolveDataPath(a.robot_config));
+  if (!robot_text.ok()) return robot_text.status();
+  const session::SessionInput robot_input{"robot.yaml", *robot_text};
   Result<RobotModel> nominal = io::LoadRobotModel(ResolveDataPath(a.robot_config));
   if (!nominal.ok()) return nominal.status();
   run->nominal = *nominal;
@@ -209,7 +212,7 @@ Status LoadRunPlan(const RunSettings& a, RunPlan* run) {
   if (!check.ok) {
     return Status::Error(ErrorCode::kDegenerateData, acquisition::PreflightRefusal(acquisition::PreflightProblems(check)));
   }
-  run->inputs = {*robot_input, *plan_input, {"run.json", RunJson(a).dump(2) + "\n"}};
+  run->inputs = {robot_input, *plan_input, {"run.json", RunJson(a).dump(2) + "\n"}};
   // The simulated cell is built before the session so that its setup can be recorded.
   if (a.robot_backend == "sim") {
     run->cell = simulation::MakeSimCell(run->nominal, run->plan, SimCellOptionsFor(a), run->plan.front().joints_rad, 0);

@@ -280,7 +280,7 @@ int SimulateSession(const SimulateArgs& args) {
             << "/: " << std::filesystem::path(run.session).filename().string()
             << "/ (the session), observations.yaml, report.json"
             << (std::filesystem::exists(std::filesystem::path(args.out) / "report.html") ? ", report.html" : "")
-            << (code == 0 ? ", calibrated_model.yaml" : "")
+            << (code == 0 ? ", calibrated_model.yaml, calibrated.urdf" : "")
             << ", truth.json, comparison_with_truth.json\n";
   return code;
 }
@@ -368,7 +368,7 @@ Command AddSimulateCommand(CLI::App& app) {
     }
     std::cout << "results in " << args->out << "/: observations.yaml, truth.json, report.json"
               << (std::filesystem::exists(out / "report.html") ? ", report.html" : "")
-              << (code == 0 ? ", calibrated_model.yaml" : "") << (comparison.empty() ? "" : ", comparison_with_truth.json")
+              << (code == 0 ? ", calibrated_model.yaml, calibrated.urdf" : "") << (comparison.empty() ? "" : ", comparison_with_truth.json")
               << "\n";
     return code;
   };

@@ -5,6 +5,7 @@
 
 #include "io/atomic_file.h"
 #include "io/observations_file.h"
+#include "io/urdf_robot_config.h"
 #include "yaml/yaml_reader.h"
 #include "io/yaml_writer.h"
 
@@ -116,6 +117,10 @@ CalibratedModel Parse(const yaml::YamlNode& node, const std::string& name, Probl
     CheckVersion(&map, kRobotFormat, kCalibratedModelVersion);
   }
   const bool calibrated = *format == kCalibratedModelFormat;
+  if (!calibrated && NamesUrdf(node)) {
+    ParseUrdfRobotConfig(&map, problems, &out);
+    return out;
+  }
 
   RobotModel& model = out.model;
   bool ok = map.String("name", &model.name);

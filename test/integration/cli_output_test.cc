@@ -87,6 +87,7 @@ TEST(CliJson, SimulatePointsAndCalibrateMatchTheirReports) {
   EXPECT_EQ(d.at("outcome"), report.at("verdict"));
   EXPECT_EQ(d.at("files").at("report"), (out / "report.json").string());
   EXPECT_EQ(d.at("files").at("calibrated_model"), (out / "calibrated_model.yaml").string());
+  EXPECT_EQ(d.at("files").at("calibrated_urdf"), (out / "calibrated.urdf").string());
   const json& c = d.at("calibration");
   for (const char* key : {"verdict", "method", "accepted", "reasons", "fx_px", "heldout_reprojection"}) {
     EXPECT_EQ(c.at(key), report.at(key)) << key;

@@ -124,6 +124,8 @@ def kind_of(lang, text):
         return ("calibrated_model", "keys")
     if "dh_convention:" in text:
         return ("robot", "keys")
+    if "urdf_file:" in text:
+        return ("urdf_robot", "urdf_robot")
     return ("unclassified", None)
 
 
@@ -159,6 +161,19 @@ def check_reads(kind, how, text, where, real):
         if result.returncode != 0:
             problem(f"{where}: selfcal plan --check refuses the documented example (exit {result.returncode}): "
                     f"{(result.stdout + result.stderr)[-1500:]}")
+    elif how == "urdf_robot":
+        # A robot config naming a URDF (docs/urdf.md): the test URDF of its urdf_file beside it, simulated on
+        # the trajectory of that robot; its format must not be refused (exit 2).
+        urdf = re.search(r"^urdf_file:\s*(\S+)", text, re.M).group(1)
+        os.makedirs(path, exist_ok=True)
+        shutil.copy(os.path.join(SRC, "test", "data", "urdf", os.path.basename(urdf)), os.path.join(path, urdf))
+        with open(os.path.join(path, "robot.yaml"), "w", encoding="utf-8") as f:
+            f.write(text)
+        robot = os.path.basename(urdf).split(".")[0]
+        result = run(["simulate", "--points", "--no-html", "--robot", os.path.join(path, "robot.yaml"), "--trajectory",
+                      os.path.join(SRC, "config", "trajectories", f"initial_{robot}.yaml"), "--out", path + "-out"])
+        if result.returncode == 2:
+            problem(f"{where}: selfcal simulate --robot refuses the documented example: {result.stderr[-1500:]}")
     elif how == "camera":
         suffix = ".xml" if kind == "visp_camera" else ".yaml"
         with open(path + suffix, "w", encoding="utf-8") as f:

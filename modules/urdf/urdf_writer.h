@@ -1,0 +1,39 @@
+// A RobotModel (typically the calibrated one) written as a URDF (docs/urdf.md): base_link, one revolute
+// joint per model joint whose origin is that joint's calibrated RotX(alpha) TransX(a) RotY(beta)
+// RotZ(theta) TransZ(d) (axis z, the model's limits), fixed joints for base_from_link0, link_n_from_flange
+// (to `tip_link`) and flange_from_cam (to `camera_link`, the camera's optical frame). Rotations whose
+// roll-pitch-yaw would be near gimbal lock are written through an intermediate link, so that every
+// origin is exact to rounding. The text is checked with urdfdom + kdl_parser before it is returned.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "base/status.h"
+#include "kinematics/robot_model.h"
+#include "urdf/urdf_robot.h"
+
+namespace selfcal::urdf {
+
+struct UrdfNames {
+  std::string robot;                // empty: the model's name
+  std::vector<std::string> joints;  // empty: joint1 .. jointN
+  std::string base_link = "base_link";
+  std::string tip_link = "tool0";
+  std::string camera_link = "camera_optical_frame";
+};
+
+// The URDF text, refused (kInternal) if KDL's forward kinematics of it differs from the model's by more
+// than the check's tolerances at its random joints.
+Result<std::string> UrdfOfModel(const RobotModel& model, const UrdfNames& names, const FkCheckOptions& check = {});
+
+// UrdfOfModel written atomically to `path`.
+Status WriteUrdf(const RobotModel& model, const UrdfNames& names, const std::string& path);
+
+// KDL's forward kinematics of the URDF `text` (chains spec.base_link -> tip_link, and -> camera_link when
+// named) against the model's base_from_flange and base_from_cam at seeded random joints within the limits;
+// refused (kInvalidInput) naming the worst pose beyond the tolerances.
+Result<FkCheck> CompareWithKdl(const std::string& text, const std::string& name, const UrdfChainSpec& spec,
+                               const RobotModel& model, const FkCheckOptions& options);
+
+}  // namespace selfcal::urdf
