@@ -11,6 +11,6 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string path = selfcal::fuzz::WriteFuzzFile("camera.yaml", selfcal::fuzz::AsText(data, size));
   selfcal::Result<selfcal::CameraIntrinsics> camera = selfcal::io::LoadCameraFile(path);
-  if (!camera.ok()) selfcal::fuzz::NoteRefusal("camera_opencv", camera.status().message(), path);
+  if (!camera.ok()) selfcal::fuzz::NoteRefusal("camera_opencv", camera.status().message(), path + ":");
   return 0;
 }

@@ -47,8 +47,7 @@ struct TempDir {
   }
 };
 
-bool NamesLine(const std::string& message, const std::string& file_name) {
-  const std::string key = file_name + ":";
+bool NamesLine(const std::string& message, const std::string& key) {
   for (size_t at = message.find(key); at != std::string::npos; at = message.find(key, at + 1)) {
     const size_t digit = at + key.size();
     if (digit < message.size() && std::isdigit(static_cast<unsigned char>(message[digit]))) return true;
@@ -75,13 +74,17 @@ std::string WriteFuzzFile(const std::string& name, const std::string& bytes) {
   return path;
 }
 
-void NoteRefusal(const char* harness, const std::string& message, const std::string& file_name) {
+void NoteRefusal(const char* harness, const std::string& message, const std::string& line_prefix) {
   static const bool enabled = std::getenv("SELFCAL_FUZZ_STATS") != nullptr;
   if (!enabled) return;
   RefusalCounts& counts = Counts();
   counts.harness = harness;
   ++counts.refusals;
-  if (NamesLine(message, file_name)) ++counts.with_line;
+  if (NamesLine(message, line_prefix)) {
+    ++counts.with_line;
+  } else if (std::getenv("SELFCAL_FUZZ_SHOW") != nullptr) {
+    std::fprintf(stderr, "refusal without a line: %s\n", message.c_str());
+  }
 }
 
 }  // namespace selfcal::fuzz

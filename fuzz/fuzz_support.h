@@ -2,10 +2,10 @@
 //
 // - FuzzDir(): one private temporary directory per process (removed at exit), for the readers that take a
 //   path (LoadTrajectoryFile, LoadCameraFile, ReadManifest, ReadJournal).
-// - NoteRefusal(): counts the refusals of a harness and how many name the input with a line
-//   (`<name>:<line>`). With SELFCAL_FUZZ_STATS=<file> in the environment the counts are appended to that
+// - NoteRefusal(): counts the refusals of a harness and how many name the line of the input
+//   (`<file>:<line>`, or for journal records `record <n>`). With SELFCAL_FUZZ_STATS=<file> in the environment the counts are appended to that
 //   file at exit, one line `<harness> refusals=N with_line=M` (scripts/fuzz reads it); without it nothing
-//   is counted or written.
+//   is counted or written. SELFCAL_FUZZ_SHOW=1 as well prints each counted refusal that names no line.
 #pragma once
 
 #include <cstddef>
@@ -27,7 +27,7 @@ const std::string& FuzzDir();
 std::string WriteFuzzFile(const std::string& name, const std::string& bytes);
 
 // Counts one refusal of `harness` whose message is `message`; it names the line when it contains
-// `<file_name>:<digits>`.
-void NoteRefusal(const char* harness, const std::string& message, const std::string& file_name);
+// `line_prefix` followed by a digit (`line_prefix` is e.g. "fuzz.yaml:" or "record ").
+void NoteRefusal(const char* harness, const std::string& message, const std::string& line_prefix);
 
 }  // namespace selfcal::fuzz

@@ -2,7 +2,7 @@
 //  1. the input as a raw journal file (framing, CRC, torn tail, damage) through session::ReadJournal;
 //  2. each line of the input framed as one valid record (session::FrameJournalRecord, so the CRC passes
 //     and the mutations reach the payloads), read back with ReadJournal and validated by ReadSessionLog.
-// Refusals of the second name the record (`journal.log:<record>`), counted as naming the line.
+// A refusal counts as naming the line when it names the record (`record <n>`).
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -36,10 +36,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string path = selfcal::fuzz::WriteFuzzFile("journal.log", FramedLines(text));
   contents = selfcal::session::ReadJournal(path);
   if (!contents.ok()) {
-    selfcal::fuzz::NoteRefusal("journal", contents.status().message(), path);
+    selfcal::fuzz::NoteRefusal("journal", contents.status().message(), "record ");
     return 0;
   }
   selfcal::Result<selfcal::session::SessionLog> log = selfcal::session::ReadSessionLog(contents->records);
-  if (!log.ok()) selfcal::fuzz::NoteRefusal("journal", log.status().message(), "record");
+  if (!log.ok()) selfcal::fuzz::NoteRefusal("journal", log.status().message(), "record ");
   return 0;
 }

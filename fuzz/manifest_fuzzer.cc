@@ -11,7 +11,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string path = selfcal::fuzz::WriteFuzzFile("session.json", selfcal::fuzz::AsText(data, size));
   selfcal::Result<selfcal::session::SessionManifest> manifest = selfcal::session::ReadManifest(selfcal::fuzz::FuzzDir());
   if (!manifest.ok()) {
-    selfcal::fuzz::NoteRefusal("manifest", manifest.status().message(), path);
+    selfcal::fuzz::NoteRefusal("manifest", manifest.status().message(), path + ":");
     return 0;
   }
   for (const selfcal::session::InputDigest& input : manifest->inputs) (void)manifest->FindInput(input.name);

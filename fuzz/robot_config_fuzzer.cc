@@ -2,6 +2,7 @@
 // io::ParseRobotModelText. Refusals should name fuzz.yaml:<line>.
 #include <cstddef>
 #include <cstdint>
+#include <string>
 
 #include "fuzz/fuzz_support.h"
 #include "io/robot_config.h"
@@ -9,6 +10,6 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const char* kName = "fuzz.yaml";
   selfcal::Result<selfcal::RobotModel> model = selfcal::io::ParseRobotModelText(selfcal::fuzz::AsText(data, size), kName);
-  if (!model.ok()) selfcal::fuzz::NoteRefusal("robot_config", model.status().message(), kName);
+  if (!model.ok()) selfcal::fuzz::NoteRefusal("robot_config", model.status().message(), std::string(kName) + ":");
   return 0;
 }

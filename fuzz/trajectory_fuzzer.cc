@@ -11,7 +11,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string path = selfcal::fuzz::WriteFuzzFile("plan.yaml", selfcal::fuzz::AsText(data, size));
   selfcal::Result<selfcal::io::TrajectoryFile> file = selfcal::io::LoadTrajectoryFile(path, 6);
   if (!file.ok()) {
-    selfcal::fuzz::NoteRefusal("trajectory", file.status().message(), path);
+    selfcal::fuzz::NoteRefusal("trajectory", file.status().message(), path + ":");
     return 0;
   }
   selfcal::planning::PlanSubject subject = selfcal::io::PlanSubjectOf(*file);
