@@ -91,10 +91,19 @@ bool ReadOpenCvMatrix(const cv::FileNode& node, const std::string& key, const st
     problems->Add("missing key `" + key + "` in " + file);
     return false;
   }
+  // rows, cols and data checked before cv::FileStorage allocates rows x cols: a mistyped `cols` (or a
+  // repeated key) can make it ask for tens of gigabytes. The intrinsics' matrices have at most 16 entries.
+  const auto small_int = [](const cv::FileNode& n) { return n.isInt() && int(n) >= 1 && int(n) <= 16; };
+  if (!node.isMap() || !small_int(node["rows"]) || !small_int(node["cols"]) || !node["data"].isSeq() ||
+      node["data"].size() != static_cast<size_t>(int(node["rows"]) * int(node["cols"]))) {
+    problems->Add("`" + key + "` in " + file + " must be an opencv-matrix (rows, cols, dt, data) of at most 16 " +
+                  "entries, with rows x cols values in data");
+    return false;
+  }
   cv::Mat m;
   try {
-    if (node.isMap()) node >> m;
-  } catch (const cv::Exception& e) {
+    node >> m;
+  } catch (const std::exception& e) {  // cv::Exception, or a std::exception of FileStorage
     m = cv::Mat();
   }
   if (m.empty() || m.channels() != 1) {
@@ -166,7 +175,7 @@ Result<CameraIntrinsics> LoadOpenCv(const std::string& path, const std::string& 
     if (!fs.open(contents, cv::FileStorage::READ | cv::FileStorage::MEMORY)) {
       return Status::Error(ErrorCode::kInvalidInput, "cannot read " + path + " as an OpenCV FileStorage file");
     }
-  } catch (const cv::Exception& e) {
+  } catch (const std::exception& e) {  // cv::Exception, or e.g. std::length_error from FileStorage::open
     return Status::Error(ErrorCode::kInvalidInput,
                          "cannot read " + path + " as an OpenCV FileStorage file: " + std::string(e.what()));
   }
@@ -250,7 +259,7 @@ Status SaveCameraOpenCv(const CameraIntrinsics& camera, const std::string& path)
     const cv::Mat d = (cv::Mat_<double>(5, 1) << camera.k1, camera.k2, camera.p1, camera.p2, camera.k3);
     fs << "camera_matrix" << k << "distortion_coefficients" << d;
     text = fs.releaseAndGetString();
-  } catch (const cv::Exception& e) {
+  } catch (const std::exception& e) {
     return Status::Error(ErrorCode::kInternal, "cannot format " + path + ": " + std::string(e.what()));
   }
   return WriteFileAtomically(path, text);

@@ -192,6 +192,14 @@ TEST_F(BadCameraFiles, OpenCv) {
   const std::string five = "{rows: 5, cols: 1, dt: d, data: [0.1, 0, 0, 0, 0]}";
   rational.replace(rational.find(five), five.size(), "{rows: 8, cols: 1, dt: d, data: [0.1, 0, 0, 0, 0, 0.2, 0, 0]}");
   EXPECT_TRUE(Refused("rational.yaml", rational, "OpenCV's rational (k4, k5, k6) model"));
+  // Found by fuzz/camera_opencv_fuzzer (fuzz/regressions/camera_opencv/): rows x cols are checked before
+  // cv::FileStorage allocates them, so a huge or mistyped size is refused, not a 10 GB allocation.
+  EXPECT_TRUE(Refused("huge.yaml", OpenCv("", "100000, cols: 100000, dt: d, data: [1]"), "of at most 16 entries"));
+  EXPECT_TRUE(Refused("cols.yaml", OpenCv("", "3, cols: x, dt: d, data: [600, 0, 320, 0, 600, 240, 0, 0, 1]"),
+                      "with rows x cols values in data"));
+  // Found by the fuzzer too: cv::FileStorage::open throws std::length_error (not cv::Exception) on this.
+  EXPECT_TRUE(Refused("length.yaml", ReadFile(SourcePath("fuzz/regressions/camera_opencv/filestorage-open-throws-length-error.yaml")),
+                      "cannot read"));
   EXPECT_TRUE(Refused("fisheye.yaml", OpenCv("fisheye_model: 1\n"), "fisheye"));
   EXPECT_TRUE(Refused("garbage.yaml", "%YAML:1.0\n---\n{ [ :\n", "cannot read"));
   EXPECT_TRUE(Refused("named.yaml", OpenCv(""), "a camera name (`A`) is for ViSP files", "A"));

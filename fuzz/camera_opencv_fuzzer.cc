@@ -1,0 +1,16 @@
+// Fuzz harness: an OpenCV FileStorage camera file (docs/camera-files.md) through io::LoadCameraFile, as
+// `.yaml` (cv::FileStorage's YAML parser, then selfcal's checks). Refusals name the file; cv::FileStorage
+// reports no line for most problems, so the line share of this harness is not a goal.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "fuzz/fuzz_support.h"
+#include "io/camera_file.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const std::string path = selfcal::fuzz::WriteFuzzFile("camera.yaml", selfcal::fuzz::AsText(data, size));
+  selfcal::Result<selfcal::CameraIntrinsics> camera = selfcal::io::LoadCameraFile(path);
+  if (!camera.ok()) selfcal::fuzz::NoteRefusal("camera_opencv", camera.status().message(), path + ":");
+  return 0;
+}
