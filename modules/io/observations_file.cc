@@ -393,7 +393,8 @@ Result<ObservationSet> ParseObservations(const yaml::YamlDocument& doc) {
     const std::map<std::string, int> lines = SubjectLines(doc.root, set);
     std::istringstream invalid(set.Validate());
     for (std::string line; std::getline(invalid, line);) {
-      problems.Add((LineOfSubject(lines, line) > 0 ? problems.At(LineOfSubject(lines, line)) : doc.path) + ": " + line);
+      const int at = LineOfSubject(lines, line);
+      problems.Add((at > 0 ? problems.At(at) : doc.path) + ": " + line);
     }
   }
   if (!problems.empty()) return problems.ToStatus("observations");
