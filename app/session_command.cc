@@ -453,7 +453,12 @@ int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, se
   for (const auto& [kind, n] : report.faults) std::cout << ", fault " << kind << " x" << n;
   std::cout << "\nnamed by prediction: " << report.named_by_prediction << " dots, " << report.dropped_by_prediction
             << " tracked dots dropped, " << report.ambiguous_by_prediction << " ambiguous detections, "
-            << report.prediction_uncorrected << " frames uncorrected\n";
+            << report.prediction_uncorrected << " frames uncorrected";
+  if (report.named_later > 0) {
+    std::cout << "; named later in the recorded frames: " << report.named_later << " dots in "
+              << report.samples_named_later << " samples";
+  }
+  std::cout << "\n";
   if (b.live_view) {
     std::cout << "live view: " << b.live_view->frames_drawn() << " frames drawn, " << b.live_view->frames_throttled()
               << " frames of moves not redrawn (at most 15 a second)\n";

@@ -4,10 +4,14 @@
 // checked against their gates, and the detections nobody tracked named by gated nearest prediction with
 // the ambiguity test (tracking/predicted_match.h), or kept as candidates of dots seen once.
 #include <map>
+#include <set>
 
 #include <Eigen/Eigenvalues>
 
+#include "acquisition/late_naming.h"
 #include "acquisition/session_runner_internal.h"
+#include "base/atomic_file.h"
+#include "capture/png_codec.h"
 
 namespace selfcal::acquisition::internal {
 
@@ -159,6 +163,61 @@ void Runner::NameByPrediction(const Capture& capture) {
     }
   }
   tracked_ = std::move(kept);
+}
+
+bool Runner::NameLater() {
+  if (c_.prediction == nullptr || c_.session == nullptr || o_.late_naming_passes <= 0) return true;
+  Result<session::SessionLog> log = session::ReadSessionLog(c_.session->journal().records());
+  if (!log.ok()) return true;  // the loop read it before: nothing is named rather than a doubtful name
+  AcceptedSamples();           // viewed_, by pose, with every sample of the journal
+  LateNamingOptions options;
+  options.prediction = o_.prediction;
+  options.correction = o_.prediction_correction;
+  options.match = o_.predicted_match;
+  options.duplicate_distance_px = o_.detector.duplicate_distance_px;
+  options.min_other_samples = o_.late_min_other_samples;
+
+  // Each accepted sample's frame, read again and detected once (an unreadable one names nothing).
+  std::vector<int> poses;
+  std::vector<tracking::DetectionReport> detected;
+  for (const auto& [pose, s] : *viewed_) {
+    const std::optional<session::AcceptedSample>& a = log->accepted.at(static_cast<size_t>(pose));
+    Result<std::string> bytes = ReadFileCapped(c_.session->path() + "/" + a->image, 64 << 20);
+    Result<vpImage<unsigned char>> image =
+        bytes.ok() ? capture::DecodeGreyPng(*bytes, a->image) : Result<vpImage<unsigned char>>(bytes.status());
+    poses.push_back(pose);
+    detected.emplace_back();
+    if (!image.ok()) {
+      ++report_.faults["late_naming_unreadable_image"];
+      Log("pose " + a->id + ": its image could not be read again (" + image.status().message() + ")");
+      continue;
+    }
+    detected.back() = tracking::DetectDots(*image, o_.detector);
+  }
+  auto record_named = [&](size_t k, const std::vector<tracking::PreviousDot>& named) {
+    if (named.empty()) return true;
+    if (!Record({{"type", "dots_named_later"}, {"pose", poses[k]}, {"dots", DotsJson(named)}})) return false;
+    for (const tracking::PreviousDot& d : named) (*viewed_)[poses[k]].dots_px[d.id] = d.centroid_px;
+    report_.named_later += static_cast<int>(named.size());
+    samples_named_later_.insert(poses[k]);
+    Log("pose " + plan_[static_cast<size_t>(poses[k])].id + ": " + std::to_string(named.size()) + " dots named later");
+    return true;
+  };
+  for (int pass = 0; pass < o_.late_naming_passes; ++pass) {
+    const int before = report_.named_later;
+    for (size_t k = 0; k < poses.size(); ++k) {
+      std::vector<ViewedSample> others;
+      for (const auto& [other, s] : *viewed_) {
+        if (other != poses[k]) others.push_back(s);
+      }
+      ViewedSample& sample = (*viewed_)[poses[k]];
+      const LateNaming late = acquisition::NameLater(*c_.prediction, others, sample, detected[k], options);
+      if (!record_named(k, late.named)) return false;
+    }
+    if (report_.named_later == before) break;  // nothing new: another pass would name nothing
+  }
+  report_.samples_named_later = static_cast<int>(samples_named_later_.size());
+  return true;
 }
 
 }  // namespace selfcal::acquisition::internal

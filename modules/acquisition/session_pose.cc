@@ -13,6 +13,15 @@ namespace selfcal::acquisition::internal {
 
 using nlohmann::json;
 
+json DotsJson(const std::vector<tracking::PreviousDot>& named) {
+  json dots = json::array();
+  for (const tracking::PreviousDot& d : named) {
+    dots.push_back({{"id", d.id}, {"u", d.centroid_px.x()}, {"v", d.centroid_px.y()}, {"area", d.area_px2},
+                    {"w", d.width_px}, {"h", d.height_px}});
+  }
+  return dots;
+}
+
 Runner::Step Runner::VisitPose(const PlannedPose& target, int pose, bool is_return, Eigen::VectorXd* expected) {
   StartPoseView();
   robot::JointReading before;
@@ -132,15 +141,7 @@ Runner::Step Runner::RecordSample(int pose, const PlannedPose& target, const Arr
                {"exposure_time_s", frame.exposure_time_s}, {"sequence", frame.sequence}})) {
     return Step::kEnd;
   }
-  auto dots_json = [](const std::vector<tracking::PreviousDot>& named) {
-    json dots = json::array();
-    for (const tracking::PreviousDot& d : named) {
-      dots.push_back({{"id", d.id}, {"u", d.centroid_px.x()}, {"v", d.centroid_px.y()}, {"area", d.area_px2},
-                      {"w", d.width_px}, {"h", d.height_px}});
-    }
-    return dots;
-  };
-  const json dots = dots_json(tracked_);
+  const json dots = DotsJson(tracked_);
   json sample = {{"type", "sample_accepted"}, {"pose", pose}, {"id", target.id}, {"role", RoleName(target.role)},
                  {"joints_rad", ToJson(capture.joints.position_rad)}, {"joint_time_s", capture.joints.time_s},
                  {"settle_time_s", arrival.settle_s}, {"arrival_time_s", arrival.arrival_s},
@@ -151,7 +152,7 @@ Runner::Step Runner::RecordSample(int pose, const PlannedPose& target, const Arr
     for (const tracking::PreviousDot& d : tracked_) named = named || d.id == c.id;
     if (!named) candidates.push_back(c);
   }
-  if (!candidates.empty()) sample["candidates"] = dots_json(candidates);
+  if (!candidates.empty()) sample["candidates"] = DotsJson(candidates);
   if (o_.journal_sim_clock) sample["sim_clock_s"] = Now();
   if (!Record(sample)) return Step::kEnd;
   RememberSample(pose, capture.joints.position_rad, tracked_, candidates);

@@ -340,6 +340,7 @@ RunReport Runner::Run() {
                                 : VisitPose(route.poses[r], route.plan_index[r], route.pass[r], &expected);
     if (step == Step::kEnd) return report_;
   }
+  if (!NameLater()) return report_;
   if (!Record({{"type", "finished"}, {"time_s", Now()}})) return report_;
   report_.outcome = RunOutcome::kCompleted;
   report_.error = ErrorCode::kOk;

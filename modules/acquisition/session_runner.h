@@ -21,6 +21,8 @@
 // that loses every dot then goes on, and the pose halts only when nothing can be named. A dot seen in one
 // sample only is predicted as a segment of its epipolar line: a detection alone on it is journaled as a
 // candidate (never an observation), which the next settled pose confirms by a short gate or forgets.
+// Once every pose of the route is visited, before `finished`: each accepted sample's image is read again
+// and the dots it lacks are named from the other samples (late_naming.h), journaled as dots_named_later.
 //
 // Resume: the journal decides. RunSession continues at the first pose with neither an accepted sample
 // nor a final skip (session/samples.h), with the dots of the last accepted sample as the tracker's state;
@@ -115,6 +117,11 @@ struct RunOptions {
   DotPredictionOptions prediction;
   tracking::PredictionCorrectionOptions prediction_correction;
   tracking::PredictedMatchOptions predicted_match;
+  // With prediction, once every pose is visited and before the session is marked finished: each accepted
+  // sample's frame is read again and the dots it lacks are named from the other samples' predictions
+  // (late_naming.h), journaled as dots_named_later; at most this many passes over the samples (0: none).
+  int late_naming_passes = 2;
+  int late_min_other_samples = 3;      // LateNamingOptions::min_other_samples
   int png_compression = 1;
   std::uint64_t frame_bytes_estimate = 400 * 1024;  // P5: free space needed per frame
   bool journal_sim_clock = false;   // simulated sessions: journal the clock with each sample (resume)
@@ -150,6 +157,8 @@ struct RunReport {
   int dropped_by_prediction = 0;   // tracked dots far outside their prediction's gate, not recorded
   int ambiguous_by_prediction = 0; // detections left unnamed: two gates, or two detections in one gate
   int prediction_uncorrected = 0;  // settled frames where no correction of the predictions was found
+  int named_later = 0;             // dots named in recorded samples' frames at the end (late_naming.h)
+  int samples_named_later = 0;     // samples that gained dots so
 };
 
 // What a live view is shown of the loop (RunContext::observe): one frame, its dots and the pose.

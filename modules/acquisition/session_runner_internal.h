@@ -19,6 +19,8 @@
 namespace selfcal::acquisition::internal {
 
 nlohmann::json ToJson(const Eigen::VectorXd& v);
+// The "dots" array of a sample record: [{"id", "u", "v", "area", "w", "h"}].
+nlohmann::json DotsJson(const std::vector<tracking::PreviousDot>& dots);
 const char* RoleName(PoseRole role);
 
 // The robot as it answered before anything moved.
@@ -131,6 +133,10 @@ class Runner {
   // The accepted samples of the session so far (the journal's), as prediction reads them, by pose: read
   // from the journal once, then kept up to date as this run accepts samples (RememberSample).
   std::vector<ViewedSample> AcceptedSamples();
+  // With prediction, after the last pose (session_naming.cc): the dots each accepted sample's frame lacks,
+  // named from the other samples (late_naming.h) and journaled as dots_named_later; false when the
+  // journal could not be written (report_ set).
+  bool NameLater();
   void RememberSample(int pose, const Eigen::VectorXd& joints_rad, const std::vector<tracking::PreviousDot>& dots,
                       const std::vector<tracking::PreviousDot>& candidates);
   // Marked dots (DotIdentifier::FindMarked) that tracking lost, found again in a settled frame.
@@ -158,6 +164,7 @@ class Runner {
   std::vector<RejectedFrame> pose_frames_;  // grabbed after settling at this pose (session_view.cc)
   std::map<int, Eigen::Vector2d> lost_;     // dots lost at this pose: their last tracked position
   std::set<int> named_ids_;                 // ids named (not tracked) at this pose's settled frame
+  std::set<int> samples_named_later_;       // poses whose samples gained dots in NameLater
 };
 
 }  // namespace selfcal::acquisition::internal

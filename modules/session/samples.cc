@@ -186,6 +186,8 @@ class LogBuilder {
       AddAccepted(f, index);
     } else if (type == "frame_rejected") {
       AddRejected(f, index);
+    } else if (type == "dots_named_later") {
+      AddNamedLater(f);
     } else if (type == "sample_skipped") {
       AddSkipped(f, index);
     } else if (type == "fault") {
@@ -334,6 +336,20 @@ class LogBuilder {
     }
     log_.last_accepted_pose = sample.pose;
     log_.accepted[sample.pose] = std::move(sample);
+  }
+
+  // dots_named_later: dots of an accepted sample's frame named after it was recorded, appended to it.
+  void AddNamedLater(const Fields& f) {
+    const int pose = Pose(f);
+    if (!log_.accepted[pose]) f.Fail("pose", "pose " + std::to_string(pose) + " has no earlier sample_accepted record");
+    AcceptedSample& sample = *log_.accepted[pose];
+    for (const SampleDot& d : ReadDots(f)) {
+      for (const SampleDot& held : sample.dots) {
+        if (held.id == d.id) f.Fail("dots", "dot " + std::to_string(d.id) + " is already in the sample of pose " + std::to_string(pose));
+      }
+      sample.dots.push_back(d);
+      ++sample.named_later;
+    }
   }
 
   SessionLog log_;

@@ -65,6 +65,9 @@ struct AcceptedSample {
   // Detections the session could pin to a dot only up to its epipolar segment (a dot seen once): never
   // observations, only a second ray that the next pose's prediction confirms or forgets (optional).
   std::vector<SampleDot> candidates;
+  // How many of `dots` were appended by dots_named_later records: named in the sample's frame after it
+  // was recorded, from the predictions of the session's other samples (acquisition/late_naming.h).
+  int named_later = 0;
   std::optional<double> sim_clock_s;
   std::size_t record = 0;
 };
@@ -145,7 +148,8 @@ struct SessionLog {
 // pose recorded; a second frame_written of an image must agree with the first; dot ids within a sample
 // are distinct; frame_rejected names an image under images/rejected/ (a repeat must agree), and a
 // sample_skipped's rejected_images name earlier frame_rejected records of its pose. A second sample_accepted of an accepted pose is kept out (the first counts) and listed in
-// duplicate_accepts. kInvalidInput naming the record, its type and field.
+// duplicate_accepts. A dots_named_later record names an accepted pose and dots not yet in its sample, which
+// are appended to that sample's dots. kInvalidInput naming the record, its type and field.
 Result<SessionLog> ReadSessionLog(const std::vector<nlohmann::json>& records);
 
 // Checks what the per-field checks of ReadSessionLog cannot: the contents of every accepted sample against

@@ -342,5 +342,42 @@ TEST(SamplesTest, VerifySampleImages) {
   EXPECT_TRUE(Contains(VerifySampleImages(session, *log).message(), "images/p00.png (pose 0): missing"));
 }
 
+// dots_named_later (acquisition/late_naming.h): the dots are appended to their pose's sample, counted,
+// and a record that names no earlier sample or a dot the sample holds is refused naming the record.
+TEST(SamplesTest, DotsNamedLaterJoinTheirSample) {
+  std::vector<json> records = SyntheticJournal();
+  const json later = {{"type", "dots_named_later"},
+                      {"pose", 0},
+                      {"dots", {{{"id", 7}, {"u", 300.0}, {"v", 120.0}, {"area", 60.0}, {"w", 9.0}, {"h", 9.0}}}}};
+  records.push_back(later);
+  Result<SessionLog> read = ReadSessionLog(records);
+  ASSERT_TRUE(read.ok()) << read.status().ToString();
+  const AcceptedSample& first = *read->accepted[0];
+  ASSERT_EQ(first.dots.size(), 3u);
+  EXPECT_EQ(first.dots[2].id, 7);
+  EXPECT_EQ(first.dots[2].u_px, 300.0);
+  EXPECT_EQ(first.named_later, 1);
+  EXPECT_EQ(read->unknown_records, 1u);  // the synthetic journal's own unknown record only
+
+  std::vector<json> no_sample = SyntheticJournal();
+  json bad = later;
+  bad["pose"] = 1;  // pose 1 was skipped
+  no_sample.push_back(bad);
+  Result<SessionLog> refused = ReadSessionLog(no_sample);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.status().message().find("(dots_named_later): field \"pose\": pose 1 has no earlier sample_accepted"),
+            std::string::npos)
+      << refused.status().message();
+
+  std::vector<json> held = SyntheticJournal();
+  bad = later;
+  bad["dots"][0]["id"] = 3;  // sample 0 holds dot 3
+  held.push_back(bad);
+  refused = ReadSessionLog(held);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.status().message().find("dot 3 is already in the sample of pose 0"), std::string::npos)
+      << refused.status().message();
+}
+
 }  // namespace
 }  // namespace selfcal::session

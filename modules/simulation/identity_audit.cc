@@ -19,12 +19,25 @@ sim::RenderOptions GeometryOnly() {
 }
 
 // Scores one sample's names against the rendered truth of its view; appends its wrong names.
+nlohmann::json MissedJson(const std::vector<std::pair<int, Eigen::Vector2d>>& missed) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& [id, uv] : missed) out.push_back({{"id", id}, {"u", uv.x()}, {"v", uv.y()}});
+  return out;
+}
+
 SampleIdentities AuditSample(const session::AcceptedSample& sample, const sim::RenderedImage& truth, double gate_px,
                              std::vector<WrongIdentity>* wrong) {
   SampleIdentities s;
   s.pose = sample.pose;
   s.pose_id = sample.id;
   for (const sim::RenderedDot& d : truth.dots) s.in_view += d.in_front && d.fully_inside ? 1 : 0;
+  std::vector<bool> named_id(truth.dots.size(), false);
+  for (const session::SampleDot& named : sample.dots) {
+    if (named.id >= 0 && named.id < static_cast<int>(truth.dots.size())) named_id[named.id] = true;
+  }
+  for (const sim::RenderedDot& d : truth.dots) {
+    if (d.in_front && d.fully_inside && !named_id[d.id]) s.missed.push_back({d.id, d.projected_centre_px});
+  }
   for (const session::SampleDot& named : sample.dots) {
     ++s.named;
     const Eigen::Vector2d pixel(named.u_px, named.v_px);
@@ -125,7 +138,8 @@ nlohmann::json IdentityAuditJson(const IdentityAudit& audit) {
                        {"named", s.named},
                        {"named_in_view", s.named_in_view},
                        {"wrong", s.wrong},
-                       {"max_right_error_px", s.max_right_error_px}});
+                       {"max_right_error_px", s.max_right_error_px},
+                       {"missed", MissedJson(s.missed)}});
   }
   nlohmann::json wrong = nlohmann::json::array();
   for (size_t k = 0; k < audit.wrong.size() && k < 50; ++k) wrong.push_back(WrongJson(audit.wrong[k]));

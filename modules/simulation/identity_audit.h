@@ -25,6 +25,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -59,6 +60,9 @@ struct SampleIdentities {
   int named_in_view = 0;  // of those, in view
   int wrong = 0;
   double max_right_error_px = 0;  // largest distance of a right name from its dot's true projection
+  // The dots in view the sample does not name, by id, at their true projected centres: where a naming
+  // that missed them should have looked.
+  std::vector<std::pair<int, Eigen::Vector2d>> missed;
   double ratio() const { return in_view > 0 ? static_cast<double>(named_in_view) / in_view : 0.0; }
 };
 
