@@ -49,12 +49,24 @@ void AddRobotOption(CLI::App* cmd, std::string* robot_path) {
   cmd->add_option("--robot", *robot_path, "Nominal robot config");
 }
 
+Result<std::string> TrajectoryForRobot(const std::string& given, const std::string& robot_name, const std::string& robot_path) {
+  if (!given.empty()) return given;
+  const std::string shipped = io::InitialTrajectoryPath(robot_name);
+  std::error_code ec;
+  if (std::filesystem::exists(ResolveDataPath(shipped), ec)) return shipped;
+  return Status::Error(ErrorCode::kInvalidInput, "no trajectory given and none shipped for robot `" + robot_name + "` (" +
+                                                     shipped + " does not exist): give one, or make one with "
+                                                     "`selfcal make-trajectory --robot " + robot_path + " --out FILE`");
+}
+
 Result<RobotAndTrajectory> LoadRobotAndTrajectory(const std::string& robot_path, const std::string& trajectory_path) {
   Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(robot_path));
   if (!robot.ok()) return robot.status();
-  Result<std::vector<Eigen::VectorXd>> joints = io::LoadTrajectory(ResolveDataPath(trajectory_path), robot->num_joints());
-  if (!joints.ok()) return joints.status();
-  return RobotAndTrajectory{std::move(robot).value(), std::move(joints).value()};
+  Result<std::string> path = TrajectoryForRobot(trajectory_path, robot->name, robot_path);
+  if (!path.ok()) return path.status();
+  Result<io::TrajectoryFile> file = io::LoadTrajectoryFileForRobot(ResolveDataPath(*path), *robot, robot_path);
+  if (!file.ok()) return file.status();
+  return RobotAndTrajectory{std::move(robot).value(), std::move(file).value().poses, *path};
 }
 
 Status EnsureDirectory(const std::string& path) {

@@ -33,10 +33,18 @@ std::string FileSha256(const std::string& path);
 // `--robot PATH`: the nominal robot config (docs/frames-and-units.md), as every simulation command takes it.
 void AddRobotOption(CLI::App* cmd, std::string* robot_path);
 
-// The nominal robot of a config and a trajectory file for it, both paths resolved by ResolveDataPath.
+// The trajectory a command takes for a robot: `given` when set, else the robot's shipped trajectory
+// (io::InitialTrajectoryPath of its name). Refused (kInvalidInput, exit 2) when none is given and none is
+// shipped for that robot, saying how to make one.
+Result<std::string> TrajectoryForRobot(const std::string& given, const std::string& robot_name, const std::string& robot_path);
+
+// The nominal robot of a config and a trajectory file for it (`trajectory_path` empty: TrajectoryForRobot),
+// both paths resolved by ResolveDataPath; a trajectory for another robot is refused with both names
+// (io::LoadTrajectoryFileForRobot, exit 2).
 struct RobotAndTrajectory {
   RobotModel robot;
   std::vector<Eigen::VectorXd> joints;
+  std::string trajectory_path;  // the one used
 };
 Result<RobotAndTrajectory> LoadRobotAndTrajectory(const std::string& robot_path, const std::string& trajectory_path);
 

@@ -13,7 +13,7 @@ namespace selfcal::app {
 namespace {
 struct IdentifiabilityArgs {
   std::string robot = "config/robots/puma560.yaml";
-  std::string trajectory = "config/trajectories/initial_puma560.yaml";
+  std::string trajectory;  // default: the robot's shipped trajectory (TrajectoryForRobot)
   int identification_poses = 15;
 };
 
@@ -30,7 +30,8 @@ Command AddIdentifiabilityCommand(CLI::App& app) {
   auto args = std::make_shared<IdentifiabilityArgs>();
   CLI::App* cmd = app.add_subcommand("identifiability", "Rank analysis of the identification Jacobian");
   AddRobotOption(cmd, &args->robot);
-  cmd->add_option("--trajectory", args->trajectory, "Trajectory file");
+  cmd->add_option("--trajectory", args->trajectory,
+                  "Trajectory file (for the robot); default: config/trajectories/initial_<robot name>.yaml");
   cmd->add_option("--identification-poses", args->identification_poses, "Use the first N poses")->check(CLI::Range(2, 10000));
   return [args]() {
     Result<RobotAndTrajectory> loaded = LoadRobotAndTrajectory(args->robot, args->trajectory);

@@ -103,7 +103,8 @@ void AddPlanOptions(CLI::App* cmd, PlanArgs* args) {
                   "Start trajectory (offending poses are repaired from a pool); default: "
                   "config/trajectories/initial_<robot name>.yaml");
   cmd->add_option("--out", args->out, "Plan file to write");
-  cmd->add_option("--check", args->check, "Check this plan instead of planning (exit 3 when it has problems)");
+  cmd->add_option("--check", args->check,
+                  "Check this plan instead of planning (exit 3 when it has problems, 2 when it is for another robot)");
   cmd->add_option("--criterion", args->criterion, "eq39 (the paper's), d-optimal or a-optimal");
   cmd->add_option("--lambda", args->lambda, "Weight of Cond(J) in eq. (39) (the paper's 1e-7)")->check(CLI::Range(0.0, 1e6));
   cmd->add_option("--seed", args->seed, "Seed of the candidate pool");
@@ -174,10 +175,9 @@ std::optional<int> SetScene(const PlanArgs& args, const RobotModel& robot, plann
   } else {
     sim::SimOptions sim_options;
     sim_options.world_seed = args.sim_world_seed;
-    Result<std::vector<Eigen::VectorXd>> scene_poses =
-        io::LoadTrajectory(ResolveDataPath(args.scene_from), robot.num_joints());
+    Result<io::TrajectoryFile> scene_poses = io::LoadTrajectoryFileForRobot(ResolveDataPath(args.scene_from), robot, args.robot);
     if (!scene_poses.ok()) return Fail(scene_poses.status());
-    const sim::SimResult world = sim::Simulate(robot, *scene_poses, sim_options);
+    const sim::SimResult world = sim::Simulate(robot, scene_poses->poses, sim_options);
     if (!world.ok) {
       return Fail(Status::Error(ErrorCode::kDegenerateData, "no simulated scene for " + args.scene_from + ": " + world.message));
     }
@@ -237,8 +237,11 @@ int WritePlan(const PlanArgs& args, planning::Criterion criterion, const plannin
   plan.poses = r.poses;
   plan.robot = problem.robot.name;
   plan.num_identification_poses = problem.num_identification_poses;
+  const bool box = args.box_center_mm.size() == 3;
   plan.description = "planned from " + plan_path + " by `selfcal plan --robot " + args.robot + " --criterion " +
-                     planning::CriterionName(criterion) + " --seed " + std::to_string(args.seed) + "` (docs/planning.md)";
+                     planning::CriterionName(criterion) + " --seed " + std::to_string(args.seed) +
+                     (!box && args.sim_world_seed != 1 ? " --sim-world-seed " + std::to_string(args.sim_world_seed) : "") +
+                     "` (docs/planning.md)";
   plan.planned_for = planning::PlannedFor{problem.camera, problem.scene, problem.constraints};
   std::ostringstream provenance;
   provenance << "criterion " << planning::CriterionName(criterion) << ", lambda " << args.lambda << ", seed " << args.seed
@@ -287,10 +290,15 @@ int RunPlanCommand(const PlanArgs& args) {
     return Fail(Status::Error(ErrorCode::kInvalidInput, "--criterion `" + args.criterion + "`: expected eq39, d-optimal or a-optimal"));
   }
   PlanArgs a = args;  // the defaults follow the robot
-  if (a.start.empty()) a.start = "config/trajectories/initial_" + robot->name + ".yaml";
+  if (a.start.empty() && a.check.empty()) {
+    Result<std::string> start = TrajectoryForRobot("", robot->name, a.robot);
+    if (!start.ok()) return Fail(start.status());
+    a.start = *start;
+  }
   if (a.scene_from.empty()) a.scene_from = a.start;
   const std::string plan_path = a.check.empty() ? a.start : a.check;
-  Result<io::TrajectoryFile> file = io::LoadTrajectoryFile(ResolveDataPath(plan_path), robot->num_joints());
+  // A plan or start made for another robot is a usage error naming both robots (exit 2).
+  Result<io::TrajectoryFile> file = io::LoadTrajectoryFileForRobot(ResolveDataPath(plan_path), *robot, a.robot);
   if (!file.ok()) return Fail(file.status());
   if (!a.check.empty()) return CheckOnly(a, *robot, *file, plan_path);
   planning::PlanningProblem problem = MakeProblem(a, *robot, *file);

@@ -201,8 +201,9 @@ Status LoadRunPlan(const RunSettings& a, RunPlan* run) {
   run->nominal = *nominal;
   Result<session::SessionInput> plan_input = session::ReadInputFile("plan.yaml", ResolveDataPath(a.plan));
   if (!plan_input.ok()) return plan_input.status();
-  // The robot name and limits are the plan check's (preflight), in the words of `plan --check`.
-  Result<io::TrajectoryFile> plan_file = io::LoadTrajectoryFile(ResolveDataPath(a.plan), run->nominal.num_joints());
+  // A plan for another robot is a usage error naming both; the limits are the plan check's (preflight),
+  // in the words of `plan --check`.
+  Result<io::TrajectoryFile> plan_file = io::LoadTrajectoryFileForRobot(ResolveDataPath(a.plan), run->nominal, a.robot_config);
   if (!plan_file.ok()) return plan_file.status();
   run->plan = PlanPoses(*plan_file);
   run->plan_check = acquisition::PlanToCheck{run->nominal, io::PlanSubjectOf(*plan_file)};
@@ -483,8 +484,24 @@ int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, se
 
 }  // namespace
 
+namespace {
+
+// No --plan: the robot's own shipped trajectory, resolved before anything is recorded (run.json names it).
+Status ResolvePlanPath(RunSettings* a) {
+  if (!a->plan.empty()) return Status::Ok();
+  Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(a->robot_config));
+  if (!robot.ok()) return robot.status();
+  Result<std::string> plan = TrajectoryForRobot("", robot->name, a->robot_config);
+  if (!plan.ok()) return plan.status();
+  a->plan = *plan;
+  return Status::Ok();
+}
+
+}  // namespace
+
 int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
   if (Status s = CheckRunSettings(&a); !s.ok()) return Fail(s);
+  if (Status s = ResolvePlanPath(&a); !s.ok()) return Fail(s);
   RunPlan run;
   if (Status s = LoadRunPlan(a, &run); !s.ok()) return Fail(s);
   Backends backends;  // a bad --address is refused before any session is touched
@@ -524,7 +541,7 @@ Command AddRunCommand(CLI::App& app) {
                   "most N more times each (0: never)")
       ->check(CLI::Range(0, 100));
   cmd->add_option("--robot-config", a->robot_config, "Nominal robot config");
-  cmd->add_option("--plan", a->plan, "Plan (trajectory file)");
+  cmd->add_option("--plan", a->plan, "Plan (trajectory file); default: config/trajectories/initial_<robot name>.yaml");
   cmd->add_option("--setup", a->setup, "Camera, yardstick and checks (docs/session-format.md); not with sim");
   cmd->add_option("--robot", a->robot_backend, "Robot backend")->check(CLI::IsMember({"sim", "network", "manual"}));
   cmd->add_option("--address", a->address, "network backend: HOST:PORT (docs/robot-protocol.md)");

@@ -28,7 +28,7 @@ namespace {
 
 struct SimulateArgs {
   std::string robot = "config/robots/puma560.yaml";
-  std::string trajectory = "config/trajectories/initial_puma560.yaml";
+  std::string trajectory;  // default: the robot's shipped trajectory (TrajectoryForRobot)
   std::string out = "out/simulate";
   double noise_px = 0.2;
   uint64_t seed = 1;
@@ -291,7 +291,8 @@ Command AddSimulateCommand(CLI::App& app) {
   auto args = std::make_shared<SimulateArgs>();
   CLI::App* cmd = app.add_subcommand("simulate", "Simulated robot with hidden errors: observe, calibrate, compare");
   AddRobotOption(cmd, &args->robot);
-  cmd->add_option("--trajectory", args->trajectory, "Trajectory file");
+  cmd->add_option("--trajectory", args->trajectory,
+                  "Trajectory file (for the robot); default: config/trajectories/initial_<robot name>.yaml");
   cmd->add_option("--out", args->out, "Output directory");
   cmd->add_option("--noise-px", args->noise_px, "Pixel noise std (px)")->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--seed", args->seed, "World and noise seed");
@@ -326,6 +327,7 @@ Command AddSimulateCommand(CLI::App& app) {
     if (!loaded.ok()) return Fail(loaded.status());
     const RobotModel* robot = &loaded->robot;
     const std::vector<Eigen::VectorXd>* joints = &loaded->joints;
+    std::cout << "robot " << robot->name << " (" << args->robot << "), trajectory " << loaded->trajectory_path << "\n";
     if (Status s = EnsureDirectory(args->out); !s.ok()) return Fail(s);
     sim::SimOptions options;
     options.world_seed = options.noise_seed = args->seed;
@@ -374,23 +376,53 @@ Command AddSimulateCommand(CLI::App& app) {
   };
 }
 
+namespace {
+
+// make-trajectory's home: --home-deg, else the config's home_deg; one value per joint (exit 2 otherwise).
+Result<std::vector<double>> HomeDeg(const std::vector<double>& given, const io::CalibratedModel& config,
+                                    const std::string& robot_path) {
+  const RobotModel& robot = config.model;
+  std::vector<double> home = given;
+  if (home.empty()) {
+    for (double q : config.home_rad) home.push_back(RadToDeg(q));
+  }
+  if (home.empty()) {
+    return Status::Error(ErrorCode::kInvalidInput, "robot `" + robot.name + "` (" + robot_path +
+                                                       ") has no home_deg and no --home-deg was given: give the joint "
+                                                       "angles (deg) where the camera looks at the scene");
+  }
+  if (static_cast<int>(home.size()) != robot.num_joints()) {
+    return Status::Error(ErrorCode::kInvalidInput, "--home-deg has " + std::to_string(home.size()) + " values, robot `" +
+                                                       robot.name + "` has " + std::to_string(robot.num_joints()) +
+                                                       " joints");
+  }
+  return home;
+}
+
+}  // namespace
+
 Command AddMakeTrajectoryCommand(CLI::App& app) {
   auto robot_path = std::make_shared<std::string>("config/robots/puma560.yaml");
   auto out_path = std::make_shared<std::string>();
   auto poses = std::make_shared<int>(25);
-  auto home_deg = std::make_shared<std::vector<double>>(sim::ArcTrajectoryOptions().home_joints_deg);
+  auto home_deg = std::make_shared<std::vector<double>>();
   CLI::App* cmd = app.add_subcommand("make-trajectory", "Write the smooth initial trajectory around the simulated scene");
   cmd->add_option("--robot", *robot_path, "Robot config");
   cmd->add_option("--out", *out_path, "Trajectory file to write")->required();
   cmd->add_option("--poses", *poses, "Number of poses")->check(CLI::Range(3, 1000));
-  cmd->add_option("--home-deg", *home_deg, "Joint angles (deg, comma-separated) where the camera looks at the scene")
+  cmd->add_option("--home-deg", *home_deg,
+                  "Joint angles (deg, comma-separated) where the camera looks at the scene; default: the config's "
+                  "home_deg")
       ->delimiter(',');
   return [robot_path, out_path, poses, home_deg]() {
-    Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(*robot_path));
-    if (!robot.ok()) return Fail(robot.status());
+    Result<io::CalibratedModel> config = io::LoadRobotConfig(ResolveDataPath(*robot_path));
+    if (!config.ok()) return Fail(config.status());
+    const RobotModel* robot = &config->model;
     sim::ArcTrajectoryOptions options;
     options.num_poses = *poses;
-    options.home_joints_deg = *home_deg;
+    Result<std::vector<double>> home = HomeDeg(*home_deg, *config, *robot_path);
+    if (!home.ok()) return Fail(home.status());
+    options.home_joints_deg = *home;
     const sim::GeneratedTrajectory t = sim::MakeArcTrajectory(*robot, options);
     if (!t.ok) return Fail(Status::Error(ErrorCode::kDegenerateData, t.message));
     const std::string description =

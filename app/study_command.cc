@@ -15,7 +15,7 @@ namespace selfcal::app {
 namespace {
 struct StudyArgs {
   std::string robot = "config/robots/puma560.yaml";
-  std::vector<std::string> trajectories = {"initial=config/trajectories/initial_puma560.yaml"};
+  std::vector<std::string> trajectories;  // default: initial=<the robot's shipped trajectory>
   int runs = 200;
   std::vector<double> noise = {0.0, 0.2, 0.5};
   uint64_t seed = 1;
@@ -33,7 +33,8 @@ Command AddStudyCommand(CLI::App& app) {
   auto args = std::make_shared<StudyArgs>();
   CLI::App* cmd = app.add_subcommand("study", "Monte Carlo: the paper's Table 2 and Fig. 6 on the simulator");
   AddRobotOption(cmd, &args->robot);
-  cmd->add_option("--trajectory", args->trajectories, "NAME=FILE, repeatable");
+  cmd->add_option("--trajectory", args->trajectories,
+                  "NAME=FILE, repeatable (each for the robot); default: initial=config/trajectories/initial_<robot name>.yaml");
   cmd->add_option("--runs", args->runs, "Runs per cell")->check(CLI::Range(1, 100000));
   cmd->add_option("--noise-px", args->noise, "Pixel noise levels (std, px)")->delimiter(',');
   cmd->add_option("--seed", args->seed, "Base seed");
@@ -52,15 +53,21 @@ Command AddStudyCommand(CLI::App& app) {
     Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(args->robot));
     if (!robot.ok()) return Fail(robot.status());
     std::vector<simulation::TrajectorySpec> trajectories;
-    for (const std::string& spec : args->trajectories) {
+    std::vector<std::string> specs = args->trajectories;
+    if (specs.empty()) {
+      Result<std::string> shipped = TrajectoryForRobot("", robot->name, args->robot);
+      if (!shipped.ok()) return Fail(shipped.status());
+      specs.push_back("initial=" + *shipped);
+    }
+    for (const std::string& spec : specs) {
       const size_t eq = spec.find('=');
       if (eq == std::string::npos || eq == 0) {
         return Fail(Status::Error(ErrorCode::kInvalidInput, "--trajectory `" + spec + "`: expected NAME=FILE"));
       }
-      Result<std::vector<Eigen::VectorXd>> joints =
-          io::LoadTrajectory(ResolveDataPath(spec.substr(eq + 1)), robot->num_joints());
-      if (!joints.ok()) return Fail(joints.status());
-      trajectories.push_back({spec.substr(0, eq), *joints});
+      Result<io::TrajectoryFile> file =
+          io::LoadTrajectoryFileForRobot(ResolveDataPath(spec.substr(eq + 1)), *robot, args->robot);
+      if (!file.ok()) return Fail(file.status());
+      trajectories.push_back({spec.substr(0, eq), file->poses});
     }
     for (double n : args->noise) {
       if (!(n >= 0 && n < 10)) return Fail(Status::Error(ErrorCode::kInvalidInput, "--noise-px: " + std::to_string(n) + " is not in [0, 10)"));

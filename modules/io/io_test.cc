@@ -70,14 +70,14 @@ TEST(YamlSchema, C1UnknownKeyInARobotJointRow) {
   std::string path = dir.File("robot.yaml");
   const std::string text = Replace(PumaText(), "d_mm: 431.8,  theta_offset_deg", "d_mm: 431.8,  theta_ofset_deg");
   const Status status = LoadRobotText(dir, text, &path);
-  EXPECT_TRUE(CleanRefusal(status, path, "unknown key `theta_ofset_deg` in `joints[3]` at " + path + ":15; did you mean `theta_offset_deg`?"));
+  EXPECT_TRUE(CleanRefusal(status, path, "unknown key `theta_ofset_deg` in `joints[3]` at " + path + ":16; did you mean `theta_offset_deg`?"));
 }
 
 TEST(YamlSchema, C1UnknownKeyWithoutCloseMatchListsTheAllowedKeys) {
   TempDir dir;
   std::string path = dir.File("robot.yaml");
   const Status status = LoadRobotText(dir, PumaText() + "payload_kg: 3\n", &path);
-  EXPECT_TRUE(CleanRefusal(status, path, "unknown key `payload_kg` at " + path + ":21; allowed keys here:"));
+  EXPECT_TRUE(CleanRefusal(status, path, "unknown key `payload_kg` at " + path + ":22; allowed keys here:"));
 }
 
 TEST(YamlSchema, C2AllMissingKeysAreListedTogether) {
@@ -261,7 +261,7 @@ TEST(MalformedFiles, C8DuplicateKeysAndSecondDocumentsAreRefused) {
   TempDir dir;
   std::string path = dir.File("robot.yaml");
   EXPECT_TRUE(CleanRefusal(LoadRobotText(dir, PumaText() + "name: other\n", &path), path,
-                           "duplicate key `name` at " + path + ":21"));
+                           "duplicate key `name` at " + path + ":22"));
   EXPECT_TRUE(CleanRefusal(LoadRobotText(dir, PumaText() + "---\nname: other\n", &path), path, "more than one YAML document"));
   EXPECT_TRUE(CleanRefusal(LoadRobotText(dir, "? [a, b]\n: 1\n", &path), path, "map keys must be plain strings"));
 }
@@ -282,7 +282,7 @@ TEST(MalformedFiles, C8BomAndCrlfAreAccepted) {
   std::string bad = crlf;
   bad.replace(bad.find("a_mm: 431.8"), 11, "a_mm: .nan ");
   WriteFile(path, bad);
-  EXPECT_TRUE(CleanRefusal(LoadRobotModel(path).status(), path, "`.nan` at " + path + ":13"));
+  EXPECT_TRUE(CleanRefusal(LoadRobotModel(path).status(), path, "`.nan` at " + path + ":14"));
 }
 
 TEST(MalformedFiles, C8MissingFileDirectoryAndFifoAreRefused) {

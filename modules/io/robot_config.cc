@@ -96,6 +96,28 @@ void ReadProvenance(MapReader* root, std::vector<std::pair<std::string, std::str
   }
 }
 
+// `home_deg` / `home_rad`: one angle per joint row, each inside its joint's limits.
+bool ReadHome(MapReader* map, const std::vector<JointRow>& rows, std::vector<double>* home) {
+  std::string key;
+  std::vector<int> lines;
+  if (!map->QuantityList("home", Unit::kAngle, static_cast<int>(rows.size()), kJointLimit, home, /*required=*/false,
+                         &key, &lines)) {
+    return false;
+  }
+  bool ok = true;
+  for (size_t j = 0; j < home->size() && j < rows.size() && j < lines.size(); ++j) {
+    const JointLimits& l = rows[j].limits;
+    if ((*home)[j] < l.min_rad || (*home)[j] > l.max_rad) {
+      map->problems()->Add("`" + map->Path(key) + "[" + std::to_string(j) + "]` at " + map->problems()->At(lines[j]) +
+                           ": joint " + std::to_string(j + 1) + " = " + std::to_string(RadToDeg((*home)[j])) +
+                           " deg is outside its limits [" + std::to_string(RadToDeg(l.min_rad)) + ", " +
+                           std::to_string(RadToDeg(l.max_rad)) + "] deg");
+      ok = false;
+    }
+  }
+  return ok;
+}
+
 CalibratedModel Parse(const yaml::YamlNode& node, const std::string& name, Problems* problems, std::string* format) {
   CalibratedModel out;
   const size_t problems_before = problems->size();
@@ -169,6 +191,12 @@ CalibratedModel Parse(const yaml::YamlNode& node, const std::string& name, Probl
       map.Disallow(key, std::string("only in a `format: ") + kCalibratedModelFormat + "` file");
     }
   }
+  if (ok) {
+    ok &= ReadHome(&map, rows, &out.home_rad);
+  } else {  // the rows are not known: the home is checked once they are
+    map.Optional("home_deg");
+    map.Optional("home_rad");
+  }
   map.Finish();
   if (!ok || problems->size() != problems_before) return out;
 
@@ -220,18 +248,27 @@ Result<RobotModel> ParseRobotModelText(const std::string& text, const std::strin
   return RobotModelOf(yaml::ParseYamlText(text, name), name);
 }
 
-Result<CalibratedModel> LoadCalibratedModel(const std::string& path) {
+namespace {
+
+// The whole file; `calibrated_only`: refused unless it is a calibrated model.
+Result<CalibratedModel> LoadRobotFile(const std::string& path, bool calibrated_only) {
   Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(path);
   if (!doc.ok()) return doc.status();
   Problems problems(path);
   std::string format;
   CalibratedModel parsed = Parse(doc->root, "", &problems, &format);
-  if (problems.empty() && format != kCalibratedModelFormat) {
+  if (calibrated_only && problems.empty() && format != kCalibratedModelFormat) {
     problems.Add(path + " is a robot config, not a calibrated model (no `format: " + kCalibratedModelFormat + "`)");
   }
-  if (!problems.empty()) return problems.ToStatus("calibrated model");
+  if (!problems.empty()) return problems.ToStatus(calibrated_only ? "calibrated model" : "robot model");
   return parsed;
 }
+
+}  // namespace
+
+Result<CalibratedModel> LoadRobotConfig(const std::string& path) { return LoadRobotFile(path, false); }
+
+Result<CalibratedModel> LoadCalibratedModel(const std::string& path) { return LoadRobotFile(path, true); }
 
 std::string RobotModelYaml(const RobotModel& model, TransformStyle style, int indent) {
   const bool exact = style == TransformStyle::kExact;

@@ -11,6 +11,8 @@
 //   base_from_link0: {xyz_mm: [0, 0, 0], rpy_deg: [0, 0, 0]}       # optional, identity by default
 //   flange_from_cam: {xyz_mm: [40, 0, 60], rpy_deg: [0, 0, 90]}    # required: nominal hand-eye
 //   link_n_from_flange: {...}      # optional, modified and modified_hayati only
+//   home_deg: [0, 20, -200, 0, 45, 0]  # optional (or home_rad): where `make-trajectory` starts its arc;
+//                                  # one value per joint, inside the joint limits
 //
 // Conventions (kinematics/robot_model.h): standard rows are Rz(q+theta) Tz(d) Tx(a) Rx(alpha);
 // modified rows are Rx(alpha) Tx(a) Rz(q+theta) Tz(d); modified_hayati rows add `beta` (optional,
@@ -53,6 +55,9 @@ struct CalibratedModel {
   IntrinsicsVector intrinsics_stddev = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
   Eigen::VectorXd parameters;  // rho (SI) in KinematicParameters order; empty = not stored
   std::vector<std::pair<std::string, std::string>> provenance;  // P7: software, hashes, session id ...
+  // A robot config's `home_deg` (rad): the joint angles where the camera looks at the scene, from which
+  // `selfcal make-trajectory` sweeps its arc (sim/trajectory_generator.h). Empty: the config gives none.
+  std::vector<double> home_rad;
 };
 
 // Reads a robot config or a calibrated-model file. Errors: ErrorCode::kInvalidInput, naming file, line, key
@@ -62,6 +67,10 @@ Result<RobotModel> LoadRobotModel(const std::string& path);
 // Parses a robot config (or calibrated-model file) already in memory, e.g. a session's verified copy;
 // `name` stands for the file in messages. Same checks and errors as LoadRobotModel.
 Result<RobotModel> ParseRobotModelText(const std::string& text, const std::string& name);
+
+// Reads a robot config or a calibrated-model file with what it says beside the model: `source` and
+// `home_deg` (CalibratedModel::home_rad). Same checks and errors as LoadRobotModel.
+Result<CalibratedModel> LoadRobotConfig(const std::string& path);
 
 // Reads a calibrated-model file (`format: selfcal-calibrated-model` required).
 Result<CalibratedModel> LoadCalibratedModel(const std::string& path);

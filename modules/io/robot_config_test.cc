@@ -114,7 +114,7 @@ TEST(RobotConfig, BetaNeedsTheHayatiConvention) {
   text.replace(text.find("theta_offset_deg: 0.0, min_deg: -45"), 21, "beta_deg: 0.1");
   WriteFile(dir.File("beta.yaml"), text);
   const Status status = LoadRobotModel(dir.File("beta.yaml")).status();
-  EXPECT_NE(status.message().find("`joints[1].beta_deg` at " + dir.File("beta.yaml") + ":13 is not allowed here: a Hayati "
+  EXPECT_NE(status.message().find("`joints[1].beta_deg` at " + dir.File("beta.yaml") + ":14 is not allowed here: a Hayati "
                                   "beta needs dh_convention: modified_hayati"),
             std::string::npos)
       << status.message();
@@ -126,7 +126,7 @@ TEST(RobotConfig, NotARotationMatrixIsRefused) {
   text.replace(text.find("rpy_deg: [0, 0, 90]"), 19, "rotation: [[1, 0, 0], [0, 1, 0], [0, 0, -1]]");
   WriteFile(dir.File("reflection.yaml"), text);
   const Status status = LoadRobotModel(dir.File("reflection.yaml")).status();
-  EXPECT_NE(status.message().find("`flange_from_cam.rotation` at " + dir.File("reflection.yaml") + ":20 is not a rotation"),
+  EXPECT_NE(status.message().find("`flange_from_cam.rotation` at " + dir.File("reflection.yaml") + ":21 is not a rotation"),
             std::string::npos)
       << status.message();
 }

@@ -108,7 +108,23 @@ std::string PlannedForYaml(const planning::PlannedFor& p) {
   return out.str();
 }
 
-Result<TrajectoryFile> Load(const std::string& path, int num_joints, const RobotModel* robot) {
+// `robot` (optional): also the joint limits and the robot name as problems of the file. `for_robot`
+// (optional): a file for another robot is refused at once, naming both (LoadTrajectoryFileForRobot).
+struct ForRobot {
+  const RobotModel* robot;
+  const std::string* config_path;
+};
+
+Status OtherRobot(const std::string& path, const std::string& line, const std::string& named, const ForRobot& r) {
+  return Status::Error(ErrorCode::kInvalidInput,
+                       "trajectory " + path + " is for robot `" + named + "` (`robot` at " + line + "), but the robot config " +
+                           *r.config_path + " is robot `" + r.robot->name + "`: give the trajectory made for `" +
+                           r.robot->name + "` (shipped: " + InitialTrajectoryPath(r.robot->name) +
+                           ") or plan one with `selfcal plan --robot " + *r.config_path + "`");
+}
+
+Result<TrajectoryFile> Load(const std::string& path, int num_joints, const RobotModel* robot,
+                            const ForRobot* for_robot = nullptr) {
   Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(path);
   if (!doc.ok()) return doc.status();
   Problems problems(path);
@@ -120,6 +136,11 @@ Result<TrajectoryFile> Load(const std::string& path, int num_joints, const Robot
   TrajectoryFile file;
   std::string& robot_name = file.robot;
   root.OptionalString("robot", &robot_name);
+  if (for_robot && !robot_name.empty() && robot_name != for_robot->robot->name) {
+    const std::string line = problems.At(root.KeyLine("robot"));
+    root.Abandon();
+    return OtherRobot(path, line, robot_name, *for_robot);
+  }
   root.OptionalString("description", &file.description);
   root.OptionalString("planner", &file.planner);
   if (root.Optional("num_identification_poses")) {
@@ -205,6 +226,17 @@ Result<TrajectoryFile> LoadTrajectoryFile(const std::string& path, const RobotMo
     return Status::Error(ErrorCode::kInvalidInput, "LoadTrajectory(" + path + "): the robot model has no joints or no limits");
   }
   return Load(path, robot.num_joints(), &robot);
+}
+
+Result<TrajectoryFile> LoadTrajectoryFileForRobot(const std::string& path, const RobotModel& robot,
+                                                  const std::string& robot_path) {
+  if (robot.num_joints() <= 0) return Status::Error(ErrorCode::kInvalidInput, "LoadTrajectory(" + path + "): the robot has no joints");
+  const ForRobot for_robot{&robot, &robot_path};
+  return Load(path, robot.num_joints(), nullptr, &for_robot);
+}
+
+std::string InitialTrajectoryPath(const std::string& robot_name) {
+  return "config/trajectories/initial_" + robot_name + ".yaml";
 }
 
 Result<std::vector<Eigen::VectorXd>> LoadTrajectory(const std::string& path, int num_joints) {

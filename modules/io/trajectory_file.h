@@ -45,6 +45,16 @@ planning::PlanSubject PlanSubjectOf(const TrajectoryFile& file);
 // count.
 Result<TrajectoryFile> LoadTrajectoryFile(const std::string& path, int num_joints);
 Result<TrajectoryFile> LoadTrajectoryFile(const std::string& path, const RobotModel& robot);
+// The trajectory file at `path` for `robot`, whose config was read from `robot_path` (for the message):
+// as LoadTrajectoryFile(path, robot.num_joints()), but a file whose `robot:` names another robot is
+// refused before its poses are read, naming both robots and both files (every command that takes a robot
+// and a trajectory: a plan made for another arm is a usage error, whatever its joint count).
+// ErrorCode::kInvalidInput.
+Result<TrajectoryFile> LoadTrajectoryFileForRobot(const std::string& path, const RobotModel& robot,
+                                                  const std::string& robot_path);
+// The shipped trajectory of a robot: "config/trajectories/initial_<robot_name>.yaml" (relative to the
+// source tree's root; docs/robots.md).
+std::string InitialTrajectoryPath(const std::string& robot_name);
 // Writes atomically (the optional keys only when set).
 Status SaveTrajectoryFile(const TrajectoryFile& file, const std::string& path);
 

@@ -14,9 +14,10 @@ namespace selfcal::planning {
 
 namespace {
 
-// Partials: slots [0, 6) the joints of pose i, [6, 12) those of the reference pose (robots up to 6 joints).
-constexpr int kSlots = 12;
-constexpr int kMaxJoints = 6;
+// Partials: slots [0, 7) the joints of pose i, [7, 14) those of the reference pose (robots up to 7 joints:
+// the Panda). Unused slots stay zero, so a 6-joint robot's values and gradients are those of 12 slots.
+constexpr int kMaxJoints = 7;
+constexpr int kSlots = 2 * kMaxJoints;
 using Jet = ceres::Jet<double, kSlots>;
 using JetMatrix = Eigen::Matrix<Jet, Eigen::Dynamic, Eigen::Dynamic>;
 
@@ -90,7 +91,7 @@ Eigen::MatrixXd TwistIdentificationJacobian(const RobotModel& model, const std::
                                             const std::vector<int>& free_columns) {
   CheckArguments(model, poses, free_columns);
   const int m = static_cast<int>(poses.size());
-  const internal::CameraTwists<Jet> ref = Twists(model, poses[0], 6);
+  const internal::CameraTwists<Jet> ref = Twists(model, poses[0], kMaxJoints);
   std::vector<PoseTerms> terms(m);
   for (int i = 1; i < m; ++i) terms[i] = Terms(Twists(model, poses[i], 0), ref, free_columns);
   return StackJ(terms, static_cast<int>(free_columns.size()));
@@ -105,7 +106,7 @@ Eq39Value EvaluateEq39(const RobotModel& model, const std::vector<Eigen::VectorX
   const int nf = static_cast<int>(free_columns.size());
   SELFCAL_CHECK(6 * (m - 1) >= nf, "J has " << 6 * (m - 1) << " rows for " << nf << " free parameters");
 
-  const internal::CameraTwists<Jet> ref = Twists(model, poses[0], 6);
+  const internal::CameraTwists<Jet> ref = Twists(model, poses[0], kMaxJoints);
   std::vector<PoseTerms> terms(m);
   for (int i = 1; i < m; ++i) terms[i] = Terms(Twists(model, poses[i], 0), ref, free_columns);
 
@@ -141,9 +142,9 @@ Eq39Value EvaluateEq39(const RobotModel& model, const std::vector<Eigen::VectorX
         const double c = (terms[i].g[k].a - terms[i - 1].g[k].a) / value.ratio_term;
         if (c == 0) continue;
         add(i, terms[i].g[k], c, 0);
-        add(0, terms[i].g[k], c, 6);
+        add(0, terms[i].g[k], c, kMaxJoints);
         add(i - 1, terms[i - 1].g[k], -c, 0);
-        add(0, terms[i - 1].g[k], -c, 6);
+        add(0, terms[i - 1].g[k], -c, kMaxJoints);
       }
     }
   }
@@ -158,7 +159,7 @@ Eq39Value EvaluateEq39(const RobotModel& model, const std::vector<Eigen::VectorX
           const double w = (u_max[row] * v_max[c] - value.condition_number * u_min[row] * v_min[c]) / s_min;
           if (w == 0) continue;
           add(i, terms[i].m(r, c), lambda * w, 0);
-          add(0, terms[i].m(r, c), lambda * w, 6);
+          add(0, terms[i].m(r, c), lambda * w, kMaxJoints);
         }
       }
     }

@@ -21,23 +21,24 @@ namespace selfcal::planning {
 
 namespace {
 
-constexpr int kMaxJoints = 6;
-using Jet6 = ceres::Jet<double, kMaxJoints>;
-using Jet12 = ceres::Jet<double, 2 * kMaxJoints>;
+// Robots up to 7 joints (the Panda); unused derivative slots stay zero.
+constexpr int kMaxJoints = 7;
+using JointJet = ceres::Jet<double, kMaxJoints>;
+using PairJet = ceres::Jet<double, 2 * kMaxJoints>;
 
 // A pose's camera centre and optical axis with their derivatives with respect to its own joints.
 struct ViewJets {
-  Vec3T<Jet6> centre, axis;
+  Vec3T<JointJet> centre, axis;
 };
 
-Jet12 Promote(const Jet6& x, int offset) {
-  Jet12 y(x.a);
+PairJet Promote(const JointJet& x, int offset) {
+  PairJet y(x.a);
   for (int k = 0; k < kMaxJoints; ++k) y.v[offset + k] = x.v[k];
   return y;
 }
 
-Vec3T<Jet12> Promote(const Vec3T<Jet6>& x, int offset) {
-  return Vec3T<Jet12>(Promote(x[0], offset), Promote(x[1], offset), Promote(x[2], offset));
+Vec3T<PairJet> Promote(const Vec3T<JointJet>& x, int offset) {
+  return Vec3T<PairJet>(Promote(x[0], offset), Promote(x[1], offset), Promote(x[2], offset));
 }
 
 // Eq. (39) plus the log barrier of every constraint that involves an optimised (identification) pose.
@@ -48,7 +49,7 @@ class BarrierObjective final : public ceres::FirstOrderFunction {
       : problem_(problem), poses_(poses), free_columns_(free_columns), lambda_(lambda) {
     const Eigen::VectorXd rho = KinematicParameters::Nominal(problem.robot);
     rho_.resize(rho.size());
-    for (int k = 0; k < rho.size(); ++k) rho_[k] = Jet6(rho[k]);
+    for (int k = 0; k < rho.size(); ++k) rho_[k] = JointJet(rho[k]);
   }
 
   void set_mu(double mu) { mu_ = mu; }
@@ -88,32 +89,32 @@ class BarrierObjective final : public ceres::FirstOrderFunction {
     std::vector<ViewJets> views(m);
     double d[kMaxJoints];
     for (int i = 0; i < m; ++i) {
-      std::vector<Jet6> q(n);
+      std::vector<JointJet> q(n);
       for (int j = 0; j < n; ++j) {
-        q[j] = Jet6(poses[i][j]);
+        q[j] = JointJet(poses[i][j]);
         if (i < m_id) q[j].v[j] = 1.0;
       }
-      const Rigid3T<Jet6> base_from_cam = BaseFromCam<Jet6>(robot, rho_.data(), q.data());
+      const Rigid3T<JointJet> base_from_cam = BaseFromCam<JointJet>(robot, rho_.data(), q.data());
       views[i].centre = base_from_cam.translation;
       views[i].axis = base_from_cam.rotation.col(2);
       if (i >= m_id) continue;
-      const Rigid3T<Jet6> cam_from_base = base_from_cam.Inverse();
+      const Rigid3T<JointJet> cam_from_base = base_from_cam.Inverse();
       for (const Eigen::Vector3d& x : problem_.scene.extent_in_base) {
-        const Vec3T<Jet6> p = cam_from_base * x.cast<Jet6>();
-        const Jet6 slacks[2] = {p.z() - Jet6(c.min_depth_m), Jet6(c.max_depth_m) - p.z()};
-        for (const Jet6& s : slacks) {
+        const Vec3T<JointJet> p = cam_from_base * x.cast<JointJet>();
+        const JointJet slacks[2] = {p.z() - JointJet(c.min_depth_m), JointJet(c.max_depth_m) - p.z()};
+        for (const JointJet& s : slacks) {
           if (!term(s.a)) return false;
           for (int j = 0; j < n; ++j) d[j] = s.v[j];
           push(i, s.a, d);
         }
-        Jet6 u, v;
-        if (!ProjectPoint<Jet6>(problem_.camera, Jet6(problem_.camera.fx_px), Jet6(problem_.camera.k1), p, &u, &v)) {
+        JointJet u, v;
+        if (!ProjectPoint<JointJet>(problem_.camera, JointJet(problem_.camera.fx_px), JointJet(problem_.camera.k1), p, &u, &v)) {
           return false;
         }
-        const Jet6 margin(c.image_margin_px);
-        const Jet6 image[4] = {u - margin, Jet6(problem_.camera.width_px - 1) - margin - u, v - margin,
-                               Jet6(problem_.camera.height_px - 1) - margin - v};
-        for (const Jet6& s : image) {
+        const JointJet margin(c.image_margin_px);
+        const JointJet image[4] = {u - margin, JointJet(problem_.camera.width_px - 1) - margin - u, v - margin,
+                               JointJet(problem_.camera.height_px - 1) - margin - v};
+        for (const JointJet& s : image) {
           if (!term(s.a)) return false;
           for (int j = 0; j < n; ++j) d[j] = s.v[j];
           push(i, s.a, d);
@@ -124,8 +125,8 @@ class BarrierObjective final : public ceres::FirstOrderFunction {
     const double d2 = c.min_spread_m * c.min_spread_m;
     for (int a = 0; a < m_id; ++a) {
       for (int b = a + 1; b < m; ++b) {
-        const Vec3T<Jet12> diff = Promote(views[a].centre, 0) - Promote(views[b].centre, kMaxJoints);
-        const Jet12 s = diff.squaredNorm() - Jet12(d2);
+        const Vec3T<PairJet> diff = Promote(views[a].centre, 0) - Promote(views[b].centre, kMaxJoints);
+        const PairJet s = diff.squaredNorm() - PairJet(d2);
         if (!term(s.a)) return false;
         push(a, s.a, s.v.data());
         push(b, s.a, s.v.data() + kMaxJoints);
@@ -134,14 +135,14 @@ class BarrierObjective final : public ceres::FirstOrderFunction {
     // Optical axes of (reference, i) apart: tau^2 - s^2 |d x z|^2 > 0 for both axes, over |d|^2.
     const double s2 = c.min_axis_sine * c.min_axis_sine;
     for (int i = 1; c.min_axis_sine > 0 && i < m_id; ++i) {
-      const Vec3T<Jet12> c0 = Promote(views[0].centre, kMaxJoints), z0 = Promote(views[0].axis, kMaxJoints);
-      const Vec3T<Jet12> ci = Promote(views[i].centre, 0), zi = Promote(views[i].axis, 0);
-      const Vec3T<Jet12> dd = ci - c0;
-      const Jet12 tau = zi.dot(dd.cross(z0));
-      const Jet12 inv = Jet12(1.0) / dd.squaredNorm();
-      const Jet12 slacks[2] = {(tau * tau - Jet12(s2) * dd.cross(z0).squaredNorm()) * inv,
-                               (tau * tau - Jet12(s2) * dd.cross(zi).squaredNorm()) * inv};
-      for (const Jet12& s : slacks) {
+      const Vec3T<PairJet> c0 = Promote(views[0].centre, kMaxJoints), z0 = Promote(views[0].axis, kMaxJoints);
+      const Vec3T<PairJet> ci = Promote(views[i].centre, 0), zi = Promote(views[i].axis, 0);
+      const Vec3T<PairJet> dd = ci - c0;
+      const PairJet tau = zi.dot(dd.cross(z0));
+      const PairJet inv = PairJet(1.0) / dd.squaredNorm();
+      const PairJet slacks[2] = {(tau * tau - PairJet(s2) * dd.cross(z0).squaredNorm()) * inv,
+                               (tau * tau - PairJet(s2) * dd.cross(zi).squaredNorm()) * inv};
+      for (const PairJet& s : slacks) {
         if (!term(s.a)) return false;
         push(i, s.a, s.v.data());
         push(0, s.a, s.v.data() + kMaxJoints);
@@ -187,7 +188,7 @@ class BarrierObjective final : public ceres::FirstOrderFunction {
   std::vector<Eigen::VectorXd> poses_;
   std::vector<int> free_columns_;
   double lambda_;
-  std::vector<Jet6> rho_;
+  std::vector<JointJet> rho_;
   double mu_ = 0;
   mutable int evaluations_ = 0;
 };

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -268,18 +269,28 @@ std::vector<std::string> ProblemLines(const std::string& output, const std::stri
 }
 
 // One check: `plan --check` and run's preflight give the same verdict in the same words on every shipped
-// trajectory, with either robot config; every shipped trajectory passes for its own robot, and a plan
-// for one robot is refused for the other in both paths.
+// trajectory; every shipped trajectory passes for its own robot (the robot its name ends with), and is
+// refused for the next shipped robot in both paths as a usage error (exit 2) naming both robots.
 TEST(Cli, PlanCheckAndRunPreflightAgreeOnEveryShippedTrajectory) {
   const fs::path dir = FreshDir("agree");
   const fs::path trajectories = fs::path(SELFCAL_SOURCE_DIR) / "config" / "trajectories";
+  const std::vector<std::string> robots = {"puma560", "ur5e", "panda", "irb140"};
   int files = 0;
+  std::set<std::string> robots_with_a_trajectory;
   for (const fs::directory_entry& e : fs::directory_iterator(trajectories)) {
     if (e.path().extension() != ".yaml") continue;
     ++files;
     const std::string name = e.path().stem().string();
-    const std::string own = name.find("ur5e") != std::string::npos ? "ur5e" : "puma560";
-    for (const std::string robot : {"puma560", "ur5e"}) {
+    std::string own;
+    for (const std::string& robot : robots) {
+      if (name.size() > robot.size() && name.compare(name.size() - robot.size() - 1, std::string::npos, "_" + robot) == 0) {
+        own = robot;
+      }
+    }
+    ASSERT_FALSE(own.empty()) << name << ": a shipped trajectory's name ends with its robot";
+    robots_with_a_trajectory.insert(own);
+    const size_t at = std::find(robots.begin(), robots.end(), own) - robots.begin();
+    for (const std::string& robot : {own, robots[(at + 1) % robots.size()]}) {
       const std::string config = "config/robots/" + robot + ".yaml";
       std::string check_out, run_out;
       const int check = RunSelfcal("plan --robot " + config + " --check " + e.path().string(), &check_out);
@@ -290,13 +301,17 @@ TEST(Cli, PlanCheckAndRunPreflightAgreeOnEveryShippedTrajectory) {
       EXPECT_EQ(ProblemLines(check_out, "  PROBLEM "), ProblemLines(run_out, "")) << name << " on " << robot;
       if (robot == own) {
         EXPECT_EQ(check, 0) << name << "\n" << check_out;
-      } else {
-        EXPECT_EQ(check, 3) << name << " on " << robot << "\n" << check_out;
-        EXPECT_NE(check_out.find("robot_mismatch: the plan is for robot `" + own + "`"), std::string::npos) << check_out;
+        continue;
+      }
+      EXPECT_EQ(check, 2) << name << " on " << robot << "\n" << check_out;
+      for (const std::string* out : {&check_out, &run_out}) {
+        EXPECT_NE(out->find("is for robot `" + own + "`"), std::string::npos) << *out;
+        EXPECT_NE(out->find("is robot `" + robot + "`"), std::string::npos) << *out;
       }
     }
   }
-  EXPECT_GE(files, 8);
+  EXPECT_EQ(robots_with_a_trajectory.size(), robots.size()) << "every shipped robot has a trajectory";
+  EXPECT_GE(files, 12);
 }
 
 }  // namespace
