@@ -4,7 +4,7 @@
 // 7 when a solution lies outside the joint limits (nothing written then).
 #include <iomanip>
 #include <iostream>
-#include <sstream>
+#include <vector>
 
 #include "app/cli_output.h"
 #include "app/cli_util.h"
@@ -21,11 +21,10 @@ struct CompensateArgs {
   std::string model, targets, out, robot;
 };
 
-std::string Degrees(const Eigen::VectorXd& q) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(3) << "[";
-  for (int j = 0; j < q.size(); ++j) out << (j ? ", " : "") << RadToDeg(q[j]);
-  return out.str() + "]";
+std::vector<double> Degrees(const Eigen::VectorXd& q) {
+  std::vector<double> out;
+  for (int j = 0; j < q.size(); ++j) out.push_back(RadToDeg(q[j]));
+  return out;
 }
 
 // One line per target on stdout, and the --json figures.

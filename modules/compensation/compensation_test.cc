@@ -43,6 +43,7 @@ TEST(Compensation, CompensatedJointsReachTheTargetsOnTheCalibratedArm) {
   ASSERT_EQ(report.targets.size(), targets.size());
   EXPECT_TRUE(report.ok());
   const Eigen::VectorXd rho_cal = KinematicParameters::Nominal(calibrated);
+  double missed_sq = 0;
   for (size_t k = 0; k < targets.size(); ++k) {
     const TargetSolution& s = report.targets[k];
     EXPECT_TRUE(s.nominal.converged) << k;
@@ -52,10 +53,12 @@ TEST(Compensation, CompensatedJointsReachTheTargetsOnTheCalibratedArm) {
     const PoseDifference reached = ComparePoses(targets[k].base_from_target, BaseFromCam(calibrated, rho_cal, s.compensated.q));
     EXPECT_LE(reached.position_m, 1e-9) << k;
     EXPECT_LE(reached.rotation_rad, 1e-9) << k;
-    // The nominal joints on the calibrated arm miss by about the size of the perturbation (1 mm, 0.1 deg).
     const PoseDifference missed = ComparePoses(targets[k].base_from_target, BaseFromCam(calibrated, rho_cal, s.nominal.q));
-    EXPECT_GT(missed.position_m, 1e-4) << k;
+    missed_sq += missed.position_m * missed.position_m;
   }
+  // The nominal joints on the calibrated arm miss by about the size of the perturbation (1 mm, 0.1 deg),
+  // RMS over the targets (one target may be missed by less where errors cancel).
+  EXPECT_GT(std::sqrt(missed_sq / static_cast<double>(targets.size())), 5e-4);
 }
 
 TEST(Compensation, FlangeTargetsWithoutSeedsStartFromThePreviousSolution) {

@@ -10,6 +10,7 @@
 #include "io/robot_config.h"
 #include "io/robot_origin.h"
 #include "io/static_transform_file.h"
+#include "io/targets_file.h"
 #include "io/urdf_robot_config.h"
 #include "support/perturbed_model.h"
 #include "support/test_robots.h"
@@ -126,6 +127,35 @@ TEST(EnteredAs, ItsJointCountMustMatchTheTable) {
   ASSERT_FALSE(refused.ok());
   EXPECT_NE(refused.status().message().find("names 2 joints, the table has 1"), std::string::npos)
       << refused.status().message();
+}
+
+TEST(TargetsFile, RoundTripIsExactAndProblemsNameTheLine) {
+  TempDir dir;
+  TargetsFile file;
+  file.robot = "puma560";
+  file.camera_frame = false;
+  Eigen::VectorXd seed(6);
+  seed << 0.1, -0.2, 0.3, -0.4, 0.5, -0.6;
+  file.targets.push_back({Rigid3(RotZ(0.3) * RotX(-1.1), Eigen::Vector3d(0.6, -0.15, 0.3)), seed});
+  file.targets.push_back({Rigid3(RotY(2.0), Eigen::Vector3d(0.5, 0.1, 0.2)), std::nullopt});
+  ASSERT_TRUE(SaveTargetsFile(file, dir.File("t.yaml")).ok());
+  Result<TargetsFile> reread = LoadTargetsFile(dir.File("t.yaml"), 6);
+  ASSERT_TRUE(reread.ok()) << reread.status().message();
+  EXPECT_EQ(reread->robot, "puma560");
+  EXPECT_FALSE(reread->camera_frame);
+  ASSERT_EQ(reread->targets.size(), 2u);
+  EXPECT_EQ(reread->targets[0].base_from_target.rotation, file.targets[0].base_from_target.rotation);
+  EXPECT_EQ(reread->targets[0].base_from_target.translation, file.targets[0].base_from_target.translation);
+  EXPECT_EQ(*reread->targets[0].seed, seed);
+  EXPECT_FALSE(reread->targets[1].seed.has_value());
+  WriteFile(dir.File("bad.yaml"),
+            "format: selfcal-targets\nversion: 1\nframe: tool\ntargets:\n  - {pose: {xyz_mm: [1, 2, 3], rpy_deg: [0, 0, 0]}, "
+            "seed_deg: [1, 2]}\n");
+  const Status bad = LoadTargetsFile(dir.File("bad.yaml"), 6).status();
+  EXPECT_NE(bad.message().find("`frame` = `tool` at " + dir.File("bad.yaml") + ":3 must be camera or flange"),
+            std::string::npos)
+      << bad.message();
+  EXPECT_NE(bad.message().find("seed_deg"), std::string::npos) << bad.message();
 }
 
 }  // namespace
