@@ -8,17 +8,18 @@
 #include "app/cli_output.h"
 #include "app/cli_util.h"
 #include "app/commands.h"
+#include "app/model_exports.h"
 #include "app/report_command.h"
 #include "io/camera_file.h"
 #include "io/hand_eye_file.h"
 #include "io/observations_file.h"
 #include "io/report_json.h"
 #include "io/robot_config.h"
+#include "observations/joint_limits.h"
 #include "base/terminal_text.h"
 #include "report/calibration_report.h"
 #include "session/session_dir.h"
 #include "session/session_observations.h"
-#include "urdf/urdf_writer.h"
 
 namespace selfcal::app {
 
@@ -155,7 +156,8 @@ Status WriteCameraFiles(const CalibrateRequest& request, const calibration::Cali
 }
 
 // A flange-pose set's result: the hand-eye transform and f_x with their standard deviations.
-Status WriteHandEye(const LoadedInput& loaded, const calibration::CalibrationReport& report, const std::string& out_dir) {
+Status WriteHandEye(const LoadedInput& loaded, const calibration::CalibrationReport& report, const std::string& out_dir,
+                    const io::RobotOrigin& origin) {
   io::HandEyeResult result;
   result.flange_from_cam = report.model->robot.flange_from_cam;
   result.fx_px = report.model->camera.fx_px;
@@ -171,7 +173,7 @@ Status WriteHandEye(const LoadedInput& loaded, const calibration::CalibrationRep
   if (Status s = io::SaveHandEye(result, path); !s.ok()) return s;
   std::cout << "hand-eye result: " << path << "\n";
   AddOutputFile("hand_eye", path);
-  return Status::Ok();
+  return WriteCameraStaticTransform(result.flange_from_cam, origin, out_dir);
 }
 
 // --json: the answer at report.json's top level (docs/report-format.md), without its per-method sections.
@@ -188,7 +190,8 @@ void RecordCalibrationFigures(const nlohmann::json& report) {
 // Writes report.json, and calibrated_model.yaml and calibrated.urdf (hand_eye.yaml for flange poses) when the verdict is
 // "accepted" (K4).
 Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationReport& report, ExitCode code,
-                    const std::string& out_dir, bool html) {
+                    const CalibrateRequest& request) {
+  const std::string& out_dir = request.out_dir;
   const std::filesystem::path out(out_dir);
   const report::ReportContext context{loaded.input, static_cast<int>(code), loaded.session};
   const std::string report_path = (out / "report.json").string();
@@ -198,12 +201,13 @@ Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationRep
   AddOutputFile("report", report_path);
   RecordCalibrationFigures(document);
   const std::string html_path = (out / "report.html").string();
-  if (html) {
+  if (request.html) {
     WriteHtmlBeside(document, html_path);
     if (std::filesystem::exists(html_path)) AddOutputFile("report_html", html_path);
   }
   if (!report.model) return Status::Ok();
-  if (loaded.observations.UsesFlangePoses()) return WriteHandEye(loaded, report, out_dir);
+  const io::RobotOrigin origin = OriginOfInput(request.robot_config, request.input, loaded.session.has_value());
+  if (loaded.observations.UsesFlangePoses()) return WriteHandEye(loaded, report, out_dir, origin);
   io::CalibratedModel model;
   model.model = report.model->robot;
   model.fx_px = report.model->camera.fx_px;
@@ -218,11 +222,18 @@ Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationRep
   if (Status s = io::SaveCalibratedModel(model, model_path); !s.ok()) return s;
   std::cout << "calibrated model (" << calibration::MethodName(report.method) << "): " << model_path << "\n";
   AddOutputFile("calibrated_model", model_path);
-  const std::string urdf_path = (out / "calibrated.urdf").string();  // docs/urdf.md
-  if (Status s = urdf::WriteUrdf(model.model, {}, urdf_path); !s.ok()) return s;
-  std::cout << "calibrated URDF: " << urdf_path << "\n";
-  AddOutputFile("calibrated_urdf", urdf_path);
-  return Status::Ok();
+  return WriteModelExports(model.model, origin, model.source, out_dir);
+}
+
+// Recorded joints outside the config's limits: the controller's reading is what happened, so they are
+// calibrated as recorded; each such pose is named on stderr and in --json (docs/observations-format.md).
+void WarnOfJointsOutsideLimits(const ObservationSet& observations) {
+  const std::vector<std::string> poses = PosesOutsideJointLimits(observations);
+  for (const std::string& pose : poses) {
+    std::cerr << "selfcal: warning: " << TerminalSafe(pose)
+              << ": calibrated as recorded (the controller's reading); run never commands beyond the limits\n";
+  }
+  if (!poses.empty()) OutputDocument()["joints_outside_limits"] = poses;
 }
 
 }  // namespace
@@ -252,6 +263,7 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   Result<LoadedInput> loaded = LoadInput(request);
   if (!loaded.ok()) return Fail(loaded.status());
   const bool from_session = loaded->session.has_value();
+  WarnOfJointsOutsideLimits(loaded->observations);
   if (from_session) {
     std::cout << "session " << request.input << ": " << loaded->observations.poses.size() << " accepted samples\n";
   }
@@ -273,7 +285,7 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
     AddOutputFile("observations", derived);
   }
   const ExitCode code = ExitCodeFor(report.verdict);
-  if (Status s = WriteOutputs(*loaded, report, code, request.out_dir, request.html); !s.ok()) return Fail(s);
+  if (Status s = WriteOutputs(*loaded, report, code, request); !s.ok()) return Fail(s);
   if (Status s = WriteCameraFiles(request, report); !s.ok()) return Fail(s);
   if (!report.accepted()) {
     std::cerr << "selfcal: " << ExitCodeName(code) << ": " << TerminalSafe(report.message)

@@ -38,6 +38,9 @@ struct CalibrateRequest {
   // Where to write the calibrated intrinsics (empty: not written), only when accepted.
   std::string write_camera_opencv{}, write_camera_visp{};
   bool html = true;  // also write report.html beside report.json (--no-html: not)
+  // The robot config the data was recorded with, for the exports in its convention and names (simulate
+  // sets it; empty: the input's own robot: a session's robot.yaml, an observations file's robot).
+  std::string robot_config{};
 };
 
 // What a calibration read and returned, for callers that compare it with a truth (`simulate`).

@@ -23,5 +23,6 @@ Command AddNameDotsCommand(CLI::App& app);
 Command AddSessionCommand(CLI::App& app);
 Command AddDetectCommand(CLI::App& app);
 Command AddReportCommand(CLI::App& app);
+Command AddCompensateCommand(CLI::App& app);
 
 }  // namespace selfcal::app

@@ -13,6 +13,7 @@ enum class ExitCode : int {
   kHardware = 4,        // robot or camera fault (the session halted)
   kSolverFailure = 5,   // the solver did not converge or failed
   kModelRejected = 6,   // converged, but the model fails its held-out checks (no model written)
+  kOutsideLimits = 7,   // compensate: a target is reachable only outside the joint limits (nothing written)
   kInternal = 70,       // a bug in selfcal (sysexits.h EX_SOFTWARE): please report it
   kInterrupted = 130,   // Ctrl-C: the robot was stopped, the session is resumable
 };
@@ -38,6 +39,7 @@ inline const char* ExitCodeName(ExitCode code) {
     case ExitCode::kHardware: return "hardware_fault";
     case ExitCode::kSolverFailure: return "solver_failure";
     case ExitCode::kModelRejected: return "model_rejected";
+    case ExitCode::kOutsideLimits: return "outside_joint_limits";
     case ExitCode::kInternal: return "internal_error";
     case ExitCode::kInterrupted: return "interrupted";
   }

@@ -27,7 +27,8 @@ int main(int argc, char** argv) {
       {"name-dots", selfcal::app::AddNameDotsCommand(app)},
       {"session", selfcal::app::AddSessionCommand(app)},
       {"detect", selfcal::app::AddDetectCommand(app)},
-      {"report", selfcal::app::AddReportCommand(app)}};
+      {"report", selfcal::app::AddReportCommand(app)},
+      {"compensate", selfcal::app::AddCompensateCommand(app)}};
   selfcal::app::AddOutputFlags(app);
   try {
     app.parse(argc, argv);

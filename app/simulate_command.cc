@@ -352,6 +352,7 @@ Command AddSimulateCommand(CLI::App& app) {
     CalibrationRun calibrated;
     CalibrateRequest request{obs_path, args->out, args->seed, MethodFromName(args->method)};
     request.html = !args->no_html;
+    request.robot_config = ResolveDataPath(args->robot);  // the exports in its convention and names
     const int code = CalibrateAndWrite(request, &calibrated);
     const calibration::CalibrationReport& result = calibrated.report;
     const ObservationSet* obs = &calibrated.observations;

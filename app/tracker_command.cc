@@ -5,14 +5,18 @@
 // nominal model) and after identification; writes a JSON report.
 #include <filesystem>
 #include <iostream>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "app/cli_output.h"
 #include "app/cli_util.h"
 #include "app/commands.h"
 #include "external/tracker_identification.h"
 #include "io/fanuc_tracker_csv.h"
 #include "io/report_json.h"
+#include "io/robot_config.h"
+#include "urdf/urdf_writer.h"
 
 namespace selfcal::app {
 
@@ -23,7 +27,47 @@ struct TrackerArgs {
   int holdout_every = 3;
   double j3_coupling = 1.0;
   std::string report = "tracker_report.json";
+  std::string out;  // the model's directory; empty: the report's
 };
+
+// The identified arm as calibrate writes it (calibrated_model.yaml, docs/calibrated-model-format.md) and,
+// when the model's joints are the controller's (no J3 coupling), as calibrated.urdf. The model's base is the
+// tracker frame and its "camera" the SMR nest (flange_from_cam = flange_from_nest).
+Status WriteTrackerModel(const TrackerArgs& args, const std::string& data_path,
+                         const external::TrackerIdentificationReport& r) {
+  const std::filesystem::path dir =
+      !args.out.empty() ? std::filesystem::path(args.out) : std::filesystem::path(args.report).parent_path();
+  if (!args.out.empty()) {
+    if (Status s = EnsureDirectory(args.out); !s.ok()) return s;
+  }
+  io::CalibratedModel model;
+  model.model = ApplyParameters(r.nominal, r.rho_identified);
+  model.parameters = r.rho_identified;
+  model.source = "selfcal identify-tracker " + data_path + " (base: the tracker frame; flange_from_cam: the SMR nest)";
+  std::ostringstream coupling;
+  coupling << "q3 = J3 + " << args.j3_coupling << " * J2 (model joint 3 from the controller's J2 and J3)";
+  model.provenance = {{"software_version", SELFCAL_VERSION},
+                      {"input_sha256", FileSha256(data_path)},
+                      {"method", "laser-tracker relative-pose identification (modules/external)"},
+                      {"joint_coupling", coupling.str()}};
+  const std::string model_path = (dir / "calibrated_model.yaml").string();
+  if (Status s = io::SaveCalibratedModel(model, model_path); !s.ok()) return s;
+  std::cout << "identified model: " << model_path << " (its joints are the model's: " << coupling.str() << ")\n";
+  AddOutputFile("calibrated_model", model_path);
+  if (args.j3_coupling != 0) {
+    std::cout << "calibrated URDF: not written: the model's joint 3 is J3 + " << args.j3_coupling
+              << " * J2, a coupling a URDF's independent joints cannot hold (--j3-coupling 0 for an uncoupled arm)\n";
+    return Status::Ok();
+  }
+  urdf::UrdfNames names;
+  names.base_link = "tracker";
+  names.camera_link = "smr_nest";
+  const std::string urdf_path = (dir / "calibrated.urdf").string();
+  if (Status s = urdf::WriteUrdf(model.model, names, urdf_path); !s.ok()) return s;
+  std::cout << "calibrated URDF: " << urdf_path << "\n";
+  AddOutputFile("calibrated_urdf", urdf_path);
+  return Status::Ok();
+}
 
 nlohmann::json ErrorsJson(const external::ErrorStats& e) {
   return {{"rows", e.count}, {"mean_mm", e.mean_m * 1e3}, {"rms_mm", e.rms_m * 1e3}, {"max_mm", e.max_m * 1e3},
@@ -44,6 +88,9 @@ Command AddTrackerCommand(CLI::App& app) {
   cmd->add_option("--holdout-every", args->holdout_every, "Hold out rows i % N == 1 (0: none)")->check(CLI::Range(0, 1000));
   cmd->add_option("--j3-coupling", args->j3_coupling, "Model q3 = J3 + c * J2 (Fanuc: 1)");
   cmd->add_option("--report", args->report, "JSON report to write");
+  cmd->add_option("--out", args->out,
+                  "Directory of the identified model (calibrated_model.yaml, and calibrated.urdf without J3 coupling); "
+                  "default: the report's directory");
   return [args]() {
     const std::string path = (std::filesystem::path(args->data_dir) / args->file).string();
     const Result<std::vector<io::FanucTrackerRow>> rows = io::LoadFanucTrackerCsv(path);
@@ -134,6 +181,9 @@ Command AddTrackerCommand(CLI::App& app) {
     doc["holdout_over_insample_rms"] = ratio;
     if (const Status s = io::WriteJsonFile(doc, args->report); !s.ok()) return Fail(s);
     std::cout << "report: " << args->report << "\n";
+    if (r.outcome == external::Outcome::kSuccess) {
+      if (const Status s = WriteTrackerModel(*args, path, r); !s.ok()) return Fail(s);
+    }
     if (r.outcome != external::Outcome::kSuccess) {
       std::cerr << "selfcal: identify-tracker: " << external::OutcomeName(r.outcome) << ": " << r.message << "\n";
       const ExitCode code = r.outcome == external::Outcome::kInvalidInput  ? ExitCode::kUsage

@@ -17,7 +17,6 @@ namespace selfcal::io {
 
 namespace {
 
-constexpr double kLimitToleranceRad = 1e-9;
 const Range kJointValue = Range::Closed(DegToRad(-720), DegToRad(720));
 const Range kPixel = Range::Closed(-1e5, 1e5);
 
@@ -32,15 +31,8 @@ std::string DirectoryOf(const std::string& path) {
   return slash == std::string::npos ? "." : path.substr(0, slash == 0 ? 1 : slash);
 }
 
-// Problems that ObservationSet::Validate() does not see: joints outside the limits (unit confusion, the
-// wrong robot; C4) and dots outside the image (C11). Empty when plausible.
-std::string JointLimitProblem(const RobotModel& robot, int joint, double value_rad) {
-  const JointLimits& l = robot.limits[joint];
-  if (value_rad >= l.min_rad - kLimitToleranceRad && value_rad <= l.max_rad + kLimitToleranceRad) return "";
-  return "is outside joint " + std::to_string(joint + 1) + "'s limits [" + Short(RadToDeg(l.min_rad)) + ", " +
-         Short(RadToDeg(l.max_rad)) + "] deg (degrees written as radians, or the wrong robot?)";
-}
-
+// A problem that ObservationSet::Validate() does not see: dots outside the image (C11). Empty when plausible.
+// (Joints outside the limits are the controller's reading: kept, and warned of by calibrate.)
 std::string PixelProblem(const CameraIntrinsics& camera, const Eigen::Vector2d& uv) {
   if (InImage(camera, uv, 0.0)) return "";
   return "lies outside the " + std::to_string(camera.width_px) + "x" + std::to_string(camera.height_px) +
@@ -221,24 +213,14 @@ bool ReadDots(const yaml::YamlNode& node, const std::string& name, const CameraI
   return ok;
 }
 
-// `joints_deg` or `joints_rad` of a pose, each value inside the robot's limits when the robot is known.
-bool ReadJoints(MapReader* map, const RobotModel* robot, Problems* problems, PoseObservation* pose) {
+// `joints_deg` or `joints_rad` of a pose. Values outside the robot's limits are kept: the controller's
+// reading is what happened (calibrate warns, observations/joint_limits.h); only the plausible range is checked.
+bool ReadJoints(MapReader* map, const RobotModel* robot, PoseObservation* pose) {
   std::vector<double> joints;
-  std::vector<int> lines;
-  std::string key;
   const int num_joints = robot ? robot->num_joints() : -1;
-  if (!map->QuantityList("joints", Unit::kAngle, num_joints, kJointValue, &joints, true, &key, &lines)) return false;
+  if (!map->QuantityList("joints", Unit::kAngle, num_joints, kJointValue, &joints, true)) return false;
   pose->joints_rad = Eigen::Map<const Eigen::VectorXd>(joints.data(), static_cast<Eigen::Index>(joints.size()));
-  bool ok = true;
-  for (int j = 0; robot && j < num_joints; ++j) {
-    if (const std::string p = JointLimitProblem(*robot, j, joints[j]); !p.empty()) {
-      const bool degrees = key.size() > 4 && key.compare(key.size() - 4, 4, "_deg") == 0;
-      problems->Add("`" + map->Path(key) + "[" + std::to_string(j) + "]` = " +
-                    Short(degrees ? RadToDeg(joints[j]) : joints[j]) + " at " + problems->At(lines[j]) + " " + p);
-      ok = false;
-    }
-  }
-  return ok;
+  return true;
 }
 
 bool ReadPose(const yaml::YamlNode& node, const std::string& name, const RobotModel* robot, const CameraIntrinsics* camera,
@@ -274,7 +256,7 @@ bool ReadPose(const yaml::YamlNode& node, const std::string& name, const RobotMo
       }
     }
   } else {
-    ok &= ReadJoints(&map, robot, problems, pose);
+    ok &= ReadJoints(&map, robot, pose);
   }
   if (const yaml::YamlNode* dots = map.Required("dots")) {
     ok &= ReadDots(*dots, map.Path("dots"), camera, problems, &pose->dots_px);
@@ -411,10 +393,6 @@ Status SaveObservations(const ObservationSet& set, const std::string& path) {
   std::string problems = set.Validate();
   if (problems.empty()) {
     for (const PoseObservation& pose : set.poses) {
-      for (int j = 0; j < pose.joints_rad.size(); ++j) {
-        const std::string p = JointLimitProblem(set.robot, j, pose.joints_rad[j]);
-        if (!p.empty()) problems += "pose " + pose.id + ": joint value " + Short(pose.joints_rad[j]) + " rad " + p + "\n";
-      }
       for (const auto& [dot, uv] : pose.dots_px) {
         const std::string p = PixelProblem(set.camera, uv);
         if (!p.empty()) problems += "pose " + pose.id + ", dot " + std::to_string(dot) + ": " + p + "\n";

@@ -32,7 +32,8 @@ inline constexpr const char* kObservationsFormat = "selfcal-observations";
 inline constexpr int kObservationsVersion = 1;
 
 // Reads and validates an observations file: schema (C1-C3), versions (P8), ObservationSet::Validate(),
-// joint values inside the robot's limits and dots inside the image. Every problem is reported together
+// joint values in the plausible range and dots inside the image; joints outside the robot's limits are the
+// controller's reading and kept (observations/joint_limits.h names them). Every problem is reported together
 // (ErrorCode::kInvalidInput), naming the file, line and key.
 Result<ObservationSet> LoadObservations(const std::string& path);
 

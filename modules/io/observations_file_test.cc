@@ -11,6 +11,7 @@
 #include "io/atomic_file.h"
 #include "io/io_test_util.h"
 #include "io/observations_file.h"
+#include "observations/joint_limits.h"
 #include "io/report_json.h"
 #include "io/trajectory_file.h"
 #include "support/test_robots.h"
@@ -213,9 +214,17 @@ TEST_F(ObservationsEdits, C3CameraValues) {
 TEST_F(ObservationsEdits, C3JointsOutsidePlausibleRanges) {
   EXPECT_TRUE(Refused(Load("[0, 30, -150, 0, 45, 0]", "[0, 30, 12000, 0, 45, 0]"),
                       "`poses[0].joints_deg[2]` = `12000` at " + path_ + ":13 is out of range: must be in [-720, 720]"));
-  // Joint 2 of the PUMA stops at 225 deg.
-  EXPECT_TRUE(Refused(Load("[0, 30, -150, 0, 45, 0]", "[0, 230, -150, 0, 45, 0]"),
-                      "`poses[0].joints_deg[1]` = 230 at " + path_ + ":13 is outside joint 2's limits [-45, 225] deg"));
+  // Joint 2 of the PUMA stops at 225 deg, but a recorded 230 is what the controller read: kept as recorded,
+  // and named by observations/joint_limits.h (calibrate's warning).
+  ASSERT_TRUE(Load("[0, 30, -150, 0, 45, 0]", "[0, 230, -150, 0, 45, 0]").ok());
+  Result<ObservationSet> outside = LoadObservations(path_);
+  ASSERT_TRUE(outside.ok());
+  EXPECT_NEAR(outside->poses[0].joints_rad[1], DegToRad(230), 1e-12);
+  const std::vector<std::string> named = PosesOutsideJointLimits(*outside);
+  ASSERT_EQ(named.size(), 1u);
+  EXPECT_EQ(named[0], "pose " + outside->poses[0].id + " (index 0): joint 2 = 230 deg outside [-45, 225] deg of robot `puma560`");
+  // ... and written back as read.
+  EXPECT_TRUE(SaveObservations(*outside, dir_.File("again.yaml")).ok());
   EXPECT_TRUE(Refused(Load("[0, 30, -150, 0, 45, 0]", "[0, 30, -150, 0, 45]"),
                       "`poses[0].joints_deg` at " + path_ + ":13 has 5 values, expected 6"));
   EXPECT_TRUE(Refused(Load("joints_deg: [0, 30, -150, 0, 45, 0]", "joints_deg: [0, 30, -150, 0, 45, 0]\n    joints_rad: [0, 0, 0, 0, 0, 0]"),

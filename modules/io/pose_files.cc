@@ -22,7 +22,6 @@ namespace {
 constexpr double kMaxTranslationM = 100.0;
 const Range kTranslation = Range::Closed(-kMaxTranslationM, kMaxTranslationM);
 const Range kJointValue = Range::Closed(DegToRad(-720), DegToRad(720));
-constexpr double kLimitToleranceRad = 1e-9;
 
 std::string Short(double v) {
   char buffer[32];
@@ -92,13 +91,6 @@ bool ReadVispPose(MapReader* root, Problems* problems, Rigid3* out) {
   return true;
 }
 
-std::string JointLimitProblem(const RobotModel& robot, int joint, double value_rad) {
-  const JointLimits& l = robot.limits[static_cast<size_t>(joint)];
-  if (value_rad >= l.min_rad - kLimitToleranceRad && value_rad <= l.max_rad + kLimitToleranceRad) return "";
-  return "is outside joint " + std::to_string(joint + 1) + "'s limits [" + Short(RadToDeg(l.min_rad)) + ", " +
-         Short(RadToDeg(l.max_rad)) + "] deg (degrees written as radians, or the wrong robot?)";
-}
-
 // One entry of a poses list: `image` and exactly one of `base_from_flange` and joints.
 bool ReadListEntry(const yaml::YamlNode& node, const std::string& name, const RobotModel* robot, Problems* problems,
                    ImagePose* pose) {
@@ -146,19 +138,10 @@ bool ReadListEntry(const yaml::YamlNode& node, const std::string& name, const Ro
     map.Optional("joints_rad");
     ok = false;
   } else {
+    // Values outside the robot's limits are kept: the controller's reading is what happened (calibrate
+    // warns, observations/joint_limits.h); only the plausible range is checked.
     std::vector<double> joints;
-    std::vector<int> lines;
-    std::string key;
-    if (map.QuantityList("joints", Unit::kAngle, robot->num_joints(), kJointValue, &joints, true, &key, &lines)) {
-      for (int j = 0; j < robot->num_joints(); ++j) {
-        if (const std::string p = JointLimitProblem(*robot, j, joints[static_cast<size_t>(j)]); !p.empty()) {
-          const bool degrees = key.size() > 4 && key.compare(key.size() - 4, 4, "_deg") == 0;
-          const double v = joints[static_cast<size_t>(j)];
-          problems->Add("`" + map.Path(key) + "[" + std::to_string(j) + "]` = " + Short(degrees ? RadToDeg(v) : v) +
-                        " at " + problems->At(lines[static_cast<size_t>(j)]) + " " + p);
-          ok = false;
-        }
-      }
+    if (map.QuantityList("joints", Unit::kAngle, robot->num_joints(), kJointValue, &joints, true)) {
       pose->joints_rad = Eigen::Map<const Eigen::VectorXd>(joints.data(), static_cast<Eigen::Index>(joints.size()));
     } else {
       ok = false;

@@ -54,7 +54,8 @@ struct ImagePose {
 // One per-image file of form (a) or (b), told apart by its keys (`rows`, `cols` or `data`: ViSP).
 Result<Rigid3> LoadPerImagePoseFile(const std::string& path);
 
-// A poses list (c). Joints are refused without `robot`; with it their count and limits are checked.
+// A poses list (c). Joints are refused without `robot`; with it their count is checked (values outside its
+// limits are kept: the controller's reading; calibrate names them).
 Result<std::vector<ImagePose>> LoadPosesList(const std::string& path, const RobotModel* robot);
 
 // A poses list entry with joint angles, for SavePosesList.

@@ -5,6 +5,7 @@
 
 #include "io/atomic_file.h"
 #include "io/observations_file.h"
+#include "io/robot_origin.h"
 #include "io/urdf_robot_config.h"
 #include "yaml/yaml_reader.h"
 #include "io/yaml_writer.h"
@@ -172,6 +173,17 @@ CalibratedModel Parse(const yaml::YamlNode& node, const std::string& name, Probl
     ok = false;
   }
 
+  RobotOrigin origin;
+  if (convention == Convention::kModifiedHayati) {
+    ok &= ReadEnteredAs(&map, &origin);  // io/robot_origin.h: read for the exports, no part of the model
+  } else {
+    map.Disallow("entered_as", "only with dh_convention: modified_hayati (the form selfcal writes)");
+  }
+  if (origin.FromUrdf() && origin.joint_names.size() != rows.size()) {
+    problems->Add("`" + map.Path("entered_as") + "` names " + std::to_string(origin.joint_names.size()) +
+                  " joints, the table has " + std::to_string(rows.size()));
+    ok = false;
+  }
   Rigid3 base_from_link0, flange_from_cam, link_n_from_flange;
   ok &= ReadTransform(&map, "base_from_link0", /*required=*/false, &base_from_link0);
   ok &= ReadTransform(&map, "flange_from_cam", /*required=*/true, &flange_from_cam);

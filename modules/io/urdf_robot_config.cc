@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "base/atomic_file.h"
+#include "io/robot_origin.h"
 #include "urdf/urdf_robot.h"
 #include "yaml/yaml_reader.h"
 
@@ -11,11 +12,6 @@ namespace selfcal::io {
 namespace {
 
 constexpr std::size_t kMaxRobotConfigBytes = 1u << 20;
-
-std::string Resolve(const std::string& file, const std::string& config_path) {
-  if (file.empty() || file.front() == '/') return file;
-  return (std::filesystem::path(config_path).parent_path() / file).lexically_normal().string();
-}
 
 }  // namespace
 
@@ -54,7 +50,7 @@ void ParseUrdfRobotConfig(MapReader* map, Problems* problems, CalibratedModel* o
   }
   map->Finish();
   if (!ok || problems->size() != before) return;
-  Result<urdf::UrdfRobot> robot = urdf::LoadUrdfRobot(Resolve(file, problems->file()), spec, flange_from_cam);
+  Result<urdf::UrdfRobot> robot = urdf::LoadUrdfRobot(ResolveBesideConfig(file, problems->file()), spec, flange_from_cam);
   if (!robot.ok()) {
     problems->Add("urdf_file `" + file + "` of " + problems->file() + ": " + robot.status().message());
     return;
@@ -71,8 +67,10 @@ Result<std::string> RobotConfigTextForSession(const std::string& path) {
   if (!doc.ok() || !NamesUrdf(doc->root)) return text;
   Result<RobotModel> model = LoadRobotModel(path);
   if (!model.ok()) return model.status();
+  Result<RobotOrigin> origin = RobotOriginOfConfigText(*text, path);
+  if (!origin.ok()) return origin.status();
   return "# Converted by selfcal from " + path + " (urdf_file; docs/urdf.md), exact SI values.\n" +
-         RobotModelYaml(*model, TransformStyle::kExact, 0);
+         RobotModelYaml(*model, TransformStyle::kExact, 0) + EnteredAsYaml(*origin);
 }
 
 }  // namespace selfcal::io

@@ -79,6 +79,7 @@ def make_real_files():
         "robot": os.path.join(SRC, "config", "robots", "puma560.yaml"),
         "session_json": os.path.join(WORK, "session", "session.json"),
         "setup_json": os.path.join(WORK, "session", "inputs", "setup.json"),
+        "static_transform": os.path.join(WORK, "cal", "camera_static_transform.yaml"),
     }
 
 
@@ -126,6 +127,10 @@ def kind_of(lang, text):
         return ("robot", "keys")
     if "urdf_file:" in text:
         return ("urdf_robot", "urdf_robot")
+    if "format: selfcal-targets" in text:
+        return ("targets", "targets")
+    if body.startswith("header:") and "child_frame_id:" in text:
+        return ("static_transform", "keys")
     return ("unclassified", None)
 
 
@@ -174,6 +179,13 @@ def check_reads(kind, how, text, where, real):
                       os.path.join(SRC, "config", "trajectories", f"initial_{robot}.yaml"), "--out", path + "-out"])
         if result.returncode == 2:
             problem(f"{where}: selfcal simulate --robot refuses the documented example: {result.stderr[-1500:]}")
+    elif how == "targets":
+        with open(path + ".yaml", "w", encoding="utf-8") as f:
+            f.write(text)
+        # compensate on the simulated calibration: a target may be out of reach (exit 5), never refused (2).
+        result = run(["compensate", real["calibrated_model"], "--targets", path + ".yaml", "--out", path + "-joints.yaml"])
+        if result.returncode == 2:
+            problem(f"{where}: selfcal compensate refuses the documented example: {result.stderr[-1500:]}")
     elif how == "camera":
         suffix = ".xml" if kind == "visp_camera" else ".yaml"
         with open(path + suffix, "w", encoding="utf-8") as f:

@@ -1,0 +1,90 @@
+#include "app/model_exports.h"
+
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "app/cli_output.h"
+#include "io/dh_config_file.h"
+#include "io/static_transform_file.h"
+#include "kinematics/dh_table.h"
+#include "urdf/urdf_writer.h"
+
+namespace selfcal::app {
+namespace {
+
+// calibrated_robot.yaml when the entered convention holds the model exactly; otherwise why not.
+Status WriteDhTable(const RobotModel& calibrated, const std::string& convention, const std::string& source,
+                    const std::filesystem::path& out) {
+  if (convention.empty()) return Status::Ok();  // entered as a URDF: calibrated.urdf is its export
+  const DhExpression dh = ExpressAsDh(calibrated, convention);
+  nlohmann::json doc = {{"convention", convention}, {"written", dh.exact}};
+  if (dh.exact) {
+    const std::string path = (out / "calibrated_robot.yaml").string();
+    if (Status s = io::SaveDhRobotConfig(dh.table, calibrated.name, source, path); !s.ok()) return s;
+    std::cout << "calibrated robot (" << convention << " DH, the robot config's convention): " << path << "\n";
+    AddOutputFile("calibrated_robot", path);
+  } else {
+    std::ostringstream why;
+    why << "calibrated robot (" << convention << " DH): not written, the calibrated model is not expressible in it:";
+    for (const std::string& loss : dh.losses) why << "\n  " << loss;
+    if (dh.dropped_position_m > 0 || dh.dropped_rotation_rad > 0) {
+      why << "\n  dropping them would move the flange by up to " << std::setprecision(3) << dh.dropped_position_m * 1e3
+          << " mm / " << RadToDeg(dh.dropped_rotation_rad) << " deg (200 random joints within the limits)";
+    }
+    why << "\n  calibrated_model.yaml (modified DH + Hayati) and calibrated.urdf hold it exactly";
+    std::cout << why.str() << "\n";
+    doc["losses"] = dh.losses;
+    doc["dropped_flange_position_mm"] = dh.dropped_position_m * 1e3;
+    doc["dropped_flange_rotation_deg"] = RadToDeg(dh.dropped_rotation_rad);
+  }
+  OutputDocument()["dh_table"] = doc;
+  return Status::Ok();
+}
+
+// The URDF's names when the robot came from one (and the joint count agrees), else the writer's defaults.
+urdf::UrdfNames NamesOf(const io::RobotOrigin& origin, int num_joints) {
+  urdf::UrdfNames names;
+  if (!origin.FromUrdf() || static_cast<int>(origin.joint_names.size()) != num_joints) return names;
+  names.joints = origin.joint_names;
+  if (!origin.base_link.empty()) names.base_link = origin.base_link;
+  if (!origin.tip_link.empty()) names.tip_link = origin.tip_link;
+  if (!origin.camera_link.empty()) names.camera_link = origin.camera_link;
+  return names;
+}
+
+}  // namespace
+
+io::RobotOrigin OriginOfInput(const std::string& robot_config, const std::string& input, bool is_session) {
+  Result<io::RobotOrigin> origin =
+      !robot_config.empty() ? io::RobotOriginOfConfig(robot_config)
+      : is_session          ? io::RobotOriginOfConfig((std::filesystem::path(input) / "inputs" / "robot.yaml").string())
+                            : io::RobotOriginOfObservations(input);
+  return origin.ok() ? *origin : io::RobotOrigin{};
+}
+
+Status WriteModelExports(const RobotModel& calibrated, const io::RobotOrigin& origin, const std::string& source,
+                         const std::string& out_dir) {
+  const std::filesystem::path out(out_dir);
+  const std::string urdf_path = (out / "calibrated.urdf").string();  // docs/urdf.md
+  if (Status s = urdf::WriteUrdf(calibrated, NamesOf(origin, calibrated.num_joints()), urdf_path); !s.ok()) return s;
+  std::cout << "calibrated URDF: " << urdf_path << "\n";
+  AddOutputFile("calibrated_urdf", urdf_path);
+  if (Status s = WriteDhTable(calibrated, origin.dh_convention, source, out); !s.ok()) return s;
+  return WriteCameraStaticTransform(calibrated.flange_from_cam, origin, out_dir);
+}
+
+Status WriteCameraStaticTransform(const Rigid3& flange_from_cam, const io::RobotOrigin& origin,
+                                  const std::string& out_dir) {
+  const urdf::UrdfNames names = NamesOf(origin, static_cast<int>(origin.joint_names.size()));
+  const io::StaticTransform transform{names.tip_link, names.camera_link, flange_from_cam};
+  const std::string path = (std::filesystem::path(out_dir) / "camera_static_transform.yaml").string();
+  if (Status s = io::SaveStaticTransform(transform, path); !s.ok()) return s;
+  std::cout << "flange-to-camera static transform (" << names.tip_link << " -> " << names.camera_link << "): " << path
+            << "\n";
+  AddOutputFile("camera_static_transform", path);
+  return Status::Ok();
+}
+
+}  // namespace selfcal::app

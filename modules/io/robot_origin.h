@@ -1,0 +1,45 @@
+// How the nominal robot was entered, for the exports that speak the user's language (docs/urdf.md,
+// docs/calibrated-model-format.md): the DH convention of a robot config, or the joint and link names of a
+// URDF. Read from the robot config, from an observations file's robot (robot_file or the robot block), or
+// from a session's recorded robot.yaml, where a URDF robot is recorded as its converted model with
+//
+//   entered_as: {base_link: "base_link", tip_link: "tool0", camera_link: "camera_optical_frame",
+//                joint_names: ["joint1", ...]}
+//
+// (accepted in modified_hayati configs, the form selfcal writes; no part of the kinematics).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "base/status.h"
+#include "io/yaml_schema.h"
+
+namespace selfcal::io {
+
+struct RobotOrigin {
+  std::string dh_convention;             // "standard", "modified", "modified_hayati"; empty for a URDF / unknown
+  std::vector<std::string> joint_names;  // the URDF's movable joints, base to tip; empty otherwise
+  std::string base_link, tip_link, camera_link;  // the URDF's links; empty otherwise
+
+  bool FromUrdf() const { return !joint_names.empty(); }
+};
+
+// `file` as named in the config at `config_path`: absolute as is, else relative to the config's directory.
+std::string ResolveBesideConfig(const std::string& file, const std::string& config_path);
+
+// The `entered_as` map of `root` into *origin (nothing when absent); problems to root->problems().
+bool ReadEnteredAs(MapReader* root, RobotOrigin* origin);
+
+// The `entered_as: {...}` line for a URDF robot (empty otherwise).
+std::string EnteredAsYaml(const RobotOrigin& origin);
+
+// Of a robot config file (a URDF-naming config: its names, the URDF read for the joint names) or its
+// text already in memory (`path` standing for the file and resolving a relative urdf_file).
+Result<RobotOrigin> RobotOriginOfConfig(const std::string& path);
+Result<RobotOrigin> RobotOriginOfConfigText(const std::string& text, const std::string& path);
+
+// Of an observations file's robot: its robot_file's origin, or its robot block's.
+Result<RobotOrigin> RobotOriginOfObservations(const std::string& path);
+
+}  // namespace selfcal::io

@@ -1,0 +1,114 @@
+// The calibrated model's exports end to end through the selfcal binary (docs/urdf.md,
+// docs/calibrated-model-format.md, docs/ros-static-transform.md), each re-read by what consumes it:
+// calibrated.urdf keeps a URDF robot's names (urdfdom) and equals the model (KDL); the flange-to-camera
+// static transform (yaml-cpp); the DH table in the entered convention, or why not.
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <urdf_parser/urdf_parser.h>
+#include <yaml-cpp/yaml.h>
+
+#include "io/robot_config.h"
+#include "support/cli.h"
+#include "support/temp_files.h"
+#include "urdf/urdf_robot.h"
+
+namespace selfcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kSource = SELFCAL_SOURCE_DIR;
+
+// The worst FK difference (m or rad) of KDL's chain base -> tip of `urdf` against the model's flange or camera.
+double WorstKdlDifference(const std::string& urdf, const std::string& base, const std::string& tip,
+                          const RobotModel& model, bool camera) {
+  const std::vector<Eigen::VectorXd> joints = urdf::RandomJointsWithinLimits(model, 300, 21);
+  Result<std::vector<Rigid3>> kdl = urdf::KdlChainPoses(urdf, "calibrated.urdf", base, tip, joints);
+  EXPECT_TRUE(kdl.ok()) << kdl.status().message();
+  if (!kdl.ok()) return 1e9;
+  const Eigen::VectorXd rho = KinematicParameters::Nominal(model);
+  double worst = 0;
+  for (size_t i = 0; i < joints.size(); ++i) {
+    const Rigid3 ours = camera ? BaseFromCam(model, rho, joints[i]) : BaseFromFlange(model, rho, joints[i]);
+    const PoseDifference d = ComparePoses(ours, (*kdl)[i]);
+    worst = std::max({worst, d.position_m, d.rotation_rad});
+  }
+  return worst;
+}
+
+TEST(ExportsChain, CalibratedUrdfKeepsTheInputsNamesAndEqualsTheModel) {
+  const fs::path dir = testing::FreshDir("ExportsChain", "names");
+  std::string output;
+  ASSERT_EQ(testing::RunSelfcal("simulate --points --no-html --quiet --json --robot " + kSource +
+                                    "/test/data/urdf/ur5e_named_robot.yaml --trajectory " + kSource +
+                                    "/config/trajectories/initial_ur5e.yaml --out " + dir.string(),
+                                &output),
+            0)
+      << output;
+  const std::string text = testing::ReadFile((dir / "calibrated.urdf").string());
+  const ::urdf::ModelInterfaceSharedPtr parsed = ::urdf::parseURDF(text);
+  ASSERT_TRUE(parsed) << text;
+  // The movable joints, base to tip, by urdfdom: walk from the tip link up to the base.
+  std::vector<std::string> revolute;
+  for (::urdf::LinkConstSharedPtr link = parsed->getLink("tool_flange"); link && link->parent_joint;
+       link = parsed->getLink(link->parent_joint->parent_link_name)) {
+    if (link->parent_joint->type == ::urdf::Joint::REVOLUTE) revolute.insert(revolute.begin(), link->parent_joint->name);
+  }
+  const std::vector<std::string> expected = {"shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint",
+                                             "wrist_1_joint",      "wrist_2_joint",       "wrist_3_joint"};
+  EXPECT_EQ(revolute, expected);
+  EXPECT_TRUE(parsed->getLink("base_link_inertia"));
+  EXPECT_TRUE(parsed->getLink("camera_color_optical_frame"));
+  Result<io::CalibratedModel> calibrated = io::LoadCalibratedModel((dir / "calibrated_model.yaml").string());
+  ASSERT_TRUE(calibrated.ok()) << calibrated.status().message();
+  const RobotModel& model = calibrated->model;
+  EXPECT_LE(WorstKdlDifference(text, "base_link_inertia", "tool_flange", model, false), 1e-9);
+  EXPECT_LE(WorstKdlDifference(text, "base_link_inertia", "camera_color_optical_frame", model, true), 1e-9);
+
+  // The static transform, named from the URDF, read with yaml-cpp.
+  const YAML::Node tf = YAML::LoadFile((dir / "camera_static_transform.yaml").string());
+  EXPECT_EQ(tf["header"]["frame_id"].as<std::string>(), "tool_flange");
+  EXPECT_EQ(tf["child_frame_id"].as<std::string>(), "camera_color_optical_frame");
+  const YAML::Node t = tf["transform"]["translation"], r = tf["transform"]["rotation"];
+  const Eigen::Quaterniond q(r["w"].as<double>(), r["x"].as<double>(), r["y"].as<double>(), r["z"].as<double>());
+  const PoseDifference d = ComparePoses(
+      model.flange_from_cam,
+      Rigid3(q.toRotationMatrix(), Eigen::Vector3d(t["x"].as<double>(), t["y"].as<double>(), t["z"].as<double>())));
+  EXPECT_LE(d.position_m, 1e-12);
+  EXPECT_LE(d.rotation_rad, 1e-12);
+  // A URDF robot's export is the URDF: no DH table is attempted.
+  EXPECT_FALSE(fs::exists(dir / "calibrated_robot.yaml"));
+  const nlohmann::json doc = nlohmann::json::parse(output);
+  EXPECT_EQ(doc.at("files").at("camera_static_transform"), (dir / "camera_static_transform.yaml").string());
+  if (!HasFailure()) fs::remove_all(dir);
+}
+
+// The shipped PUMA config is standard DH; its parallel joints 2 and 3 get a calibrated beta, which standard
+// DH cannot hold: nothing is written for it, and the output says why and what it would cost.
+TEST(ExportsChain, AStandardDhRobotWithACalibratedBetaGetsTheReasonInsteadOfATable) {
+  const fs::path dir = testing::FreshDir("ExportsChain", "puma");
+  std::string output;
+  ASSERT_EQ(testing::RunSelfcalInSource("simulate --points --no-html --robot config/robots/puma560.yaml --out " +
+                                            dir.string(),
+                                        &output),
+            0)
+      << output;
+  EXPECT_FALSE(fs::exists(dir / "calibrated_robot.yaml"));
+  EXPECT_NE(output.find("calibrated robot (standard DH): not written, the calibrated model is not expressible in it"),
+            std::string::npos)
+      << output;
+  EXPECT_NE(output.find("j3.beta = "), std::string::npos) << output;
+  EXPECT_NE(output.find("(Hayati's parallel-axis parameter), which standard DH cannot hold"), std::string::npos);
+  EXPECT_NE(output.find("dropping them would move the flange by up to"), std::string::npos) << output;
+  // The default names, tool0 -> camera_optical_frame.
+  const YAML::Node tf = YAML::LoadFile((dir / "camera_static_transform.yaml").string());
+  EXPECT_EQ(tf["header"]["frame_id"].as<std::string>(), "tool0");
+  EXPECT_EQ(tf["child_frame_id"].as<std::string>(), "camera_optical_frame");
+  if (!HasFailure()) fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace selfcal
