@@ -46,6 +46,10 @@ Eigen::VectorXd BundleStartFromPaper(const ObservationSet& obs, const PaperPipel
 
 namespace {
 
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 // The held-out reprojection figures of the calibrated and the nominal model (see bundle_stage.h), every
 // estimated intrinsic's uncertainty in the calibrated model's prediction.
 void VerifyHeldOutReprojection(const ObservationSet& obs, BundleStageReport* report) {
@@ -102,20 +106,29 @@ BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineR
   const std::vector<int> verification_poses = obs.PosesWithRole(PoseRole::kVerification);
   const bool valid = !verification_poses.empty() && obs.Validate().empty();
   const bool verify = valid && !obs.check_distances.empty();
+  auto step = std::chrono::steady_clock::now();
   if (verify) {
     report.verification_nominal = VerifyDistances(obs, verification_poses, obs.robot, KinematicParameters::Nominal(obs.robot),
                                                   obs.camera.fx_px, obs.check_distances);
+    report.seconds_verification += SecondsSince(step);
   }
   if (b.rho.size() == obs.robot.num_parameters() && b.rho.allFinite() && std::isfinite(b.fx_px) && b.fx_px > 0) {
     report.calibrated_robot = ApplyParameters(obs.robot, b.rho);
     report.calibrated_rho = KinematicParameters::Nominal(report.calibrated_robot);
     report.calibrated_camera = WithIntrinsics(obs.camera, b.intrinsics);
+    step = std::chrono::steady_clock::now();
     if (valid) VerifyHeldOutReprojection(obs, &report);
+    report.seconds_heldout = SecondsSince(step);
+    step = std::chrono::steady_clock::now();
     report.fit_geometry = FitGeometryOf(obs, b);
+    report.seconds_fit_geometry = SecondsSince(step);
     if (verify) {
       ObservationSet calibrated = obs;
       calibrated.camera = report.calibrated_camera;
+      step = std::chrono::steady_clock::now();
       report.verification = VerifyDistances(calibrated, verification_poses, obs.robot, b.rho, b.fx_px, obs.check_distances);
+      report.seconds_verification += SecondsSince(step);
+      step = std::chrono::steady_clock::now();
       if (b.covariance_available) {
         // Order free, then the estimated intrinsics, f_x first when estimated (the others not propagated).
         // A held f_x: zero variance.
@@ -128,9 +141,10 @@ BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineR
       } else {
         report.predicted_error.message = "covariance unavailable: " + b.covariance_message;
       }
+      report.seconds_predicted_error = SecondsSince(step);
     }
   }
-  report.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
+  report.seconds_total = SecondsSince(clock_start);
   return report;
 }
 

@@ -65,6 +65,11 @@ struct BundleStageReport {
   // The camera poses and the identification residuals at the bundle's solution (fit_geometry.h), for the
   // report's plots; empty when the bundle gave no model.
   FitGeometry fit_geometry;
+  // Wall seconds of each step after the solve (bundle.seconds), and of the whole stage.
+  double seconds_verification = 0;     // the check distances with the nominal and the bundle's model
+  double seconds_heldout = 0;          // both held-out reprojections
+  double seconds_fit_geometry = 0;
+  double seconds_predicted_error = 0;
   double seconds_total = 0;
 };
 

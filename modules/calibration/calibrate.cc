@@ -1,5 +1,7 @@
 #include "calibration/calibrate.h"
 
+#include <chrono>
+
 namespace selfcal::calibration {
 
 const char* MethodName(Method method) { return method == Method::kPaper ? "paper" : "bundle"; }
@@ -150,9 +152,8 @@ void CheckAcceptance(const ObservationSet& obs, const ObservationSet& original, 
   for (const std::string& reason : report->acceptance.Reasons()) report->message += "; " + reason;
 }
 
-}  // namespace
-
-CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateOptions& options) {
+// Calibrate without its total time.
+CalibrationReport CalibrateSteps(const ObservationSet& observations, const CalibrateOptions& options) {
   CalibrationReport report;
   report.method = options.method;
   const bool flange_poses = observations.UsesFlangePoses();
@@ -205,7 +206,11 @@ CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateO
   }
   if (flange_poses && report.bundle) CheckFlangePoses(observations, obs, options, &report);
   if (flange_poses) progress.Advance();
-  if (report.accepted()) CheckAcceptance(obs, observations, &report);
+  if (report.accepted()) {
+    const auto start = std::chrono::steady_clock::now();
+    CheckAcceptance(obs, observations, &report);
+    report.seconds_acceptance = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
   progress.Advance();
   if (!report.accepted()) return report;  // no model for a result that is not to be applied
   CalibratedModel model;
@@ -237,6 +242,15 @@ CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateO
     model.method_description += ", flange poses with their stated noise";
   }
   report.model = std::move(model);
+  return report;
+}
+
+}  // namespace
+
+CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  CalibrationReport report = CalibrateSteps(observations, options);
+  report.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
 }
 

@@ -112,6 +112,9 @@ struct CalibrationReport {
   Acceptance acceptance;
   // Method::kPaper on joint angles, converged: the held-out figures of its model and of the nominal one.
   std::optional<PaperHeldOut> paper_heldout;
+  // Wall seconds of the acceptance checks and of the whole call (every stage: paper.seconds_*,
+  // bundle->bundle.seconds and bundle->seconds_*).
+  double seconds_acceptance = 0, seconds_total = 0;
 
   bool accepted() const { return verdict == Verdict::kAccepted; }
   // The chosen method's held-out verification (3-D error of the check distances), before and after.

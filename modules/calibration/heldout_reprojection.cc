@@ -100,7 +100,7 @@ struct DotInformation {
   bool usable = false;
   Eigen::Matrix3d sqrt_inverse = Eigen::Matrix3d::Zero();
   Eigen::MatrixXd k;
-  int column = -1;  // of its block in U
+  int column = -1;  // index of its block among the usable dots
 };
 
 std::map<int, DotInformation> IdentificationInformation(const ObservationSet& obs, const Projector& projector,
@@ -135,30 +135,60 @@ std::map<int, DotInformation> IdentificationInformation(const ObservationSet& ob
   return info;
 }
 
-// One verification residual: detection - prediction, and its row pair of U (C = sigma^2 (I + U U^T)).
+// One verification residual: detection - prediction, and its rows of U (C = sigma^2 I + U U^T, U in px):
+// U = [G | D] with G (2 x theta) dense and D zero except the 2 x 3 block of its dot.
 struct Residual {
   int slot = -1;  // index into HeldOutReprojection::poses
   Eigen::Vector2d r = Eigen::Vector2d::Zero();
+  Eigen::MatrixXd g;                           // 2 x theta
+  Eigen::Matrix<double, 2, 3> d = Eigen::Matrix<double, 2, 3>::Zero();
+  int dot = -1;                                // index of its dot's block
 };
 
-// r^T C^-1 r over the given residuals, C = sigma^2 I + U U^T (U in px), by the Woodbury identity.
-double ChiSquareOf(const std::vector<int>& rows, const std::vector<Residual>& residuals, const Eigen::MatrixXd& u,
-                   double sigma) {
-  const int n = static_cast<int>(rows.size());
-  Eigen::VectorXd r(2 * n);
-  Eigen::MatrixXd us(2 * n, u.cols());
-  for (int k = 0; k < n; ++k) {
-    r.segment<2>(2 * k) = residuals[rows[k]].r;
-    us.middleRows<2>(2 * k) = u.middleRows<2>(2 * rows[k]);
+// r^T C^-1 r over the given residuals, C = sigma^2 I + U U^T, by the Woodbury identity:
+// (r^T r - b^T M^-1 b) / sigma^2 with M = U^T U + sigma^2 I and b = U^T r. M's dot part is block
+// diagonal (3 x 3 per dot), so M^-1 b comes from the Schur complement on the theta block:
+// O(residuals x theta^2 + theta^3), not O(dots^3) (the dense M had 3 x dots + theta rows).
+double ChiSquareOf(const std::vector<int>& rows, const std::vector<Residual>& residuals, int num_dots, double sigma) {
+  if (rows.empty()) return 0;
+  const int nt = static_cast<int>(residuals[rows.front()].g.cols());
+  const double s2 = sigma * sigma;
+  std::vector<Eigen::Matrix3d> mdd(num_dots, Eigen::Matrix3d::Zero());
+  std::vector<Eigen::MatrixXd> mdt(num_dots);  // D_j^T G, 3 x theta
+  std::vector<Eigen::Vector3d> bd(num_dots, Eigen::Vector3d::Zero());
+  std::vector<bool> seen(num_dots, false);
+  Eigen::MatrixXd mtt = Eigen::MatrixXd::Zero(nt, nt);
+  Eigen::VectorXd bt = Eigen::VectorXd::Zero(nt);
+  double rr = 0;
+  for (int k : rows) {
+    const Residual& e = residuals[k];
+    if (!seen[e.dot]) mdt[e.dot] = Eigen::MatrixXd::Zero(3, nt);
+    seen[e.dot] = true;
+    mdd[e.dot] += e.d.transpose() * e.d;
+    mdt[e.dot] += e.d.transpose() * e.g;
+    bd[e.dot] += e.d.transpose() * e.r;
+    mtt += e.g.transpose() * e.g;
+    bt += e.g.transpose() * e.r;
+    rr += e.r.squaredNorm();
   }
-  Eigen::MatrixXd m = us.transpose() * us;
-  m.diagonal().array() += sigma * sigma;
-  const Eigen::VectorXd b = us.transpose() * r;
-  return (r.squaredNorm() - b.dot(m.ldlt().solve(b))) / (sigma * sigma);
+  mtt.diagonal().array() += s2;
+  double quadratic = 0;  // b^T M^-1 b
+  for (int j = 0; j < num_dots; ++j) {
+    if (!seen[j]) continue;
+    mdd[j].diagonal().array() += s2;
+    const Eigen::LDLT<Eigen::Matrix3d> block(mdd[j]);
+    const Eigen::MatrixXd k = block.solve(mdt[j]);  // M_dd^-1 M_dt
+    const Eigen::Vector3d y = block.solve(bd[j]);
+    quadratic += bd[j].dot(y);
+    mtt -= mdt[j].transpose() * k;
+    bt -= mdt[j].transpose() * y;
+  }
+  if (nt > 0) quadratic += bt.dot(mtt.ldlt().solve(bt));
+  return (rr - quadratic) / s2;
 }
 
 HeldOutFigure FigureOf(const std::string& pose_id, const std::vector<int>& rows, const std::vector<Residual>& residuals,
-                       const Eigen::MatrixXd& u, double sigma, int noise_dof) {
+                       int num_dots, double sigma, int noise_dof) {
   HeldOutFigure f;
   f.pose_id = pose_id;
   f.noise_dof = noise_dof;
@@ -172,7 +202,7 @@ HeldOutFigure FigureOf(const std::string& pose_id, const std::vector<int>& rows,
   }
   f.rms_px = std::sqrt(sum2 / f.dof);
   f.max_px = worst;
-  f.chi_square = ChiSquareOf(rows, residuals, u, sigma);
+  f.chi_square = ChiSquareOf(rows, residuals, num_dots, sigma);
   f.chi_square_limit = ChiSquareQuantile(kHeldOutTestLevel, f.dof, noise_dof);
   f.p_value = ChiSquareUpperTail(f.chi_square, f.dof, noise_dof);
   f.test_passed = f.chi_square <= f.chi_square_limit;
@@ -201,12 +231,11 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
   std::map<int, DotInformation> info = IdentificationInformation(obs, projector, dots_in_base, excluded);
   const int nt = projector.num_theta();
   const Eigen::MatrixXd theta_root = nt > 0 ? CovarianceRoot(model.covariance) : Eigen::MatrixXd();
-  int columns = nt;
+  int num_dots = 0;
   for (auto& [id, d] : info) {
-    if (d.usable) d.column = (columns += 3) - 3;
+    if (d.usable) d.column = num_dots++;
   }
   std::vector<Residual> residuals;
-  std::vector<Eigen::MatrixXd> rows_of_u;  // one 2 x columns block per residual
   std::vector<std::vector<int>> rows_of_pose;
   for (int v : obs.PosesWithRole(PoseRole::kVerification)) {
     const PoseObservation& pose = obs.poses[v];
@@ -221,13 +250,15 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
         ++report.num_not_predicted;
         continue;
       }
-      Eigen::MatrixXd block = Eigen::MatrixXd::Zero(2, columns);
-      if (nt > 0) block.leftCols(nt) = (jt - jd * d->second.k) * theta_root;
-      block.middleCols<3>(d->second.column) = jd * d->second.sqrt_inverse * noise_px;
+      Residual e;
+      e.slot = static_cast<int>(rows_of_pose.size());
+      e.r = pixel - uv;
+      e.g = nt > 0 ? Eigen::MatrixXd((jt - jd * d->second.k) * theta_root) : Eigen::MatrixXd(2, 0);
+      e.d = jd * d->second.sqrt_inverse * noise_px;
+      e.dot = d->second.column;
       rows.push_back(static_cast<int>(residuals.size()));
-      residuals.push_back({static_cast<int>(rows_of_pose.size()), pixel - uv});
+      residuals.push_back(std::move(e));
       report.residuals.push_back({pose.id, id, pixel, pixel - uv});
-      rows_of_u.push_back(std::move(block));
     }
     if (!rows.empty()) {
       report.poses.push_back({pose.id});
@@ -238,14 +269,12 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
     report.message = "no verification image sees a dot that the identification images place";
     return report;
   }
-  Eigen::MatrixXd u(2 * residuals.size(), columns);
-  for (size_t k = 0; k < residuals.size(); ++k) u.middleRows<2>(2 * k) = rows_of_u[k];
   std::vector<int> all(residuals.size());
   for (size_t k = 0; k < all.size(); ++k) all[k] = static_cast<int>(k);
   for (size_t s = 0; s < report.poses.size(); ++s) {
-    report.poses[s] = FigureOf(report.poses[s].pose_id, rows_of_pose[s], residuals, u, noise_px, noise_dof);
+    report.poses[s] = FigureOf(report.poses[s].pose_id, rows_of_pose[s], residuals, num_dots, noise_px, noise_dof);
   }
-  report.overall = FigureOf("", all, residuals, u, noise_px, noise_dof);
+  report.overall = FigureOf("", all, residuals, num_dots, noise_px, noise_dof);
   report.ok = true;
   return report;
 }

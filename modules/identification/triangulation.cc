@@ -81,10 +81,12 @@ TriangulationResult TriangulatePoint(const CameraIntrinsics& camera, double fx_p
     const Eigen::Vector2d xy = PixelToNormalized(camera, fx_px, track.pixels[k]);
     rays[k] = (track.base_from_cam[k].rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized();
   }
-  // Depth is unobservable when all viewing lines are parallel (including opposite directions).
+  // Depth is unobservable when all viewing lines are parallel (including opposite directions). The first
+  // pair at or above the limit settles it (usually among the first few: O(views), not O(views^2)); only a
+  // refusal looks at every pair, for the largest angle it names.
   double max_angle = 0;
-  for (int a = 0; a < num_views; ++a) {
-    for (int b = a + 1; b < num_views; ++b) {
+  for (int a = 0; a < num_views && !(max_angle >= kMinRayAngleRad); ++a) {
+    for (int b = a + 1; b < num_views && !(max_angle >= kMinRayAngleRad); ++b) {
       max_angle = std::max(max_angle, std::atan2(rays[a].cross(rays[b]).norm(), std::abs(rays[a].dot(rays[b]))));
     }
   }

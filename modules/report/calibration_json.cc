@@ -436,10 +436,19 @@ json CalibrationReportJson(const ObservationSet& obs, const calibration::Calibra
   if (report.hand_eye_start) j["hand_eye"] = HandEyeJson(report);
   // Timing in one place, so that two reports of the same input compare equal without it.
   const calibration::PaperPipelineReport& p = report.paper;
+  const calibration::BundleStageReport* b = report.bundle ? &*report.bundle : nullptr;
+  auto bundle_seconds = [b](double calibration::BundleStageReport::*field) { return b ? json(b->*field) : json(); };
   j["timing"] = {{"paper_two_view_s", p.seconds_two_view},
                  {"paper_identification_s", p.seconds_identification},
                  {"paper_total_s", p.seconds_total},
-                 {"bundle_s", report.bundle ? json(report.bundle->bundle.seconds) : json()}};
+                 {"bundle_s", b ? json(b->bundle.seconds) : json()},
+                 {"bundle_verification_s", bundle_seconds(&calibration::BundleStageReport::seconds_verification)},
+                 {"bundle_heldout_s", bundle_seconds(&calibration::BundleStageReport::seconds_heldout)},
+                 {"bundle_fit_geometry_s", bundle_seconds(&calibration::BundleStageReport::seconds_fit_geometry)},
+                 {"bundle_predicted_error_s", bundle_seconds(&calibration::BundleStageReport::seconds_predicted_error)},
+                 {"bundle_stage_total_s", bundle_seconds(&calibration::BundleStageReport::seconds_total)},
+                 {"acceptance_s", report.seconds_acceptance},
+                 {"total_s", report.seconds_total}};
   return j;
 }
 
