@@ -1,6 +1,7 @@
 // Fuzz harness: an OpenCV FileStorage camera file (docs/camera-files.md) through io::LoadCameraFile, as
-// `.yaml` (cv::FileStorage's YAML parser, then selfcal's checks). Refusals name the file; cv::FileStorage
-// reports no line for most problems, so the line share of this harness is not a goal.
+// `.yaml` (cv::FileStorage's YAML parser, then selfcal's checks). Refusals should name camera.yaml:<line>:
+// cv::FileStorage keeps no lines, io/opencv_lines.h finds the key's in the text (a parse error's line is
+// the one cv::FileStorage's parser names).
 #include <cstddef>
 #include <cstdint>
 #include <string>

@@ -1,5 +1,6 @@
 // Fuzz harness: a session manifest, session.json (docs/session-format.md), through session::ReadManifest
-// of a temporary session folder. Refusals name the file; JSON documents are not refused by line.
+// of a temporary session folder. Refusals should name session.json:<line> (the lines of its keys come from
+// base/json_lines.h).
 #include <cstddef>
 #include <cstdint>
 #include <string>

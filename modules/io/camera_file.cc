@@ -16,7 +16,9 @@
 #include <visp3/core/vpXmlParserCamera.h>
 
 #include "base/atomic_file.h"
+#include "base/terminal_text.h"
 #include "io/camera_xml.h"
+#include "io/opencv_lines.h"
 #include "io/yaml_schema.h"
 
 namespace selfcal::io {
@@ -56,10 +58,17 @@ std::string Suggestion(const std::string& key, const std::vector<std::string>& a
   return list;
 }
 
-// The intrinsics' own checks (principal point inside the image, ...), one problem each.
-void AddValidation(const CameraIntrinsics& camera, const std::string& where, Problems* problems) {
+// The intrinsics' own checks (principal point inside the image, ...), one problem each, at the line of
+// the key that holds the value (`at(key)`: "<file>:<line>").
+template <typename At>
+void AddValidation(const CameraIntrinsics& camera, const At& at, Problems* problems) {
   std::istringstream invalid(camera.Validate());
-  for (std::string line; std::getline(invalid, line);) problems->Add(where + ": " + line);
+  for (std::string line; std::getline(invalid, line);) {
+    const char* key = line.rfind("image size", 0) == 0               ? "image_width"
+                      : line[0] == 'k' || line[0] == 'p'           ? "distortion_coefficients"
+                                                                     : "camera_matrix";
+    problems->Add("`" + std::string(key) + "` at " + at(key) + ": " + line);
+  }
 }
 
 // --- OpenCV FileStorage -------------------------------------------------------------------------------
@@ -74,11 +83,11 @@ const std::vector<std::string> kOpenCvKeys = {
 bool ReadOpenCvInt(const cv::FileNode& node, const std::string& key, const std::string& file, Problems* problems,
                    int* out) {
   if (node.empty() || node.isNone()) {
-    problems->Add("missing key `" + key + "` in " + file);
+    problems->Add("missing key `" + key + "` in the document at " + file);
     return false;
   }
   if (!node.isInt() || static_cast<int>(node) < 1 || static_cast<int>(node) > 100000) {
-    problems->Add("`" + key + "` in " + file + " must be an integer in [1, 100000]");
+    problems->Add("`" + key + "` at " + file + " must be an integer in [1, 100000]");
     return false;
   }
   *out = static_cast<int>(node);
@@ -88,7 +97,7 @@ bool ReadOpenCvInt(const cv::FileNode& node, const std::string& key, const std::
 bool ReadOpenCvMatrix(const cv::FileNode& node, const std::string& key, const std::string& file, Problems* problems,
                       cv::Mat* out) {
   if (node.empty() || node.isNone()) {
-    problems->Add("missing key `" + key + "` in " + file);
+    problems->Add("missing key `" + key + "` in the document at " + file);
     return false;
   }
   // rows, cols and data checked before cv::FileStorage allocates rows x cols: a mistyped `cols` (or a
@@ -96,7 +105,7 @@ bool ReadOpenCvMatrix(const cv::FileNode& node, const std::string& key, const st
   const auto small_int = [](const cv::FileNode& n) { return n.isInt() && int(n) >= 1 && int(n) <= 16; };
   if (!node.isMap() || !small_int(node["rows"]) || !small_int(node["cols"]) || !node["data"].isSeq() ||
       node["data"].size() != static_cast<size_t>(int(node["rows"]) * int(node["cols"]))) {
-    problems->Add("`" + key + "` in " + file + " must be an opencv-matrix (rows, cols, dt, data) of at most 16 " +
+    problems->Add("`" + key + "` at " + file + " must be an opencv-matrix (rows, cols, dt, data) of at most 16 " +
                   "entries, with rows x cols values in data");
     return false;
   }
@@ -107,14 +116,14 @@ bool ReadOpenCvMatrix(const cv::FileNode& node, const std::string& key, const st
     m = cv::Mat();
   }
   if (m.empty() || m.channels() != 1) {
-    problems->Add("`" + key + "` in " + file + " must be an opencv-matrix (rows, cols, dt, data)");
+    problems->Add("`" + key + "` at " + file + " must be an opencv-matrix (rows, cols, dt, data)");
     return false;
   }
   m.convertTo(*out, CV_64F);
   for (int r = 0; r < out->rows; ++r) {
     for (int c = 0; c < out->cols; ++c) {
       if (!std::isfinite(out->at<double>(r, c))) {
-        problems->Add("`" + key + "` in " + file + " has a non-finite entry");
+        problems->Add("`" + key + "` at " + file + " has a non-finite entry");
         return false;
       }
     }
@@ -125,22 +134,22 @@ bool ReadOpenCvMatrix(const cv::FileNode& node, const std::string& key, const st
 // K = [fx 0 cx; 0 fy cy; 0 0 1] exactly (no skew: selfcal's model has none).
 void ReadCameraMatrix(const cv::Mat& k, const std::string& file, Problems* problems, CameraIntrinsics* camera) {
   if (k.rows != 3 || k.cols != 3) {
-    problems->Add("`camera_matrix` in " + file + " is " + std::to_string(k.rows) + "x" + std::to_string(k.cols) +
+    problems->Add("`camera_matrix` at " + file + " is " + std::to_string(k.rows) + "x" + std::to_string(k.cols) +
                   ", must be 3x3");
     return;
   }
   if (k.at<double>(0, 1) != 0) {
-    problems->Add("`camera_matrix` in " + file + " has skew " + Num(k.at<double>(0, 1)) +
+    problems->Add("`camera_matrix` at " + file + " has skew " + Num(k.at<double>(0, 1)) +
                   " (entry [0][1]); selfcal's camera model has none and cannot represent it");
   }
   if (k.at<double>(1, 0) != 0 || k.at<double>(2, 0) != 0 || k.at<double>(2, 1) != 0 || k.at<double>(2, 2) != 1) {
-    problems->Add("`camera_matrix` in " + file + " must be [fx 0 cx; 0 fy cy; 0 0 1]");
+    problems->Add("`camera_matrix` at " + file + " must be [fx 0 cx; 0 fy cy; 0 0 1]");
   }
   camera->fx_px = k.at<double>(0, 0);
   camera->cx_px = k.at<double>(0, 2);
   camera->cy_px = k.at<double>(1, 2);
   if (!(camera->fx_px > 0) || !(k.at<double>(1, 1) > 0)) {
-    problems->Add("`camera_matrix` in " + file + ": fx and fy must be > 0");
+    problems->Add("`camera_matrix` at " + file + ": fx and fy must be > 0");
     return;
   }
   camera->mu = k.at<double>(1, 1) / camera->fx_px;
@@ -150,7 +159,7 @@ void ReadCameraMatrix(const cv::Mat& k, const std::string& file, Problems* probl
 void ReadDistortion(const cv::Mat& d, const std::string& file, Problems* problems, CameraIntrinsics* camera) {
   const int n = static_cast<int>(d.total());
   if ((d.rows != 1 && d.cols != 1) || (n != 4 && n != 5 && n != 8 && n != 12 && n != 14)) {
-    problems->Add("`distortion_coefficients` in " + file + " is " + std::to_string(d.rows) + "x" +
+    problems->Add("`distortion_coefficients` at " + file + " is " + std::to_string(d.rows) + "x" +
                   std::to_string(d.cols) + ", must be a vector of 4, 5, 8, 12 or 14 coefficients");
     return;
   }
@@ -163,9 +172,19 @@ void ReadDistortion(const cv::Mat& d, const std::string& file, Problems* problem
   for (int i = 5; i < n; ++i) {
     if (v[i] == 0) continue;
     const char* model = i < 8 ? "rational (k4, k5, k6)" : i < 12 ? "thin-prism (s1..s4)" : "tilted-sensor (tau_x, tau_y)";
-    problems->Add("`distortion_coefficients` in " + file + ": coefficient " + std::to_string(i) + " = " + Num(v[i]) +
+    problems->Add("`distortion_coefficients` at " + file + ": coefficient " + std::to_string(i) + " = " + Num(v[i]) +
                   " belongs to OpenCV's " + model + " model, which selfcal cannot represent");
   }
+}
+
+// The text could not be read as FileStorage: OpenCV's reason at the line its parser names, else line 1
+// (an empty file, an unknown header).
+Status OpenCvReadError(const std::string& path, const std::string& what) {
+  const std::optional<OpenCvParseError> parsed = ParseOpenCvError(what);
+  const std::string reason = parsed ? parsed->reason : what;
+  return Status::Error(ErrorCode::kInvalidInput, "cannot read " + path + " as an OpenCV FileStorage file: " + path +
+                                                     ":" + std::to_string(parsed ? parsed->line : 1) + ": " +
+                                                     TerminalSafe(reason));
 }
 
 Result<CameraIntrinsics> LoadOpenCv(const std::string& path, const std::string& contents) {
@@ -173,34 +192,41 @@ Result<CameraIntrinsics> LoadOpenCv(const std::string& path, const std::string& 
   cv::FileStorage fs;
   try {
     if (!fs.open(contents, cv::FileStorage::READ | cv::FileStorage::MEMORY)) {
-      return Status::Error(ErrorCode::kInvalidInput, "cannot read " + path + " as an OpenCV FileStorage file");
+      return OpenCvReadError(path, "not a FileStorage text");
     }
   } catch (const std::exception& e) {  // cv::Exception, or e.g. std::length_error from FileStorage::open
-    return Status::Error(ErrorCode::kInvalidInput,
-                         "cannot read " + path + " as an OpenCV FileStorage file: " + std::string(e.what()));
+    return OpenCvReadError(path, contents.empty() ? "the file is empty" : e.what());
   }
   const cv::FileNode root = fs.root();
-  if (!root.isMap()) return Status::Error(ErrorCode::kInvalidInput, path + ": the top level must be a map of keys");
+  const OpenCvLines lines(contents, root.isMap() ? root.keys() : std::vector<std::string>{});
+  const auto at = [&](const std::string& key) { return path + ":" + std::to_string(lines.Key(key)); };
+  if (!root.isMap()) {
+    return Status::Error(ErrorCode::kInvalidInput, path + ":" + std::to_string(lines.Document()) +
+                                                       ": the top level must be a map of keys");
+  }
   for (const std::string& key : root.keys()) {
     if (std::find(kOpenCvKeys.begin(), kOpenCvKeys.end(), key) == kOpenCvKeys.end()) {
-      problems.Add("unknown key `" + key + "` in " + path + Suggestion(key, {kOpenCvKeys.begin(), kOpenCvKeys.begin() + 4}));
+      problems.Add("unknown key `" + TerminalSafe(key) + "` at " + at(key) +
+                   Suggestion(key, {kOpenCvKeys.begin(), kOpenCvKeys.begin() + 4}));
     }
   }
   CameraIntrinsics camera;
-  bool ok = ReadOpenCvInt(root["image_width"], "image_width", path, &problems, &camera.width_px);
-  ok &= ReadOpenCvInt(root["image_height"], "image_height", path, &problems, &camera.height_px);
+  bool ok = ReadOpenCvInt(root["image_width"], "image_width", at("image_width"), &problems, &camera.width_px);
+  ok &= ReadOpenCvInt(root["image_height"], "image_height", at("image_height"), &problems, &camera.height_px);
   cv::Mat k, d;
-  if (ReadOpenCvMatrix(root["camera_matrix"], "camera_matrix", path, &problems, &k)) {
-    ReadCameraMatrix(k, path, &problems, &camera);
+  if (ReadOpenCvMatrix(root["camera_matrix"], "camera_matrix", at("camera_matrix"), &problems, &k)) {
+    ReadCameraMatrix(k, at("camera_matrix"), &problems, &camera);
   }
-  if (ReadOpenCvMatrix(root["distortion_coefficients"], "distortion_coefficients", path, &problems, &d)) {
-    ReadDistortion(d, path, &problems, &camera);
+  if (ReadOpenCvMatrix(root["distortion_coefficients"], "distortion_coefficients", at("distortion_coefficients"),
+                       &problems, &d)) {
+    ReadDistortion(d, at("distortion_coefficients"), &problems, &camera);
   }
   const cv::FileNode fisheye = root["fisheye_model"];
   if (!fisheye.empty() && !fisheye.isNone() && (!fisheye.isInt() || static_cast<int>(fisheye) != 0)) {
-    problems.Add("`fisheye_model` in " + path + " is set: OpenCV's fisheye model is not selfcal's and is refused");
+    problems.Add("`fisheye_model` at " + at("fisheye_model") +
+                 " is set: OpenCV's fisheye model is not selfcal's and is refused");
   }
-  if (ok && problems.empty()) AddValidation(camera, path, &problems);
+  if (ok && problems.empty()) AddValidation(camera, at, &problems);
   if (!problems.empty()) return problems.ToStatus("camera intrinsics");
   return camera;
 }

@@ -179,13 +179,17 @@ class BadCameraFiles : public ::testing::Test {
 
 TEST_F(BadCameraFiles, OpenCv) {
   ASSERT_TRUE(LoadCameraFile((WriteFile(dir_.File("good.yaml"), OpenCv("")), dir_.File("good.yaml"))).ok());
-  EXPECT_TRUE(Refused("unknown.yaml", OpenCv("distortion_coeffs: 3\n"), "unknown key `distortion_coeffs`"));
+  // Issue 16: every refusal names the line (cv::FileStorage keeps none: io/opencv_lines.h finds the key's).
+  EXPECT_TRUE(Refused("unknown.yaml", OpenCv("distortion_coeffs: 3\n"),
+                      "unknown key `distortion_coeffs` at " + dir_.File("unknown.yaml") + ":9"));
   EXPECT_TRUE(Refused("unknown.yaml", OpenCv("distortion_coeffs: 3\n"), "did you mean `distortion_coefficients`?"));
   std::string missing = OpenCv("");
   missing.replace(missing.find("image_height: 480\n"), 18, "");
-  EXPECT_TRUE(Refused("missing.yaml", missing, "missing key `image_height`"));
+  EXPECT_TRUE(Refused("missing.yaml", missing, "missing key `image_height` in the document at " + dir_.File("missing.yaml") + ":3"));
   EXPECT_TRUE(Refused("size.yaml", OpenCv("", "2, cols: 3, dt: d, data: [600, 0, 320, 0, 600, 240]"),
-                      "`camera_matrix` in " + dir_.File("size.yaml") + " is 2x3, must be 3x3"));
+                      "`camera_matrix` at " + dir_.File("size.yaml") + ":5 is 2x3, must be 3x3"));
+  EXPECT_TRUE(Refused("centre.yaml", OpenCv("", "3, cols: 3, dt: d, data: [600, 0, 700, 0, 600, 240, 0, 0, 1]"),
+                      "`camera_matrix` at " + dir_.File("centre.yaml") + ":5: cx_px = 700 must lie in [0, width]"));
   EXPECT_TRUE(Refused("skew.yaml", OpenCv("", "3, cols: 3, dt: d, data: [600, 0.5, 320, 0, 600, 240, 0, 0, 1]"),
                       "has skew 0.5"));
   std::string rational = OpenCv("");
@@ -200,8 +204,13 @@ TEST_F(BadCameraFiles, OpenCv) {
   // Found by the fuzzer too: cv::FileStorage::open throws std::length_error (not cv::Exception) on this.
   EXPECT_TRUE(Refused("length.yaml", ReadFile(SourcePath("fuzz/regressions/camera_opencv/filestorage-open-throws-length-error.yaml")),
                       "cannot read"));
-  EXPECT_TRUE(Refused("fisheye.yaml", OpenCv("fisheye_model: 1\n"), "fisheye"));
-  EXPECT_TRUE(Refused("garbage.yaml", "%YAML:1.0\n---\n{ [ :\n", "cannot read"));
+  EXPECT_TRUE(Refused("fisheye.yaml", OpenCv("fisheye_model: 1\n"), "`fisheye_model` at " + dir_.File("fisheye.yaml") + ":9 is set"));
+  // A parse error: the line cv::FileStorage's parser names; a file it cannot start reading: line 1.
+  EXPECT_TRUE(Refused("garbage.yaml", "%YAML:1.0\n---\nimage_width: 5\nimage_height: [\n",
+                      "cannot read " + dir_.File("garbage.yaml") + " as an OpenCV FileStorage file: " +
+                          dir_.File("garbage.yaml") + ":4: Missing , between the elements"));
+  EXPECT_TRUE(Refused("empty.yaml", "", dir_.File("empty.yaml") + ":1: "));
+  EXPECT_TRUE(Refused("utf16.yaml", std::string("\xff\xfe" "a\0:\0", 6), dir_.File("utf16.yaml") + ":1: "));
   EXPECT_TRUE(Refused("named.yaml", OpenCv(""), "a camera name (`A`) is for ViSP files", "A"));
   EXPECT_TRUE(Refused("camera.txt", OpenCv(""), "unknown format"));
   const Result<CameraIntrinsics> none = LoadCameraFile(dir_.File("absent.yaml"));
@@ -214,7 +223,7 @@ TEST_F(BadCameraFiles, Visp) {
   const std::string model = "      <type>perspectiveProjWithoutDistortion</type>\n      <px>600</px>\n      <py>601</py>\n"
                             "      <u0>320</u0>\n      <v0>240</v0>\n";
   ASSERT_TRUE(LoadCameraFile((WriteFile(dir_.File("good.xml"), Visp(model)), dir_.File("good.xml"))).ok());
-  EXPECT_TRUE(Refused("name.xml", Visp(model), "no camera named `B` in " + dir_.File("name.xml") + " (cameras: `A`)", "B"));
+  EXPECT_TRUE(Refused("name.xml", Visp(model), "no camera named `B` in <root> at " + dir_.File("name.xml") + ":2 (cameras: `A`)", "B"));
   std::string typo = model;
   typo.replace(typo.find("<py>601</py>"), 12, "<pyy>601</pyy>");
   EXPECT_TRUE(Refused("typo.xml", Visp(typo), "unknown element <pyy> in <model> at " + dir_.File("typo.xml") + ":10; did you mean <py>?"));
@@ -227,9 +236,12 @@ TEST_F(BadCameraFiles, Visp) {
   EXPECT_TRUE(Refused("number.xml", Visp(text), "<u0> = `3x0` at " + dir_.File("number.xml") + ":11 is not a finite number"));
   std::string two = Visp(model);
   two.replace(two.find("</root>"), 7, "  <camera><name>C</name></camera>\n</root>");
-  EXPECT_TRUE(Refused("two.xml", two, "holds several cameras (`A`, `C`); choose one by name"));
+  EXPECT_TRUE(Refused("two.xml", two, "holds several cameras (`A`, `C`); choose one by name (the second at " +
+                                           dir_.File("two.xml") + ":15)"));
+  EXPECT_TRUE(Refused("rot.xml", "<?xml version=\"1.0\"?>\n<rot></rot>\n",
+                      "the root element <rot> at " + dir_.File("rot.xml") + ":2 is not <root>"));
   const std::string unclosed = Visp(model);
-  EXPECT_TRUE(Refused("broken.xml", unclosed.substr(0, unclosed.find("</root>")), "element <root> opened at line 2 is never closed"));
+  EXPECT_TRUE(Refused("broken.xml", unclosed.substr(0, unclosed.find("</root>")), dir_.File("broken.xml") + ":2: element <root> is never closed"));
   EXPECT_TRUE(Refused("cut.xml", unclosed.substr(0, 64), "unterminated tag"));
   std::string nosize = Visp(model);
   nosize.replace(nosize.find("    <image_width>640</image_width>\n"), 35, "");

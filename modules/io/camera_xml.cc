@@ -46,8 +46,12 @@ std::string Decode(const std::string& s) {
   return out;
 }
 
-// Parses `s` into the single top-level element. Returns an error message ("line N: ...") or "".
-std::string ParseXml(const std::string& s, XmlElement* top) {
+// Parses `s` into the single top-level element. Returns an error message, its line in *error_line, or "".
+std::string ParseXml(const std::string& s, XmlElement* top, int* error_line) {
+  const auto fail = [error_line](int at, const std::string& why) {
+    *error_line = at;
+    return why;
+  };
   std::vector<XmlElement> stack;
   std::vector<XmlElement> tops;
   int line = 1;
@@ -58,7 +62,7 @@ std::string ParseXml(const std::string& s, XmlElement* top) {
       const size_t next = std::min(s.find('<', i), s.size());
       const std::string text = s.substr(i, next - i);
       if (stack.empty()) {
-        if (!Trim(text).empty()) return "line " + std::to_string(line) + ": text outside the root element";
+        if (!Trim(text).empty()) return fail(line, "text outside the root element");
       } else {
         stack.back().text += text;
       }
@@ -74,16 +78,16 @@ std::string ParseXml(const std::string& s, XmlElement* top) {
       return true;
     };
     if (s.compare(i, 4, "<!--") == 0) {
-      if (!skip_to("-->")) return "line " + std::to_string(line) + ": unterminated comment";
+      if (!skip_to("-->")) return fail(line, "unterminated comment");
       continue;
     }
     if (s.compare(i, 2, "<?") == 0) {
-      if (!skip_to("?>")) return "line " + std::to_string(line) + ": unterminated declaration";
+      if (!skip_to("?>")) return fail(line, "unterminated declaration");
       continue;
     }
-    if (s.compare(i, 2, "<!") == 0) return "line " + std::to_string(line) + ": DTDs and CDATA sections are not accepted";
+    if (s.compare(i, 2, "<!") == 0) return fail(line, "DTDs and CDATA sections are not accepted");
     const size_t close = s.find('>', i);
-    if (close == std::string::npos) return "line " + std::to_string(line) + ": unterminated tag";
+    if (close == std::string::npos) return fail(line, "unterminated tag");
     std::string tag = Trim(s.substr(i + 1, close - i - 1));
     const int tag_line = line;
     advance(i, close + 1);
@@ -91,8 +95,8 @@ std::string ParseXml(const std::string& s, XmlElement* top) {
     if (!tag.empty() && tag[0] == '/') {
       const std::string name = Trim(tag.substr(1));
       if (stack.empty() || stack.back().name != name) {
-        return "line " + std::to_string(tag_line) + ": closing tag </" + name + "> does not match" +
-               (stack.empty() ? std::string(" any open element") : " <" + stack.back().name + ">");
+        return fail(tag_line, "closing tag </" + name + "> does not match" +
+               (stack.empty() ? std::string(" any open element") : " <" + stack.back().name + ">"));
       }
       XmlElement done = std::move(stack.back());
       stack.pop_back();
@@ -103,7 +107,7 @@ std::string ParseXml(const std::string& s, XmlElement* top) {
     const bool self_closing = !tag.empty() && tag.back() == '/';
     if (self_closing) tag = Trim(tag.substr(0, tag.size() - 1));
     if (tag.empty() || tag.find_first_of(" \t\r\n=\"'") != std::string::npos) {
-      return "line " + std::to_string(tag_line) + ": <" + tag + "> is not a plain element (attributes are not accepted)";
+      return fail(tag_line, "<" + tag + "> is not a plain element (attributes are not accepted)");
     }
     XmlElement e;
     e.name = tag;
@@ -114,8 +118,11 @@ std::string ParseXml(const std::string& s, XmlElement* top) {
       stack.push_back(std::move(e));
     }
   }
-  if (!stack.empty()) return "element <" + stack.back().name + "> opened at line " + std::to_string(stack.back().line) + " is never closed";
-  if (tops.size() != 1) return "the document must have exactly one root element (found " + std::to_string(tops.size()) + ")";
+  if (!stack.empty()) return fail(stack.back().line, "element <" + stack.back().name + "> is never closed");
+  if (tops.size() != 1) {
+    return fail(tops.empty() ? line : tops[1].line,
+                "the document must have exactly one root element (found " + std::to_string(tops.size()) + ")");
+  }
   *top = std::move(tops[0]);
   return "";
 }
@@ -213,12 +220,14 @@ Result<CameraIntrinsics> ParseVispCameraXml(const std::string& path, const std::
                                             const std::string& camera_name) {
   Problems problems(path);
   XmlElement root;
-  if (const std::string error = ParseXml(contents, &root); !error.empty()) {
-    return Status::Error(ErrorCode::kInvalidInput, "cannot read " + path + " as a ViSP camera file: " + error);
+  int error_line = 1;
+  if (const std::string error = ParseXml(contents, &root, &error_line); !error.empty()) {
+    return Status::Error(ErrorCode::kInvalidInput,
+                         "cannot read " + path + " as a ViSP camera file: " + problems.At(error_line) + ": " + error);
   }
   if (root.name != "root") {
-    return Status::Error(ErrorCode::kInvalidInput, "cannot read " + path + " as a ViSP camera file: the root element is <" +
-                                                      root.name + ">, not <root>");
+    return Status::Error(ErrorCode::kInvalidInput, "cannot read " + path + " as a ViSP camera file: the root element <" +
+                                                       root.name + "> at " + problems.At(root.line) + " is not <root>");
   }
   CheckChildren(root, {"camera"}, {"camera"}, &problems);
   std::vector<const XmlElement*> cameras;
@@ -231,12 +240,15 @@ Result<CameraIntrinsics> ParseVispCameraXml(const std::string& path, const std::
   }
   std::string list;
   for (const std::string& n : names) list += (list.empty() ? "`" : ", `") + n + "`";
-  if (names.empty()) problems.Add("no <camera> in " + path);
+  if (names.empty()) problems.Add("no <camera> in <root> at " + problems.At(root.line));
   if (!names.empty() && cameras.empty()) {
-    problems.Add("no camera named `" + camera_name + "` in " + path + " (cameras: " + list + ")");
+    problems.Add("no camera named `" + camera_name + "` in <root> at " + problems.At(root.line) + " (cameras: " + list +
+                 ")");
   } else if (cameras.size() > 1) {
-    problems.Add(camera_name.empty() ? path + " holds several cameras (" + list + "); choose one by name"
-                                     : "camera `" + camera_name + "` appears more than once in " + path);
+    problems.Add(camera_name.empty() ? path + " holds several cameras (" + list + "); choose one by name (the second at " +
+                                           problems.At(cameras[1]->line) + ")"
+                                     : "camera `" + camera_name + "` appears more than once in " + path + " (again at " +
+                                           problems.At(cameras[1]->line) + ")");
   }
   if (!problems.empty() || cameras.size() != 1) return problems.ToStatus("camera intrinsics");
   const XmlElement& camera = *cameras[0];

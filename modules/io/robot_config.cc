@@ -1,6 +1,7 @@
 #include "io/robot_config.h"
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "io/atomic_file.h"
@@ -156,6 +157,7 @@ CalibratedModel Parse(const yaml::YamlNode& node, const std::string& name, Probl
   ok &= convention != Convention::kInvalid;
 
   std::vector<JointRow> rows;
+  std::vector<int> row_lines;  // of each joint row, for the model's own checks below
   if (const yaml::YamlNode* joints = map.Required("joints")) {
     const std::string path = map.Path("joints");
     if (!joints->IsSequence() || joints->items.empty() || static_cast<int>(joints->items.size()) > kMaxJoints) {
@@ -166,6 +168,7 @@ CalibratedModel Parse(const yaml::YamlNode& node, const std::string& name, Probl
     } else {
       rows.resize(joints->items.size());
       for (size_t i = 0; i < rows.size(); ++i) {
+        row_lines.push_back(joints->items[i].line);
         ok &= ReadJoint(joints->items[i], path + "[" + std::to_string(i) + "]", convention, problems, &rows[i]);
       }
     }
@@ -225,9 +228,14 @@ CalibratedModel Parse(const yaml::YamlNode& node, const std::string& name, Probl
     for (size_t i = 0; i < rows.size(); ++i) model.links[i].beta = rows[i].link.beta;
     model.link_n_from_flange = link_n_from_flange;
   }
+  // The model's own checks, each at the line of the joint row it names ("joint 3: ..."), else the robot's.
   std::istringstream invalid(model.Validate());
   for (std::string line; std::getline(invalid, line);) {
-    problems->Add("robot `" + model.name + "` in " + problems->file() + ": " + line);
+    int joint = 0;
+    const bool of_a_joint = std::sscanf(line.c_str(), "joint %d:", &joint) == 1 && joint >= 1 &&
+                            joint <= static_cast<int>(row_lines.size());
+    problems->Add("robot `" + model.name + "` at " + problems->At(of_a_joint ? row_lines[joint - 1] : map.line()) + ": " +
+                  line);
   }
   return out;
 }

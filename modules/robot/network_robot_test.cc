@@ -340,6 +340,11 @@ TEST(NetworkRobotTest, ConnectChecksJointCountLimitsAndTheStartReadingAgainstThe
   const std::string hello3 = protocol::HelloReply({"", "fake", "f-1", "", false}, 3);
   const std::string limits3 = protocol::LimitsReply(testing::ThreeJointOptions().limits);
   const std::string at_rest = protocol::JointsReply(Reading(Eigen::Vector3d(0.1, 0.2, 0.3)));
+  JointLimits two;
+  two.lower_rad = Eigen::Vector2d(-1, -1);
+  two.upper_rad = Eigen::Vector2d(1, 1);
+  two.max_velocity_rad_s = Eigen::Vector2d(1, 1);
+  const std::string limits2 = protocol::LimitsReply(two);
   struct Case {
     const char* what;
     std::string hello, limits;
@@ -348,14 +353,10 @@ TEST(NetworkRobotTest, ConnectChecksJointCountLimitsAndTheStartReadingAgainstThe
   };
   const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
   const std::vector<Case> cases = {
-      {"2 joints in HELLO", protocol::HelloReply({"", "fake", "f-1", "", false}, 2), protocol::LimitsReply([] {
-         JointLimits l;
-         l.lower_rad = Eigen::Vector2d(-1, -1);
-         l.upper_rad = Eigen::Vector2d(1, 1);
-         l.max_velocity_rad_s = Eigen::Vector2d(1, 1);
-         return l;
-       }()),
+      {"2 joints in HELLO", protocol::HelloReply({"", "fake", "f-1", "", false}, 2), limits2,
        [&](int) { return at_rest; }, "HELLO reports 2 joints, the robot config has 3"},
+      {"2 joints in LIMITS", hello3, limits2,
+       [&](int) { return at_rest; }, "LIMITS: malformed reply \"OK -1 -1 1 1 1 1\": 6 numbers, expected 3 x 3 joints"},
       {"short reading", hello3, limits3, [](int) { return std::string("OK 1 0.1 0.2 0 0"); },
        "the start reading has 2 joints, the robot config has 3"},
       {"NaN", hello3, limits3, [&](int) { return protocol::JointsReply(Reading(Eigen::Vector3d(0.1, nan, 0.3))); },

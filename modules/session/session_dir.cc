@@ -8,12 +8,15 @@
 #include <algorithm>
 #include <cerrno>
 #include <filesystem>
+#include <optional>
 #include <regex>
 #include <set>
 
 #include "base/atomic_file.h"
 #include "base/sha256.h"
+#include "base/terminal_text.h"
 #include "session/file_util.h"
+#include "session/json_fields.h"
 
 namespace selfcal::session {
 
@@ -72,15 +75,16 @@ nlohmann::json ManifestToJson(const SessionManifest& manifest) {
           {"inputs", inputs}};
 }
 
-// Problems of one JSON object's keys: missing required ones and unknown ones.
-void CheckKeys(const nlohmann::json& object, const std::string& where, const std::vector<std::string>& keys,
-               std::vector<std::string>* problems) {
+// Problems of one JSON object's keys (the object at `path`, messages prefixed by `where`): missing
+// required ones (at the object's line) and unknown ones (at theirs).
+void CheckKeys(const nlohmann::json& object, const JsonPath& path, const std::string& where,
+               const std::vector<std::string>& keys, JsonFields* fields) {
   for (const std::string& key : keys) {
-    if (!object.contains(key)) problems->push_back(where + "missing key \"" + key + "\"");
+    if (!object.contains(key)) fields->Add(path, where + "missing key \"" + key + "\"");
   }
   for (const auto& item : object.items()) {
     if (std::find(keys.begin(), keys.end(), item.key()) == keys.end()) {
-      problems->push_back(where + "unknown key \"" + item.key() + "\"");
+      fields->Add(path.Member(item.key()), where + "unknown key \"" + TerminalSafe(item.key()) + "\"");
     }
   }
 }
@@ -91,27 +95,53 @@ std::string JoinProblems(const std::vector<std::string>& problems) {
   return text;
 }
 
+// One entry of `inputs` (at `path`, messages prefixed by `where`) into *digest.
+void ParseInputDigest(const nlohmann::json& entry, const JsonPath& path, const std::string& where, JsonFields* fields,
+                      std::set<std::string>* names, InputDigest* digest) {
+  CheckKeys(entry, path, where, {"name", "bytes", "sha256"}, fields);
+  if (entry.contains("name") && entry["name"].is_string()) digest->name = entry["name"].get<std::string>();
+  if (!SafeFileName(digest->name)) fields->Add(path.Member("name"), where + "\"name\" must be a plain file name");
+  if (!names->insert(digest->name).second) {
+    fields->Add(path.Member("name"), where + "input \"" + TerminalSafe(digest->name) + "\" repeats");
+  }
+  if (entry.contains("bytes") && entry["bytes"].is_number_unsigned()) {
+    digest->bytes = entry["bytes"].get<std::uint64_t>();
+  } else {
+    fields->Add(path.Member("bytes"), where + "\"bytes\" must be a non-negative integer");
+  }
+  if (entry.contains("sha256") && entry["sha256"].is_string()) digest->sha256_hex = entry["sha256"];
+  if (!IsLowerHex(digest->sha256_hex, 64)) {
+    fields->Add(path.Member("sha256"), where + "\"sha256\" must be 64 lower-case hex digits");
+  }
+}
+
+// session.json's text; every refusal names `file` and the line ("<file>:<line>: ...", session/json_fields.h).
 Result<SessionManifest> ParseManifest(const std::string& text, const std::string& file) {
-  const nlohmann::json json = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (json.is_discarded() || !json.is_object()) return Usage(file + ": not a JSON object");
+  JsonFields fields(text, file);
+  const std::optional<nlohmann::json> parsed = fields.ParseObject();
+  if (!parsed) return fields.ToStatus();
+  const nlohmann::json& json = *parsed;
+  const JsonPath root;
   if (!json.contains("format") || json["format"] != kSessionFormatName) {
-    return Usage(file + ": \"format\" is not \"" + kSessionFormatName + "\": not a selfcal session");
+    fields.Add(root.Member("format"), std::string("\"format\" is not \"") + kSessionFormatName + "\": not a selfcal session");
+    return fields.ToStatus();
   }
   if (!json.contains("version") || !json["version"].is_number_integer()) {
-    return Usage(file + ": \"version\" must be an integer");
+    fields.Add(root.Member("version"), "\"version\" must be an integer");
+    return fields.ToStatus();
   }
   SessionManifest manifest;
   manifest.version = json["version"].get<int>();
   if (manifest.version != kSessionFormatVersion) {
-    return Usage(file + ": unknown major version " + std::to_string(manifest.version) + " (this selfcal reads " +
-                 std::to_string(kSessionFormatVersion) + ")");
+    fields.Add(root.Member("version"), "unknown major version " + std::to_string(manifest.version) +
+                                           " (this selfcal reads " + std::to_string(kSessionFormatVersion) + ")");
+    return fields.ToStatus();
   }
-  std::vector<std::string> problems;
-  CheckKeys(json, "", {"format", "version", "session_id", "created_utc", "software_version", "inputs"}, &problems);
+  CheckKeys(json, root, "", {"format", "version", "session_id", "created_utc", "software_version", "inputs"}, &fields);
   auto string_field = [&](const char* key, std::string* out) {
     if (!json.contains(key)) return;
     if (!json[key].is_string()) {
-      problems.push_back(std::string("\"") + key + "\" must be a string");
+      fields.Add(root.Member(key), std::string("\"") + key + "\" must be a string");
       return;
     }
     *out = json[key].get<std::string>();
@@ -120,40 +150,32 @@ Result<SessionManifest> ParseManifest(const std::string& text, const std::string
   string_field("created_utc", &manifest.created_utc);
   string_field("software_version", &manifest.software_version);
   if (json.contains("session_id") && !ValidSessionId(manifest.session_id)) {
-    problems.push_back("\"session_id\" \"" + manifest.session_id + "\" is not 1-128 of [A-Za-z0-9._-]");
+    fields.Add(root.Member("session_id"),
+               "\"session_id\" \"" + TerminalSafe(manifest.session_id) + "\" is not 1-128 of [A-Za-z0-9._-]");
   }
   if (json.contains("created_utc") && !ValidUtcTime(manifest.created_utc)) {
-    problems.push_back("\"created_utc\" \"" + manifest.created_utc + "\" is not UTC ISO 8601");
+    fields.Add(root.Member("created_utc"), "\"created_utc\" \"" + TerminalSafe(manifest.created_utc) + "\" is not UTC ISO 8601");
   }
   if (json.contains("software_version") && manifest.software_version.empty()) {
-    problems.push_back("\"software_version\" is empty");
+    fields.Add(root.Member("software_version"), "\"software_version\" is empty");
   }
-  if (json.contains("inputs") && !json["inputs"].is_array()) problems.push_back("\"inputs\" must be an array");
+  if (json.contains("inputs") && !json["inputs"].is_array()) fields.Add(root.Member("inputs"), "\"inputs\" must be an array");
   if (json.contains("inputs") && json["inputs"].is_array()) {
     std::set<std::string> names;
     for (std::size_t i = 0; i < json["inputs"].size(); ++i) {
       const nlohmann::json& entry = json["inputs"][i];
+      const JsonPath at = root.Member("inputs").Element(i);
       const std::string where = "inputs[" + std::to_string(i) + "]: ";
       if (!entry.is_object()) {
-        problems.push_back(where + "must be an object");
+        fields.Add(at, where + "must be an object");
         continue;
       }
-      CheckKeys(entry, where, {"name", "bytes", "sha256"}, &problems);
       InputDigest digest;
-      if (entry.contains("name") && entry["name"].is_string()) digest.name = entry["name"].get<std::string>();
-      if (!SafeFileName(digest.name)) problems.push_back(where + "\"name\" must be a plain file name");
-      if (!names.insert(digest.name).second) problems.push_back(where + "input \"" + digest.name + "\" repeats");
-      if (entry.contains("bytes") && entry["bytes"].is_number_unsigned()) {
-        digest.bytes = entry["bytes"].get<std::uint64_t>();
-      } else {
-        problems.push_back(where + "\"bytes\" must be a non-negative integer");
-      }
-      if (entry.contains("sha256") && entry["sha256"].is_string()) digest.sha256_hex = entry["sha256"];
-      if (!IsLowerHex(digest.sha256_hex, 64)) problems.push_back(where + "\"sha256\" must be 64 lower-case hex digits");
+      ParseInputDigest(entry, at, where, &fields, &names, &digest);
       manifest.inputs.push_back(digest);
     }
   }
-  if (!problems.empty()) return Usage(file + ": " + JoinProblems(problems));
+  if (!fields.ok()) return fields.ToStatus();
   return manifest;
 }
 

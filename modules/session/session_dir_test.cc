@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <functional>
 
@@ -245,28 +246,36 @@ TEST(SessionDirTest, TheManifestIsReadStrictly) {
   const std::string path = dir.File("s");
   ASSERT_TRUE(CreateTestSession(path).ok());
   const nlohmann::json good = nlohmann::json::parse(ReadFile(path + "/session.json"));
+  // Issue 16: each refusal names the line too, of the key it is about (a missing key: of its object).
   struct Case {
     std::function<void(nlohmann::json&)> edit;
     std::string expected;
+    std::string line_of;  // the text on the line the refusal names
   };
   const std::vector<Case> cases = {
-      {[](nlohmann::json& j) { j["version"] = 2; }, "unknown major version 2"},
-      {[](nlohmann::json& j) { j["format"] = "other"; }, "not a selfcal session"},
-      {[](nlohmann::json& j) { j["extra"] = 1; }, "unknown key \"extra\""},
-      {[](nlohmann::json& j) { j.erase("created_utc"); }, "missing key \"created_utc\""},
-      {[](nlohmann::json& j) { j["inputs"][0]["sha256"] = "ABC"; }, "inputs[0]: \"sha256\" must be 64"},
-      {[](nlohmann::json& j) { j["inputs"][1]["bytes"] = -1; }, "inputs[1]: \"bytes\""},
-      {[](nlohmann::json& j) { j["session_id"] = 7; }, "\"session_id\" must be a string"},
+      {[](nlohmann::json& j) { j["version"] = 2; }, "unknown major version 2", "\"version\": 2"},
+      {[](nlohmann::json& j) { j["format"] = "other"; }, "\"format\" is not \"selfcal-session\": not a selfcal session",
+       "\"format\": \"other\""},
+      {[](nlohmann::json& j) { j["extra"] = 1; }, "unknown key \"extra\"", "\"extra\": 1"},
+      {[](nlohmann::json& j) { j.erase("created_utc"); }, "missing key \"created_utc\"", "{"},
+      {[](nlohmann::json& j) { j["inputs"][0]["sha256"] = "ABC"; }, "inputs[0]: \"sha256\" must be 64",
+       "\"sha256\": \"ABC\""},
+      {[](nlohmann::json& j) { j["inputs"][1]["bytes"] = -1; }, "inputs[1]: \"bytes\"", "\"bytes\": -1"},
+      {[](nlohmann::json& j) { j["session_id"] = 7; }, "\"session_id\" must be a string", "\"session_id\": 7"},
   };
   for (const Case& c : cases) {
     nlohmann::json edited = good;
     c.edit(edited);
-    WriteFile(path + "/session.json", edited.dump(2));
+    const std::string text = edited.dump(2);
+    WriteFile(path + "/session.json", text);
     Result<Session> session = OpenSession(path, {}, false);
     ASSERT_FALSE(session.ok()) << c.expected;
     EXPECT_EQ(session.status().code(), ErrorCode::kInvalidInput);
-    EXPECT_TRUE(Contains(session.status().message(), c.expected)) << session.status().message();
-    EXPECT_TRUE(Contains(session.status().message(), "session.json")) << session.status().message();
+    const size_t at = text.find(c.line_of);
+    ASSERT_NE(at, std::string::npos) << c.line_of;
+    const std::string line = std::to_string(1 + std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
+    EXPECT_TRUE(Contains(session.status().message(), path + "/session.json:" + line + ": " + c.expected))
+        << "line " << line << ": " << session.status().message();
   }
   WriteFile(path + "/session.json", good.dump(2));
   std::filesystem::rename(path + "/journal.log", path + "/journal.log.moved");
@@ -274,8 +283,11 @@ TEST(SessionDirTest, TheManifestIsReadStrictly) {
   ASSERT_FALSE(no_journal.ok());
   EXPECT_TRUE(Contains(no_journal.status().message(), "has no journal.log")) << no_journal.status().message();
   EXPECT_FALSE(Exists(path + "/journal.log"));  // not started afresh
-  WriteFile(path + "/session.json", "not json");
-  EXPECT_FALSE(OpenSession(path, {}, false).ok());
+  WriteFile(path + "/session.json", "{\n  \"format\": \"selfcal-session\",\n  not json\n}\n");
+  Result<Session> not_json = OpenSession(path, {}, false);
+  ASSERT_FALSE(not_json.ok());
+  EXPECT_TRUE(Contains(not_json.status().message(), path + "/session.json:3: not JSON: syntax error"))
+      << not_json.status().message();
   std::filesystem::remove(path + "/session.json");
   Result<Session> missing = OpenSession(path, {}, false);
   ASSERT_FALSE(missing.ok());

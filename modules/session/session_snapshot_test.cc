@@ -162,7 +162,7 @@ TEST(SetupFileTest, RoundTripAndStrictness) {
   EXPECT_EQ(read.check_distances[1].dot_b, 4);
   EXPECT_EQ(read.yardsticks[0].length_m, 0.1);
   const Status bad = ParseSetupFile(R"({"format":"selfcal-session-setup","version":2})", "x/setup.json", &read);
-  EXPECT_TRUE(Contains(bad.message(), "x/setup.json: format must be selfcal-session-setup version 1")) << bad.message();
+  EXPECT_TRUE(Contains(bad.message(), "x/setup.json:1: format must be selfcal-session-setup version 1")) << bad.message();
 }
 
 }  // namespace

@@ -1,9 +1,12 @@
 #include "session/setup_file.h"
 
-#include <cmath>
+#include <optional>
 #include <set>
+#include <utility>
 
 #include <nlohmann/json.hpp>
+
+#include "session/json_fields.h"
 
 namespace selfcal::session {
 
@@ -17,21 +20,73 @@ json KnownDistancesJson(const std::vector<KnownDistance>& distances) {
   return a;
 }
 
-// The optional naming keys (setup_file.h) into *naming; an error message, or empty.
-std::string ParseNaming(const json& j, SetupNaming* naming) {
-  if (j.contains("reference_image")) naming->reference_image = j.at("reference_image").get<std::string>();
-  if (!j.contains("reference_dots")) return "";
+// The optional naming keys (setup_file.h) into *naming; problems into *fields.
+void ParseNaming(const json& j, JsonFields* fields, SetupNaming* naming) {
+  if (j.contains("reference_image")) fields->GetString(j, {}, "reference_image", &naming->reference_image);
+  if (!j.contains("reference_dots")) return;
+  const json* dots = fields->GetArray(j, {}, "reference_dots");
+  if (dots == nullptr) return;
+  const JsonPath list = JsonPath{}.Member("reference_dots");
   std::set<int> ids;
-  for (const json& d : j.at("reference_dots")) {
-    const ReferenceDot r{d.at("id").get<int>(), d.at("u_px").get<double>(), d.at("v_px").get<double>(),
-                         d.at("area_px2").get<double>()};
-    if (r.id < 0 || !ids.insert(r.id).second) return "reference_dots: id " + std::to_string(r.id) + " is negative or repeated";
-    if (!std::isfinite(r.u_px) || !std::isfinite(r.v_px) || !(r.area_px2 >= 0)) {
-      return "reference_dots: id " + std::to_string(r.id) + " has a non-finite position or a negative area";
+  for (std::size_t i = 0; i < dots->size(); ++i) {
+    const json& d = (*dots)[i];
+    const JsonPath at = list.Element(i);
+    if (!d.is_object()) {
+      fields->Add(at, "`" + at.name + "` must be an object {id, u_px, v_px, area_px2}");
+      continue;
+    }
+    ReferenceDot r;
+    if (!(fields->GetInt(d, at, "id", &r.id) & fields->GetDouble(d, at, "u_px", &r.u_px) &
+          fields->GetDouble(d, at, "v_px", &r.v_px) & fields->GetDouble(d, at, "area_px2", &r.area_px2))) {
+      continue;
+    }
+    if (r.id < 0 || !ids.insert(r.id).second) {
+      fields->Add(at, "`" + at.name + "`: id " + std::to_string(r.id) + " is negative or repeated");
+    } else if (!(r.area_px2 >= 0)) {
+      fields->Add(at, "`" + at.name + "`: id " + std::to_string(r.id) + " has a negative area");
     }
     naming->reference_dots.push_back(r);
   }
-  return "";
+}
+
+// The camera block into *camera, each key checked (sizes and fx_px positive).
+void ParseCamera(const json& j, JsonFields* fields, CameraIntrinsics* camera) {
+  const json* c = fields->Get(j, {}, "camera");
+  if (c == nullptr) return;
+  const JsonPath at = JsonPath{}.Member("camera");
+  if (!c->is_object()) {
+    fields->Add(at, "`camera` must be an object (found " + JsonTypeName(*c) + ")");
+    return;
+  }
+  for (const auto& [key, out] : {std::pair{"width_px", &camera->width_px}, std::pair{"height_px", &camera->height_px}}) {
+    if (fields->GetInt(*c, at, key, out) && *out <= 0) fields->Add(at.Member(key), "`camera." + std::string(key) + "` must be positive");
+  }
+  if (fields->GetDouble(*c, at, "fx_px", &camera->fx_px) && !(camera->fx_px > 0)) {
+    fields->Add(at.Member("fx_px"), "`camera.fx_px` must be positive");
+  }
+  fields->GetDouble(*c, at, "mu", &camera->mu);
+  fields->GetDouble(*c, at, "cx_px", &camera->cx_px);
+  fields->GetDouble(*c, at, "cy_px", &camera->cy_px);
+  fields->GetDouble(*c, at, "k1", &camera->k1);
+}
+
+// yardsticks or check_distances: [{dot_a, dot_b, length_m}].
+void ParseDistances(const json& j, const std::string& key, JsonFields* fields, std::vector<KnownDistance>* out) {
+  const json* list = fields->GetArray(j, {}, key);
+  if (list == nullptr) return;
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    const JsonPath at = JsonPath{}.Member(key).Element(i);
+    const json& d = (*list)[i];
+    if (!d.is_object()) {
+      fields->Add(at, "`" + at.name + "` must be an object {dot_a, dot_b, length_m}");
+      continue;
+    }
+    KnownDistance distance;
+    if (fields->GetInt(d, at, "dot_a", &distance.dot_a) & fields->GetInt(d, at, "dot_b", &distance.dot_b) &
+        fields->GetDouble(d, at, "length_m", &distance.length_m)) {
+      out->push_back(distance);
+    }
+  }
 }
 
 }  // namespace
@@ -57,38 +112,28 @@ std::string SetupFileText(const ObservationSet& setup, const SetupNaming& naming
 }
 
 Status ParseSetupFile(const std::string& text, const std::string& name, ObservationSet* set, SetupNaming* naming) {
-  auto bad = [&](const std::string& why) { return Status::Error(ErrorCode::kInvalidInput, name + ": " + why); };
-  json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (j.is_discarded() || !j.is_object()) return bad("not a JSON object");
-  if (j.value("format", "") != kSetupFormatName || j.value("version", 0) != kSetupFormatVersion) {
-    return bad(std::string("format must be ") + kSetupFormatName + " version " + std::to_string(kSetupFormatVersion));
+  JsonFields fields(text, name);
+  const std::optional<json> parsed = fields.ParseObject();
+  if (!parsed) return fields.ToStatus();
+  const json& j = *parsed;
+  std::string format;
+  int version = 0;
+  if (!fields.GetString(j, {}, "format", &format) || !fields.GetInt(j, {}, "version", &version)) {
+    return fields.ToStatus();
   }
-  try {
-    const json& c = j.at("camera");
-    set->camera.width_px = c.at("width_px").get<int>();
-    set->camera.height_px = c.at("height_px").get<int>();
-    set->camera.fx_px = c.at("fx_px").get<double>();
-    set->camera.mu = c.at("mu").get<double>();
-    set->camera.cx_px = c.at("cx_px").get<double>();
-    set->camera.cy_px = c.at("cy_px").get<double>();
-    set->camera.k1 = c.at("k1").get<double>();
-    set->pixel_noise_px = j.at("pixel_noise_px").get<double>();
-    for (const char* key : {"yardsticks", "check_distances"}) {
-      std::vector<KnownDistance>& out = std::string(key) == "yardsticks" ? set->yardsticks : set->check_distances;
-      for (const json& d : j.at(key)) {
-        out.push_back({d.at("dot_a").get<int>(), d.at("dot_b").get<int>(), d.at("length_m").get<double>()});
-      }
-    }
-    if (naming != nullptr) {
-      if (const std::string why = ParseNaming(j, naming); !why.empty()) return bad(why);
-    }
-  } catch (const json::exception& e) {
-    return bad(std::string("missing or mistyped key: ") + e.what());
+  if (format != kSetupFormatName || version != kSetupFormatVersion) {
+    fields.Add(JsonPath{}.Member(format != kSetupFormatName ? "format" : "version"),
+               std::string("format must be ") + kSetupFormatName + " version " + std::to_string(kSetupFormatVersion));
+    return fields.ToStatus();
   }
-  if (!(set->camera.fx_px > 0) || set->camera.width_px <= 0 || set->camera.height_px <= 0 || !(set->pixel_noise_px > 0)) {
-    return bad("camera size, fx_px and pixel_noise_px must be positive");
+  ParseCamera(j, &fields, &set->camera);
+  if (fields.GetDouble(j, {}, "pixel_noise_px", &set->pixel_noise_px) && !(set->pixel_noise_px > 0)) {
+    fields.Add(JsonPath{}.Member("pixel_noise_px"), "`pixel_noise_px` must be positive");
   }
-  return Status::Ok();
+  ParseDistances(j, "yardsticks", &fields, &set->yardsticks);
+  ParseDistances(j, "check_distances", &fields, &set->check_distances);
+  if (naming != nullptr) ParseNaming(j, &fields, naming);
+  return fields.ok() ? Status::Ok() : fields.ToStatus();
 }
 
 }  // namespace selfcal::session

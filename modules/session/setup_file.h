@@ -39,8 +39,9 @@ std::string SetupFileText(const ObservationSet& setup, const SetupNaming& naming
 
 // Parses setup.json text into the camera, pixel_noise_px, yardsticks and check_distances of *set (its
 // robot and poses are left alone) and, when `naming` is given, the optional naming keys. kInvalidInput
-// naming `name` for another format or version, a missing or mistyped key, a non-positive camera size,
-// fx_px or pixel noise, or reference dots with a repeated id or a non-finite position.
+// when it is not JSON, another format or version, a key is missing or mistyped (integers must be
+// integers), a camera size, fx_px or the pixel noise is not positive, or reference dots repeat an id or
+// have a negative area: every problem as "<name>:<line>: ..." (session/json_fields.h), joined by "; ".
 Status ParseSetupFile(const std::string& text, const std::string& name, ObservationSet* set,
                       SetupNaming* naming = nullptr);
 

@@ -1,6 +1,10 @@
 #include "session/setup_file.h"
 
+#include <algorithm>
+#include <functional>
+
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 namespace selfcal::session {
 namespace {
@@ -52,6 +56,55 @@ TEST(SetupFile, RepeatedReferenceIdIsRefusedNamingTheFile) {
   EXPECT_EQ(s.code(), ErrorCode::kInvalidInput);
   EXPECT_NE(s.message().find("cell/setup.json"), std::string::npos) << s.message();
   EXPECT_NE(s.message().find("id 3"), std::string::npos) << s.message();
+}
+
+// The line (from 1) of the first `"key":` at or after the first `after` in `text`.
+int LineOf(const std::string& text, const std::string& key, const std::string& after = "") {
+  const size_t from = after.empty() ? 0 : text.find("\"" + after + "\":");
+  const size_t at = text.find("\"" + key + "\":", from);
+  EXPECT_NE(at, std::string::npos) << key;
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+}
+
+// Issue 16: setup.json's refusals named the key but never the line, and showed nlohmann's exception text
+// ("[json.exception.out_of_range.403] key 'camera' not found"); each names file and line now.
+TEST(SetupFile, EveryRefusalNamesTheFileAndTheLineOfItsKey) {
+  struct Case {
+    std::function<void(nlohmann::json&)> change;
+    std::string key, after;
+    int offset;  // lines after the key's: a missing key is named at its object's `{`
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {[](auto& j) { j["camera"]["fx_px"] = "big"; }, "fx_px", "", 0, "`camera.fx_px` must be a finite number (found string)"},
+      {[](auto& j) { j["camera"].erase("k1"); }, "camera", "", 0, "missing key `k1` in `camera`"},
+      {[](auto& j) { j["yardsticks"][0]["dot_a"] = 1.5; }, "dot_a", "yardsticks", 0,
+       "`yardsticks[0].dot_a` must be an integer in [-2147483648, 2147483647] (found number)"},
+      {[](auto& j) { j["check_distances"][0].erase("length_m"); }, "dot_a", "check_distances", -1,
+       "missing key `length_m` in `check_distances[0]`"},
+      {[](auto& j) { j["pixel_noise_px"] = -1; }, "pixel_noise_px", "", 0, "`pixel_noise_px` must be positive"},
+      {[](auto& j) { j["camera"]["width_px"] = 0; }, "width_px", "", 0, "`camera.width_px` must be positive"},
+      {[](auto& j) { j["version"] = 2; }, "version", "", 0, "format must be selfcal-session-setup version 1"},
+      {[](auto& j) { j["camera"] = 5; }, "camera", "", 0, "`camera` must be an object (found number)"},
+  };
+  for (const Case& c : cases) {
+    nlohmann::json j = nlohmann::json::parse(SetupFileText(ASetup()));
+    c.change(j);
+    const std::string text = j.dump(2);
+    ObservationSet back;
+    const Status s = ParseSetupFile(text, "cell/setup.json", &back);
+    ASSERT_FALSE(s.ok()) << c.expected;
+    EXPECT_EQ(s.code(), ErrorCode::kInvalidInput);
+    EXPECT_EQ(s.message(), "cell/setup.json:" + std::to_string(LineOf(text, c.key, c.after) + c.offset) + ": " + c.expected);
+  }
+  // Not JSON, not an object: the line where nlohmann stopped, without its exception's text.
+  ObservationSet back;
+  const Status syntax = ParseSetupFile("{\n  \"format\": \"selfcal-session-setup\"\n  \"version\": 1\n}\n", "setup.json", &back);
+  EXPECT_EQ(syntax.message().rfind("setup.json:3: not JSON: syntax error while parsing object", 0), 0u) << syntax.message();
+  EXPECT_EQ(syntax.message().find("json.exception"), std::string::npos) << syntax.message();
+  EXPECT_EQ(ParseSetupFile("\n[1, 2]", "setup.json", &back).message(),
+            "setup.json:2: the document is not a JSON object (found array)");
+  EXPECT_EQ(ParseSetupFile("", "setup.json", &back).message().rfind("setup.json:1: not JSON: ", 0), 0u);
 }
 
 }  // namespace

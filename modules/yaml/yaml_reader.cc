@@ -1,5 +1,6 @@
 #include "yaml/yaml_reader.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <new>
@@ -119,7 +120,7 @@ Status Normalise(const YamlRules& rules, const std::string& name, std::string* t
   const std::string& t = *text;
   const auto starts = [&](const char* prefix, size_t n) { return t.size() >= n && std::memcmp(t.data(), prefix, n) == 0; };
   if (!Terse(rules) && (starts("\x00\x00\xFE\xFF", 4) || starts("\xFF\xFE\x00\x00", 4) || starts("\xFE\xFF", 2) || starts("\xFF\xFE", 2))) {
-    return UsageError(name + " is UTF-16 or UTF-32 encoded; save it as UTF-8");
+    return UsageError("a UTF-16 or UTF-32 byte order mark at " + At(name, 1) + ": the file is not UTF-8; save it as UTF-8");
   }
   const size_t start = starts("\xEF\xBB\xBF", 3) ? 3 : 0;
   std::string out;
@@ -307,7 +308,9 @@ class TreeBuilder : public YAML::EventHandler {
 
 Result<YamlDocument> ParseYamlText(const std::string& text_in, const std::string& name, const YamlRules& rules) {
   if (text_in.size() > rules.max_bytes) {
-    return UsageError(name + " is larger than " + std::to_string(rules.max_bytes) + " bytes");
+    const int line = 1 + static_cast<int>(std::count(text_in.begin(), text_in.begin() + rules.max_bytes, '\n'));
+    return UsageError("the file is larger than " + std::to_string(rules.max_bytes) + " bytes (the limit falls at " +
+                      At(name, line) + ")");
   }
   std::string text = text_in;
   if (Status s = Normalise(rules, name, &text); !s.ok()) return s;
@@ -334,7 +337,7 @@ Result<YamlDocument> ParseYamlText(const std::string& text_in, const std::string
   } catch (...) {
     return UsageError("cannot parse " + name + ": unknown error");
   }
-  if (!found) return UsageError(name + " is empty (no YAML document)");
+  if (!found) return UsageError("no YAML document at " + At(name, 1) + " (the file is empty or holds only comments)");
   return doc;
 }
 

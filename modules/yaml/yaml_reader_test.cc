@@ -60,11 +60,13 @@ TEST(YamlReader, UserFileRefusalsSayWhereAfterTheProblem) {
             "YAML nested deeper than 2 levels at f.yaml:1");
   EXPECT_NE(Refusal("a: b\x01\n").find("control character U+0001 at f.yaml:1"), std::string::npos);
   EXPECT_NE(Refusal("a: 1\nb: \xC3\x28\n").find("invalid UTF-8 (byte 0xC3) at f.yaml:2"), std::string::npos);
-  EXPECT_EQ(Refusal("\xFF\xFE" "a\0"), "f.yaml is UTF-16 or UTF-32 encoded; save it as UTF-8");
+  EXPECT_EQ(Refusal("\xFF\xFE" "a\0"), "a UTF-16 or UTF-32 byte order mark at f.yaml:1: the file is not UTF-8; save it as UTF-8");
   EXPECT_EQ(Refusal("a: 1\n---\nb: 2\n"), "more than one YAML document (a second `---`) at f.yaml:2");
-  EXPECT_EQ(Refusal("# only a comment\n"), "f.yaml is empty (no YAML document)");
+  EXPECT_EQ(Refusal("# only a comment\n"), "no YAML document at f.yaml:1 (the file is empty or holds only comments)");
   EXPECT_EQ(Refusal("a: 12345\n", YamlRules{4, kMaxYamlDepth, kMaxYamlNodes, YamlWording::kUserFile}),
-            "f.yaml is larger than 4 bytes");
+            "the file is larger than 4 bytes (the limit falls at f.yaml:1)");
+  EXPECT_EQ(Refusal("a: 1\nb: 2\nc: 3\n", YamlRules{9, kMaxYamlDepth, kMaxYamlNodes, YamlWording::kUserFile}),
+            "the file is larger than 9 bytes (the limit falls at f.yaml:2)");
   EXPECT_NE(Refusal("a: {\n").find("malformed YAML at f.yaml:"), std::string::npos);
 }
 

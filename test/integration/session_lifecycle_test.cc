@@ -53,7 +53,7 @@ TEST(SessionLifecycle, BadAddressLeavesNothingAndIsRefusedFirst) {
   // A setup for the real-camera path: the one a simulated run records.
   ASSERT_EQ(RunSelfcal("run --session " + (dir / "sim").string() + " --seed 3", &output), 0) << output;
   const std::string setup = (dir / "sim" / "inputs" / "setup.json").string();
-  for (const std::string address : {"nohostport", "localhost:abc", "localhost:70000"}) {
+  for (const std::string address : {"nohostport", "localhost:abc", "127.0.0.1:abc", "localhost:70000"}) {
     EXPECT_EQ(RunSelfcal("run --session " + session + " --robot network --camera v4l2 --setup " + setup +
                              " --address " + address,
                          &output),
