@@ -22,9 +22,11 @@ struct LateNamingOptions {
   tracking::PredictionCorrectionOptions correction;
   tracking::PredictedMatchOptions match;
   // A dot is looked for only when at least this many other samples hold it: its point then rests on
-  // three rays or more, so that one poor ray cannot carry it off (a two-ray point can lie several of its
-  // own sigmas away). Dots seen less often still compete: a detection in their gates is named by none.
-  int min_other_samples = 3;
+  // four rays or more, so that one poor ray cannot carry it off (a two-ray point can lie several of its
+  // own sigmas away, and a wrong name given at a settled pose from such a point then looks right beside
+  // two good rays: with three, PUMA D-optimal seed 16 copied one wrong name into another sample). Dots
+  // seen less often still compete: a detection in their gates is named by none.
+  int min_other_samples = 4;
   // A detection this close to a dot the sample already holds is that dot's blob (tracking/dot_detector.h).
   double duplicate_distance_px = 3.0;
   // The correction needs at least this many of the sample's dots predicted from the others.

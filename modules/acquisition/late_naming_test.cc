@@ -56,23 +56,23 @@ TEST(LateNaming, TheDotsASampleLostAreNamedFromTheOtherSamplesUnderTheirTrueIds)
   EXPECT_GE(late.ambiguous + static_cast<int>(late.named.size()), missing);
 }
 
-TEST(LateNaming, ADotFewerThanThreeOtherSamplesHoldIsNotNamed) {
+TEST(LateNaming, ADotFewerThanFourOtherSamplesHoldIsNotNamed) {
   Scene s = MakeScene();
   int rare = -1;
   for (const auto& [id, px] : s.truth) {
     if (rare < 0 && s.sample.dots_px.count(id) == 0) rare = id;
   }
   ASSERT_GE(rare, 0);
-  for (size_t k = 2; k < s.others.size(); ++k) s.others[k].dots_px.erase(rare);  // held by two others only
+  for (size_t k = 3; k < s.others.size(); ++k) s.others[k].dots_px.erase(rare);  // held by three others only
   const LateNaming late = NameLater(s.cell.nominal, s.others, s.sample, s.detected, LateNamingOptions());
   ASSERT_TRUE(late.corrected);
   for (const tracking::PreviousDot& d : late.named) EXPECT_NE(d.id, rare);
-  LateNamingOptions two;
-  two.min_other_samples = 2;
-  const LateNaming with_two = NameLater(s.cell.nominal, s.others, s.sample, s.detected, two);
+  LateNamingOptions three;
+  three.min_other_samples = 3;
+  const LateNaming with_three = NameLater(s.cell.nominal, s.others, s.sample, s.detected, three);
   bool named = false;
-  for (const tracking::PreviousDot& d : with_two.named) named = named || d.id == rare;
-  EXPECT_TRUE(named) << "with two rays enough, the dot is found: the rule above is what kept it out";
+  for (const tracking::PreviousDot& d : with_three.named) named = named || d.id == rare;
+  EXPECT_TRUE(named) << "with three rays enough, the dot is found: the rule above is what kept it out";
 }
 
 TEST(LateNaming, ADetectionWithARivalInItsGateNamesNeither) {

@@ -121,7 +121,7 @@ struct RunOptions {
   // sample's frame is read again and the dots it lacks are named from the other samples' predictions
   // (late_naming.h), journaled as dots_named_later; at most this many passes over the samples (0: none).
   int late_naming_passes = 2;
-  int late_min_other_samples = 3;      // LateNamingOptions::min_other_samples
+  int late_min_other_samples = 4;      // LateNamingOptions::min_other_samples
   int png_compression = 1;
   std::uint64_t frame_bytes_estimate = 400 * 1024;  // P5: free space needed per frame
   bool journal_sim_clock = false;   // simulated sessions: journal the clock with each sample (resume)
