@@ -26,6 +26,7 @@ struct StudyArgs {
   bool no_bundle = false;
   bool flat_sheet = false;
   bool rendered = false;
+  int jobs = 0;
 };
 }  // namespace
 
@@ -47,6 +48,9 @@ Command AddStudyCommand(CLI::App& app) {
   cmd->add_flag("--rendered", args->rendered,
                 "Also run on rendered images (detector centroids) at grey-level noise 0 / 2 / 5 and blur 1 px; "
                 "dots spaced so that none touch in any view, for every row");
+  cmd->add_option("--jobs", args->jobs,
+                  "Runs computed at once (threads); default 0: every core. The results do not depend on it")
+      ->check(CLI::Range(0, 1024));
   cmd->add_flag("--bound-sweep", args->bound_sweep,
                 "Also sweep the two-view Cramer-Rao bound over field of view, depth spread and baseline");
   return [args]() {
@@ -81,6 +85,7 @@ Command AddStudyCommand(CLI::App& app) {
     options.with_bundle = !args->no_bundle;
     options.sim.flat_sheet = args->flat_sheet;
     options.progress = Progress();
+    options.jobs = args->jobs;
     if (args->rendered) {
       options.sim.separation_dot_radius_m = options.rendered.dot_radius_m;
       // Image noise levels (grey levels on a 200/40 paper/ink contrast) and the centroid noise the solvers

@@ -1,6 +1,7 @@
 #include "sim/image_renderer.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 #include <sstream>
@@ -35,33 +36,39 @@ void ProjectWithDerivative(const CameraIntrinsics& cam, const Eigen::Vector3d& p
   *duv = Eigen::Vector2d(cam.fx_px * (dx * s + x * ds), cam.fx_px * cam.mu * (dy * s + y * ds));
 }
 
-// Separable Gaussian blur of a row-major float image, border replicated.
+// Separable Gaussian blur of a row-major float image, border replicated. Away from the border the taps
+// need no clamping (the same terms in the same order).
 void GaussianBlur(std::vector<double>* image, int width, int height, double sigma) {
   const int radius = static_cast<int>(std::ceil(4.0 * sigma));
   std::vector<double> kernel(2 * radius + 1);
   double sum = 0;
   for (int k = -radius; k <= radius; ++k) sum += kernel[k + radius] = std::exp(-0.5 * k * k / (sigma * sigma));
   for (double& w : kernel) w /= sum;
+  const double* weights = kernel.data() + radius;  // weights[k], k in [-radius, radius]
   std::vector<double> tmp(image->size());
   const std::vector<double>& in = *image;
   for (int v = 0; v < height; ++v) {
+    const double* row = &in[static_cast<size_t>(v) * width];
     for (int u = 0; u < width; ++u) {
       double acc = 0;
-      for (int k = -radius; k <= radius; ++k)
-        acc += kernel[k + radius] * in[v * width + std::clamp(u + k, 0, width - 1)];
-      tmp[v * width + u] = acc;
+      if (u >= radius && u + radius < width) {
+        for (int k = -radius; k <= radius; ++k) acc += weights[k] * row[u + k];
+      } else {
+        for (int k = -radius; k <= radius; ++k) acc += weights[k] * row[std::clamp(u + k, 0, width - 1)];
+      }
+      tmp[static_cast<size_t>(v) * width + u] = acc;
     }
   }
+  std::vector<double> acc(static_cast<size_t>(width));
   for (int v = 0; v < height; ++v) {
-    for (int u = 0; u < width; ++u) {
-      double acc = 0;
-      for (int k = -radius; k <= radius; ++k)
-        acc += kernel[k + radius] * tmp[std::clamp(v + k, 0, height - 1) * width + u];
-      (*image)[v * width + u] = acc;
+    std::fill(acc.begin(), acc.end(), 0.0);
+    for (int k = -radius; k <= radius; ++k) {  // row by row: the same sum per pixel, k ascending
+      const double* row = &tmp[static_cast<size_t>(std::clamp(v + k, 0, height - 1)) * width];
+      for (int u = 0; u < width; ++u) acc[static_cast<size_t>(u)] += weights[k] * row[u];
     }
+    std::copy(acc.begin(), acc.end(), image->begin() + static_cast<std::ptrdiff_t>(v) * width);
   }
 }
-
 
 // Pixel bounds of a projected rim (px, pixel centres at integers).
 struct RimBounds {
@@ -120,10 +127,119 @@ bool TraceRim(const CameraIntrinsics& camera, const Eigen::Vector3d& c, const Ei
   return true;
 }
 
+// Where the ray through pixel point (u, v) meets the plane of the disc (centre c, normal n; camera
+// frame, m); false when it meets it nowhere in front. The same arithmetic for samples and pixel corners.
+bool PlanePoint(const CameraIntrinsics& camera, const Eigen::Vector3d& n, double n_dot_c, double u, double v,
+                Eigen::Vector3d* point) {
+  const Eigen::Vector2d xy = PixelToNormalized(camera, camera.fx_px, Eigen::Vector2d(u, v));
+  const Eigen::Vector3d ray(xy.x(), xy.y(), 1.0);
+  const double denominator = n.dot(ray);
+  if (denominator == 0) return false;
+  const double t = n_dot_c / denominator;
+  if (t <= 0) return false;
+  *point = t * ray;
+  return true;
+}
+
+// A point of the image mapped to the disc's plane (PlanePoint), or not (ok false).
+struct PlaneSample {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  bool ok = false;
+};
+
+// A square block of samples: all inside the disc (+1), all outside (-1), or undecided (0, to be sampled
+// one by one), from the plane points of the block's corners and centre. The map from the block to the
+// plane is affine to second order (its curvature over a pixel is ~1e-6 of a pixel), so the block's points
+// lie within `spread` (the largest corner distance from the centre's point) of the centre's point and in
+// the convex hull of the corners' points up to that curvature. A quarter of `spread` of margin on both
+// tests keeps every decided block's samples on the side the per-sample test puts them.
+int8_t DecideBlock(const PlaneSample* const corners[4], const PlaneSample& centre, const Eigen::Vector3d& c, double r) {
+  if (!centre.ok) return 0;
+  double spread = 0, farthest = 0;
+  for (int k = 0; k < 4; ++k) {
+    if (!corners[k]->ok) return 0;
+    spread = std::max(spread, (corners[k]->point - centre.point).norm());
+    farthest = std::max(farthest, (corners[k]->point - c).norm());
+  }
+  const double margin = 0.25 * spread;
+  if (farthest + margin < r) return 1;
+  if ((centre.point - c).norm() - spread - margin > r) return -1;
+  return 0;
+}
+
+// The disc's blocks over a box of pixels: each pixel decided whole, and each undecided one by quarters
+// (when s is even), so that only the samples near the rim are projected one by one.
+class DiscBlocks {
+ public:
+  DiscBlocks(const CameraIntrinsics& camera, const Eigen::Vector3d& c, const Eigen::Vector3d& n, double r, int s,
+             int i0, int i1, int j0, int j1)
+      : camera_(camera), c_(c), n_(n), n_dot_c_(n.dot(c)), r_(r), s_(s), i0_(i0), j0_(j0), w_(i1 - i0 + 1),
+        h_(j1 - j0 + 1), corners_(static_cast<size_t>(w_ + 1) * (h_ + 1)), centres_(static_cast<size_t>(w_) * h_),
+        kind_(centres_.size(), 0) {
+    for (int gj = 0; gj <= h_; ++gj) {
+      for (int gi = 0; gi <= w_; ++gi) corners_[Corner(gi, gj)] = At(i0 + gi - 0.5, j0 + gj - 0.5);
+    }
+    for (int gj = 0; gj < h_; ++gj) {
+      for (int gi = 0; gi < w_; ++gi) {
+        const size_t k = static_cast<size_t>(gj) * w_ + gi;
+        centres_[k] = At(i0 + gi, j0 + gj);
+        const PlaneSample* const corners[4] = {&corners_[Corner(gi, gj)], &corners_[Corner(gi + 1, gj)],
+                                               &corners_[Corner(gi, gj + 1)], &corners_[Corner(gi + 1, gj + 1)]};
+        kind_[k] = DecideBlock(corners, centres_[k], c_, r_);
+      }
+    }
+  }
+
+  PlaneSample At(double u, double v) const {
+    PlaneSample sample;
+    sample.ok = PlanePoint(camera_, n_, n_dot_c_, u, v, &sample.point);
+    return sample;
+  }
+  double n_dot_c() const { return n_dot_c_; }
+  int8_t Pixel(int i, int j) const { return kind_[static_cast<size_t>(j - j0_) * w_ + (i - i0_)]; }
+
+  // The kinds of the four quarters of undecided pixel (i, j), row-major (0 each when s is odd).
+  std::array<int8_t, 4> Quarters(int i, int j) const {
+    std::array<int8_t, 4> quarters{0, 0, 0, 0};
+    if (s_ % 2 != 0) return quarters;
+    const int gi = i - i0_, gj = j - j0_;
+    PlaneSample grid[3][3];  // [row][column]: pixel corners, edge midpoints, centre
+    grid[0][0] = corners_[Corner(gi, gj)];
+    grid[0][2] = corners_[Corner(gi + 1, gj)];
+    grid[2][0] = corners_[Corner(gi, gj + 1)];
+    grid[2][2] = corners_[Corner(gi + 1, gj + 1)];
+    grid[1][1] = centres_[static_cast<size_t>(gj) * w_ + gi];
+    grid[0][1] = At(i, j - 0.5);
+    grid[1][0] = At(i - 0.5, j);
+    grid[1][2] = At(i + 0.5, j);
+    grid[2][1] = At(i, j + 0.5);
+    for (int qb = 0; qb < 2; ++qb) {
+      for (int qa = 0; qa < 2; ++qa) {
+        const PlaneSample* const corners[4] = {&grid[qb][qa], &grid[qb][qa + 1], &grid[qb + 1][qa],
+                                               &grid[qb + 1][qa + 1]};
+        quarters[static_cast<size_t>(2 * qb + qa)] =
+            DecideBlock(corners, At(i - 0.25 + 0.5 * qa, j - 0.25 + 0.5 * qb), c_, r_);
+      }
+    }
+    return quarters;
+  }
+
+ private:
+  size_t Corner(int gi, int gj) const { return static_cast<size_t>(gj) * (w_ + 1) + gi; }
+
+  const CameraIntrinsics& camera_;
+  Eigen::Vector3d c_, n_;
+  double n_dot_c_, r_;
+  int s_, i0_, j0_, w_, h_;
+  std::vector<PlaneSample> corners_, centres_;
+  std::vector<int8_t> kind_;
+};
+
 // The s x s samples of every pixel in the bounds (one pixel of margin: the rim points are 1.4 degrees
 // apart) that see the disc (centre c, normal n, radius r; camera frame, m). Sets the dot's sample area
 // and centroid; ORs its samples into `mask` (one bit per sample, all dots) and marks the dots whose
 // samples it shares as overlapping neighbours (`owner`: the last dot that darkened a sample there).
+// Blocks DiscBlocks decides are not projected sample by sample: the same bits and sums, in the same order.
 void SampleDisc(const CameraIntrinsics& camera, const Eigen::Vector3d& c, const Eigen::Vector3d& n, double r, int s,
                 const RimBounds& bounds, size_t d, std::vector<RenderedDot>* dots, std::vector<uint64_t>* mask,
                 std::vector<int>* owner) {
@@ -134,42 +250,47 @@ void SampleDisc(const CameraIntrinsics& camera, const Eigen::Vector3d& c, const 
   const int i1 = std::min(width - 1, static_cast<int>(std::ceil(bounds.umax - 0.5)) + 1);
   const int j0 = std::max(0, static_cast<int>(std::floor(bounds.vmin + 0.5)) - 1);
   const int j1 = std::min(height - 1, static_cast<int>(std::ceil(bounds.vmax - 0.5)) + 1);
-  const double n_dot_c = n.dot(c);
   long long dark = 0;
   double su = 0, sv = 0;
-  for (int j = j0; j <= j1; ++j) {
-    for (int i = i0; i <= i1; ++i) {
-      uint64_t bits = 0;
-      for (int b = 0; b < s; ++b) {
-        const double v = j - 0.5 + (b + 0.5) / s;
-        for (int a = 0; a < s; ++a) {
-          const double u = i - 0.5 + (a + 0.5) / s;
-          const Eigen::Vector2d xy = PixelToNormalized(camera, camera.fx_px, Eigen::Vector2d(u, v));
-          const Eigen::Vector3d ray(xy.x(), xy.y(), 1.0);
-          const double denominator = n.dot(ray);
-          if (denominator == 0) continue;
-          const double t = n_dot_c / denominator;
-          if (t <= 0) continue;
-          if ((t * ray - c).squaredNorm() <= r * r) {
+  if (i0 <= i1 && j0 <= j1) {
+    const DiscBlocks blocks(camera, c, n, r, s, i0, i1, j0, j1);
+    for (int j = j0; j <= j1; ++j) {
+      for (int i = i0; i <= i1; ++i) {
+        const int8_t pixel = blocks.Pixel(i, j);
+        if (pixel < 0) continue;
+        std::array<int8_t, 4> quarters{pixel, pixel, pixel, pixel};
+        if (pixel == 0) quarters = blocks.Quarters(i, j);
+        uint64_t bits = 0;
+        for (int b = 0; b < s; ++b) {
+          const double v = j - 0.5 + (b + 0.5) / s;
+          for (int a = 0; a < s; ++a) {
+            const double u = i - 0.5 + (a + 0.5) / s;
+            const int8_t kind = quarters[static_cast<size_t>(2 * (2 * b >= s) + (2 * a >= s))];
+            if (kind < 0) continue;
+            if (kind == 0) {
+              Eigen::Vector3d point;
+              if (!PlanePoint(camera, n, blocks.n_dot_c(), u, v, &point)) continue;
+              if (!((point - c).squaredNorm() <= r * r)) continue;
+            }
             bits |= uint64_t{1} << (b * s + a);
             ++dark;
             su += u;
             sv += v;
           }
         }
-      }
-      if (bits == 0) continue;
-      const size_t at = static_cast<size_t>(j) * width + i;
-      if (((*mask)[at] & bits) != 0 && (*owner)[at] >= 0) {
-        RenderedDot& other = (*dots)[(*owner)[at]];
-        dot.overlapping = other.overlapping = true;
-        if (std::find(dot.neighbours.begin(), dot.neighbours.end(), other.id) == dot.neighbours.end()) {
-          dot.neighbours.push_back(other.id);
-          other.neighbours.push_back(dot.id);
+        if (bits == 0) continue;
+        const size_t at = static_cast<size_t>(j) * width + i;
+        if (((*mask)[at] & bits) != 0 && (*owner)[at] >= 0) {
+          RenderedDot& other = (*dots)[(*owner)[at]];
+          dot.overlapping = other.overlapping = true;
+          if (std::find(dot.neighbours.begin(), dot.neighbours.end(), other.id) == dot.neighbours.end()) {
+            dot.neighbours.push_back(other.id);
+            other.neighbours.push_back(dot.id);
+          }
         }
+        (*mask)[at] |= bits;
+        (*owner)[at] = dot.id;
       }
-      (*mask)[at] |= bits;
-      (*owner)[at] = dot.id;
     }
   }
   dot.visible = dark > 0;
@@ -205,6 +326,15 @@ void MarkNearNeighbours(const std::vector<std::vector<Eigen::Vector2d>>& rims, d
   }
 }
 
+// std::clamp(std::lround(g), 0, 255) without the library call: lround rounds halves away from zero, and
+// g - trunc(g) is exact, so for g > 0 this is the same integer; g <= 0 gives 0 either way.
+inline unsigned char RoundToGrey(double g) {
+  if (!(g > 0)) return 0;
+  if (g >= 255) return 255;
+  const int whole = static_cast<int>(g);
+  return static_cast<unsigned char>(g - whole >= 0.5 ? whole + 1 : whole);
+}
+
 // Image formation: coverage -> grey, blur, noise, quantisation.
 void FormImage(const std::vector<uint64_t>& mask, int width, int height, const RenderOptions& options,
                uint64_t noise_seed, vpImage<unsigned char>* image) {
@@ -222,7 +352,7 @@ void FormImage(const std::vector<uint64_t>& mask, int width, int height, const R
   for (size_t k = 0; k < grey.size(); ++k) {
     double g = grey[k];
     if (options.noise_std_grey > 0) g += options.noise_std_grey * noise(rng);
-    image->bitmap[k] = static_cast<unsigned char>(std::clamp(std::lround(g), 0L, 255L));
+    image->bitmap[k] = RoundToGrey(g);
   }
 }
 

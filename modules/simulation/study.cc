@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
+#include <mutex>
 #include <numeric>
+#include <thread>
 
 namespace selfcal::simulation {
 
@@ -40,7 +43,63 @@ double Stat::Percentile(double p) const {
 
 namespace {
 
+constexpr size_t kFailuresKept = 5;
+
+void AppendStat(Stat* into, const Stat& later) {
+  into->values.insert(into->values.end(), later.values.begin(), later.values.end());
+}
+
+void AppendFailures(std::vector<std::string>* into, const std::vector<std::string>& later) {
+  for (const std::string& f : later) {
+    if (into->size() < kFailuresKept) into->push_back(f);
+  }
+}
+
+}  // namespace
+
+void StudyCell::Append(const StudyCell& later) {
+  runs += later.runs;
+  runs_failed += later.runs_failed;
+  AppendFailures(&failures, later.failures);
+  centroids.Append(later.centroids);
+  Stat StudyCell::*const stats[] = {
+      &StudyCell::position_mm, &StudyCell::orientation_1e4rad, &StudyCell::fx_px, &StudyCell::position_true_scale_mm,
+      &StudyCell::scale_ratio_error, &StudyCell::opencv_position_mm, &StudyCell::opencv_orientation_1e4rad,
+      &StudyCell::opencv_position_true_scale_mm, &StudyCell::bound_position_mm_fx_unknown,
+      &StudyCell::bound_orientation_1e4rad_fx_unknown, &StudyCell::bound_fx_px, &StudyCell::bound_position_mm_fx_known,
+      &StudyCell::bound_orientation_1e4rad_fx_known, &StudyCell::error3d_nominal_mm, &StudyCell::error3d_calibrated_mm,
+      &StudyCell::pose_position_nominal_mm, &StudyCell::pose_position_calibrated_mm,
+      &StudyCell::pose_orientation_nominal_1e4rad, &StudyCell::pose_orientation_calibrated_1e4rad,
+      &StudyCell::fx_final_error_px, &StudyCell::yardstick_scale_error, &StudyCell::seconds_per_calibration,
+      &StudyCell::bundle_position_mm, &StudyCell::bundle_orientation_1e4rad, &StudyCell::bundle_fx_px,
+      &StudyCell::bundle_bound_position_mm, &StudyCell::bundle_bound_orientation_1e4rad, &StudyCell::bundle_bound_fx_px,
+      &StudyCell::bundle_error3d_mm, &StudyCell::bundle_pose_position_mm, &StudyCell::bundle_pose_orientation_1e4rad,
+      &StudyCell::bundle_bound_pose_position_mm, &StudyCell::bundle_bound_pose_orientation_1e4rad,
+      &StudyCell::bundle_predicted3d_mm, &StudyCell::bundle_predicted3d_parameters_mm,
+      &StudyCell::bundle_predicted3d_pixels_mm, &StudyCell::bundle_bound3d_mm, &StudyCell::bundle_bound3d_parameters_mm,
+      &StudyCell::bundle_seconds};
+  for (Stat StudyCell::*stat : stats) AppendStat(&(this->*stat), later.*stat);
+  bundle_runs += later.bundle_runs;
+  bundle_runs_failed += later.bundle_runs_failed;
+  AppendFailures(&bundle_failures, later.bundle_failures);
+  bundle_intervals += later.bundle_intervals;
+  bundle_covered += later.bundle_covered;
+  for (const auto& [name, stat] : later.bundle_parameter_error) AppendStat(&bundle_parameter_error[name], stat);
+  for (const auto& [name, stat] : later.bundle_parameter_bound) AppendStat(&bundle_parameter_bound[name], stat);
+}
+
+namespace {
+
 constexpr double kMm = 1e3;
+
+// The report's fields the runs set (the first run's that set them), with whether this run set them.
+struct RunHeader {
+  bool paper_set = false, bundle_set = false;
+  int identifiable_parameters = 0;
+  std::vector<std::string> fixed_parameters;
+  int bundle_free_parameters = 0;
+  std::vector<std::string> bundle_fixed_parameters;
+};
 constexpr double k1e4 = 1e4;
 
 // Scores one pipeline run against the simulator's truth and adds to the cell.
@@ -171,19 +230,20 @@ bundle::CramerRaoReport BundleBound(const sim::SimResult& world, const Observati
 
 // Runs the bundle stage on one observation set and scores it against the truth; adds to the cell.
 void ScoreBundle(const sim::SimResult& world, const ObservationSet& obs, const calibration::PaperPipelineReport& paper,
-                 const StudyOptions& options, StudyCell* cell, StudyReport* study) {
+                 const StudyOptions& options, StudyCell* cell, RunHeader* study) {
   const sim::SimTruth& truth = world.truth;
   ++cell->bundle_runs;
   const calibration::BundleStageReport stage = calibration::RunBundleStage(obs, paper, options.bundle);
   const bundle::BundleReport& b = stage.bundle;
   if (b.outcome != bundle::Outcome::kConverged) {
     ++cell->bundle_runs_failed;
-    if (cell->bundle_failures.size() < 5) {
+    if (cell->bundle_failures.size() < kFailuresKept) {
       cell->bundle_failures.push_back(std::string(bundle::OutcomeName(b.outcome)) + ": " + b.message);
     }
     return;
   }
   if (study->bundle_free_parameters == 0) {
+    study->bundle_set = true;
     study->bundle_free_parameters = static_cast<int>(b.free_indices.size());
     study->bundle_fixed_parameters = b.fixed_names;
   }
@@ -277,7 +337,125 @@ void ScoreBundle(const sim::SimResult& world, const ObservationSet& obs, const c
   }
 }
 
+
+// The study's cells of one trajectory, empty: the point rows, then the rendered rows.
+std::vector<StudyCell> EmptyCells(const TrajectorySpec& trajectory, const StudyOptions& options) {
+  const size_t num_point_cells = options.noise_levels_px.size();
+  std::vector<StudyCell> cells(num_point_cells + options.rendered_levels.size());
+  for (size_t l = 0; l < cells.size(); ++l) {
+    if (l < num_point_cells) {
+      cells[l].trajectory = trajectory.name;
+      cells[l].noise_px = options.noise_levels_px[l];
+    } else {
+      const RenderedLevel& level = options.rendered_levels[l - num_point_cells];
+      cells[l].trajectory = trajectory.name + "/" + level.name;
+      cells[l].noise_px = level.assumed_noise_px;
+      cells[l].rendered = true;
+    }
+  }
+  return cells;
+}
+
+// What one run adds to the cells of its trajectory and to the report's header.
+struct RunResult {
+  std::vector<StudyCell> cells;
+  RunHeader header;
+};
+
+// Run `run` of one trajectory: its world, then every cell's observations, pipeline and bundle. Depends
+// only on its arguments (seeds from options.seed and run), so runs may go in any order on any thread.
+RunResult RunOne(const RobotModel& nominal, const TrajectorySpec& trajectory, const StudyOptions& options, int run) {
+  RunResult result;
+  result.cells = EmptyCells(trajectory, options);
+  std::vector<StudyCell>& cells = result.cells;
+  const size_t num_point_cells = options.noise_levels_px.size();
+  sim::SimOptions sim_options = options.sim;
+  sim_options.world_seed = options.seed + static_cast<uint64_t>(run);
+  const sim::SimResult world = sim::Simulate(nominal, trajectory.joints, sim_options);
+  for (size_t l = 0; l < cells.size(); ++l) {
+    StudyCell& cell = cells[l];
+    ++cell.runs;
+    if (!world.ok) {
+      ++cell.runs_failed;
+      cell.failures.push_back("simulation: " + world.message);
+      if (options.with_bundle) {
+        ++cell.bundle_runs;
+        ++cell.bundle_runs_failed;
+      }
+      continue;
+    }
+    const uint64_t noise_seed = options.seed * 7919 + 1000003ULL * static_cast<uint64_t>(run) + l;
+    ObservationSet obs;
+    if (!cell.rendered) {
+      obs = sim::Reobserve(world, cell.noise_px, noise_seed);
+    } else {
+      const RenderedLevel& level = options.rendered_levels[l - num_point_cells];
+      RenderedObservationOptions rendered = options.rendered;
+      rendered.render.noise_std_grey = level.noise_std_grey;
+      rendered.render.blur_sigma_px = level.blur_sigma_px;
+      rendered.assumed_noise_px = level.assumed_noise_px;
+      obs = ObserveRendered(world, rendered, noise_seed, &cell.centroids);
+    }
+    calibration::PaperPipelineReport report = calibration::RunPaperPipeline(obs, options.pipeline);
+    bool score_paper = true;
+    if (report.outcome != calibration::Outcome::kSuccess) {
+      ++cell.runs_failed;
+      cell.failures.push_back(std::string(calibration::OutcomeName(report.outcome)) + ": " + report.message);
+      score_paper = !report.measurements.empty() && report.calibrated_rho.size() > 0;
+    }
+    if (score_paper) {
+      if (result.header.identifiable_parameters == 0) {
+        result.header.paper_set = true;
+        result.header.identifiable_parameters = report.identifiability.rank;
+        result.header.fixed_parameters = report.identifiability.fixed_names;
+      }
+      ScoreRun(world, obs, report, options, &cell);
+    }
+    if (options.with_bundle) ScoreBundle(world, obs, report, options, &cell, &result.header);
+  }
+  return result;
+}
+
+// Computes `count` results on `jobs` threads (the calling thread among them), each index once; the
+// first exception thrown is rethrown here after every thread has ended.
+template <typename Result, typename Compute>
+std::vector<Result> ComputeInParallel(int count, int jobs, const Compute& compute) {
+  std::vector<Result> results(static_cast<size_t>(count));
+  std::mutex mutex;
+  int next = 0;
+  std::exception_ptr error;
+  auto work = [&]() {
+    for (;;) {
+      int index = 0;
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (next >= count || error) return;
+        index = next++;
+      }
+      try {
+        Result r = compute(index);
+        std::lock_guard<std::mutex> lock(mutex);
+        results[static_cast<size_t>(index)] = std::move(r);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!error) error = std::current_exception();
+      }
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int t = 1; t < std::min(jobs, count); ++t) threads.emplace_back(work);
+  work();
+  for (std::thread& t : threads) t.join();
+  if (error) std::rethrow_exception(error);
+  return results;
+}
+
 }  // namespace
+
+int StudyJobs(const StudyOptions& options) {
+  if (options.jobs > 0) return options.jobs;
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+}
 
 StudyReport RunStudy(const RobotModel& nominal, const std::vector<TrajectorySpec>& trajectories,
                      const StudyOptions& options) {
@@ -285,68 +463,34 @@ StudyReport RunStudy(const RobotModel& nominal, const std::vector<TrajectorySpec
   StudyReport study;
   study.flat_sheet = options.sim.flat_sheet;
   ProgressScope progress(options.progress, static_cast<int64_t>(trajectories.size()) * options.runs, "study runs");
+  std::mutex progress_mutex;
+  RunHeader header;
   for (const TrajectorySpec& trajectory : trajectories) {
-    const size_t num_point_cells = options.noise_levels_px.size();
-    std::vector<StudyCell> cells(num_point_cells + options.rendered_levels.size());
-    for (size_t l = 0; l < cells.size(); ++l) {
-      if (l < num_point_cells) {
-        cells[l].trajectory = trajectory.name;
-        cells[l].noise_px = options.noise_levels_px[l];
-      } else {
-        const RenderedLevel& level = options.rendered_levels[l - num_point_cells];
-        cells[l].trajectory = trajectory.name + "/" + level.name;
-        cells[l].noise_px = level.assumed_noise_px;
-        cells[l].rendered = true;
+    std::vector<StudyCell> cells = EmptyCells(trajectory, options);
+    const std::vector<RunResult> runs =
+        ComputeInParallel<RunResult>(options.runs, StudyJobs(options), [&](int run) {
+          RunResult result = RunOne(nominal, trajectory, options, run);
+          std::lock_guard<std::mutex> lock(progress_mutex);
+          progress.Advance();
+          return result;
+        });
+    for (const RunResult& run : runs) {  // in run order: the report of runs made one after the other
+      for (size_t l = 0; l < cells.size(); ++l) cells[l].Append(run.cells[l]);
+      if (run.header.paper_set && header.identifiable_parameters == 0) {
+        header.identifiable_parameters = run.header.identifiable_parameters;
+        header.fixed_parameters = run.header.fixed_parameters;
       }
-    }
-    for (int run = 0; run < options.runs; ++run) {
-      sim::SimOptions sim_options = options.sim;
-      sim_options.world_seed = options.seed + static_cast<uint64_t>(run);
-      const sim::SimResult world = sim::Simulate(nominal, trajectory.joints, sim_options);
-      for (size_t l = 0; l < cells.size(); ++l) {
-        StudyCell& cell = cells[l];
-        ++cell.runs;
-        if (!world.ok) {
-          ++cell.runs_failed;
-          if (cell.failures.size() < 5) cell.failures.push_back("simulation: " + world.message);
-          if (options.with_bundle) {
-            ++cell.bundle_runs;
-            ++cell.bundle_runs_failed;
-          }
-          continue;
-        }
-        const uint64_t noise_seed = options.seed * 7919 + 1000003ULL * static_cast<uint64_t>(run) + l;
-        ObservationSet obs;
-        if (!cell.rendered) {
-          obs = sim::Reobserve(world, cell.noise_px, noise_seed);
-        } else {
-          const RenderedLevel& level = options.rendered_levels[l - num_point_cells];
-          RenderedObservationOptions rendered = options.rendered;
-          rendered.render.noise_std_grey = level.noise_std_grey;
-          rendered.render.blur_sigma_px = level.blur_sigma_px;
-          rendered.assumed_noise_px = level.assumed_noise_px;
-          obs = ObserveRendered(world, rendered, noise_seed, &cell.centroids);
-        }
-        calibration::PaperPipelineReport report = calibration::RunPaperPipeline(obs, options.pipeline);
-        bool score_paper = true;
-        if (report.outcome != calibration::Outcome::kSuccess) {
-          ++cell.runs_failed;
-          if (cell.failures.size() < 5) cell.failures.push_back(std::string(calibration::OutcomeName(report.outcome)) + ": " + report.message);
-          score_paper = !report.measurements.empty() && report.calibrated_rho.size() > 0;
-        }
-        if (score_paper) {
-          if (study.identifiable_parameters == 0) {
-            study.identifiable_parameters = report.identifiability.rank;
-            study.fixed_parameters = report.identifiability.fixed_names;
-          }
-          ScoreRun(world, obs, report, options, &cell);
-        }
-        if (options.with_bundle) ScoreBundle(world, obs, report, options, &cell, &study);
+      if (run.header.bundle_set && header.bundle_free_parameters == 0) {
+        header.bundle_free_parameters = run.header.bundle_free_parameters;
+        header.bundle_fixed_parameters = run.header.bundle_fixed_parameters;
       }
-      progress.Advance();
     }
     study.cells.insert(study.cells.end(), cells.begin(), cells.end());
   }
+  study.identifiable_parameters = header.identifiable_parameters;
+  study.fixed_parameters = header.fixed_parameters;
+  study.bundle_free_parameters = header.bundle_free_parameters;
+  study.bundle_fixed_parameters = header.bundle_fixed_parameters;
   study.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return study;
 }

@@ -53,6 +53,10 @@ struct StudyOptions {
   std::vector<RenderedLevel> rendered_levels;
   RenderedObservationOptions rendered;  // dot radius, detector, match radius (render noise/blur per level)
   ProgressSink* progress = nullptr;     // the runs (trajectories x runs), for a person watching; null: none
+  // Runs computed at once on this many threads (0: std::thread::hardware_concurrency). The runs are
+  // independent and seeded and are merged in run order: the report is the same for every value (apart
+  // from the wall times it holds).
+  int jobs = 0;
 };
 
 // Running sample statistics.
@@ -122,6 +126,11 @@ struct StudyCell {
   std::map<std::string, Stat> bundle_parameter_error, bundle_parameter_bound;
   // (e) Wall time of one bundle solve (the screen's refits included).
   Stat bundle_seconds;
+
+  // Adds the runs of `later` (the same trajectory and level) after this cell's: counts summed, samples
+  // appended in order, failure messages kept up to the first few. Merging the cells of single runs in
+  // run order gives the cell the runs would have filled one after the other.
+  void Append(const StudyCell& later);
 };
 
 struct StudyReport {
@@ -133,6 +142,9 @@ struct StudyReport {
   bool flat_sheet = false;
   double seconds_total = 0;
 };
+
+// The threads RunStudy uses: options.jobs, or the hardware's concurrency when that is 0.
+int StudyJobs(const StudyOptions& options);
 
 StudyReport RunStudy(const RobotModel& nominal, const std::vector<TrajectorySpec>& trajectories,
                      const StudyOptions& options);

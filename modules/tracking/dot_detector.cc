@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <numeric>
 #include <sstream>
 
@@ -39,6 +40,18 @@ void Union(std::vector<int>* parent, int a, int b) {
   (*parent)[static_cast<size_t>(a)] = b;  // the smaller label (earlier in raster order) is the root
 }
 
+// The first u' >= u with row[u'] != 0, or w: background runs are skipped 8 bytes at a time.
+int NextDark(const std::uint8_t* row, int u, int w) {
+  while (u + 8 <= w) {
+    std::uint64_t bytes = 0;
+    std::memcpy(&bytes, row + u, sizeof bytes);
+    if (bytes != 0) break;
+    u += 8;
+  }
+  while (u < w && row[u] == 0) ++u;
+  return u;
+}
+
 // Two-pass labelling of the dark pixels (dark[v * width + u] != 0), 8-connected. Components in raster
 // order of their first pixel.
 std::vector<Component> LabelDarkComponents(const vpImage<unsigned char>& image, const std::vector<std::uint8_t>& dark) {
@@ -50,8 +63,7 @@ std::vector<Component> LabelDarkComponents(const vpImage<unsigned char>& image, 
     const std::uint8_t* row = &dark[static_cast<size_t>(v * w)];
     int* lab = &labels[static_cast<size_t>(v * w)];
     const int* up = v > 0 ? &labels[static_cast<size_t>((v - 1) * w)] : nullptr;
-    for (int u = 0; u < w; ++u) {
-      if (row[u] == 0) continue;
+    for (int u = NextDark(row, 0, w); u < w; u = NextDark(row, u + 1, w)) {
       int label = -1;
       auto take = [&](int l) {
         if (l < 0) return;
@@ -85,9 +97,9 @@ std::vector<Component> LabelDarkComponents(const vpImage<unsigned char>& image, 
     }
   }
   for (int v = 0; v < h; ++v) {
-    for (int u = 0; u < w; ++u) {
+    const std::uint8_t* row = &dark[static_cast<size_t>(v * w)];
+    for (int u = NextDark(row, 0, w); u < w; u = NextDark(row, u + 1, w)) {
       const int l = labels[static_cast<size_t>(v * w + u)];
-      if (l < 0) continue;
       Component& c = components[static_cast<size_t>(index[static_cast<size_t>(Find(&parent, l))])];
       if (static_cast<int>(image[v][u]) < c.darkest) {
         c.darkest = image[v][u];
@@ -110,30 +122,42 @@ std::vector<std::uint8_t> GlobalDarkMask(const vpImage<unsigned char>& image, in
   return dark;
 }
 
-// I <= box mean - offset, the box (side 2 half + 1) clipped to the image; box sums from an integral image.
+// I <= box mean - offset, the box (side 2 half + 1) clipped to the image, in integers: n I + n offset <=
+// sum. The box sums come from column sums over the box's rows, slid down the image, and their prefix
+// along each row (exact integers, in cache); boxes not clipped left or right share one n.
 std::vector<std::uint8_t> AdaptiveDarkMask(const vpImage<unsigned char>& image, int window, int offset) {
   const int w = static_cast<int>(image.getWidth()), h = static_cast<int>(image.getHeight());
-  std::vector<std::uint32_t> integral(static_cast<size_t>((w + 1) * (h + 1)), 0);
-  for (int v = 0; v < h; ++v) {
-    std::uint32_t row = 0;
-    for (int u = 0; u < w; ++u) {
-      row += image[v][u];
-      integral[static_cast<size_t>((v + 1) * (w + 1) + u + 1)] = integral[static_cast<size_t>(v * (w + 1) + u + 1)] + row;
-    }
-  }
   const int half = window / 2;
-  std::vector<std::uint8_t> dark(static_cast<size_t>(w * h), 0);
+  std::vector<std::int64_t> column(static_cast<size_t>(w), 0), prefix(static_cast<size_t>(w) + 1, 0);
+  std::vector<std::uint8_t> dark(static_cast<size_t>(w) * h, 0);
+  int top = 0, bottom = 0;  // the column sums hold rows [top, bottom)
   for (int v = 0; v < h; ++v) {
     const int v0 = std::max(0, v - half), v1 = std::min(h, v + half + 1);
-    for (int u = 0; u < w; ++u) {
-      const int u0 = std::max(0, u - half), u1 = std::min(w, u + half + 1);
-      const std::uint32_t sum = integral[static_cast<size_t>(v1 * (w + 1) + u1)] - integral[static_cast<size_t>(v0 * (w + 1) + u1)] -
-                                integral[static_cast<size_t>(v1 * (w + 1) + u0)] + integral[static_cast<size_t>(v0 * (w + 1) + u0)];
-      const int n = (u1 - u0) * (v1 - v0);
-      // I <= mean - offset, in integers: n I <= sum - n offset.
-      dark[static_cast<size_t>(v * w + u)] =
-          static_cast<long>(n) * (image[v][u] + offset) <= static_cast<long>(sum) ? 1 : 0;
+    for (; bottom < v1; ++bottom) {
+      const unsigned char* row = image[bottom];
+      for (int u = 0; u < w; ++u) column[static_cast<size_t>(u)] += row[u];
     }
+    for (; top < v0; ++top) {
+      const unsigned char* row = image[top];
+      for (int u = 0; u < w; ++u) column[static_cast<size_t>(u)] -= row[u];
+    }
+    for (int u = 0; u < w; ++u) prefix[static_cast<size_t>(u) + 1] = prefix[static_cast<size_t>(u)] + column[static_cast<size_t>(u)];
+    const unsigned char* pixels = image[v];
+    std::uint8_t* out = &dark[static_cast<size_t>(v) * w];
+    const std::int64_t rows = v1 - v0;
+    auto test = [&](int u) {
+      const int u0 = std::max(0, u - half), u1 = std::min(w, u + half + 1);
+      const std::int64_t sum = prefix[static_cast<size_t>(u1)] - prefix[static_cast<size_t>(u0)];
+      out[u] = (u1 - u0) * rows * (pixels[u] + offset) <= sum ? 1 : 0;
+    };
+    const int inner_begin = std::min(w, half), inner_end = std::max(inner_begin, w - half - 1);
+    for (int u = 0; u < inner_begin; ++u) test(u);
+    const std::int64_t n = static_cast<std::int64_t>(2 * half + 1) * rows;
+    const std::int64_t* p = prefix.data();
+    for (int u = inner_begin; u < inner_end; ++u) {
+      out[u] = n * (pixels[u] + offset) <= p[u + half + 1] - p[u - half] ? 1 : 0;
+    }
+    for (int u = inner_end; u < w; ++u) test(u);
   }
   return dark;
 }
