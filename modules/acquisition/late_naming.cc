@@ -31,8 +31,7 @@ std::vector<tracking::PredictedDot> CorrectedGates(const PredictionModel& model,
   sigma->clear();
   for (const tracking::PredictedDot& p : predicted.dots) {
     gates.push_back(correction.Apply(p));
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(gates.back().cov_px2);
-    sigma->push_back(std::sqrt(std::max(0.0, eig.eigenvalues()(1))));
+    sigma->push_back(GateSigmaPx(gates.back()));
   }
   return gates;
 }
@@ -53,6 +52,11 @@ bool NearAny(const std::map<int, Eigen::Vector2d>& held, const Eigen::Vector2d& 
 }
 
 }  // namespace
+
+double GateSigmaPx(const tracking::PredictedDot& gate) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(gate.cov_px2);
+  return std::sqrt(std::max(0.0, eig.eigenvalues()(1)));
+}
 
 LateNaming NameLater(const PredictionModel& model, const std::vector<ViewedSample>& others,
                      const ViewedSample& sample, const tracking::DetectionReport& detected,

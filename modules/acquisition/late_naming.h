@@ -39,6 +39,10 @@ struct LateNaming {
   bool corrected = false;                    // false: too few anchors, nothing named
 };
 
+// The std of a prediction's gate along its longest axis, in px: what decides whether the gate is short
+// enough to name (DotPredictionOptions::max_gate_sigma_px).
+double GateSigmaPx(const tracking::PredictedDot& gate);
+
 // The dots of `sample` (its joints, its named dots) that can be named among `detected` (the sample's
 // frame, detected again) from the predictions of `others` (the session's other accepted samples).
 LateNaming NameLater(const PredictionModel& model, const std::vector<ViewedSample>& others,

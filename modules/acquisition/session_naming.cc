@@ -6,8 +6,6 @@
 #include <map>
 #include <set>
 
-#include <Eigen/Eigenvalues>
-
 #include "acquisition/late_naming.h"
 #include "acquisition/session_runner_internal.h"
 #include "base/atomic_file.h"
@@ -95,8 +93,7 @@ void Runner::NameByPrediction(const Capture& capture) {
   std::vector<double> gate_sigma;  // along the gate's longest axis
   for (const tracking::PredictedDot& p : predicted.dots) {
     gates.push_back(correction.Apply(p));
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(gates.back().cov_px2);
-    gate_sigma.push_back(std::sqrt(std::max(0.0, eig.eigenvalues()(1))));
+    gate_sigma.push_back(GateSigmaPx(gates.back()));
     gates.back().names = p.names && gate_sigma.back() <= o_.prediction.max_gate_sigma_px;
     if (gates.back().names) naming.push_back(gates.back());
   }
@@ -194,15 +191,7 @@ bool Runner::NameLater() {
     }
     detected.back() = tracking::DetectDots(*image, o_.detector);
   }
-  auto record_named = [&](size_t k, const std::vector<tracking::PreviousDot>& named) {
-    if (named.empty()) return true;
-    if (!Record({{"type", "dots_named_later"}, {"pose", poses[k]}, {"dots", DotsJson(named)}})) return false;
-    for (const tracking::PreviousDot& d : named) (*viewed_)[poses[k]].dots_px[d.id] = d.centroid_px;
-    report_.named_later += static_cast<int>(named.size());
-    samples_named_later_.insert(poses[k]);
-    Log("pose " + plan_[static_cast<size_t>(poses[k])].id + ": " + std::to_string(named.size()) + " dots named later");
-    return true;
-  };
+  std::set<int> gained;  // poses whose samples gained dots
   for (int pass = 0; pass < o_.late_naming_passes; ++pass) {
     const int before = report_.named_later;
     for (size_t k = 0; k < poses.size(); ++k) {
@@ -212,11 +201,17 @@ bool Runner::NameLater() {
       }
       ViewedSample& sample = (*viewed_)[poses[k]];
       const LateNaming late = acquisition::NameLater(*c_.prediction, others, sample, detected[k], options);
-      if (!record_named(k, late.named)) return false;
+      if (late.named.empty()) continue;
+      if (!Record({{"type", "dots_named_later"}, {"pose", poses[k]}, {"dots", DotsJson(late.named)}})) return false;
+      for (const tracking::PreviousDot& d : late.named) sample.dots_px[d.id] = d.centroid_px;
+      report_.named_later += static_cast<int>(late.named.size());
+      gained.insert(poses[k]);
+      Log("pose " + plan_[static_cast<size_t>(poses[k])].id + ": " + std::to_string(late.named.size()) +
+          " dots named later");
     }
     if (report_.named_later == before) break;  // nothing new: another pass would name nothing
   }
-  report_.samples_named_later = static_cast<int>(samples_named_later_.size());
+  report_.samples_named_later = static_cast<int>(gained.size());
   return true;
 }
 

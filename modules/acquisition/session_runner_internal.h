@@ -164,7 +164,6 @@ class Runner {
   std::vector<RejectedFrame> pose_frames_;  // grabbed after settling at this pose (session_view.cc)
   std::map<int, Eigen::Vector2d> lost_;     // dots lost at this pose: their last tracked position
   std::set<int> named_ids_;                 // ids named (not tracked) at this pose's settled frame
-  std::set<int> samples_named_later_;       // poses whose samples gained dots in NameLater
 };
 
 }  // namespace selfcal::acquisition::internal
