@@ -5,31 +5,17 @@
 
 #include <Eigen/Dense>
 
-#include "tracking/planar_fit.h"
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 
 namespace selfcal::acquisition {
-namespace {
-
-struct Ray {
-  Eigen::Vector3d origin;     // camera centre, base frame
-  Eigen::Vector3d direction;  // unit, base frame
-};
-
-// A dot's 3-D estimate in the base frame.
-struct Point {
-  Eigen::Vector3d p = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-};
 
 Ray RayOf(const PredictionModel& m, const Rigid3& base_from_cam, const Eigen::Vector2d& uv) {
   const Eigen::Vector2d xy = PixelToNormalized(m.camera, m.camera.fx_px, uv);
   return {base_from_cam.translation, (base_from_cam.rotation * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).normalized()};
 }
 
-// A pixel through a correction (the identity when none was fitted).
-Eigen::Vector2d MapPixel(const tracking::PredictionCorrection& c, const Eigen::Vector2d& uv) {
-  return c.ok ? tracking::MapPoint(c.observed_from_predicted, uv) : uv;
-}
+namespace {
 
 // Lateral std (m) of a ray at distance z from its camera: the pixel noise and the nominal model's own
 // error per ray, which the rays of a nominal model carry into every triangulation.
@@ -37,7 +23,8 @@ double LateralSigma(const PredictionModel& m, double ray_model_sigma_px, double 
   return std::max(z, 1e-3) * std::hypot(m.pixel_noise_px, ray_model_sigma_px) / m.camera.fx_px;
 }
 
-// Weighted linear least squares over the rays; false when the rays do not fix a point in front of them.
+}  // namespace
+
 bool Triangulate(const PredictionModel& m, double ray_model_sigma_px, const std::vector<Ray>& rays, Point* out) {
   std::vector<double> w(rays.size(), 1.0);
   for (int pass = 0; pass < 2; ++pass) {
@@ -62,7 +49,6 @@ bool Triangulate(const PredictionModel& m, double ray_model_sigma_px, const std:
   return out->p.allFinite() && out->cov.allFinite();
 }
 
-// Projection of a base-frame point with its covariance, plus the new frame's pixel noise.
 bool ProjectPrediction(const PredictionModel& m, const Rigid3& cam_from_base, const Point& x, int id,
                        tracking::PredictedDot* out) {
   const Eigen::Vector3d p = cam_from_base * x.p;
@@ -84,6 +70,8 @@ bool ProjectPrediction(const PredictionModel& m, const Rigid3& cam_from_base, co
   out->cov_px2 = jb * x.cov * jb.transpose() + m.pixel_noise_px * m.pixel_noise_px * Eigen::Matrix2d::Identity();
   return out->cov_px2.allFinite();
 }
+
+namespace {
 
 // A single-ray dot anywhere in the depth range of the scene as that sample saw it: the depths (along its
 // camera axis) of the sample's triangulated dots, widened by a margin. Its prediction is the segment of
@@ -139,65 +127,126 @@ std::map<int, Point> TriangulateAll(const PredictionModel& model, double ray_mod
   return points;
 }
 
-// The rays of every sample's dots, each sample's pixels through its correction.
+// The rays of every sample's dots.
 RaysById SampleRays(const PredictionModel& model, const std::vector<ViewedSample>& samples,
-                    const std::vector<Rigid3>& base_from_cams,
-                    const std::vector<tracking::PredictionCorrection>& corrections) {
+                    const std::vector<Rigid3>& base_from_cams) {
   RaysById rays;
   for (size_t s = 0; s < samples.size(); ++s) {
     for (const auto& [id, uv] : samples[s].dots_px) {
-      rays[id].push_back({static_cast<int>(s), RayOf(model, base_from_cams[s], MapPixel(corrections[s], uv))});
+      rays[id].push_back({static_cast<int>(s), RayOf(model, base_from_cams[s], uv)});
     }
   }
   return rays;
 }
 
-// Each sample's pixels mapped onto its nominal camera: the nominal model puts every sample's camera a
-// little off, by an amount that differs from pose to pose, so rays from distant poses miss each other
-// and a point triangulated from them is off in a way no correction of the new frame can remove. For
-// each sample after the first (which holds the gauge), the robust planar map from its observed pixels
-// to the projections of the points triangulated from all samples absorbs most of its camera's error;
-// a few rounds of triangulating and mapping make the rays agree.
-std::vector<tracking::PredictionCorrection> SampleCorrections(const PredictionModel& model,
-                                                              const std::vector<ViewedSample>& samples,
-                                                              const std::vector<Rigid3>& base_from_cams,
-                                                              const DotPredictionOptions& options) {
-  std::vector<tracking::PredictionCorrection> corrections(samples.size());
-  for (int round = 0; round < options.sample_correction_rounds && samples.size() > 2; ++round) {
-    const RaysById rays = SampleRays(model, samples, base_from_cams, corrections);
-    const std::map<int, Point> points = TriangulateAll(model, options.ray_model_sigma_px, rays, false);
-    for (size_t s = 1; s < samples.size(); ++s) {
-      const Rigid3 cam_from_base = base_from_cams[s].Inverse();
-      std::vector<Eigen::Vector2d> observed, nominal;
-      for (const auto& [id, uv] : samples[s].dots_px) {
-        const auto it = points.find(id);
-        if (it == points.end() || rays.at(id).size() < 3) continue;
-        if (const std::optional<Eigen::Vector2d> p = Project(model.camera, cam_from_base * it->second.p)) {
-          observed.push_back(uv);
-          nominal.push_back(*p);
-        }
+// The camera of a frame resected on its dots that have points: cv::solvePnP (iterative, from `guess`)
+// in normalised coordinates, then once more without the dots off by more than the larger of
+// `inlier_px` and three times the median. Empty when fewer than `min_dots` remain or the solve fails.
+std::optional<Rigid3> Resect(const PredictionModel& m, const Rigid3& base_from_cam_guess,
+                             const std::map<int, Eigen::Vector2d>& px, const std::map<int, Point>& points,
+                             int min_dots, double inlier_px) {
+  std::vector<cv::Point3d> object;
+  std::vector<cv::Point2d> image;
+  for (const auto& [id, uv] : px) {
+    const auto it = points.find(id);
+    if (it == points.end()) continue;
+    const Eigen::Vector2d xy = PixelToNormalized(m.camera, m.camera.fx_px, uv);
+    object.emplace_back(it->second.p.x(), it->second.p.y(), it->second.p.z());
+    image.emplace_back(xy.x(), xy.y());
+  }
+  const Rigid3 guess = base_from_cam_guess.Inverse();
+  cv::Mat r, rvec(3, 1, CV_64F), tvec(3, 1, CV_64F);
+  cv::eigen2cv(guess.rotation, r);
+  cv::Rodrigues(r, rvec);
+  for (int k = 0; k < 3; ++k) tvec.at<double>(k) = guess.translation[k];
+  for (int pass = 0; pass < 2; ++pass) {
+    if (static_cast<int>(object.size()) < min_dots) return std::nullopt;
+    if (!cv::solvePnP(object, image, cv::Mat::eye(3, 3, CV_64F), cv::noArray(), rvec, tvec, true,
+                      cv::SOLVEPNP_ITERATIVE)) {
+      return std::nullopt;
+    }
+    std::vector<cv::Point2d> reprojected;
+    cv::projectPoints(object, rvec, tvec, cv::Mat::eye(3, 3, CV_64F), cv::noArray(), reprojected);
+    std::vector<double> error_px(object.size());
+    for (size_t k = 0; k < object.size(); ++k) error_px[k] = m.camera.fx_px * cv::norm(reprojected[k] - image[k]);
+    std::vector<double> sorted = error_px;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+    const double limit = std::max(inlier_px, 3 * sorted[sorted.size() / 2]);
+    std::vector<cv::Point3d> kept_object;
+    std::vector<cv::Point2d> kept_image;
+    for (size_t k = 0; k < object.size(); ++k) {
+      if (error_px[k] <= limit) {
+        kept_object.push_back(object[k]);
+        kept_image.push_back(image[k]);
       }
-      if (static_cast<int>(observed.size()) < options.min_sample_correction_dots) continue;
-      tracking::PredictionCorrection c =
-          tracking::FitPredictionCorrection(observed, nominal, tracking::PredictionCorrectionOptions());
-      if (c.ok) corrections[s] = c;
+    }
+    if (pass == 1 || kept_object.size() == object.size()) break;
+    object.swap(kept_object);
+    image.swap(kept_image);
+  }
+  cv::Rodrigues(rvec, r);
+  Rigid3 cam_from_base;
+  cv::cv2eigen(r, cam_from_base.rotation);
+  for (int k = 0; k < 3; ++k) cam_from_base.translation[k] = tvec.at<double>(k);
+  if (!cam_from_base.rotation.allFinite() || !cam_from_base.translation.allFinite()) return std::nullopt;
+  return cam_from_base.Inverse();
+}
+
+// Each sample's camera resected on the points: the nominal model puts every sample's camera a little
+// off, by an amount that differs from pose to pose, so rays from distant poses miss each other and a
+// point triangulated from them is off in a way no correction of the new frame can remove. For each
+// sample after the first (which holds the gauge), the camera that projects the points triangulated from
+// all samples (those with three rays or more) onto its pixels replaces the nominal one; a few rounds of
+// triangulating and resecting make the rays agree. A pose, not a planar map of pixels: a dot nearer or
+// farther than the scene's middle keeps its parallax (a planar map put the epipolar lines of dots seen
+// once 11-16 px off in later frames).
+std::vector<Rigid3> ResectSamples(const PredictionModel& model, const std::vector<ViewedSample>& samples,
+                                  std::vector<Rigid3> base_from_cams, const DotPredictionOptions& options) {
+  for (int round = 0; round < options.sample_correction_rounds && samples.size() > 2; ++round) {
+    const RaysById rays = SampleRays(model, samples, base_from_cams);
+    std::map<int, Point> points = TriangulateAll(model, options.ray_model_sigma_px, rays, false);
+    for (auto it = points.begin(); it != points.end();) it = rays.at(it->first).size() < 3 ? points.erase(it) : std::next(it);
+    for (size_t s = 1; s < samples.size(); ++s) {
+      if (samples[s].base_from_cam) continue;
+      if (const std::optional<Rigid3> c = Resect(model, base_from_cams[s], samples[s].dots_px, points,
+                                                 options.min_sample_correction_dots, options.resection_inlier_px)) {
+        base_from_cams[s] = *c;
+      }
     }
   }
-  return corrections;
+  return base_from_cams;
 }
 
 }  // namespace
+
+std::vector<Rigid3> SampleCameras(const PredictionModel& model, const std::vector<ViewedSample>& samples,
+                                  const DotPredictionOptions& options) {
+  const Eigen::VectorXd rho = KinematicParameters::Nominal(model.robot);
+  std::vector<Rigid3> base_from_cams;
+  bool all_given = true;
+  for (const ViewedSample& s : samples) {
+    base_from_cams.push_back(s.base_from_cam ? *s.base_from_cam : BaseFromCam(model.robot, rho, s.joints_rad));
+    all_given = all_given && s.base_from_cam.has_value();
+  }
+  if (all_given) return base_from_cams;
+  return ResectSamples(model, samples, std::move(base_from_cams), options);
+}
 
 DotPredictionReport PredictDots(const PredictionModel& model, const std::vector<ViewedSample>& samples,
                                 const Eigen::VectorXd& joints_rad, const std::map<int, Eigen::Vector2d>& current_px,
                                 const DotPredictionOptions& options) {
   const Eigen::VectorXd rho = KinematicParameters::Nominal(model.robot);
-  std::vector<Rigid3> base_from_cams;  // of every sample, once
-  for (size_t s = 0; s < samples.size(); ++s) base_from_cams.push_back(BaseFromCam(model.robot, rho, samples[s].joints_rad));
-  const std::vector<tracking::PredictionCorrection> corrections =
-      SampleCorrections(model, samples, base_from_cams, options);
-  const RaysById rays = SampleRays(model, samples, base_from_cams, corrections);
-  const Rigid3 base_from_cam_now = BaseFromCam(model.robot, rho, joints_rad);
+  const std::vector<Rigid3> base_from_cams = SampleCameras(model, samples, options);  // of every sample, once
+  const RaysById rays = SampleRays(model, samples, base_from_cams);
+  // The new frame's camera, resected on the dots already known in it when enough of them have points.
+  Rigid3 base_from_cam_now = BaseFromCam(model.robot, rho, joints_rad);
+  if (options.resect_new_frame && samples.size() >= 2) {
+    const std::map<int, Point> sample_points = TriangulateAll(model, options.ray_model_sigma_px, rays, false);
+    if (const std::optional<Rigid3> c = Resect(model, base_from_cam_now, current_px, sample_points,
+                                               options.min_sample_correction_dots, options.resection_inlier_px)) {
+      base_from_cam_now = *c;
+    }
+  }
   RaysById with_current = rays;
   for (const auto& [id, uv] : current_px) {
     if (rays.count(id)) with_current[id].push_back({-1, RayOf(model, base_from_cam_now, uv)});
@@ -208,9 +257,7 @@ DotPredictionReport PredictDots(const PredictionModel& model, const std::vector<
     const size_t last = samples.size() - 1;
     const Rigid3& base_from_cam = base_from_cams[last];
     for (const auto& [id, uv] : samples[last].candidates_px) {
-      if (rays.count(id)) {
-        with_candidates[id].push_back({static_cast<int>(last), RayOf(model, base_from_cam, MapPixel(corrections[last], uv))});
-      }
+      if (rays.count(id)) with_candidates[id].push_back({static_cast<int>(last), RayOf(model, base_from_cam, uv)});
     }
   }
   const std::map<int, Point> points = TriangulateAll(model, options.ray_model_sigma_px, with_candidates, false);

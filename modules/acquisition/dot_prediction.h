@@ -14,13 +14,17 @@
 // `current_px`, the dots already known in the new frame (tracked into it): a second view when only one
 // sample has been accepted; they never enter a dot's own prediction, which rests on the accepted samples
 // alone. The nominal model puts each sample's camera a little off, differently at every pose; before the
-// points are triangulated, each sample's pixels are mapped onto its nominal camera by the robust planar
-// map that makes its rays agree with the other samples' (a few rounds; the first sample holds the gauge),
-// so that a point seen from distant poses lands where the dots around it do. Nothing here is iterative
-// beyond those rounds and one reweighting, and nothing is differentiated automatically.
+// points are triangulated, each sample's camera is resected on the points triangulated from all samples
+// (cv::solvePnP from the nominal pose, a few rounds; the first sample holds the gauge), so that a point
+// seen from distant poses lands where the dots around it do, and the new frame's camera is resected on
+// the dots known in it. A resected pose, unlike a planar map of pixels, keeps the parallax of a dot
+// nearer or farther than the scene's middle. Cameras known better (bundled_cameras.h: the samples'
+// cameras and f_x from a bundle of their images, which the session loop gives) are used as given. Nothing
+// here is iterative beyond those rounds and one reweighting, and nothing is differentiated automatically.
 #pragma once
 
 #include <map>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -43,6 +47,9 @@ struct ViewedSample {
   Eigen::VectorXd joints_rad;
   std::map<int, Eigen::Vector2d> dots_px;
   std::map<int, Eigen::Vector2d> candidates_px;  // unconfirmed (session_pose.cc): used from the latest sample only
+  // The sample's camera when it is known better than the nominal model's (bundled_cameras.h): used as
+  // it is, never resected.
+  std::optional<Rigid3> base_from_cam;
 };
 
 struct DotPredictionOptions {
@@ -63,10 +70,14 @@ struct DotPredictionOptions {
   // into a large error in depth.
   double ray_model_sigma_px = 1.0;
   double max_candidate_gate_sigma_px = 40;
-  // Each sample's pixels are mapped onto its nominal camera (dot_prediction.cc, SampleCorrections) in
-  // this many rounds, from at least this many of its dots seen in three samples or more.
+  // Each sample's camera is resected on the triangulated dots (dot_prediction.cc, SampleCameras) in
+  // this many rounds, from at least this many of its dots seen in three samples or more; the dots
+  // farther than this (or three times the median) from the resected projection are left out of it.
   int sample_correction_rounds = 2;
   int min_sample_correction_dots = 8;
+  double resection_inlier_px = 3.0;
+  // The new frame's camera is resected too, on the dots of `current_px` that have points.
+  bool resect_new_frame = true;
 };
 
 struct DotPredictionReport {
@@ -82,6 +93,35 @@ struct DotPredictionReport {
   int single_ray = 0;     // known dots predicted from one ray, over the scene's depth range
   int not_predicted = 0;  // known dots without a usable prediction (behind, outside, no depth)
 };
+
+// The building blocks, shared with the search for dots seen in few samples (seen_once.h).
+struct Ray {
+  Eigen::Vector3d origin;     // camera centre, base frame
+  Eigen::Vector3d direction;  // unit, base frame
+};
+
+// A dot's 3-D estimate in the base frame.
+struct Point {
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+};
+
+// The ray through a pixel of a camera at `base_from_cam`.
+Ray RayOf(const PredictionModel& m, const Rigid3& base_from_cam, const Eigen::Vector2d& uv);
+
+// Weighted linear least squares over the rays (each weighted by its lateral std at its depth: pixel
+// noise and `ray_model_sigma_px`, one reweighting); false when they fix no point in front of them.
+bool Triangulate(const PredictionModel& m, double ray_model_sigma_px, const std::vector<Ray>& rays, Point* out);
+
+// The projection of a point with its covariance, plus the frame's pixel noise, as a gate of dot `id`.
+bool ProjectPrediction(const PredictionModel& m, const Rigid3& cam_from_base, const Point& x, int id,
+                       tracking::PredictedDot* out);
+
+// Every sample's camera in the base frame: a given one (ViewedSample::base_from_cam) as it is; else the
+// first (the gauge) at its nominal pose, the others resected on the dots triangulated from all of them
+// (DotPredictionOptions::sample_correction_rounds).
+std::vector<Rigid3> SampleCameras(const PredictionModel& model, const std::vector<ViewedSample>& samples,
+                                  const DotPredictionOptions& options);
 
 // Predictions of every dot of `samples` in a frame taken at `joints_rad`, where the dots `current_px`
 // are already known (may be empty).

@@ -18,7 +18,7 @@ TEST(DotPrediction, ErrorsFollowTheCovarianceWithTheTrueModel) {
   const Cell c = MakeCell(0, 0, 4);
   std::mt19937_64 rng(9);
   std::vector<ViewedSample> samples;
-  for (int k = 0; k < 4; ++k) samples.push_back({c.joints[k], Observe(c, c.joints[k], &rng), {}});
+  for (int k = 0; k < 4; ++k) samples.push_back({c.joints[k], Observe(c, c.joints[k], &rng), {}, {}});
   PredictionModel truth = c.nominal;
   truth.robot = ApplyParameters(c.nominal.robot, c.rho_true);
   const std::map<int, Eigen::Vector2d> next = Observe(c, c.joints[5], &rng);
@@ -42,7 +42,7 @@ TEST(DotPrediction, ASingleRayDotIsPredictedAlongItsEpipolarLine) {
   const Cell c = MakeCell(0, 0, 6);
   std::mt19937_64 rng(3);
   std::vector<ViewedSample> samples;
-  for (int k = 0; k < 3; ++k) samples.push_back({c.joints[k], Observe(c, c.joints[k], &rng), {}});
+  for (int k = 0; k < 3; ++k) samples.push_back({c.joints[k], Observe(c, c.joints[k], &rng), {}, {}});
   const std::map<int, Eigen::Vector2d> next = Observe(c, c.joints[5], &rng);
   int lost = -1;  // a dot seen everywhere, then lost after the first sample
   for (const auto& [id, px] : samples[0].dots_px) {
@@ -67,7 +67,7 @@ TEST(DotPrediction, CorrectedOnAnchorsANominalModelNamesTheOtherDotsRight) {
   const Cell c = MakeCell(1e-3, 0.2 * 3.14159265358979 / 180, 8);  // the simulator's hidden error levels
   std::mt19937_64 rng(5);
   std::vector<ViewedSample> samples;
-  for (int k = 0; k < 4; ++k) samples.push_back({c.joints[k], Observe(c, c.joints[k], &rng), {}});
+  for (int k = 0; k < 4; ++k) samples.push_back({c.joints[k], Observe(c, c.joints[k], &rng), {}, {}});
   const std::map<int, Eigen::Vector2d> next = Observe(c, c.joints[5], &rng);
   const DotPredictionReport r = PredictDots(c.nominal, samples, c.joints[5], {}, DotPredictionOptions());
   double raw_worst = 0;
@@ -109,7 +109,7 @@ TEST(DotPrediction, EveryDotSeenOnceLiesInItsSegmentGate) {
   std::mt19937_64 rng(12);
   PredictionModel truth = c.nominal;
   truth.robot = ApplyParameters(c.nominal.robot, c.rho_true);
-  const std::vector<ViewedSample> samples = {{c.joints[0], Observe(c, c.joints[0], &rng), {}}};
+  const std::vector<ViewedSample> samples = {{c.joints[0], Observe(c, c.joints[0], &rng), {}, {}}};
   const std::map<int, Eigen::Vector2d> next = Observe(c, c.joints[5], &rng);
   std::map<int, Eigen::Vector2d> tracked;  // half the dots carried into the new frame give the depths
   for (const auto& [id, px] : next) {
@@ -134,7 +134,7 @@ TEST(DotPrediction, ACandidateGivesASecondRayThatConfirmsOrForgets) {
   PredictionModel truth = c.nominal;
   truth.robot = ApplyParameters(c.nominal.robot, c.rho_true);
   std::vector<ViewedSample> samples;
-  for (int k = 0; k < 3; ++k) samples.push_back({c.joints[2 * k], Observe(c, c.joints[2 * k], &rng), {}});
+  for (int k = 0; k < 3; ++k) samples.push_back({c.joints[2 * k], Observe(c, c.joints[2 * k], &rng), {}, {}});
   const std::map<int, Eigen::Vector2d> next = Observe(c, c.joints[5], &rng);
   std::vector<int> everywhere;  // dots seen in the first and last sample and in the new frame
   for (const auto& [id, px] : samples[0].dots_px) {
@@ -174,7 +174,7 @@ TEST(DotPrediction, ACandidateGivesASecondRayThatConfirmsOrForgets) {
 // triangulated from distant poses is off in a way the new frame's correction cannot remove. Mapping each
 // sample's pixels onto its nominal camera first brings the predictions of the dots no anchor carries
 // back into their gates.
-TEST(DotPrediction, SampleCorrectionsBringPointsFromDistantPosesIntoTheirGates) {
+TEST(DotPrediction, ResectedSampleCamerasBringPointsFromDistantPosesIntoTheirGates) {
   Cell c = MakeCell(0.002, 0.004, 21);
   const double kSwing = 0.08;  // rad: farther and the scene leaves the view of this synthetic cell
   for (size_t k = 1; k < c.joints.size(); ++k) {
@@ -182,7 +182,7 @@ TEST(DotPrediction, SampleCorrectionsBringPointsFromDistantPosesIntoTheirGates) 
   }
   std::mt19937_64 rng(5);
   std::vector<ViewedSample> samples;
-  for (int k = 0; k < 5; ++k) samples.push_back({c.joints[k], Observe(c, c.joints[k], &rng), {}});
+  for (int k = 0; k < 5; ++k) samples.push_back({c.joints[k], Observe(c, c.joints[k], &rng), {}, {}});
   const std::map<int, Eigen::Vector2d> next = Observe(c, c.joints[5], &rng);
   // Anchors: the even dots, as if tracked into the new frame; the odd ones are predicted and checked.
   auto worst = [&](int rounds, double* rms_px) {

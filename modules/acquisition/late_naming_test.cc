@@ -35,7 +35,7 @@ Scene MakeScene() {
     s.detected.dots.push_back(d);
     s.id_of_detection.push_back(id);
   }
-  for (int k = 1; k < 6; ++k) s.others.push_back({s.cell.joints[k], Observe(s.cell, s.cell.joints[k], &rng), {}});
+  for (int k = 1; k < 6; ++k) s.others.push_back({s.cell.joints[k], Observe(s.cell, s.cell.joints[k], &rng), {}, {}});
   return s;
 }
 

@@ -6,7 +6,9 @@
 #include <map>
 #include <set>
 
+#include "acquisition/bundled_cameras.h"
 #include "acquisition/late_naming.h"
+#include "acquisition/seen_once.h"
 #include "acquisition/session_runner_internal.h"
 #include "base/atomic_file.h"
 #include "capture/png_codec.h"
@@ -68,12 +70,15 @@ tracking::PredictionCorrection Correction(const std::vector<tracking::PredictedD
 
 void Runner::NameByPrediction(const Capture& capture) {
   candidates_.clear();
-  const std::vector<ViewedSample> samples = AcceptedSamples();
+  std::vector<ViewedSample> samples = AcceptedSamples();
   if (samples.empty()) return;
   std::map<int, Eigen::Vector2d> tracked_px;
   for (const tracking::PreviousDot& d : tracked_) tracked_px[d.id] = d.centroid_px;
+  // The samples' cameras and f_x as their images give them (bundled_cameras.h), when three or more.
+  PredictionModel model = *c_.prediction;
+  UseBundledCameras(BundleSampleCameras(model, samples, o_.prediction), &model, &samples);
   const DotPredictionReport predicted =
-      PredictDots(*c_.prediction, samples, capture.joints.position_rad, tracked_px, o_.prediction);
+      PredictDots(model, samples, capture.joints.position_rad, tracked_px, o_.prediction);
   if (predicted.dots.empty()) return;
   const tracking::DetectionReport detected = tracking::DetectDots(capture.frame.image, o_.detector);
   std::vector<Eigen::Vector2d> centroids;
@@ -191,26 +196,59 @@ bool Runner::NameLater() {
     }
     detected.back() = tracking::DetectDots(*image, o_.detector);
   }
+  // The samples in pose order, with their cameras and f_x as the images give them (bundled_cameras.h).
+  PredictionModel model = *c_.prediction;
+  std::vector<ViewedSample> all;
+  for (const int pose : poses) all.push_back((*viewed_)[pose]);
+  const BundledCameras bundled = BundleSampleCameras(model, all, o_.prediction);
+  Log("cameras of the samples from their images: " + bundled.message);
+  UseBundledCameras(bundled, &model, &all);
   std::set<int> gained;  // poses whose samples gained dots
-  for (int pass = 0; pass < o_.late_naming_passes; ++pass) {
-    const int before = report_.named_later;
-    for (size_t k = 0; k < poses.size(); ++k) {
-      std::vector<ViewedSample> others;
-      for (const auto& [other, s] : *viewed_) {
-        if (other != poses[k]) others.push_back(s);
-      }
-      ViewedSample& sample = (*viewed_)[poses[k]];
-      const LateNaming late = acquisition::NameLater(*c_.prediction, others, sample, detected[k], options);
-      if (late.named.empty()) continue;
-      if (!Record({{"type", "dots_named_later"}, {"pose", poses[k]}, {"dots", DotsJson(late.named)}})) return false;
-      for (const tracking::PreviousDot& d : late.named) sample.dots_px[d.id] = d.centroid_px;
-      report_.named_later += static_cast<int>(late.named.size());
-      gained.insert(poses[k]);
-      Log("pose " + plan_[static_cast<size_t>(poses[k])].id + ": " + std::to_string(late.named.size()) +
-          " dots named later");
+  auto record = [&](size_t k, const std::vector<tracking::PreviousDot>& dots) {
+    if (!Record({{"type", "dots_named_later"}, {"pose", poses[k]}, {"dots", DotsJson(dots)}})) return false;
+    for (const tracking::PreviousDot& d : dots) {
+      all[k].dots_px[d.id] = d.centroid_px;
+      (*viewed_)[poses[k]].dots_px[d.id] = d.centroid_px;
     }
-    if (report_.named_later == before) break;  // nothing new: another pass would name nothing
+    report_.named_later += static_cast<int>(dots.size());
+    gained.insert(poses[k]);
+    return true;
+  };
+  // Passes over the samples, each naming from all the others (late_naming.h), until one names nothing.
+  auto late_passes = [&] {
+    for (int pass = 0; pass < o_.late_naming_passes; ++pass) {
+      const int before = report_.named_later;
+      for (size_t k = 0; k < poses.size(); ++k) {
+        std::vector<ViewedSample> others;
+        for (size_t j = 0; j < all.size(); ++j) {
+          if (j != k) others.push_back(all[j]);
+        }
+        const LateNaming late = acquisition::NameLater(model, others, all[k], detected[k], options);
+        if (late.named.empty()) continue;
+        if (!record(k, late.named)) return false;
+        Log("pose " + plan_[static_cast<size_t>(poses[k])].id + ": " + std::to_string(late.named.size()) +
+            " dots named later");
+      }
+      if (report_.named_later == before) break;  // nothing new: another pass would name nothing
+    }
+    return true;
+  };
+  if (!late_passes()) return false;
+  // Then the dots held by few samples, by hypotheses that further samples support (seen_once.h).
+  SeenOnceOptions seen_once;
+  seen_once.prediction = o_.prediction;
+  seen_once.duplicate_distance_px = o_.detector.duplicate_distance_px;
+  const SeenOnceReport few = NameSeenOnce(model, all, detected, seen_once);
+  std::map<size_t, std::vector<tracking::PreviousDot>> by_sample;
+  for (const SeenOnceName& n : few.named) by_sample[static_cast<size_t>(n.sample)].push_back(n.dot);
+  for (const auto& [k, dots] : by_sample) {
+    if (!record(k, dots)) return false;
   }
+  Log("dots held by few samples: " + std::to_string(few.looked_for) + " looked for, " +
+      std::to_string(few.dots_named) + " named in " + std::to_string(few.named.size()) + " further frames, " +
+      std::to_string(few.rivalled) + " with rival hypotheses, " + std::to_string(few.conflicts) + " in conflict");
+  // Their new rays fix points of other dots better, which the samples lacking them may now name.
+  if (few.dots_named > 0 && !late_passes()) return false;
   report_.samples_named_later = static_cast<int>(gained.size());
   return true;
 }
