@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <regex>
 #include <sstream>
 #include <vector>
 
@@ -187,8 +188,23 @@ Status OpenCvReadError(const std::string& path, const std::string& what) {
                                                      TerminalSafe(reason));
 }
 
+// OpenCV 4.6's YAML reader loops forever on some texts whose first line is a malformed `%YAML` directive
+// (found by the camera_opencv fuzz harness): such a line is refused before OpenCV sees the text. The
+// directive OpenCV writes is `%YAML:1.0`; `%YAML 1.x` is the YAML standard's.
+bool MalformedYamlDirective(const std::string& contents) {
+  if (contents.rfind("%YAML", 0) != 0) return false;
+  const std::string line = contents.substr(0, contents.find('\n'));
+  static const std::regex directive(R"(%YAML[: ]1\.[0-9]+[ \t\r]*)");
+  return !std::regex_match(line, directive);
+}
+
 Result<CameraIntrinsics> LoadOpenCv(const std::string& path, const std::string& contents) {
   Problems problems(path);
+  if (MalformedYamlDirective(contents)) {
+    return Status::Error(ErrorCode::kInvalidInput, "cannot read " + path + " as an OpenCV FileStorage file: " + path +
+                                                       ":1: the first line must be the directive `%YAML:1.0` (found `" +
+                                                       TerminalSafe(contents.substr(0, std::min<size_t>(contents.find('\n'), 60))) + "`)");
+  }
   cv::FileStorage fs;
   try {
     if (!fs.open(contents, cv::FileStorage::READ | cv::FileStorage::MEMORY)) {

@@ -204,6 +204,12 @@ TEST_F(BadCameraFiles, OpenCv) {
   // Found by the fuzzer too: cv::FileStorage::open throws std::length_error (not cv::Exception) on this.
   EXPECT_TRUE(Refused("length.yaml", ReadFile(SourcePath("fuzz/regressions/camera_opencv/filestorage-open-throws-length-error.yaml")),
                       "cannot read"));
+  // Found by the fuzzer: OpenCV 4.6's YAML reader never returns on this text (a malformed `%YAML` line
+  // first): such a directive is refused before OpenCV reads the text.
+  EXPECT_TRUE(Refused("hang.yaml", ReadFile(SourcePath("fuzz/regressions/camera_opencv/malformed-yaml-directive-hangs-opencv.yaml")),
+                      dir_.File("hang.yaml") + ":1: the first line must be the directive `%YAML:1.0`"));
+  ASSERT_TRUE(LoadCameraFile((WriteFile(dir_.File("standard.yaml"), "%YAML 1.2" + OpenCv("").substr(9)), dir_.File("standard.yaml"))).ok())
+      << "the YAML standard's directive is not refused";
   EXPECT_TRUE(Refused("fisheye.yaml", OpenCv("fisheye_model: 1\n"), "`fisheye_model` at " + dir_.File("fisheye.yaml") + ":9 is set"));
   // A parse error: the line cv::FileStorage's parser names; a file it cannot start reading: line 1.
   EXPECT_TRUE(Refused("garbage.yaml", "%YAML:1.0\n---\nimage_width: 5\nimage_height: [\n",
