@@ -141,10 +141,11 @@ RaysById SampleRays(const PredictionModel& model, const std::vector<ViewedSample
 
 // The camera of a frame resected on its dots that have points: cv::solvePnP (iterative, from `guess`)
 // in normalised coordinates, then once more without the dots off by more than the larger of
-// `inlier_px` and three times the median. Empty when fewer than `min_dots` remain or the solve fails.
+// `inlier_px` and three times the median. Empty when fewer than `min_dots` remain, the solve fails, or
+// fewer than `min_agreeing_fraction` of all the dots lie within `inlier_px` of the pose's projection.
 std::optional<Rigid3> Resect(const PredictionModel& m, const Rigid3& base_from_cam_guess,
                              const std::map<int, Eigen::Vector2d>& px, const std::map<int, Point>& points,
-                             int min_dots, double inlier_px) {
+                             int min_dots, double inlier_px, double min_agreeing_fraction) {
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
   for (const auto& [id, uv] : px) {
@@ -154,6 +155,8 @@ std::optional<Rigid3> Resect(const PredictionModel& m, const Rigid3& base_from_c
     object.emplace_back(it->second.p.x(), it->second.p.y(), it->second.p.z());
     image.emplace_back(xy.x(), xy.y());
   }
+  const std::vector<cv::Point3d> all_object = object;
+  const std::vector<cv::Point2d> all_image = image;
   const Rigid3 guess = base_from_cam_guess.Inverse();
   cv::Mat r, rvec(3, 1, CV_64F), tvec(3, 1, CV_64F);
   cv::eigen2cv(guess.rotation, r);
@@ -184,6 +187,16 @@ std::optional<Rigid3> Resect(const PredictionModel& m, const Rigid3& base_from_c
     object.swap(kept_object);
     image.swap(kept_image);
   }
+  // Most of the dots must agree with the pose: when many are wrong (a tracker that jumped onto other
+  // blobs), the pose they give is no better than the nominal one, and the robust correction downstream
+  // (tracking/predicted_match.h) is what finds them out.
+  std::vector<cv::Point2d> reprojected;
+  cv::projectPoints(all_object, rvec, tvec, cv::Mat::eye(3, 3, CV_64F), cv::noArray(), reprojected);
+  size_t agree = 0;
+  for (size_t k = 0; k < all_object.size(); ++k) {
+    agree += m.camera.fx_px * cv::norm(reprojected[k] - all_image[k]) <= inlier_px ? 1 : 0;
+  }
+  if (static_cast<double>(agree) < min_agreeing_fraction * static_cast<double>(all_object.size())) return std::nullopt;
   cv::Rodrigues(rvec, r);
   Rigid3 cam_from_base;
   cv::cv2eigen(r, cam_from_base.rotation);
@@ -209,7 +222,8 @@ std::vector<Rigid3> ResectSamples(const PredictionModel& model, const std::vecto
     for (size_t s = 1; s < samples.size(); ++s) {
       if (samples[s].base_from_cam) continue;
       if (const std::optional<Rigid3> c = Resect(model, base_from_cams[s], samples[s].dots_px, points,
-                                                 options.min_sample_correction_dots, options.resection_inlier_px)) {
+                                                 options.min_sample_correction_dots, options.resection_inlier_px,
+                                                 options.min_resection_agreeing_fraction)) {
         base_from_cams[s] = *c;
       }
     }
@@ -243,7 +257,8 @@ DotPredictionReport PredictDots(const PredictionModel& model, const std::vector<
   if (options.resect_new_frame && samples.size() >= 2) {
     const std::map<int, Point> sample_points = TriangulateAll(model, options.ray_model_sigma_px, rays, false);
     if (const std::optional<Rigid3> c = Resect(model, base_from_cam_now, current_px, sample_points,
-                                               options.min_sample_correction_dots, options.resection_inlier_px)) {
+                                               options.min_sample_correction_dots, options.resection_inlier_px,
+                                                 options.min_resection_agreeing_fraction)) {
       base_from_cam_now = *c;
     }
   }

@@ -76,6 +76,8 @@ struct DotPredictionOptions {
   int sample_correction_rounds = 2;
   int min_sample_correction_dots = 8;
   double resection_inlier_px = 3.0;
+  // A resection is kept only when at least this share of the frame's dots lie within that distance.
+  double min_resection_agreeing_fraction = 0.7;
   // The new frame's camera is resected too, on the dots of `current_px` that have points.
   bool resect_new_frame = true;
 };
