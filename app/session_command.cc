@@ -104,9 +104,12 @@ json RunJson(const RunSettings& a) {
   return run;
 }
 
+// run.json as the session records it.
+std::string RunJsonText(const RunSettings& a) { return RunJson(a).dump(2) + "\n"; }
+
 // The simulated cell of these settings, through their run.json (the recorded form an audit rebuilds from).
 simulation::SimCellOptions SimCellOptionsFor(const RunSettings& a) {
-  return simulation::SimCellOptionsFor(RunJson(a)).value();
+  return simulation::SimCellOptionsFor(RunJsonText(a)).value();
 }
 
 // Typed confirmation before a real backend moves (R1): the operator types the robot's serial. The
@@ -213,7 +216,7 @@ Status LoadRunPlan(const RunSettings& a, RunPlan* run) {
   if (!check.ok) {
     return Status::Error(ErrorCode::kDegenerateData, acquisition::PreflightRefusal(acquisition::PreflightProblems(check)));
   }
-  run->inputs = {robot_input, *plan_input, {"run.json", RunJson(a).dump(2) + "\n"}};
+  run->inputs = {robot_input, *plan_input, {"run.json", RunJsonText(a)}};
   // The simulated cell is built before the session so that its setup can be recorded.
   if (a.robot_backend == "sim") {
     run->cell = simulation::MakeSimCell(run->nominal, run->plan, SimCellOptionsFor(a), run->plan.front().joints_rad, 0);
@@ -556,7 +559,10 @@ Command AddRunCommand(CLI::App& app) {
   cmd->add_option("--supersampling", a->supersampling, "sim: samples per pixel side")->check(CLI::Range(1, 8));
   AddIdentifyOptions(cmd, &a->identify, "default: the simulator's truth with sim, else order");
   auto fault = [&](const char* name, std::vector<int>* v, const char* what) {
-    cmd->add_option(name, *v, what)->delimiter(',')->group("Simulated faults (sim robot, 0-based call counts)");
+    cmd->add_option(name, *v, what)
+        ->delimiter(',')
+        ->check(CLI::NonNegativeNumber)
+        ->group("Simulated faults (sim robot, 0-based call counts)");
   };
   fault("--fault-reject-move", &a->fault_reject_moves, "reject move #k");
   fault("--fault-protective-stop-move", &a->fault_pstop_moves, "protective stop half way through move #k");

@@ -1,5 +1,6 @@
 #include "simulation/session_audit.h"
 
+#include "base/terminal_text.h"
 #include "io/robot_config.h"
 #include "session/samples.h"
 #include "session/session_snapshot.h"
@@ -18,15 +19,15 @@ Result<SimCellOptions> SimulatedRunOptions(const session::SessionSnapshot& snaps
   Result<std::string> text = snapshot.Input("run.json");
   if (!text.ok()) return text.status();
   const std::string name = path + "/inputs/run.json";
-  const nlohmann::json run = nlohmann::json::parse(*text, nullptr, /*allow_exceptions=*/false);
-  if (run.is_discarded()) return Refuse(name + ": not valid JSON");
-  if (!IsSimulatedRun(run)) {
-    return Refuse("session " + path + " was recorded with robot \"" + run.value("robot", "?") + "\" and camera \"" +
-                  run.value("camera", "?") + "\" (" + name +
+  Result<RunBackends> backends = ReadRunBackends(*text, name);
+  if (!backends.ok()) return backends.status();
+  if (!backends->simulated()) {
+    return Refuse("session " + path + " was recorded with robot \"" + TerminalSafe(backends->robot) +
+                  "\" and camera \"" + TerminalSafe(backends->camera) + "\" (" + backends->robot_at +
                   "): only a session recorded with the simulated robot and camera (run --robot sim --camera sim) "
                   "has a hidden truth to audit against");
   }
-  return SimCellOptionsFor(run, name);
+  return SimCellOptionsFor(*text, name);
 }
 
 // The world `selfcal run` built for this session, rebuilt from its inputs and checked against setup.json.

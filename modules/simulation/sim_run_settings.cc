@@ -1,69 +1,137 @@
 #include "simulation/sim_run_settings.h"
 
+#include <cstdint>
+#include <cstdio>
+#include <optional>
 #include <set>
+#include <utility>
 #include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "session/json_fields.h"
 
 namespace selfcal::simulation {
 
 namespace {
 
-// The value of `key` in `object` as T; a message naming `name` and the key when missing or mistyped.
-template <typename T>
-bool Get(const nlohmann::json& object, const std::string& key, const std::string& name, T* value,
-         std::string* problem) {
-  const auto it = object.find(key);
-  if (it == object.end()) {
-    *problem = name + ": key \"" + key + "\" is missing";
+using nlohmann::json;
+using session::JsonFields;
+using session::JsonPath;
+using session::JsonTypeName;
+
+// A range's bound as messages show it ("0", "10", "0.5").
+std::string Number(double x) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", x);
+  return text;
+}
+
+// "must be in [lo, hi] (found v)" after a value read but out of range.
+void AddOutOfRange(const JsonPath& at, const std::string& lo, const std::string& hi, const json& found,
+                   JsonFields* fields) {
+  fields->Add(at, "`" + at.name + "` must be in [" + lo + ", " + hi + "] (found " + found.dump() + ")");
+}
+
+// The member `key` of the object at `path` as a finite number in [lo, hi]; false after a problem.
+bool GetDoubleIn(const json& object, const JsonPath& path, const std::string& key, double lo, double hi,
+                 JsonFields* fields, double* out) {
+  if (!fields->GetDouble(object, path, key, out)) return false;
+  if (*out >= lo && *out <= hi) return true;
+  AddOutOfRange(path.Member(key), Number(lo), Number(hi), *out, fields);
+  return false;
+}
+
+// "seed": any unsigned 64-bit integer.
+bool GetSeed(const json& object, JsonFields* fields, uint64_t* out) {
+  const json* value = fields->Get(object, {}, "seed");
+  if (value == nullptr) return false;
+  if (!value->is_number_unsigned()) {
+    const std::string found = value->is_number_integer() ? value->dump() : JsonTypeName(*value);
+    fields->Add(JsonPath{}.Member("seed"),
+                "`seed` must be an integer in [0, 18446744073709551615] (found " + found + ")");
     return false;
   }
-  try {
-    *value = it->get<T>();
-  } catch (const nlohmann::json::exception&) {
-    *problem = name + ": key \"" + key + "\" = " + it->dump() + " has the wrong type";
-    return false;
-  }
+  *out = value->get<uint64_t>();
   return true;
+}
+
+// A fault list of `faults` (at `path`): an array of 0-based call counts into *out.
+void GetCallCounts(const json& faults, const JsonPath& path, const std::string& key, JsonFields* fields,
+                   std::set<int>* out) {
+  const json* list = fields->GetArray(faults, path, key);
+  if (list == nullptr) return;
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    const json& k = (*list)[i];
+    if (k.is_number_unsigned() && k.get<uint64_t>() <= uint64_t{INT32_MAX}) {
+      out->insert(static_cast<int>(k.get<uint64_t>()));
+      continue;
+    }
+    const JsonPath at = path.Member(key).Element(i);
+    const std::string found = k.is_number_integer() ? k.dump() : JsonTypeName(k);
+    fields->Add(at, "`" + at.name + "` must be a call count, an integer in [0, 2147483647] (found " + found + ")");
+  }
+}
+
+// "faults": the simulated robot's injected faults, every key known.
+void ParseFaults(const json& run, JsonFields* fields, robot::SimulatedRobotFaults* faults) {
+  const json* f = fields->Get(run, {}, "faults");
+  if (f == nullptr) return;
+  const JsonPath at = JsonPath{}.Member("faults");
+  if (!f->is_object()) {
+    fields->Add(at, "`faults` must be an object (found " + JsonTypeName(*f) + ")");
+    return;
+  }
+  const std::pair<const char*, std::set<int>*> lists[] = {
+      {"reject_moves", &faults->reject_moves},       {"protective_stop_moves", &faults->protective_stop_moves},
+      {"hang_moves", &faults->hang_moves},           {"disconnect_moves", &faults->disconnect_moves},
+      {"jog_after_moves", &faults->jog_after_moves}, {"slow_settle_moves", &faults->slow_settle_moves},
+      {"stale_reads", &faults->stale_reads},         {"nan_reads", &faults->nan_reads},
+      {"short_reads", &faults->short_reads}};
+  std::vector<std::string> known = {"jog_delay_s"};
+  for (const auto& [key, set] : lists) {
+    GetCallCounts(*f, at, key, fields, set);
+    known.push_back(key);
+  }
+  fields->CheckKnown(*f, at, known);
+  // Written only when not the default (docs/session-format.md).
+  if (f->contains("jog_delay_s")) GetDoubleIn(*f, at, "jog_delay_s", 0, 10, fields, &faults->jog_delay_s);
 }
 
 }  // namespace
 
-bool IsSimulatedRun(const nlohmann::json& run_json) {
-  return run_json.is_object() && run_json.value("robot", "") == "sim" && run_json.value("camera", "") == "sim";
-}
-
-Result<SimCellOptions> SimCellOptionsFor(const nlohmann::json& run_json, const std::string& name) {
-  if (!run_json.is_object()) return Status::Error(ErrorCode::kInvalidInput, name + ": not a JSON object");
+Result<SimCellOptions> SimCellOptionsFor(const std::string& run_json_text, const std::string& name) {
+  JsonFields fields(run_json_text, name);
+  const std::optional<json> parsed = fields.ParseObject();
+  if (!parsed) return fields.ToStatus();
+  const json& run = *parsed;
   SimCellOptions o;
-  std::string problem;
   uint64_t seed = 0;
-  nlohmann::json faults;
-  if (!Get(run_json, "seed", name, &seed, &problem) ||
-      !Get(run_json, "grey_noise", name, &o.camera.render.noise_std_grey, &problem) ||
-      !Get(run_json, "blur_px", name, &o.camera.render.blur_sigma_px, &problem) ||
-      !Get(run_json, "supersampling", name, &o.camera.render.supersampling, &problem) ||
-      !Get(run_json, "faults", name, &faults, &problem)) {
-    return Status::Error(ErrorCode::kInvalidInput, problem);
+  GetSeed(run, &fields, &seed);
+  GetDoubleIn(run, {}, "grey_noise", 0, 50, &fields, &o.camera.render.noise_std_grey);
+  GetDoubleIn(run, {}, "blur_px", 0, 10, &fields, &o.camera.render.blur_sigma_px);
+  int& supersampling = o.camera.render.supersampling;
+  if (fields.GetInt(run, {}, "supersampling", &supersampling) && (supersampling < 1 || supersampling > 8)) {
+    AddOutOfRange(JsonPath{}.Member("supersampling"), "1", "8", supersampling, &fields);
   }
+  ParseFaults(run, &fields, &o.faults);
+  if (!fields.ok()) return fields.ToStatus();
   o.world.world_seed = seed;
   o.world.noise_seed = seed;
   o.world.pixel_noise_px = 0.02;  // the centroid noise the solvers are told (measured 0.01 px at grey noise 2)
-  const std::pair<const char*, std::set<int>*> lists[] = {
-      {"reject_moves", &o.faults.reject_moves},       {"protective_stop_moves", &o.faults.protective_stop_moves},
-      {"hang_moves", &o.faults.hang_moves},           {"disconnect_moves", &o.faults.disconnect_moves},
-      {"jog_after_moves", &o.faults.jog_after_moves}, {"slow_settle_moves", &o.faults.slow_settle_moves},
-      {"stale_reads", &o.faults.stale_reads},         {"nan_reads", &o.faults.nan_reads},
-      {"short_reads", &o.faults.short_reads}};
-  for (const auto& [key, set] : lists) {
-    std::vector<int> v;
-    if (!Get(faults, key, name + " faults", &v, &problem)) return Status::Error(ErrorCode::kInvalidInput, problem);
-    set->insert(v.begin(), v.end());
-  }
-  if (faults.contains("jog_delay_s")) {  // written only when not the default
-    if (!Get(faults, "jog_delay_s", name + " faults", &o.faults.jog_delay_s, &problem)) {
-      return Status::Error(ErrorCode::kInvalidInput, problem);
-    }
-  }
   return o;
+}
+
+Result<RunBackends> ReadRunBackends(const std::string& run_json_text, const std::string& name) {
+  JsonFields fields(run_json_text, name);
+  const std::optional<json> parsed = fields.ParseObject();
+  if (!parsed) return fields.ToStatus();
+  RunBackends backends;
+  fields.GetString(*parsed, {}, "robot", &backends.robot);
+  fields.GetString(*parsed, {}, "camera", &backends.camera);
+  if (!fields.ok()) return fields.ToStatus();
+  backends.robot_at = fields.At(JsonPath{}.Member("robot"));
+  return backends;
 }
 
 }  // namespace selfcal::simulation

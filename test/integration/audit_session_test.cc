@@ -4,6 +4,7 @@
 // not reproduce, and a --json inside the session are refused with exit 2.
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <functional>
 #include <sstream>
@@ -75,6 +76,14 @@ class AuditSessionTest : public ::testing::Test {
     RewriteInput(session, name, input.dump(2) + "\n");
     return RunSelfcal("audit " + session.string(), output);
   }
+  // The 1-based line of the first `needle` in `file`, as text (the line a refusal names).
+  static std::string LineOf(const fs::path& file, const std::string& needle) {
+    const std::string text = ReadFile(file.string());
+    const std::size_t at = text.find(needle);
+    EXPECT_NE(at, std::string::npos) << needle;
+    const auto end = text.begin() + static_cast<long>(std::min(at, text.size()));
+    return std::to_string(1 + std::count(text.begin(), end, '\n'));
+  }
   static fs::path* root_;
   static int run_code_;
   static std::string run_output_;
@@ -115,6 +124,18 @@ TEST_F(AuditSessionTest, RefusesASessionNotRecordedWithTheSimulatedRobot) {
       << output;
   EXPECT_TRUE(Contains(output, "recorded with robot \"manual\"")) << output;
   EXPECT_TRUE(Contains(output, "simulated robot")) << output;
+  const std::string line = LineOf(*root_ / "manual" / "inputs" / "run.json", "\"robot\"");
+  EXPECT_TRUE(Contains(output, "inputs/run.json:" + line + "): only a session recorded")) << output;
+}
+
+TEST_F(AuditSessionTest, RefusesARunJsonValueOutOfRangeNamingItsLine) {
+  std::string output;
+  EXPECT_EQ(AuditChanged("bad_run", "run.json", [](nlohmann::json* run) { (*run)["supersampling"] = 9; }, &output), 2)
+      << output;
+  const fs::path run_json = *root_ / "bad_run" / "inputs" / "run.json";
+  const std::string line = LineOf(run_json, "\"supersampling\"");
+  EXPECT_TRUE(Contains(output, run_json.string() + ":" + line + ": `supersampling` must be in [1, 8] (found 9)"))
+      << output;
 }
 
 TEST_F(AuditSessionTest, RefusesASessionWhoseSetupTheRebuiltWorldDoesNotReproduce) {
