@@ -218,5 +218,46 @@ TEST(DotPrediction, ResectedSampleCamerasBringPointsFromDistantPosesIntoTheirGat
   EXPECT_LE(corrected, 13.8) << "raw worst chi-square " << raw;
 }
 
+// The new frame's camera is resected on the dots known in it: with a few of them wrong it still lands
+// where it lands with none wrong (the predictions of the other dots closer than the nominal camera's);
+// with most of them wrong (a tracker that jumped onto other blobs) the pose is refused and the nominal
+// camera stays, so that the robust correction downstream can find the wrong dots out.
+TEST(DotPrediction, TheNewFrameIsResectedOnItsKnownDotsUnlessMostOfThemAreWrong) {
+  const Cell c = MakeCell(1e-3, 0.2 * 3.14159265358979 / 180, 8);
+  std::mt19937_64 rng(5);
+  std::vector<ViewedSample> samples;
+  for (int k = 0; k < 4; ++k) samples.push_back({c.joints[k], Observe(c, c.joints[k], &rng), {}, {}});
+  const std::map<int, Eigen::Vector2d> next = Observe(c, c.joints[5], &rng);
+  std::map<int, Eigen::Vector2d> known;  // two thirds of the dots, tracked into the frame
+  for (const auto& [id, px] : next) {
+    if (id % 3 != 0) known[id] = px;
+  }
+  auto rms_of_the_others = [&](const std::map<int, Eigen::Vector2d>& current, bool resect) {
+    DotPredictionOptions options;
+    options.resect_new_frame = resect;
+    const DotPredictionReport r = PredictDots(c.nominal, samples, c.joints[5], current, options);
+    double sum2 = 0;
+    int n = 0;
+    for (const tracking::PredictedDot& p : r.dots) {
+      if (p.id % 3 != 0 || !next.count(p.id) || !p.names) continue;
+      sum2 += (p.uv_px - next.at(p.id)).squaredNorm();
+      ++n;
+    }
+    EXPECT_GE(n, 10);
+    return std::sqrt(sum2 / std::max(n, 1));
+  };
+  const double nominal = rms_of_the_others(known, false);
+  std::map<int, Eigen::Vector2d> few_wrong = known, most_wrong = known;
+  int k = 0;
+  for (auto& [id, px] : few_wrong) px += (k++ % 10 == 0) ? Eigen::Vector2d(25, -18) : Eigen::Vector2d::Zero();
+  k = 0;
+  for (auto& [id, px] : most_wrong) px += (k++ % 10 < 6) ? Eigen::Vector2d(25, -18) : Eigen::Vector2d::Zero();
+  const double clean = rms_of_the_others(known, true);
+  const double few = rms_of_the_others(few_wrong, true), most = rms_of_the_others(most_wrong, true);
+  EXPECT_LT(clean, 0.8 * nominal) << "resected: " << clean << " px, nominal " << nominal << " px";
+  EXPECT_LT(few, 1.05 * clean) << "resected on a tenth wrong: " << few << " px, on none " << clean << " px";
+  EXPECT_NEAR(most, nominal, 1e-9) << "six tenths wrong: the nominal camera stays";
+}
+
 }  // namespace
 }  // namespace selfcal::acquisition
