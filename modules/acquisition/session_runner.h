@@ -21,8 +21,11 @@
 // that loses every dot then goes on, and the pose halts only when nothing can be named. A dot seen in one
 // sample only is predicted as a segment of its epipolar line: a detection alone on it is journaled as a
 // candidate (never an observation), which the next settled pose confirms by a short gate or forgets.
-// Once every pose of the route is visited, before `finished`: each accepted sample's image is read again
-// and the dots it lacks are named from the other samples (late_naming.h), journaled as dots_named_later.
+// From three accepted samples on, every prediction uses the samples' cameras and f_x as a bundle of their
+// own images gives them (bundled_cameras.h). Once every pose of the route is visited, before `finished`:
+// each accepted sample's image is read again and the dots it lacks are named from the other samples
+// (late_naming.h), then the dots held by at most three samples where further samples support a point for
+// them (seen_once.h), all journaled as dots_named_later.
 //
 // Resume: the journal decides. RunSession continues at the first pose with neither an accepted sample
 // nor a final skip (session/samples.h), with the dots of the last accepted sample as the tracker's state;
