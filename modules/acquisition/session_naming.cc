@@ -167,6 +167,65 @@ void Runner::NameByPrediction(const Capture& capture) {
   tracked_ = std::move(kept);
 }
 
+namespace {
+
+struct EndOfSessionNaming {
+  std::map<size_t, std::vector<tracking::PreviousDot>> named;  // by sample index, in the order named
+  std::vector<std::string> log;
+};
+
+// Every name the end of the session gives (late_naming.h, then seen_once.h, then late naming again), in
+// memory: a pure function of the samples and their frames' detections.
+EndOfSessionNaming NameAtTheEnd(PredictionModel model, std::vector<ViewedSample> all,
+                                const std::vector<tracking::DetectionReport>& detected,
+                                const LateNamingOptions& options, const RunOptions& o) {
+  EndOfSessionNaming out;
+  // The samples' cameras and f_x as their images give them (bundled_cameras.h).
+  const BundledCameras bundled = BundleSampleCameras(model, all, o.prediction);
+  out.log.push_back("cameras of the samples from their images: " + bundled.message);
+  UseBundledCameras(bundled, &model, &all);
+  int named = 0;
+  auto add = [&](size_t k, const std::vector<tracking::PreviousDot>& dots) {
+    for (const tracking::PreviousDot& d : dots) {
+      all[k].dots_px[d.id] = d.centroid_px;
+      out.named[k].push_back(d);
+    }
+    named += static_cast<int>(dots.size());
+  };
+  // Passes over the samples, each naming from all the others, until one names nothing.
+  auto late_passes = [&] {
+    for (int pass = 0; pass < o.late_naming_passes; ++pass) {
+      const int before = named;
+      for (size_t k = 0; k < all.size(); ++k) {
+        std::vector<ViewedSample> others;
+        for (size_t j = 0; j < all.size(); ++j) {
+          if (j != k) others.push_back(all[j]);
+        }
+        add(k, acquisition::NameLater(model, others, all[k], detected[k], options).named);
+      }
+      if (named == before) break;  // nothing new: another pass would name nothing
+    }
+  };
+  late_passes();
+  // Then the dots held by few samples, by hypotheses that further samples support.
+  SeenOnceOptions seen_once;
+  seen_once.prediction = o.prediction;
+  seen_once.duplicate_distance_px = o.detector.duplicate_distance_px;
+  const SeenOnceReport few = NameSeenOnce(model, all, detected, seen_once);
+  std::map<size_t, std::vector<tracking::PreviousDot>> by_sample;
+  for (const SeenOnceName& n : few.named) by_sample[static_cast<size_t>(n.sample)].push_back(n.dot);
+  for (const auto& [k, dots] : by_sample) add(k, dots);
+  out.log.push_back("dots held by few samples: " + std::to_string(few.looked_for) + " looked for, " +
+                    std::to_string(few.dots_named) + " named in " + std::to_string(few.named.size()) +
+                    " further frames, " + std::to_string(few.rivalled) + " with rival hypotheses, " +
+                    std::to_string(few.conflicts) + " in conflict");
+  // Their new rays fix points of other dots better, which the samples lacking them may now name.
+  if (few.dots_named > 0) late_passes();
+  return out;
+}
+
+}  // namespace
+
 bool Runner::NameLater() {
   if (c_.prediction == nullptr || c_.session == nullptr || o_.late_naming_passes <= 0) return true;
   Result<session::SessionLog> log = session::ReadSessionLog(c_.session->journal().records());
@@ -196,59 +255,32 @@ bool Runner::NameLater() {
     }
     detected.back() = tracking::DetectDots(*image, o_.detector);
   }
-  // The samples in pose order, with their cameras and f_x as the images give them (bundled_cameras.h).
-  PredictionModel model = *c_.prediction;
+  // The state this step starts from: every sample without the dots an earlier, interrupted run of it
+  // named, so that a run resumed after a kill in the middle of it names exactly what an uninterrupted
+  // one does; only what is not in the journal yet is written.
   std::vector<ViewedSample> all;
-  for (const int pose : poses) all.push_back((*viewed_)[pose]);
-  const BundledCameras bundled = BundleSampleCameras(model, all, o_.prediction);
-  Log("cameras of the samples from their images: " + bundled.message);
-  UseBundledCameras(bundled, &model, &all);
-  std::set<int> gained;  // poses whose samples gained dots
-  auto record = [&](size_t k, const std::vector<tracking::PreviousDot>& dots) {
-    if (!Record({{"type", "dots_named_later"}, {"pose", poses[k]}, {"dots", DotsJson(dots)}})) return false;
-    for (const tracking::PreviousDot& d : dots) {
-      all[k].dots_px[d.id] = d.centroid_px;
-      (*viewed_)[poses[k]].dots_px[d.id] = d.centroid_px;
-    }
-    report_.named_later += static_cast<int>(dots.size());
-    gained.insert(poses[k]);
-    return true;
-  };
-  // Passes over the samples, each naming from all the others (late_naming.h), until one names nothing.
-  auto late_passes = [&] {
-    for (int pass = 0; pass < o_.late_naming_passes; ++pass) {
-      const int before = report_.named_later;
-      for (size_t k = 0; k < poses.size(); ++k) {
-        std::vector<ViewedSample> others;
-        for (size_t j = 0; j < all.size(); ++j) {
-          if (j != k) others.push_back(all[j]);
-        }
-        const LateNaming late = acquisition::NameLater(model, others, all[k], detected[k], options);
-        if (late.named.empty()) continue;
-        if (!record(k, late.named)) return false;
-        Log("pose " + plan_[static_cast<size_t>(poses[k])].id + ": " + std::to_string(late.named.size()) +
-            " dots named later");
-      }
-      if (report_.named_later == before) break;  // nothing new: another pass would name nothing
-    }
-    return true;
-  };
-  if (!late_passes()) return false;
-  // Then the dots held by few samples, by hypotheses that further samples support (seen_once.h).
-  SeenOnceOptions seen_once;
-  seen_once.prediction = o_.prediction;
-  seen_once.duplicate_distance_px = o_.detector.duplicate_distance_px;
-  const SeenOnceReport few = NameSeenOnce(model, all, detected, seen_once);
-  std::map<size_t, std::vector<tracking::PreviousDot>> by_sample;
-  for (const SeenOnceName& n : few.named) by_sample[static_cast<size_t>(n.sample)].push_back(n.dot);
-  for (const auto& [k, dots] : by_sample) {
-    if (!record(k, dots)) return false;
+  for (const int pose : poses) {
+    ViewedSample s = (*viewed_)[pose];
+    const session::AcceptedSample& a = *log->accepted.at(static_cast<size_t>(pose));
+    for (size_t k = a.dots.size() - static_cast<size_t>(a.named_later); k < a.dots.size(); ++k) s.dots_px.erase(a.dots[k].id);
+    all.push_back(s);
   }
-  Log("dots held by few samples: " + std::to_string(few.looked_for) + " looked for, " +
-      std::to_string(few.dots_named) + " named in " + std::to_string(few.named.size()) + " further frames, " +
-      std::to_string(few.rivalled) + " with rival hypotheses, " + std::to_string(few.conflicts) + " in conflict");
-  // Their new rays fix points of other dots better, which the samples lacking them may now name.
-  if (few.dots_named > 0 && !late_passes()) return false;
+  EndOfSessionNaming end = NameAtTheEnd(*c_.prediction, std::move(all), detected, options, o_);
+  for (const std::string& line : end.log) Log(line);
+  std::set<int> gained;  // poses whose samples gained dots
+  for (const auto& [k, dots] : end.named) {
+    const int pose = poses[k];
+    std::vector<tracking::PreviousDot> fresh;
+    for (const tracking::PreviousDot& d : dots) {
+      if (!(*viewed_)[pose].dots_px.count(d.id)) fresh.push_back(d);
+    }
+    if (fresh.empty()) continue;
+    if (!Record({{"type", "dots_named_later"}, {"pose", pose}, {"dots", DotsJson(fresh)}})) return false;
+    for (const tracking::PreviousDot& d : fresh) (*viewed_)[pose].dots_px[d.id] = d.centroid_px;
+    report_.named_later += static_cast<int>(fresh.size());
+    gained.insert(pose);
+    Log("pose " + plan_[static_cast<size_t>(pose)].id + ": " + std::to_string(fresh.size()) + " dots named later");
+  }
   report_.samples_named_later = static_cast<int>(gained.size());
   return true;
 }
