@@ -108,7 +108,9 @@ bool Runner::StartFromJournal(const session::SessionLog& log, std::vector<int>* 
     report_.message = "the plan has no pose: nothing to record";
     return false;
   }
-  if (!log.finished && !Record({{"type", "finished"}, {"time_s", Now()}})) return false;
+  // Every pose visited, but stopped before `finished`: the end of the session (naming later in the
+  // recorded frames) is done now, as an uninterrupted run does it.
+  if (!log.finished && (!NameLater() || !Record({{"type", "finished"}, {"time_s", Now()}}))) return false;
   report_.outcome = RunOutcome::kCompleted;
   report_.error = ErrorCode::kOk;
   report_.message = "every pose of the session is done";
