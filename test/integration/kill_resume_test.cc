@@ -193,5 +193,47 @@ TEST(KillResume, RandomKillsLoseNothingAndTheResultIsIdentical) {
   fs::remove_all(root);
 }
 
+// Killed after its last sample and before `finished` (while it names dots in the recorded frames), a
+// session resumed completes that step: its observations are the uninterrupted run's, byte for byte (the
+// resume used to write `finished` at once, with no pose left to visit, and the late names were lost).
+TEST(KillResume, AKillAfterTheLastSampleIsResumedIntoTheSameNamesLater) {
+  const fs::path root = fs::temp_directory_path() / ("selfcal_kill_end_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  fs::create_directories(root);
+  const fs::path log = root / "log.txt";
+  const std::vector<std::string> run = {"run", "--seed", "4", "--supersampling", "2", "--session"};
+  auto args = [&](const fs::path& dir, bool resume) {
+    std::vector<std::string> a = run;
+    a.push_back(dir.string());
+    if (resume) a.insert(a.end(), {"--resume", "--take-over-stale-lock"});
+    return a;
+  };
+  ASSERT_EQ(RunToEnd(args(root / "clean", false), log), 0) << ReadFile(log);
+  const pid_t pid = Spawn(args(root / "killed", false), log);
+  const fs::path journal = root / "killed" / "journal.log";
+  auto samples = [&] {
+    const std::string text = fs::exists(journal) ? ReadFile(journal) : "";
+    int n = 0;
+    for (size_t at = text.find("sample_accepted"); at != std::string::npos; at = text.find("sample_accepted", at + 1)) ++n;
+    return n;
+  };
+  for (int i = 0; i < 6000 && samples() < 25; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ::kill(pid, SIGKILL);
+  bool killed = false;
+  Wait(pid, &killed);
+  ASSERT_TRUE(killed) << "the run finished before the kill: " << ReadFile(log);
+  const std::string at_kill = ReadFile(journal);
+  ASSERT_EQ(at_kill.find("\"finished\""), std::string::npos);
+  ASSERT_EQ(RunToEnd(args(root / "killed", true), log), 0) << ReadFile(log);
+  for (const std::string dir : {"clean", "killed"}) {
+    // Exit 6 is a refused model (see the test above): the observations are written either way.
+    const int code = RunToEnd({"calibrate", (root / dir).string(), "--out", (root / (dir + "_cal")).string()}, log);
+    ASSERT_TRUE(code == 0 || code == 6) << ReadFile(log);
+  }
+  EXPECT_NE(ReadFile(root / "clean" / "journal.log").find("dots_named_later"), std::string::npos);
+  EXPECT_EQ(ReadFile(root / "killed_cal" / "observations.yaml"), ReadFile(root / "clean_cal" / "observations.yaml"));
+  fs::remove_all(root);
+}
+
 }  // namespace
 }  // namespace selfcal
