@@ -205,6 +205,14 @@ Result<CameraIntrinsics> LoadOpenCv(const std::string& path, const std::string& 
                                                        ":1: the first line must be the directive `%YAML:1.0` (found `" +
                                                        TerminalSafe(contents.substr(0, std::min<size_t>(contents.find('\n'), 60))) + "`)");
   }
+  // A second `%YAML` directive inside the document hangs that reader too (found by the fuzzer after the
+  // first fix); a camera file has one, on its first line.
+  if (const size_t again = contents.find("%YAML", 1); again != std::string::npos && contents.rfind("%YAML", 0) == 0) {
+    const long line = 1 + std::count(contents.begin(), contents.begin() + static_cast<long>(again), '\n');
+    return Status::Error(ErrorCode::kInvalidInput, "cannot read " + path + " as an OpenCV FileStorage file: " + path +
+                                                       ":" + std::to_string(line) +
+                                                       ": a second `%YAML` directive inside the document");
+  }
   cv::FileStorage fs;
   try {
     if (!fs.open(contents, cv::FileStorage::READ | cv::FileStorage::MEMORY)) {

@@ -208,6 +208,9 @@ TEST_F(BadCameraFiles, OpenCv) {
   // first): such a directive is refused before OpenCV reads the text.
   EXPECT_TRUE(Refused("hang.yaml", ReadFile(SourcePath("fuzz/regressions/camera_opencv/malformed-yaml-directive-hangs-opencv.yaml")),
                       dir_.File("hang.yaml") + ":1: the first line must be the directive `%YAML:1.0`"));
+  // Then this one, found after that fix: a second `%YAML` directive (on line 2, after `---`).
+  EXPECT_TRUE(Refused("second.yaml", ReadFile(SourcePath("fuzz/regressions/camera_opencv/second-yaml-directive-hangs-opencv.yaml")),
+                      dir_.File("second.yaml") + ":2: a second `%YAML` directive inside the document"));
   ASSERT_TRUE(LoadCameraFile((WriteFile(dir_.File("standard.yaml"), "%YAML 1.2" + OpenCv("").substr(9)), dir_.File("standard.yaml"))).ok())
       << "the YAML standard's directive is not refused";
   EXPECT_TRUE(Refused("fisheye.yaml", OpenCv("fisheye_model: 1\n"), "`fisheye_model` at " + dir_.File("fisheye.yaml") + ":9 is set"));
