@@ -162,16 +162,21 @@ std::optional<Rigid3> Resect(const PredictionModel& m, const Rigid3& base_from_c
   cv::eigen2cv(guess.rotation, r);
   cv::Rodrigues(r, rvec);
   for (int k = 0; k < 3; ++k) tvec.at<double>(k) = guess.translation[k];
+  // Each dot's distance (px) from the projection of the pose at rvec, tvec.
+  auto errors_px = [&](const std::vector<cv::Point3d>& points_3d, const std::vector<cv::Point2d>& observed) {
+    std::vector<cv::Point2d> reprojected;
+    cv::projectPoints(points_3d, rvec, tvec, cv::Mat::eye(3, 3, CV_64F), cv::noArray(), reprojected);
+    std::vector<double> error(points_3d.size());
+    for (size_t k = 0; k < points_3d.size(); ++k) error[k] = m.camera.fx_px * cv::norm(reprojected[k] - observed[k]);
+    return error;
+  };
   for (int pass = 0; pass < 2; ++pass) {
     if (static_cast<int>(object.size()) < min_dots) return std::nullopt;
     if (!cv::solvePnP(object, image, cv::Mat::eye(3, 3, CV_64F), cv::noArray(), rvec, tvec, true,
                       cv::SOLVEPNP_ITERATIVE)) {
       return std::nullopt;
     }
-    std::vector<cv::Point2d> reprojected;
-    cv::projectPoints(object, rvec, tvec, cv::Mat::eye(3, 3, CV_64F), cv::noArray(), reprojected);
-    std::vector<double> error_px(object.size());
-    for (size_t k = 0; k < object.size(); ++k) error_px[k] = m.camera.fx_px * cv::norm(reprojected[k] - image[k]);
+    const std::vector<double> error_px = errors_px(object, image);
     std::vector<double> sorted = error_px;
     std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
     const double limit = std::max(inlier_px, 3 * sorted[sorted.size() / 2]);
@@ -190,12 +195,8 @@ std::optional<Rigid3> Resect(const PredictionModel& m, const Rigid3& base_from_c
   // Most of the dots must agree with the pose: when many are wrong (a tracker that jumped onto other
   // blobs), the pose they give is no better than the nominal one, and the robust correction downstream
   // (tracking/predicted_match.h) is what finds them out.
-  std::vector<cv::Point2d> reprojected;
-  cv::projectPoints(all_object, rvec, tvec, cv::Mat::eye(3, 3, CV_64F), cv::noArray(), reprojected);
-  size_t agree = 0;
-  for (size_t k = 0; k < all_object.size(); ++k) {
-    agree += m.camera.fx_px * cv::norm(reprojected[k] - all_image[k]) <= inlier_px ? 1 : 0;
-  }
+  const std::vector<double> all_error_px = errors_px(all_object, all_image);
+  const auto agree = std::count_if(all_error_px.begin(), all_error_px.end(), [&](double e) { return e <= inlier_px; });
   if (static_cast<double>(agree) < min_agreeing_fraction * static_cast<double>(all_object.size())) return std::nullopt;
   cv::Rodrigues(rvec, r);
   Rigid3 cam_from_base;

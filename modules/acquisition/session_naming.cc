@@ -177,9 +177,14 @@ struct EndOfSessionNaming {
 // Every name the end of the session gives (late_naming.h, then seen_once.h, then late naming again), in
 // memory: a pure function of the samples and their frames' detections.
 EndOfSessionNaming NameAtTheEnd(PredictionModel model, std::vector<ViewedSample> all,
-                                const std::vector<tracking::DetectionReport>& detected,
-                                const LateNamingOptions& options, const RunOptions& o) {
+                                const std::vector<tracking::DetectionReport>& detected, const RunOptions& o) {
   EndOfSessionNaming out;
+  LateNamingOptions options;
+  options.prediction = o.prediction;
+  options.correction = o.prediction_correction;
+  options.match = o.predicted_match;
+  options.duplicate_distance_px = o.detector.duplicate_distance_px;
+  options.min_other_samples = o.late_min_other_samples;
   // The samples' cameras and f_x as their images give them (bundled_cameras.h).
   const BundledCameras bundled = BundleSampleCameras(model, all, o.prediction);
   out.log.push_back("cameras of the samples from their images: " + bundled.message);
@@ -231,12 +236,6 @@ bool Runner::NameLater() {
   Result<session::SessionLog> log = session::ReadSessionLog(c_.session->journal().records());
   if (!log.ok()) return true;  // the loop read it before: nothing is named rather than a doubtful name
   AcceptedSamples();           // viewed_, by pose, with every sample of the journal
-  LateNamingOptions options;
-  options.prediction = o_.prediction;
-  options.correction = o_.prediction_correction;
-  options.match = o_.predicted_match;
-  options.duplicate_distance_px = o_.detector.duplicate_distance_px;
-  options.min_other_samples = o_.late_min_other_samples;
 
   // Each accepted sample's frame, read again and detected once (an unreadable one names nothing).
   std::vector<int> poses;
@@ -265,7 +264,7 @@ bool Runner::NameLater() {
     for (size_t k = a.dots.size() - static_cast<size_t>(a.named_later); k < a.dots.size(); ++k) s.dots_px.erase(a.dots[k].id);
     all.push_back(s);
   }
-  EndOfSessionNaming end = NameAtTheEnd(*c_.prediction, std::move(all), detected, options, o_);
+  EndOfSessionNaming end = NameAtTheEnd(*c_.prediction, std::move(all), detected, o_);
   for (const std::string& line : end.log) Log(line);
   std::set<int> gained;  // poses whose samples gained dots
   for (const auto& [k, dots] : end.named) {
