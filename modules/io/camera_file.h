@@ -16,6 +16,7 @@
 // k3. Every error is ErrorCode::kInvalidInput and names the file (and the key); nothing is written on error.
 #pragma once
 
+#include <chrono>
 #include <string>
 
 #include "base/status.h"
@@ -23,9 +24,19 @@
 
 namespace selfcal::io {
 
+// How long OpenCV may take to read a camera file (at most 16 MiB; a real one takes milliseconds).
+inline constexpr std::chrono::milliseconds kOpenCvReadLimit{10000};
+
 // Reads the intrinsics of `path` (format from the name and, for `.xml`, the root element). `camera_name`
 // selects a camera of a ViSP file (empty: the file must hold exactly one); not allowed for OpenCV files.
-Result<CameraIntrinsics> LoadCameraFile(const std::string& path, const std::string& camera_name = "");
+// OpenCV files are read in a child process stopped after `opencv_limit` (OpenCV 4.6's YAML reader loops
+// forever on some malformed texts): a text it does not finish is refused, naming the file.
+Result<CameraIntrinsics> LoadCameraFile(const std::string& path, const std::string& camera_name = "",
+                                        std::chrono::milliseconds opencv_limit = kOpenCvReadLimit);
+
+// The OpenCV reading of LoadCameraFile on the text `contents` of `path`, in this process and without a
+// time limit: for the fuzz harness, whose coverage a child process would hide.
+Result<CameraIntrinsics> ParseOpenCvCameraText(const std::string& path, const std::string& contents);
 
 // Writes cv::FileStorage YAML (image_width, image_height, camera_matrix, distortion_coefficients with
 // all five coefficients), atomically.

@@ -1,4 +1,5 @@
 // Camera intrinsics files (OpenCV FileStorage, ViSP XML) and the observations file's lens keys.
+#include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <iostream>
@@ -226,6 +227,29 @@ TEST_F(BadCameraFiles, OpenCv) {
   ASSERT_FALSE(none.ok());
   EXPECT_EQ(none.status().code(), ErrorCode::kInvalidInput);
   EXPECT_NE(none.status().message().find(dir_.File("absent.yaml")), std::string::npos) << none.status().ToString();
+}
+
+// Found by the fuzzer after the two fixes above: a text on which OpenCV 4.6's YAML reader never returns,
+// with no sign to refuse it by. The reader runs in a child process that is stopped at the time limit.
+TEST_F(BadCameraFiles, AnOpenCvTextWhoseReaderNeverFinishesIsStoppedAndRefusedNamingTheFile) {
+  const std::string path = dir_.File("hang3.yaml");
+  WriteFile(path, ReadFile(SourcePath("fuzz/regressions/camera_opencv/reader-never-finishes-stopped-by-time-limit.yaml")));
+  const auto start = std::chrono::steady_clock::now();
+  const Result<CameraIntrinsics> cam = LoadCameraFile(path, "", std::chrono::milliseconds(500));
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_FALSE(cam.ok());
+  EXPECT_EQ(cam.status().code(), ErrorCode::kInvalidInput);
+  EXPECT_NE(cam.status().message().find(path + ":1: OpenCV's reader did not finish the text within 0.5 s and was stopped"),
+            std::string::npos) << cam.status().ToString();
+  EXPECT_GE(seconds, 0.49);
+  EXPECT_LT(seconds, 10.0);
+  // The same limit leaves a good file's reading alone, to the bit.
+  WriteFile(dir_.File("good.yaml"), OpenCv(""));
+  const Result<CameraIntrinsics> good = LoadCameraFile(dir_.File("good.yaml"), "", std::chrono::milliseconds(500));
+  const Result<CameraIntrinsics> here = ParseOpenCvCameraText(dir_.File("good.yaml"), OpenCv(""));
+  ASSERT_TRUE(good.ok() && here.ok()) << (good.ok() ? here.status().ToString() : good.status().ToString());
+  EXPECT_EQ(IntrinsicsOf(*good), IntrinsicsOf(*here));
+  EXPECT_EQ(good->k1, 0.1);
 }
 
 TEST_F(BadCameraFiles, Visp) {
