@@ -294,7 +294,9 @@ DotPredictionReport PredictDots(const PredictionModel& model, const std::vector<
     }
     if (const std::optional<Eigen::Vector2d> a = Project(model.camera, cam_from_base * x)) report.anchor_px[id] = *a;
   }
-  for (const auto& [id, r] : rays) {
+  for (const auto& entry : rays) {
+    const int id = entry.first;  // named, not a structured binding: lambdas capture those only from C++20
+    const auto& r = entry.second;
     // One ray (or rays that fix no point): the latest sample's ray over the scene's depth range.
     auto segment = [&](tracking::PredictedDot* p) {
       const auto& [s, ray] = r.back();
