@@ -5,11 +5,10 @@
 
 #include <kdl/chain.hpp>
 #include <kdl/chainfksolverpos_recursive.hpp>
-#include <kdl/tree.hpp>
-#include <kdl_parser/kdl_parser.hpp>
 #include <urdf_parser/urdf_parser.h>
 
 #include "base/atomic_file.h"
+#include "urdf/kdl_chain.h"
 #include "urdf/urdf_chain.h"
 #include "urdf/urdf_writer.h"
 
@@ -100,15 +99,11 @@ std::vector<Eigen::VectorXd> RandomJointsWithinLimits(const RobotModel& model, i
 Result<std::vector<Rigid3>> KdlChainPoses(const std::string& text, const std::string& name,
                                           const std::string& base_link, const std::string& tip_link,
                                           const std::vector<Eigen::VectorXd>& joints) {
-  KDL::Tree tree;
-  if (!kdl_parser::treeFromString(text, tree)) {
-    return Status::Error(ErrorCode::kInvalidInput, name + ": kdl_parser could not build a KDL tree from the URDF");
-  }
-  KDL::Chain chain;
-  if (!tree.getChain(base_link, tip_link, chain)) {
-    return Status::Error(ErrorCode::kInvalidInput,
-                         name + ": KDL finds no chain from `" + base_link + "` to `" + tip_link + "`");
-  }
+  const ::urdf::ModelInterfaceSharedPtr parsed = ::urdf::parseURDF(text);
+  if (!parsed) return Status::Error(ErrorCode::kInvalidInput, name + ": urdfdom could not read the URDF");
+  Result<KDL::Chain> built = KdlChainOf(*parsed, name, base_link, tip_link);
+  if (!built.ok()) return built.status();
+  const KDL::Chain& chain = *built;
   KDL::ChainFkSolverPos_recursive solver(chain);
   std::vector<Rigid3> poses;
   for (const Eigen::VectorXd& q : joints) {

@@ -7,7 +7,7 @@
 // named, a link rigidly attached below tip_link whose frame is the camera's optical frame (flange_from_cam).
 // Only revolute joints with limits are taken (their limits and names kept); prismatic, continuous, planar
 // and floating joints on the chain are refused by name. The converted model's forward kinematics is then
-// checked against KDL's (kdl_parser builds the chain from the same URDF) at seeded random joint values
+// checked against KDL's (the KDL chain built from urdfdom's reading of the same URDF, kdl_chain.h) at seeded random joint values
 // within the limits, and refused with the worst pose when they differ by more than 1e-9 m / 1e-9 rad.
 #pragma once
 

@@ -3,7 +3,7 @@
 // RotZ(theta) TransZ(d) (axis z, the model's limits), fixed joints for base_from_link0, link_n_from_flange
 // (to `tip_link`) and flange_from_cam (to `camera_link`, the camera's optical frame). Rotations whose
 // roll-pitch-yaw would be near gimbal lock are written through an intermediate link, so that every
-// origin is exact to rounding. The text is checked with urdfdom + kdl_parser before it is returned.
+// origin is exact to rounding. The text is checked with urdfdom + KDL before it is returned.
 #pragma once
 
 #include <string>

@@ -20,7 +20,7 @@ RobotModel CalibratedLike(const RobotModel& nominal, std::uint64_t seed) {
   return ApplyParameters(nominal, rho);
 }
 
-// KDL's forward kinematics of `text` (re-read by kdl_parser, i.e. urdfdom) against the model's.
+// KDL's forward kinematics of `text` (re-read by urdfdom, the chain built by kdl_chain.h) against the model's.
 void ExpectKdlEqualsModel(const std::string& text, const RobotModel& model) {
   const std::vector<Eigen::VectorXd> joints = RandomJointsWithinLimits(model, 1000, 21);
   Result<std::vector<Rigid3>> tips = KdlChainPoses(text, "written", "base_link", "tool0", joints);

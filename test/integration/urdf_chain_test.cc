@@ -1,5 +1,5 @@
 // A URDF robot end to end: simulate (points mode) with the test UR5e URDF as the nominal robot, then the
-// calibrated.urdf that calibrate wrote re-read by urdfdom + kdl_parser: its KDL forward kinematics equals
+// calibrated.urdf that calibrate wrote re-read by urdfdom + KDL: its KDL forward kinematics equals
 // the calibrated model of calibrated_model.yaml to 1e-9 m / 1e-9 rad at random joints within the limits.
 #include <filesystem>
 
