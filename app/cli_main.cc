@@ -25,6 +25,18 @@ int RunCommandLine(int argc, char** argv, const std::vector<CommandEntry>& entri
   std::vector<std::pair<const char*, Command>> commands;
   for (const CommandEntry& entry : entries) commands.emplace_back(entry.name, entry.add(app));
   AddOutputFlags(app);
+  // CLI11 answers --help before it looks at the other words, so `selfcal calibrat --help` would print
+  // the top-level help and exit 0: a mistyped command or option beside --help is a usage error too.
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--") == 0) break;
+    if (std::strcmp(argv[i], "--help") != 0 && std::strcmp(argv[i], "-h") != 0) continue;
+    if (const std::string message = UnknownNameMessage(app, argc, argv); !message.empty()) {
+      std::cerr << message << "\n";
+      PrintUsageErrorDocument(argc, argv, message);
+      return static_cast<int>(ExitCode::kUsage);
+    }
+    break;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -261,6 +261,13 @@ TEST(CliHelp, SuggestsTheNearestCommandAndOption) {
   EXPECT_NE(output.find("did you mean `discard`?"), std::string::npos) << output;
   EXPECT_EQ(testing::RunSelfcal("xyzzy", &output), 2) << output;
   EXPECT_NE(output.find("unknown command `xyzzy`; the commands are: calibrate"), std::string::npos) << output;
+  // Beside --help too (CLI11 would answer the help first and exit 0), in both executables.
+  EXPECT_EQ(testing::RunSelfcal("calibrat --help", &output), 2) << output;
+  EXPECT_NE(output.find("unknown command `calibrat`; did you mean `calibrate`?"), std::string::npos) << output;
+  EXPECT_EQ(testing::RunSelfcal("calibrate --metod paper --help", &output), 2) << output;
+  EXPECT_NE(output.find("did you mean `--method`?"), std::string::npos) << output;
+  EXPECT_EQ(testing::RunSelfcal("simulate --nois-px 1 --help", &output), 2) << output;
+  EXPECT_NE(output.find("did you mean `--noise-px`?"), std::string::npos) << output;
 }
 
 TEST(CliMessages, FileTextIsEscapedBeforeItReachesTheTerminal) {
