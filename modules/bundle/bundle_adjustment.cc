@@ -317,17 +317,10 @@ void TriangulateStartDots(const Eigen::VectorXd& rho_start, BundleData* data, Bu
 // The rho indices held by request, and the intrinsics estimated after the names (EstimatedIntrinsicsOf).
 // Returns the unknown names, one per line.
 std::string HeldParameters(int num_joints, BundleOptions* options, std::vector<int>* held) {
-  std::string problems = ResolveParameterNames(options->held_parameters, num_joints, held);
-  if (!options->free_parameters.empty()) {
-    std::vector<int> named_free;
-    problems += ResolveParameterNames(options->free_parameters, num_joints, &named_free);
-    const int n = KinematicParameters(num_joints).size();
-    for (int i = 0; i < n; ++i) {
-      if (std::find(named_free.begin(), named_free.end(), i) == named_free.end()) held->push_back(i);
-    }
-    std::sort(held->begin(), held->end());
-    held->erase(std::unique(held->begin(), held->end()), held->end());
-  }
+  std::vector<int> ignored;
+  std::string problems = ResolveParameterNames(options->held_parameters, num_joints, &ignored);
+  if (!options->free_parameters.empty()) problems += ResolveParameterNames(options->free_parameters, num_joints, &ignored);
+  *held = HeldParameterIndices(*options, num_joints);
   options->intrinsics = EstimatedIntrinsicsOf(*options, num_joints);
   if (!held->empty()) options->require_generic_rank = false;
   return problems;

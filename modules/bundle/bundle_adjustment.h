@@ -171,6 +171,10 @@ std::string ResolveParameterNames(const std::vector<std::string>& names, int num
 // held_parameters and free_parameters (unknown names are ignored here; RunBundleAdjustment refuses them).
 IntrinsicsMask EstimatedIntrinsicsOf(const BundleOptions& options, int num_joints);
 
+// The rho indices a bundle with these options holds by request: those named in held_parameters, and
+// with a free_parameters list every index it does not name (unknown names ignored), ascending.
+std::vector<int> HeldParameterIndices(const BundleOptions& options, int num_joints);
+
 // The rho on `target` (same joint count) that gives the same base_from_cam(q) for every q as `source_rho`
 // on `source`: joint parameters copied, base and camera corrections re-expressed against target's
 // constant transforms (exact). E.g. the paper pipeline's metric calibrated model on the nominal model.

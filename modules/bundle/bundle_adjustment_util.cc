@@ -6,6 +6,8 @@
 #include "base/status.h"
 #include "bundle/bundle_adjustment.h"
 
+#include <algorithm>
+
 namespace selfcal::bundle {
 
 std::string BundleOptions::Validate() const {
@@ -96,6 +98,22 @@ IntrinsicsMask EstimatedIntrinsicsOf(const BundleOptions& options, int num_joint
   }
   for (int k = 0; k < kNumIntrinsics; ++k) out[k] = out[k] && !held[k];
   return out;
+}
+
+std::vector<int> HeldParameterIndices(const BundleOptions& options, int num_joints) {
+  std::vector<int> held;
+  ResolveParameterNames(options.held_parameters, num_joints, &held);
+  if (!options.free_parameters.empty()) {
+    std::vector<int> named_free;
+    ResolveParameterNames(options.free_parameters, num_joints, &named_free);
+    const int n = KinematicParameters(num_joints).size();
+    for (int i = 0; i < n; ++i) {
+      if (std::find(named_free.begin(), named_free.end(), i) == named_free.end()) held.push_back(i);
+    }
+    std::sort(held.begin(), held.end());
+    held.erase(std::unique(held.begin(), held.end()), held.end());
+  }
+  return held;
 }
 
 const char* OutcomeName(Outcome outcome) {

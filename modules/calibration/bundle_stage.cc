@@ -81,8 +81,16 @@ BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineR
                                  const BundleStageOptions& options) {
   const auto clock_start = std::chrono::steady_clock::now();
   BundleStageReport report;
-  const Eigen::VectorXd rho_start =
+  Eigen::VectorXd rho_start =
       BundleStartFromPaper(obs, paper, &report.fx_start_px, &report.start, &report.start_note);
+  // A held parameter is the robot description's value, not the paper pipeline's estimate of it: the bundle
+  // keeps held entries at their start (`--fix kinematics` trusts the nominal kinematics).
+  const std::vector<int> held = bundle::HeldParameterIndices(options.bundle, obs.robot.num_joints());
+  if (!held.empty() && report.start == BundleStart::kPaperPipeline) {
+    const Eigen::VectorXd nominal = KinematicParameters::Nominal(obs.robot);
+    for (const int i : held) rho_start[i] = nominal[i];
+    report.start_note += "; held parameters at nominal";
+  }
   // A held f_x is the one the user stated (the observations' camera), not the paper's estimate.
   if (!bundle::EstimatedIntrinsicsOf(options.bundle, obs.robot.num_joints())[kFx]) {
     report.fx_start_px = obs.camera.fx_px;

@@ -119,6 +119,31 @@ TEST(BundleStage, HeldOutErrorBelowThePaperPipelinesAtAFifthOfAPixel) {
   EXPECT_LT(median(bundle_pose), 0.5 * median(paper_pose));
 }
 
+// A parameter held by request keeps the robot description's value, not the paper pipeline's estimate of
+// it (`--fix j3`, `--fix kinematics`: the user trusts the nominal values).
+TEST(BundleStage, HeldParametersStayAtTheirNominalValuesNotThePaperPipelines) {
+  const sim::SimResult world = World(0.2, 3);
+  const ObservationSet& obs = world.observations;
+  const PaperPipelineReport paper = RunPaperPipeline(obs, PaperPipelineOptions());
+  ASSERT_EQ(paper.outcome, Outcome::kSuccess) << paper.message;
+  BundleStageOptions options;
+  options.bundle.held_parameters = {"j3"};
+  const BundleStageReport r = RunBundleStage(obs, paper, options);
+  ASSERT_EQ(r.bundle.outcome, bundle::Outcome::kConverged) << r.bundle.message;
+  ASSERT_EQ(r.start, BundleStart::kPaperPipeline) << r.start_note;
+  const KinematicParameters names(6);
+  const Eigen::VectorXd nominal = KinematicParameters::Nominal(obs.robot);
+  const Eigen::VectorXd from_paper = bundle::ExpressOnModel(obs.robot, paper.calibrated_robot, paper.calibrated_rho);
+  int moved_by_paper = 0;
+  for (int i = 0; i < names.size(); ++i) {
+    if (names.name(i).rfind("j3.", 0) != 0) continue;
+    EXPECT_EQ(r.bundle.rho[i], nominal[i]) << names.name(i);
+    moved_by_paper += from_paper[i] != nominal[i] ? 1 : 0;
+  }
+  EXPECT_GT(moved_by_paper, 0) << "the paper pipeline estimated none of j3's parameters: the test shows nothing";
+  EXPECT_NE(r.start_note.find("held parameters at nominal"), std::string::npos) << r.start_note;
+}
+
 TEST(BundleStage, FailedPaperPipelineStartsFromTheNominalModelWithThePrior) {
   const sim::SimResult world = World(0.2, 1);
   PaperPipelineReport failed;
