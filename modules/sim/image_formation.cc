@@ -2,11 +2,38 @@
 
 #include <algorithm>
 #include <cmath>
-#include <random>
 
 namespace selfcal::sim {
 
 namespace {
+
+// Ziggurat of Doornik (2005), "An Improved Ziggurat Method to Generate Normal Random Samples": 128
+// layers of equal area kV, the base layer's tail beyond kR.
+constexpr int kLayers = 128;
+constexpr double kR = 3.442619855899;
+constexpr double kV = 9.91256303526217e-3;
+
+struct ZigguratTables {
+  double x[kLayers + 1];  // the layers' right edges, decreasing from x[1] = kR to x[kLayers] = 0
+  double ratio[kLayers];  // x[i + 1] / x[i]: the part of layer i wholly under the curve
+};
+
+const ZigguratTables& Tables() {
+  static const ZigguratTables tables = [] {
+    ZigguratTables t{};
+    double f = std::exp(-0.5 * kR * kR);
+    t.x[0] = kV / f;  // the base layer's rectangle, as wide as its area with the tail
+    t.x[1] = kR;
+    t.x[kLayers] = 0;
+    for (int i = 2; i < kLayers; ++i) {
+      t.x[i] = std::sqrt(-2 * std::log(kV / t.x[i - 1] + f));
+      f = std::exp(-0.5 * t.x[i] * t.x[i]);
+    }
+    for (int i = 0; i < kLayers; ++i) t.ratio[i] = t.x[i + 1] / t.x[i];
+    return t;
+  }();
+  return tables;
+}
 
 // Columns [lo, hi] of one row, inclusive.
 struct Span {
@@ -182,14 +209,13 @@ void FormImage(FrameBuffers* frame, const RenderOptions& options, uint64_t noise
   unsigned char* out = image->bitmap;
   const bool noisy = options.noise_std_grey > 0;
   const double sigma = options.noise_std_grey;
-  std::mt19937_64 rng(noise_seed);
-  std::normal_distribution<double> noise(0.0, 1.0);
+  GaussianNoise noise(noise_seed);
   std::vector<double> deviates(static_cast<size_t>(width));  // one row's, drawn in pixel order
   const unsigned char plain = RoundToGrey(elsewhere);
   for (int v = 0; v < height; ++v) {
     const size_t row = static_cast<size_t>(v) * width;
     if (noisy) {
-      for (double& d : deviates) d = noise(rng);
+      noise.Fill(deviates.data(), deviates.size());
     }
     int u = 0;
     auto fill_to = [&](int end) {  // columns [u, end): the constant grey level
@@ -210,6 +236,35 @@ void FormImage(FrameBuffers* frame, const RenderOptions& options, uint64_t noise
     }
     fill_to(width);
   }
+}
+
+GaussianNoise::GaussianNoise(uint64_t seed) : state_(seed), edge_(Tables().x), ratio_(Tables().ratio) {
+  state_ = Bits();  // nearby seeds, distant states
+}
+
+double GaussianNoise::Edge(int layer, double u) {
+  const ZigguratTables& t = Tables();
+  for (int i = layer;;) {
+    if (std::abs(u) < t.ratio[i]) return u * t.x[i];
+    if (i == 0) return Tail(u < 0);
+    const double x = u * t.x[i];
+    const double f0 = std::exp(-0.5 * (t.x[i] * t.x[i] - x * x));          // f(x) / f(x[i])
+    const double f1 = std::exp(-0.5 * (t.x[i + 1] * t.x[i + 1] - x * x));  // f(x) / f(x[i + 1])
+    if (f1 + Uniform() * (f0 - f1) < 1.0) return x;
+    const uint64_t bits = Bits();  // rejected: a new layer and uniform
+    i = static_cast<int>(bits & 0x7f);
+    u = 2 * Unit(bits) - 1;
+  }
+}
+
+// Marsaglia's (1964) tail beyond kR.
+double GaussianNoise::Tail(bool negative) {
+  double x, y;
+  do {
+    x = std::log(1 - Uniform()) / kR;  // 1 - [0, 1) = (0, 1]: finite logarithms
+    y = std::log(1 - Uniform());
+  } while (-2 * y < x * x);
+  return negative ? x - kR : kR - x;
 }
 
 }  // namespace selfcal::sim

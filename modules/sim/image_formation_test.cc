@@ -15,6 +15,63 @@
 namespace selfcal::sim {
 namespace {
 
+// Standard normal CDF.
+double Phi(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
+
+// The ziggurat's deviates are standard normal: moments, tail fractions beyond the ziggurat's base
+// (3.44) and further, and the Kolmogorov-Smirnov distance, over n = 2^21 deviates. Standard errors:
+// mean 1 / sqrt(n) = 6.9e-4, variance sqrt(2 / n) = 9.8e-4, fraction p: sqrt(p / n); tolerances 5 of
+// them. The KS distance's 0.1 % critical value is 1.95 / sqrt(n) = 1.3e-3.
+TEST(GaussianNoise, DeviatesAreStandardNormal) {
+  const size_t n = size_t{1} << 21;
+  std::vector<double> x(n);
+  GaussianNoise noise(20261203);
+  noise.Fill(x.data(), n);
+  double sum = 0, sum2 = 0, sum4 = 0;
+  size_t beyond_1 = 0, beyond_base = 0, beyond_4 = 0;
+  for (double v : x) {
+    ASSERT_TRUE(std::isfinite(v));
+    sum += v;
+    sum2 += v * v;
+    sum4 += v * v * v * v;
+    beyond_1 += std::abs(v) > 1;
+    beyond_base += std::abs(v) > 3.442619855899;
+    beyond_4 += std::abs(v) > 4;
+  }
+  const double mean = sum / n, variance = sum2 / n - mean * mean;
+  EXPECT_NEAR(mean, 0.0, 5 / std::sqrt(n));
+  EXPECT_NEAR(variance, 1.0, 5 * std::sqrt(2.0 / n));
+  EXPECT_NEAR(sum4 / n, 3.0, 5 * std::sqrt(96.0 / n));  // E x^4 = 3, var x^4 = 105 - 9
+  auto expect_fraction = [n](size_t count, double beyond, const char* what) {
+    const double p = 2 * (1 - Phi(beyond));
+    EXPECT_NEAR(static_cast<double>(count) / n, p, 5 * std::sqrt(p / n) + 1.0 / n) << what;
+  };
+  expect_fraction(beyond_1, 1, "|x| > 1");
+  expect_fraction(beyond_base, 3.442619855899, "|x| > R (the tail)");
+  expect_fraction(beyond_4, 4, "|x| > 4");
+  std::sort(x.begin(), x.end());
+  double ks = 0;
+  for (size_t k = 0; k < n; k += 7) {  // every 7th order statistic
+    const double cdf = Phi(x[k]);
+    ks = std::max({ks, std::abs(cdf - static_cast<double>(k) / n), std::abs(cdf - static_cast<double>(k + 1) / n)});
+  }
+  EXPECT_LT(ks, 1.95 / std::sqrt(n));
+}
+
+// The same seed gives the same deviates, Next and Fill alike; neighbouring seeds are unrelated.
+TEST(GaussianNoise, SeededAndReproducible) {
+  std::vector<double> a(1000), b(1000), c(1000);
+  GaussianNoise(5).Fill(a.data(), a.size());
+  GaussianNoise one_by_one(5);
+  for (double& v : b) v = one_by_one.Next();
+  EXPECT_EQ(a, b);
+  GaussianNoise(6).Fill(c.data(), c.size());
+  double correlation = 0;
+  for (size_t k = 0; k < a.size(); ++k) correlation += a[k] * c[k];
+  EXPECT_LT(std::abs(correlation / a.size()), 5 / std::sqrt(1000.0));  // independent: ~ 1 / sqrt(n)
+  EXPECT_NE(a, c);
+}
+
 // The blur the renderer had before it blurred only around the dots: every pixel of the frame, border
 // replicated, horizontal then vertical, the taps in ascending order.
 std::vector<double> FullFrameBlur(std::vector<double> image, int width, int height, double sigma) {
