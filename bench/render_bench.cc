@@ -5,6 +5,9 @@
 // frame; docs/performance.md has the table.
 #include <benchmark/benchmark.h>
 
+#include <vector>
+
+#include "sim/image_formation.h"
 #include "sim/image_renderer.h"
 #include "sim/sim_world.h"
 #include "support/sim_worlds.h"
@@ -43,6 +46,18 @@ void BM_RenderFrame(benchmark::State& state) {
 }
 BENCHMARK(BM_RenderFrame)->ArgNames({"noise_grey", "blur_px"})->Args({0, 0})->Args({2, 0})->Args({5, 1})
     ->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
+
+// The renderer's Gaussian noise alone: one frame's 640 x 480 deviates.
+void BM_GaussianNoiseFrame(benchmark::State& state) {
+  std::vector<double> deviates(640 * 480);
+  uint64_t seed = 7;
+  for (auto _ : state) {
+    sim::GaussianNoise noise(seed++);
+    noise.Fill(deviates.data(), deviates.size());
+    benchmark::DoNotOptimize(deviates.data());
+  }
+}
+BENCHMARK(BM_GaussianNoiseFrame)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
 
 }  // namespace
 }  // namespace selfcal

@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <random>
 #include <sstream>
 
 #include <Eigen/LU>
 
 #include "base/status.h"
+#include "sim/image_formation.h"
 
 namespace selfcal::sim {
 
@@ -36,38 +36,21 @@ void ProjectWithDerivative(const CameraIntrinsics& cam, const Eigen::Vector3d& p
   *duv = Eigen::Vector2d(cam.fx_px * (dx * s + x * ds), cam.fx_px * cam.mu * (dy * s + y * ds));
 }
 
-// Separable Gaussian blur of a row-major float image, border replicated. Away from the border the taps
-// need no clamping (the same terms in the same order).
-void GaussianBlur(std::vector<double>* image, int width, int height, double sigma) {
-  const int radius = static_cast<int>(std::ceil(4.0 * sigma));
-  std::vector<double> kernel(2 * radius + 1);
-  double sum = 0;
-  for (int k = -radius; k <= radius; ++k) sum += kernel[k + radius] = std::exp(-0.5 * k * k / (sigma * sigma));
-  for (double& w : kernel) w /= sum;
-  const double* weights = kernel.data() + radius;  // weights[k], k in [-radius, radius]
-  std::vector<double> tmp(image->size());
-  const std::vector<double>& in = *image;
-  for (int v = 0; v < height; ++v) {
-    const double* row = &in[static_cast<size_t>(v) * width];
-    for (int u = 0; u < width; ++u) {
-      double acc = 0;
-      if (u >= radius && u + radius < width) {
-        for (int k = -radius; k <= radius; ++k) acc += weights[k] * row[u + k];
-      } else {
-        for (int k = -radius; k <= radius; ++k) acc += weights[k] * row[std::clamp(u + k, 0, width - 1)];
-      }
-      tmp[static_cast<size_t>(v) * width + u] = acc;
+// cos t and sin t of the rim points t = 2 pi k / kRimPoints, computed once.
+struct RimAngles {
+  double cos[kRimPoints], sin[kRimPoints];
+};
+const RimAngles& Angles() {
+  static const RimAngles angles = [] {
+    RimAngles a{};
+    for (int k = 0; k < kRimPoints; ++k) {
+      const double t = 2 * kPi * k / kRimPoints;
+      a.cos[k] = std::cos(t);
+      a.sin[k] = std::sin(t);
     }
-  }
-  std::vector<double> acc(static_cast<size_t>(width));
-  for (int v = 0; v < height; ++v) {
-    std::fill(acc.begin(), acc.end(), 0.0);
-    for (int k = -radius; k <= radius; ++k) {  // row by row: the same sum per pixel, k ascending
-      const double* row = &tmp[static_cast<size_t>(std::clamp(v + k, 0, height - 1)) * width];
-      for (int u = 0; u < width; ++u) acc[static_cast<size_t>(u)] += weights[k] * row[u];
-    }
-    std::copy(acc.begin(), acc.end(), image->begin() + static_cast<std::ptrdiff_t>(v) * width);
-  }
+    return a;
+  }();
+  return angles;
 }
 
 // Pixel bounds of a projected rim (px, pixel centres at integers).
@@ -83,10 +66,10 @@ struct RimBounds {
 bool TraceRim(const CameraIntrinsics& camera, const Eigen::Vector3d& c, const Eigen::Vector3d& e1,
               const Eigen::Vector3d& e2, double r, RenderedDot* dot, std::vector<Eigen::Vector2d>* rim,
               RimBounds* bounds) {
+  const RimAngles& angles = Angles();
   bool in_front = c.z() > 0;
   for (int k = 0; k < kRimPoints && in_front; ++k) {
-    const double t = 2 * kPi * k / kRimPoints;
-    in_front = (c + r * (std::cos(t) * e1 + std::sin(t) * e2)).z() > 1e-9;
+    in_front = (c + r * (angles.cos[k] * e1 + angles.sin[k] * e2)).z() > 1e-9;
   }
   if (!in_front) return false;
   dot->in_front = true;
@@ -99,9 +82,8 @@ bool TraceRim(const CameraIntrinsics& camera, const Eigen::Vector3d& c, const Ei
   double& vmax = bounds->vmax;
   rim->reserve(kRimPoints);
   for (int k = 0; k < kRimPoints; ++k) {
-    const double t = 2 * kPi * k / kRimPoints;
-    const Eigen::Vector3d p = c + r * (std::cos(t) * e1 + std::sin(t) * e2);
-    const Eigen::Vector3d dp = r * (-std::sin(t) * e1 + std::cos(t) * e2);
+    const Eigen::Vector3d p = c + r * (angles.cos[k] * e1 + angles.sin[k] * e2);
+    const Eigen::Vector3d dp = r * (-angles.sin[k] * e1 + angles.cos[k] * e2);
     Eigen::Vector2d uv, duv;
     ProjectWithDerivative(camera, p, dp, &uv, &duv);
     rim->push_back(uv);
@@ -127,11 +109,38 @@ bool TraceRim(const CameraIntrinsics& camera, const Eigen::Vector3d& c, const Ei
   return true;
 }
 
+// PixelToNormalized(camera, camera.fx_px, (u, v)), by a scalar Newton iteration when the lens is
+// radial (p1 = p2 = 0): the 2-D iteration's steps then lie along the ray from the principal point
+// (the distorted point is an eigenvector of the Jacobian), so it is this one on the radius, rho
+// (1 + k1 rho^2 + k2 rho^4 + k3 rho^6) = rho_d, without the 2 x 2 solves, from a closer start. Both converge to the last
+// bits; where they differ in the last bit a sample's verdict could change only within ~1e-15 of the rim.
+Eigen::Vector2d Undistort(const CameraIntrinsics& camera, double u, double v) {
+  const double xd = (u - camera.cx_px) / camera.fx_px;
+  const double yd = ((v - camera.cy_px) / camera.mu) / camera.fx_px;
+  if (!camera.HasDistortion()) return Eigen::Vector2d(xd, yd);
+  const double rd = std::sqrt(xd * xd + yd * yd);
+  if (camera.p1 != 0 || camera.p2 != 0 || rd == 0) return PixelToNormalized(camera, camera.fx_px, Eigen::Vector2d(u, v));
+  const double k1 = camera.k1, k2 = camera.k2, k3 = camera.k3;
+  const double rd2 = rd * rd;
+  double rho = rd / (1 + k1 * rd2 + k2 * rd2 * rd2 + k3 * rd2 * rd2 * rd2);  // first order in the coefficients
+  if (!(rho > 0)) rho = rd;
+  for (int i = 0; i < 50; ++i) {
+    const double r2 = rho * rho;
+    const double radial = 1 + k1 * r2 + k2 * r2 * r2 + k3 * r2 * r2 * r2;
+    const double slope = 1 + 3 * k1 * r2 + 5 * k2 * r2 * r2 + 7 * k3 * r2 * r2 * r2;
+    const double step = (rho * radial - rd) / slope;
+    if (!std::isfinite(step)) break;
+    rho -= step;
+    if (std::abs(step) <= 1e-15 * std::max(1.0, rho)) return Eigen::Vector2d(xd, yd) * (rho / rd);
+  }
+  return PixelToNormalized(camera, camera.fx_px, Eigen::Vector2d(u, v));  // not converged: the 2-D iteration's answer
+}
+
 // Where the ray through pixel point (u, v) meets the plane of the disc (centre c, normal n; camera
 // frame, m); false when it meets it nowhere in front. The same arithmetic for samples and pixel corners.
 bool PlanePoint(const CameraIntrinsics& camera, const Eigen::Vector3d& n, double n_dot_c, double u, double v,
                 Eigen::Vector3d* point) {
-  const Eigen::Vector2d xy = PixelToNormalized(camera, camera.fx_px, Eigen::Vector2d(u, v));
+  const Eigen::Vector2d xy = Undistort(camera, u, v);
   const Eigen::Vector3d ray(xy.x(), xy.y(), 1.0);
   const double denominator = n.dot(ray);
   if (denominator == 0) return false;
@@ -155,27 +164,31 @@ struct PlaneSample {
 // tests keeps every decided block's samples on the side the per-sample test puts them.
 int8_t DecideBlock(const PlaneSample* const corners[4], const PlaneSample& centre, const Eigen::Vector3d& c, double r) {
   if (!centre.ok) return 0;
-  double spread = 0, farthest = 0;
+  double spread2 = 0, farthest2 = 0;  // the largest squared distances: sqrt is monotone, one root each
   for (int k = 0; k < 4; ++k) {
     if (!corners[k]->ok) return 0;
-    spread = std::max(spread, (corners[k]->point - centre.point).norm());
-    farthest = std::max(farthest, (corners[k]->point - c).norm());
+    spread2 = std::max(spread2, (corners[k]->point - centre.point).squaredNorm());
+    farthest2 = std::max(farthest2, (corners[k]->point - c).squaredNorm());
   }
+  const double spread = std::sqrt(spread2), farthest = std::sqrt(farthest2);
   const double margin = 0.25 * spread;
   if (farthest + margin < r) return 1;
   if ((centre.point - c).norm() - spread - margin > r) return -1;
   return 0;
 }
 
-// The disc's blocks over a box of pixels: each pixel decided whole, and each undecided one by quarters
-// (when s is even), so that only the samples near the rim are projected one by one.
+// The disc's blocks over a box of pixels: each pixel decided whole, and the samples of each undecided
+// one by interpolation (Verdicts), so that only the samples nearest the rim are projected one by one.
 class DiscBlocks {
  public:
   DiscBlocks(const CameraIntrinsics& camera, const Eigen::Vector3d& c, const Eigen::Vector3d& n, double r, int s,
              int i0, int i1, int j0, int j1)
       : camera_(camera), c_(c), n_(n), n_dot_c_(n.dot(c)), r_(r), s_(s), i0_(i0), j0_(j0), w_(i1 - i0 + 1),
         h_(j1 - j0 + 1), corners_(static_cast<size_t>(w_ + 1) * (h_ + 1)), centres_(static_cast<size_t>(w_) * h_),
-        kind_(centres_.size(), 0) {
+        kind_(centres_.size(), 0), all_bits_(s == 8 ? ~uint64_t{0} : (uint64_t{1} << (s * s)) - 1) {
+    for (int a = 0; a < s; ++a) offsets_[a] = (a + 0.5) / s - 0.5;
+    fits_w_ = (w_ + 1) / 2;
+    fits_.resize(static_cast<size_t>(fits_w_) * ((h_ + 1) / 2));
     for (int gj = 0; gj <= h_; ++gj) {
       for (int gi = 0; gi <= w_; ++gi) corners_[Corner(gi, gj)] = At(i0 + gi - 0.5, j0 + gj - 0.5);
     }
@@ -198,34 +211,85 @@ class DiscBlocks {
   double n_dot_c() const { return n_dot_c_; }
   int8_t Pixel(int i, int j) const { return kind_[static_cast<size_t>(j - j0_) * w_ + (i - i0_)]; }
 
-  // The kinds of the four quarters of undecided pixel (i, j), row-major (0 each when s is odd).
-  std::array<int8_t, 4> Quarters(int i, int j) const {
-    std::array<int8_t, 4> quarters{0, 0, 0, 0};
-    if (s_ % 2 != 0) return quarters;
+  // The samples of undecided pixel (i, j) decided without projecting each: f = |plane point - c|^2 - r^2
+  // is interpolated biquadratically over the 2 x 2 pixels around it from its values at their 9 corners
+  // (the map to the plane is a homography after the lens: over 2 px f is a quadratic up to third-order
+  // terms ~1e-3 of a sample spacing). The interpolant's error at the 4 pixel centres, where the nodal
+  // polynomial of the nodes -1, 0, 1 is within 3 % of its largest value, bounds it over the block; a
+  // sample is decided when its interpolated f is beyond 50 times that bound. Sets the bits (b s + a) of
+  // the samples surely inside in *dark and of those to be projected in *unsure (all of them when the box
+  // is narrower than 2 px or a ray of the block misses the plane). The same corners and centres as the
+  // pixels' decisions: no new projection.
+  void Verdicts(int i, int j, uint64_t* dark, uint64_t* unsure) {
+    *dark = 0;
+    *unsure = all_bits_;
+    if (w_ < 2 || h_ < 2) return;
     const int gi = i - i0_, gj = j - j0_;
-    PlaneSample grid[3][3];  // [row][column]: pixel corners, edge midpoints, centre
-    grid[0][0] = corners_[Corner(gi, gj)];
-    grid[0][2] = corners_[Corner(gi + 1, gj)];
-    grid[2][0] = corners_[Corner(gi, gj + 1)];
-    grid[2][2] = corners_[Corner(gi + 1, gj + 1)];
-    grid[1][1] = centres_[static_cast<size_t>(gj) * w_ + gi];
-    grid[0][1] = At(i, j - 0.5);
-    grid[1][0] = At(i - 0.5, j);
-    grid[1][2] = At(i + 0.5, j);
-    grid[2][1] = At(i, j + 0.5);
-    for (int qb = 0; qb < 2; ++qb) {
-      for (int qa = 0; qa < 2; ++qa) {
-        const PlaneSample* const corners[4] = {&grid[qb][qa], &grid[qb][qa + 1], &grid[qb + 1][qa],
-                                               &grid[qb + 1][qa + 1]};
-        quarters[static_cast<size_t>(2 * qb + qa)] =
-            DecideBlock(corners, At(i - 0.25 + 0.5 * qa, j - 0.25 + 0.5 * qb), c_, r_);
+    const int bi = gi / 2, bj = gj / 2;  // the block; an odd last column or row shares the one before's pixel
+    const int ci = std::min(2 * bi, w_ - 2), cj = std::min(2 * bj, h_ - 2);  // the block's first corner
+    BlockFit& fit = fits_[static_cast<size_t>(bj) * fits_w_ + bi];
+    if (!fit.done) Fit(ci, cj, &fit);
+    if (!fit.ok) return;
+    uint64_t inside = 0, undecided = 0;
+    const double u0 = i - (i0_ + ci + 0.5), v0 = j - (j0_ + cj + 0.5);  // pixel centre - block centre, px
+    for (int b = 0; b < s_; ++b) {
+      double wv[3];
+      Weights(v0 + offsets_[b], wv);
+      double g[3];
+      for (int p = 0; p < 3; ++p) g[p] = wv[0] * fit.f[0][p] + wv[1] * fit.f[1][p] + wv[2] * fit.f[2][p];
+      for (int a = 0; a < s_; ++a) {
+        double wu[3];
+        Weights(u0 + offsets_[a], wu);
+        const double value = wu[0] * g[0] + wu[1] * g[1] + wu[2] * g[2];
+        const int bit = b * s_ + a;
+        inside |= static_cast<uint64_t>(value < -fit.tolerance) << bit;
+        undecided |= static_cast<uint64_t>(value >= -fit.tolerance && value <= fit.tolerance) << bit;
       }
     }
-    return quarters;
+    *dark = inside;
+    *unsure = undecided;
   }
 
  private:
+  // f at a 2 x 2 pixel block's 9 corners [row][column] and the margin of its interpolation.
+  struct BlockFit {
+    bool done = false, ok = false;
+    double f[3][3] = {};
+    double tolerance = 0;
+  };
+  void Fit(int ci, int cj, BlockFit* fit) const {
+    fit->done = true;
+    for (int q = 0; q < 3; ++q) {
+      for (int p = 0; p < 3; ++p) {
+        const PlaneSample& node = corners_[Corner(ci + p, cj + q)];
+        if (!node.ok) return;
+        fit->f[q][p] = (node.point - c_).squaredNorm() - r_ * r_;
+      }
+    }
+    double error = 0;
+    for (int q = 0; q < 2; ++q) {
+      for (int p = 0; p < 2; ++p) {
+        const PlaneSample& check = centres_[static_cast<size_t>(cj + q) * w_ + ci + p];
+        if (!check.ok) return;
+        double wu[3], wv[3];
+        Weights(p == 0 ? -0.5 : 0.5, wu);
+        Weights(q == 0 ? -0.5 : 0.5, wv);
+        double value = 0;
+        for (int k = 0; k < 3; ++k) value += wv[k] * (wu[0] * fit->f[k][0] + wu[1] * fit->f[k][1] + wu[2] * fit->f[k][2]);
+        error = std::max(error, std::abs(value - ((check.point - c_).squaredNorm() - r_ * r_)));
+      }
+    }
+    fit->tolerance = 50 * error + 1e-9 * r_ * r_;
+    fit->ok = true;
+  }
+
   size_t Corner(int gi, int gj) const { return static_cast<size_t>(gj) * (w_ + 1) + gi; }
+  // Lagrange weights of the nodes at t = -1, 0, 1 (t: the offset from the block's centre, px).
+  static void Weights(double t, double w[3]) {
+    w[0] = 0.5 * t * (t - 1);
+    w[1] = 1 - t * t;
+    w[2] = 0.5 * t * (t + 1);
+  }
 
   const CameraIntrinsics& camera_;
   Eigen::Vector3d c_, n_;
@@ -233,16 +297,37 @@ class DiscBlocks {
   int s_, i0_, j0_, w_, h_;
   std::vector<PlaneSample> corners_, centres_;
   std::vector<int8_t> kind_;
+  uint64_t all_bits_;
+  double offsets_[8];  // of the samples a = 0..s-1 from the pixel's centre, px
+  int fits_w_;
+  std::vector<BlockFit> fits_;  // per 2 x 2 block, row-major, filled when first needed
 };
+
+// The number of set bits of an 8-bit row and the sum of their positions, from a table.
+struct RowBits {
+  uint8_t count[256], position_sum[256];
+};
+const RowBits& RowBitTable() {
+  static const RowBits table = [] {
+    RowBits t{};
+    for (int row = 0; row < 256; ++row) {
+      for (int a = 0; a < 8; ++a) {
+        if ((row >> a) & 1) t.count[row] += 1, t.position_sum[row] += static_cast<uint8_t>(a);
+      }
+    }
+    return t;
+  }();
+  return table;
+}
 
 // The s x s samples of every pixel in the bounds (one pixel of margin: the rim points are 1.4 degrees
 // apart) that see the disc (centre c, normal n, radius r; camera frame, m). Sets the dot's sample area
 // and centroid; ORs its samples into `mask` (one bit per sample, all dots) and marks the dots whose
-// samples it shares as overlapping neighbours (`owner`: the last dot that darkened a sample there).
-// Blocks DiscBlocks decides are not projected sample by sample: the same bits and sums, in the same order.
+// samples it shares as overlapping neighbours (`owner`: the last dot that darkened a sample there);
+// adds the box to frame->boxes. Samples DiscBlocks decides are not projected one by one: the same bits,
+// and the same sums (exact integers, or in the samples' order).
 void SampleDisc(const CameraIntrinsics& camera, const Eigen::Vector3d& c, const Eigen::Vector3d& n, double r, int s,
-                const RimBounds& bounds, size_t d, std::vector<RenderedDot>* dots, std::vector<uint64_t>* mask,
-                std::vector<int>* owner) {
+                const RimBounds& bounds, size_t d, std::vector<RenderedDot>* dots, FrameBuffers* frame) {
   const int width = camera.width_px, height = camera.height_px;
   const double inv_s2 = 1.0 / (s * s);
   RenderedDot& dot = (*dots)[d];
@@ -250,32 +335,48 @@ void SampleDisc(const CameraIntrinsics& camera, const Eigen::Vector3d& c, const 
   const int i1 = std::min(width - 1, static_cast<int>(std::ceil(bounds.umax - 0.5)) + 1);
   const int j0 = std::max(0, static_cast<int>(std::floor(bounds.vmin + 0.5)) - 1);
   const int j1 = std::min(height - 1, static_cast<int>(std::ceil(bounds.vmax - 0.5)) + 1);
-  long long dark = 0;
+  // With s a power of two every sample coordinate is a multiple of 1 / (2 s): the coordinate sums are
+  // integers in those units, exact in any order (the per-sample double sums were exact too), so whole
+  // pixels add closed forms. Other s keep the ordered per-sample double sums.
+  const bool exact_sums = (s & (s - 1)) == 0;
+  const RowBits& row_bits = RowBitTable();
+  const uint64_t full_bits = s == 8 ? ~uint64_t{0} : (uint64_t{1} << (s * s)) - 1;
+  long long dark = 0, su2s = 0, sv2s = 0;  // sums of 2 s u and 2 s v (exact_sums)
   double su = 0, sv = 0;
   if (i0 <= i1 && j0 <= j1) {
-    const DiscBlocks blocks(camera, c, n, r, s, i0, i1, j0, j1);
+    frame->boxes.push_back(PixelBox{i0, i1, j0, j1});
+    std::vector<uint64_t>* mask = &frame->mask;  // dark samples, all dots
+    std::vector<int>* owner = &frame->owner;     // the last dot that darkened a sample of the pixel
+    DiscBlocks blocks(camera, c, n, r, s, i0, i1, j0, j1);
     for (int j = j0; j <= j1; ++j) {
       for (int i = i0; i <= i1; ++i) {
         const int8_t pixel = blocks.Pixel(i, j);
         if (pixel < 0) continue;
-        std::array<int8_t, 4> quarters{pixel, pixel, pixel, pixel};
-        if (pixel == 0) quarters = blocks.Quarters(i, j);
-        uint64_t bits = 0;
-        for (int b = 0; b < s; ++b) {
-          const double v = j - 0.5 + (b + 0.5) / s;
-          for (int a = 0; a < s; ++a) {
-            const double u = i - 0.5 + (a + 0.5) / s;
-            const int8_t kind = quarters[static_cast<size_t>(2 * (2 * b >= s) + (2 * a >= s))];
-            if (kind < 0) continue;
-            if (kind == 0) {
-              Eigen::Vector3d point;
-              if (!PlanePoint(camera, n, blocks.n_dot_c(), u, v, &point)) continue;
-              if (!((point - c).squaredNorm() <= r * r)) continue;
-            }
-            bits |= uint64_t{1} << (b * s + a);
+        uint64_t bits = full_bits, unsure = 0;
+        if (pixel == 0) blocks.Verdicts(i, j, &bits, &unsure);
+        for (; unsure != 0; unsure &= unsure - 1) {  // project the undecided samples
+          const int bit = __builtin_ctzll(unsure);
+          Eigen::Vector3d point;
+          if (!PlanePoint(camera, n, blocks.n_dot_c(), i - 0.5 + (bit % s + 0.5) / s, j - 0.5 + (bit / s + 0.5) / s,
+                          &point)) {
+            continue;
+          }
+          if ((point - c).squaredNorm() <= r * r) bits |= uint64_t{1} << bit;
+        }
+        if (exact_sums) {  // per row b: sum over its dark a of (2 s i - s + 2 a + 1), and of (2 s j - s + 2 b + 1)
+          for (int b = 0; b < s; ++b) {
+            const unsigned row = static_cast<unsigned>((bits >> (b * s)) & ((1u << s) - 1));
+            const int count = row_bits.count[row];
+            dark += count;
+            su2s += count * (2LL * s * i - s + 1) + 2 * row_bits.position_sum[row];
+            sv2s += count * (2LL * s * j - s + 2 * b + 1);
+          }
+        } else {  // the double sums in the samples' order, b then a
+          for (uint64_t rest = bits; rest != 0; rest &= rest - 1) {
+            const int bit = __builtin_ctzll(rest);
             ++dark;
-            su += u;
-            sv += v;
+            su += i - 0.5 + (bit % s + 0.5) / s;
+            sv += j - 0.5 + (bit / s + 0.5) / s;
           }
         }
         if (bits == 0) continue;
@@ -292,6 +393,10 @@ void SampleDisc(const CameraIntrinsics& camera, const Eigen::Vector3d& c, const 
         (*owner)[at] = dot.id;
       }
     }
+  }
+  if (exact_sums) {
+    su = static_cast<double>(su2s) / (2 * s);
+    sv = static_cast<double>(sv2s) / (2 * s);
   }
   dot.visible = dark > 0;
   dot.clipped = dot.visible && !dot.fully_inside;
@@ -310,12 +415,21 @@ void MarkNearNeighbours(const std::vector<std::vector<Eigen::Vector2d>>& rims, d
       if (!db.visible) continue;
       const double centre_distance = (da.area_centroid_px - db.area_centroid_px).norm();
       if (centre_distance > da.max_radius_px + db.max_radius_px + merge_gap_px) continue;
-      double closest = 1e300;
-      for (const Eigen::Vector2d& p : rims[a]) {
-        for (const Eigen::Vector2d& q : rims[b]) closest = std::min(closest, (p - q).squaredNorm());
+      bool near = da.overlapping && std::count(da.neighbours.begin(), da.neighbours.end(), db.id) > 0;
+      // Some rim pair closer than the gap. A point of rim a farther than max_radius_px + gap from b's
+      // centroid has no such partner (triangle inequality, with a margin for round-off).
+      const double reach = db.max_radius_px + merge_gap_px + 1e-9;
+      for (size_t k = 0; k < rims[a].size() && !near; ++k) {
+        const Eigen::Vector2d& p = rims[a][k];
+        if ((p - db.area_centroid_px).squaredNorm() > reach * reach) continue;
+        for (const Eigen::Vector2d& q : rims[b]) {
+          if (std::sqrt((p - q).squaredNorm()) < merge_gap_px) {
+            near = true;
+            break;
+          }
+        }
       }
-      if (da.overlapping && std::count(da.neighbours.begin(), da.neighbours.end(), db.id) > 0) closest = 0;
-      if (std::sqrt(closest) < merge_gap_px) {
+      if (near) {
         da.near_other = db.near_other = true;
         if (std::count(da.neighbours.begin(), da.neighbours.end(), db.id) == 0) {
           da.neighbours.push_back(db.id);
@@ -323,36 +437,6 @@ void MarkNearNeighbours(const std::vector<std::vector<Eigen::Vector2d>>& rims, d
         }
       }
     }
-  }
-}
-
-// std::clamp(std::lround(g), 0, 255) without the library call: lround rounds halves away from zero, and
-// g - trunc(g) is exact, so for g > 0 this is the same integer; g <= 0 gives 0 either way.
-inline unsigned char RoundToGrey(double g) {
-  if (!(g > 0)) return 0;
-  if (g >= 255) return 255;
-  const int whole = static_cast<int>(g);
-  return static_cast<unsigned char>(g - whole >= 0.5 ? whole + 1 : whole);
-}
-
-// Image formation: coverage -> grey, blur, noise, quantisation.
-void FormImage(const std::vector<uint64_t>& mask, int width, int height, const RenderOptions& options,
-               uint64_t noise_seed, vpImage<unsigned char>* image) {
-  const int s = options.supersampling;
-  const double inv_s2 = 1.0 / (s * s);
-  std::vector<double> grey(mask.size(), options.background_grey);
-  const double contrast = options.background_grey - options.dot_grey;
-  for (size_t k = 0; k < mask.size(); ++k) {
-    if (mask[k] != 0) grey[k] -= contrast * __builtin_popcountll(mask[k]) * inv_s2;
-  }
-  if (options.blur_sigma_px > 0) GaussianBlur(&grey, width, height, options.blur_sigma_px);
-  image->resize(static_cast<unsigned>(height), static_cast<unsigned>(width));
-  std::mt19937_64 rng(noise_seed);
-  std::normal_distribution<double> noise(0.0, 1.0);
-  for (size_t k = 0; k < grey.size(); ++k) {
-    double g = grey[k];
-    if (options.noise_std_grey > 0) g += options.noise_std_grey * noise(rng);
-    image->bitmap[k] = RoundToGrey(g);
   }
 }
 
@@ -432,8 +516,7 @@ RenderedImage RenderDots(const CameraIntrinsics& camera, const Rigid3& base_from
 
   RenderedImage out;
   out.dots.resize(scene.centres_in_base.size());
-  std::vector<uint64_t> mask(static_cast<size_t>(width) * height, 0);  // dark samples, all dots
-  std::vector<int> owner(static_cast<size_t>(width) * height, -1);     // last dot that darkened a sample here
+  FrameLease lease(width, height);
   std::vector<std::vector<Eigen::Vector2d>> rims(out.dots.size());
 
   for (size_t d = 0; d < out.dots.size(); ++d) {
@@ -445,10 +528,10 @@ RenderedImage RenderDots(const CameraIntrinsics& camera, const Rigid3& base_from
     PlaneAxes(n, &e1, &e2);
     RimBounds bounds;
     if (!TraceRim(camera, c, e1, e2, r, &out.dots[d], &rims[d], &bounds)) continue;
-    SampleDisc(camera, c, n, r, options.supersampling, bounds, d, &out.dots, &mask, &owner);
+    SampleDisc(camera, c, n, r, options.supersampling, bounds, d, &out.dots, &lease.buffers());
   }
   MarkNearNeighbours(rims, options.merge_gap_px, &out.dots);
-  FormImage(mask, width, height, options, noise_seed, &out.image);
+  FormImage(&lease.buffers(), options, noise_seed, &out.image);
   return out;
 }
 

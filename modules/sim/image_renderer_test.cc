@@ -82,6 +82,55 @@ TEST(ImageRenderer, FrontoParallelDiscCentroidIsTheProjectedCentre) {
   std::printf("fronto-parallel: worst supersample centroid error %.5f px\n", worst_sample);
 }
 
+// The rendered coverage of a disc is its area. Fronto-parallel discs (k1 = 0: circles of radius
+// R = f r / z px) at random positions and depths 0.45-0.75 m (R = 5.3-8.9 px), S x S samples per pixel.
+// The dark-sample count errs only along the rim: about 2 pi R S sample cells there, each off by a
+// fraction of a sample of random sign (variance ~1/12), so its std is about sqrt(2 pi R S / 12)
+// samples, that / S^2 in px^2 (0.07 px^2 at R = 6.5 px, S = 8: 0.05 % of the area); tolerances 5 of
+// them per disc and 5 / sqrt(n) of them for the mean over the discs (no bias). The image holds the same
+// coverage (background 255, dot 0: coverage = (255 - grey) / 255) up to the rounding of the partly
+// covered pixels, at most 0.5 / 255 each. S = 8, 4 (the exact coordinate sums) and 3 (the ordered ones).
+TEST(ImageRenderer, RenderedCoverageIsTheDiscArea) {
+  const CameraIntrinsics camera;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> xy(-0.15, 0.15), depth(0.45, 0.75);
+  for (int s : {8, 4, 3}) {
+    RenderOptions options = Clean();
+    options.supersampling = s;
+    options.background_grey = 255;
+    options.dot_grey = 0;
+    const int n = 30;
+    double sum_error = 0, sum_std = 0, sum_error2 = 0;
+    for (int trial = 0; trial < n; ++trial) {
+      const Eigen::Vector3d centre(xy(rng), 0.75 * xy(rng), depth(rng));
+      const double r = 0.004;
+      const RenderedImage out = RenderDots(camera, Rigid3(), OneDot(centre, -Eigen::Vector3d::UnitZ(), r), options, 1);
+      const RenderedDot& dot = out.dots[0];
+      ASSERT_TRUE(dot.Clean());
+      const double radius_px = camera.fx_px * r / centre.z();
+      const double area = kPi * radius_px * radius_px;
+      const double sample_std = std::sqrt(2 * kPi * radius_px * s / 12.0) / (s * s);
+      double coverage = 0;
+      int partial = 0;
+      for (unsigned k = 0; k < out.image.getSize(); ++k) {
+        const int g = out.image.bitmap[k];
+        coverage += (255 - g) / 255.0;
+        partial += g > 0 && g < 255;
+      }
+      EXPECT_NEAR(dot.sample_area_px2, area, 5 * sample_std) << "S = " << s << ", trial " << trial;
+      EXPECT_NEAR(coverage, dot.sample_area_px2, partial * 0.5 / 255 + 1e-9) << "S = " << s << ", trial " << trial;
+      EXPECT_LT((dot.sample_centroid_px - dot.projected_centre_px).norm(), 5 * sample_std / (2 * radius_px))
+          << "S = " << s << ", trial " << trial;
+      sum_error += dot.sample_area_px2 - area;
+      sum_error2 += (dot.sample_area_px2 - area) * (dot.sample_area_px2 - area);
+      sum_std += sample_std;
+    }
+    EXPECT_NEAR(sum_error / n, 0.0, 5 * sum_std / n / std::sqrt(n)) << "S = " << s;
+    std::printf("S = %d: sample area error RMS %.4f px^2, expected about %.4f\n", s, std::sqrt(sum_error2 / n),
+                sum_std / n);
+  }
+}
+
 // Per-dot radii (a grid's larger origin dot): each disc has its own area, exactly.
 TEST(ImageRenderer, PerDotRadiiScaleEachDiscsArea) {
   const CameraIntrinsics camera;
