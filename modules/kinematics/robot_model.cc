@@ -7,6 +7,7 @@
 
 #include "base/status.h"
 #include "kinematics/autodiff_jacobian.h"
+#include "kinematics/damped_least_squares.h"
 
 namespace selfcal {
 
@@ -154,7 +155,6 @@ bool WithinLimits(const RobotModel& model, const Eigen::VectorXd& q, double marg
 
 bool SolveCameraIk(const RobotModel& model, const Eigen::VectorXd& rho, const Rigid3& base_from_cam_target,
                    const Eigen::VectorXd& seed, Eigen::VectorXd* q) {
-  const int n = model.num_joints();
   Eigen::VectorXd x = seed;
   // Residual: target^-1 * current as (translation, rotation vector); zero at the solution.
   const Rigid3 cam_target_from_base = base_from_cam_target.Inverse();
@@ -171,27 +171,10 @@ bool SolveCameraIk(const RobotModel& model, const Eigen::VectorXd& rho, const Ri
     out[4] = T(0.5) * (err.rotation(0, 2) - err.rotation(2, 0));
     out[5] = T(0.5) * (err.rotation(1, 0) - err.rotation(0, 1));
   };
-  double lambda = 1e-3;
-  Eigen::VectorXd r;
-  Eigen::MatrixXd jac = AutodiffJacobian(residual, x, 6, &r);
-  for (int iter = 0; iter < 200; ++iter) {
-    // The antisymmetric part also vanishes at a 180 degree error: check the full rotation at the end.
-    if (r.norm() < 1e-12) break;
-    const Eigen::MatrixXd jtj = jac.transpose() * jac;
-    const Eigen::VectorXd step = -(jtj + lambda * Eigen::MatrixXd::Identity(n, n)).ldlt().solve(jac.transpose() * r);
-    Eigen::VectorXd candidate = x + step;
-    Eigen::VectorXd r_new;
-    Eigen::MatrixXd jac_new = AutodiffJacobian(residual, candidate, 6, &r_new);
-    if (r_new.norm() < r.norm()) {
-      x = candidate;
-      r = r_new;
-      jac = jac_new;
-      lambda = std::max(lambda * 0.3, 1e-12);
-    } else {
-      lambda *= 10;
-      if (lambda > 1e8) break;
-    }
-  }
+  // The antisymmetric part also vanishes at a 180 degree error: the full rotation is checked at the end.
+  MinimiseDampedLeastSquares(
+      [&](const Eigen::VectorXd& at, Eigen::VectorXd* r, Eigen::MatrixXd* jac) { *jac = AutodiffJacobian(residual, at, 6, r); },
+      &x);
   const Rigid3 reached = BaseFromCam(model, rho, x);
   const PoseDifference diff = ComparePoses(reached, base_from_cam_target);
   *q = x;

@@ -4,9 +4,71 @@
 #include <random>
 
 #include "base/status.h"
+#include "kinematics/damped_least_squares.h"
+#include "planning/pose_twists.h"
 #include "planning/view_geometry.h"
 
 namespace selfcal::planning {
+
+namespace {
+
+// Every scene point of `base_from_cam`'s view in the depth range and inside the image by the margin less
+// `slack_px` (the depth range widened by slack_m); *reason names the first that is not.
+bool ViewFits(const PlanningProblem& problem, const Rigid3& base_from_cam, double slack_px, double slack_m,
+              std::string* reason) {
+  const PlanConstraints& c = problem.constraints;
+  const Rigid3 cam_from_base = base_from_cam.Inverse();
+  for (size_t k = 0; k < problem.scene.extent_in_base.size(); ++k) {
+    const Eigen::Vector3d p = cam_from_base * problem.scene.extent_in_base[k];
+    if (p.z() < c.min_depth_m - slack_m || p.z() > c.max_depth_m + slack_m) {
+      if (reason) *reason = "scene point " + std::to_string(k) + " outside the depth range";
+      return false;
+    }
+    double u = 0, v = 0;
+    ProjectPoint<double>(problem.camera, problem.camera.fx_px, problem.camera.k1, p, &u, &v);
+    if (ImageMargin(problem.camera, u, v) < c.image_margin_px - slack_px) {
+      if (reason) *reason = "scene point " + std::to_string(k) + " outside the image less the margin";
+      return false;
+    }
+  }
+  return true;
+}
+
+// SolveCameraIk's damped least squares (kinematics/damped_least_squares.h: the same residual, steps and
+// stopping rules) with the residual's Jacobian from the joints' spatial twists (planning/pose_twists.h) instead of
+// autodiff through every parameter: the candidate pool solves thousands of these. Nominal model only.
+bool SolveCameraIkNominal(const RobotModel& model, const Rigid3& target, const Eigen::VectorXd& seed,
+                          Eigen::VectorXd* q) {
+  const int n = model.num_joints();
+  const Eigen::Matrix3d rt = target.rotation.transpose();
+  auto evaluate = [&](const Eigen::VectorXd& x, Eigen::VectorXd* r, Eigen::MatrixXd* jac) {
+    const internal::CameraTwists<double> tw = internal::ComputeCameraTwists<double>(model, x.data());
+    const Eigen::Matrix3d e = rt * tw.base_from_cam.rotation;
+    const Eigen::Vector3d c = tw.base_from_cam.translation;
+    r->resize(6);
+    r->head<3>() = rt * (c - target.translation);
+    (*r)[3] = 0.5 * (e(2, 1) - e(1, 2));
+    (*r)[4] = 0.5 * (e(0, 2) - e(2, 0));
+    (*r)[5] = 0.5 * (e(1, 0) - e(0, 1));
+    jac->resize(6, n);
+    for (int j = 0; j < n; ++j) {
+      const int k = KinematicParameters::JointOffset(j) + 3;  // theta_j moves the camera like q_j
+      const Eigen::Vector3d& w = tw.omega[k];
+      jac->col(j).head<3>() = rt * (w.cross(c) + tw.v[k]);
+      Eigen::Matrix3d wx;
+      wx << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
+      const Eigen::Matrix3d de = rt * wx * tw.base_from_cam.rotation;
+      jac->col(j).tail<3>() << 0.5 * (de(2, 1) - de(1, 2)), 0.5 * (de(0, 2) - de(2, 0)), 0.5 * (de(1, 0) - de(0, 1));
+    }
+  };
+  Eigen::VectorXd x = seed;
+  MinimiseDampedLeastSquares(evaluate, &x);
+  const PoseDifference diff = ComparePoses(BaseFromCam(model, KinematicParameters::Nominal(model), x), target);
+  *q = x;
+  return diff.position_m < 1e-10 && diff.rotation_rad < 1e-10;
+}
+
+}  // namespace
 
 bool PoseFeasible(const PlanningProblem& problem, const Eigen::VectorXd& q, std::string* reason) {
   const PlanConstraints& c = problem.constraints;
@@ -21,21 +83,7 @@ bool PoseFeasible(const PlanningProblem& problem, const Eigen::VectorXd& q, std:
       return false;
     }
   }
-  const Rigid3 cam_from_base = BaseFromCam(robot, KinematicParameters::Nominal(robot), q).Inverse();
-  for (size_t k = 0; k < problem.scene.extent_in_base.size(); ++k) {
-    const Eigen::Vector3d p = cam_from_base * problem.scene.extent_in_base[k];
-    if (p.z() < c.min_depth_m || p.z() > c.max_depth_m) {
-      if (reason) *reason = "scene point " + std::to_string(k) + " outside the depth range";
-      return false;
-    }
-    double u = 0, v = 0;
-    ProjectPoint<double>(problem.camera, problem.camera.fx_px, problem.camera.k1, p, &u, &v);
-    if (ImageMargin(problem.camera, u, v) < c.image_margin_px) {
-      if (reason) *reason = "scene point " + std::to_string(k) + " outside the image less the margin";
-      return false;
-    }
-  }
-  return true;
+  return ViewFits(problem, BaseFromCam(robot, KinematicParameters::Nominal(robot), q), 0.0, 0.0, reason);
 }
 
 std::vector<Eigen::VectorXd> MakeCandidatePool(const PlanningProblem& problem,
@@ -77,8 +125,12 @@ std::vector<Eigen::VectorXd> MakeCandidatePool(const PlanningProblem& problem,
     r.col(0) = x;
     r.col(1) = z.cross(x);
     r.col(2) = z;
+    // The view is decided by the target pose (reached to 1e-10 m and rad when IK succeeds): a target that
+    // breaks a view constraint by more than rounding is not solved for, which leaves the pool unchanged.
+    const Rigid3 target(r, position);
+    if (!ViewFits(problem, target, 1e-6, 1e-9, nullptr)) continue;
     Eigen::VectorXd q;
-    if (!SolveCameraIk(robot, rho, Rigid3(r, position), seed, &q)) continue;
+    if (!SolveCameraIkNominal(robot, target, seed, &q)) continue;
     // Same arm and wrist configuration as the first template (no flips): within the travel bound of it.
     if ((q - templates[0]).lpNorm<Eigen::Infinity>() > problem.constraints.max_joint_travel_rad) continue;
     if (PoseFeasible(problem, q)) pool.push_back(q);

@@ -8,8 +8,9 @@
 // (free rho, f_x, and the two yardstick dots, which the stiff length term couples) is
 //   H = sum_c sum_j A_cj^T A_cj + yardstick - sum_j H_gj H_jj^-1 H_gj^T          (dots j >= 2 eliminated)
 // in units of 1 / sigma_px^2; the covariance of (free rho, f_x) is sigma_px^2 times the top-left block of
-// H^-1. Contributions are cached per candidate pose, so evaluating a design of m poses out of a pool costs
-// O(dots * m * size^2) (~0.1 ms for 15 poses, 80 dots, 25 unknowns).
+// H^-1, the inverse of the Schur complement of the yardstick block. Contributions are cached per candidate
+// pose and summed per design (Sums); a design that differs from summed ones by one pose (the exchange)
+// costs O(dots * (free + 1)^2): ~25 us for 80 dots, 25 unknowns (bench/core_bench.cc BM_FisherExchange...).
 //
 // Criteria: D = log det of the (free rho, f_x) information (maximised; unit-free up to a constant),
 // A = sum over (free rho, f_x) of variance / prior variance (minimised; priors 1 mm, 0.2 deg, 10 px by
@@ -50,12 +51,18 @@ class FisherDesign {
 
   FisherValue Evaluate(const std::vector<int>& design) const;
 
- private:
-  struct Candidate {
-    Eigen::MatrixXd h_gg;                 // global x global, summed over dots
-    std::vector<Eigen::Matrix3d> h_jj;    // per eliminated dot
-    std::vector<Eigen::MatrixXd> h_gj;    // global x 3 per eliminated dot
+  // The contributions of a set of poses, summed (the unit of the exchange: every pose but one).
+  struct Sums {
+    Eigen::MatrixXd h_gg;               // global x global, summed over dots
+    std::vector<Eigen::Matrix3d> h_jj;  // per eliminated dot
+    Eigen::MatrixXd h_gj;               // (free + f_x) x 3 per eliminated dot, side by side (yardstick rows are 0)
   };
+  Sums Sum(const std::vector<int>& design, int skip_position = -1) const;  // without design[skip_position]
+  // The design of `sums` plus candidate `extra` (-1: none). with_variances false: only ok and log_det.
+  FisherValue EvaluateSums(const Sums& sums, int extra, bool with_variances) const;
+
+ private:
+  using Candidate = Sums;
   PlanningProblem problem_;
   std::vector<int> free_columns_;
   FisherDesignOptions options_;

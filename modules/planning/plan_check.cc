@@ -371,9 +371,10 @@ MoveImageMotion ImageMotionBetween(const std::vector<Eigen::Vector2d>& from, con
     motion.median_px = motion.max_px = std::numeric_limits<double>::infinity();
     return motion;
   }
-  std::sort(shifts.begin(), shifts.end());
+  // The element a sort would put at size / 2 (nth_element: the planner asks this thousands of times).
+  motion.max_px = *std::max_element(shifts.begin(), shifts.end());
+  std::nth_element(shifts.begin(), shifts.begin() + shifts.size() / 2, shifts.end());
   motion.median_px = shifts[shifts.size() / 2];
-  motion.max_px = shifts.back();
   return motion;
 }
 

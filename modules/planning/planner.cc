@@ -337,16 +337,40 @@ void PlanExchange(const PlanningProblem& problem, const PlannerOptions& options,
   std::vector<Eigen::VectorXd> candidates;
   for (int i = 0; i < m_id; ++i) candidates.push_back(result->poses[i]);
   candidates.insert(candidates.end(), pool.begin(), pool.end());
+  const int num_candidates = static_cast<int>(candidates.size());
   const Eigen::VectorXd rho = KinematicParameters::Nominal(problem.robot);
   std::vector<Rigid3> views;
   std::vector<std::vector<Eigen::Vector2d>> images;  // the dots' pixels: image motion between candidates
   for (const Eigen::VectorXd& q : candidates) {
-    design.AddCandidate(q);
     views.push_back(BaseFromCam(problem.robot, rho, q));
     images.push_back(DotImages(problem, q));
   }
+  // A candidate's Fisher contribution is computed when it is first evaluated (many never pass the
+  // pairwise constraints); the designs below index candidates, the FisherDesign its own order.
+  std::vector<int> fisher_index(num_candidates, -1);
+  auto fisher = [&](int cand) {
+    if (fisher_index[cand] < 0) fisher_index[cand] = design.AddCandidate(candidates[cand]);
+    return fisher_index[cand];
+  };
+  auto fisher_design = [&](const std::vector<int>& cands) {
+    std::vector<int> out;
+    for (int cand : cands) out.push_back(fisher(cand));
+    return out;
+  };
   const std::vector<Eigen::Vector2d> first_verification =
       m > m_id ? DotImages(problem, result->poses[m_id]) : std::vector<Eigen::Vector2d>();
+  // Median image motion between candidates (index num_candidates: the first verification pose), each pair
+  // computed once.
+  std::vector<double> motion_cache(static_cast<size_t>(num_candidates) * (num_candidates + 1),
+                                   std::numeric_limits<double>::quiet_NaN());
+  auto motion = [&](int a, int b) {
+    const int lo = std::min(a, b), hi = std::max(a, b);
+    double& cached = motion_cache[static_cast<size_t>(lo) * (num_candidates + 1) + hi];
+    if (std::isnan(cached)) {
+      cached = ImageMotionBetween(images[lo], hi < num_candidates ? images[hi] : first_verification).median_px;
+    }
+    return cached;
+  };
   std::vector<Rigid3> verification;
   for (int i = m_id; i < m; ++i) verification.push_back(BaseFromCam(problem.robot, rho, result->poses[i]));
   const PlanConstraints& c = problem.constraints;
@@ -366,16 +390,16 @@ void PlanExchange(const PlanningProblem& problem, const PlannerOptions& options,
     }
     // Image motion of the moves into and out of the slot (the visit order is the slots'): every exchange
     // keeps each move within the bound.
-    if (!(ImageMotionBetween(images[chosen[slot - 1]], images[cand]).median_px <= c.max_image_motion_px)) return false;
-    const std::vector<Eigen::Vector2d>& next = slot + 1 < m_id ? images[chosen[slot + 1]] : first_verification;
-    if (!next.empty() && !(ImageMotionBetween(images[cand], next).median_px <= c.max_image_motion_px)) return false;
+    if (!(motion(chosen[slot - 1], cand) <= c.max_image_motion_px)) return false;
+    const int next = slot + 1 < m_id ? chosen[slot + 1] : m > m_id ? num_candidates : -1;
+    if (next >= 0 && !(motion(cand, next) <= c.max_image_motion_px)) return false;
     for (const Rigid3& v : verification) {
       if ((views[cand].translation - v.translation).norm() < c.min_spread_m) return false;
     }
     if (slot > 0 && AxisSine<double>(views[chosen[0]], views[cand]) < c.min_axis_sine) return false;
     return true;
   };
-  double best = DesignScore(options.criterion, design.Evaluate(chosen));
+  double best = DesignScore(options.criterion, design.Evaluate(fisher_design(chosen)));
   ++result->evaluations;
   // One unit per slot of a pass; a design that stops changing ends the step early.
   ProgressScope progress(options.progress, static_cast<int64_t>(options.max_exchange_sweeps) * std::max(m_id - 1, 0),
@@ -386,10 +410,13 @@ void PlanExchange(const PlanningProblem& problem, const PlannerOptions& options,
     for (int slot = 1; slot < m_id; ++slot) {  // pose 0 stays: it is the reference of every pair
       const int current = chosen[slot];
       int best_candidate = current;
-      for (int cand = 0; cand < design.num_candidates(); ++cand) {
+      // Every pose but the slot's summed once; each candidate then costs one EvaluateSums.
+      const FisherDesign::Sums rest = design.Sum(fisher_design(chosen), slot);
+      for (int cand = 0; cand < num_candidates; ++cand) {
         if (cand == current || !compatible(cand, slot)) continue;
         chosen[slot] = cand;
-        const double score = DesignScore(options.criterion, design.Evaluate(chosen));
+        const double score = DesignScore(
+            options.criterion, design.EvaluateSums(rest, fisher(cand), options.criterion == Criterion::kAOptimal));
         ++result->evaluations;
         if (score < best - 1e-9 * std::abs(best)) {
           best = score;
@@ -406,13 +433,19 @@ void PlanExchange(const PlanningProblem& problem, const PlannerOptions& options,
 }
 
 // The visit order that lets the session track the dots through every move (visit_order.h): kept when
-// the check accepts it or the given order fails too.
-void OrderAsTour(const PlanningProblem& problem, std::vector<Eigen::VectorXd>* poses) {
+// the check accepts it or the given order fails too. Returns the check of the order kept.
+PlanCheck OrderAsTour(const PlanningProblem& problem, std::vector<Eigen::VectorXd>* poses) {
   const VisitOrder visit = OrderForTracking(problem, *poses);
   std::vector<Eigen::VectorXd> reordered;
   reordered.reserve(poses->size());
   for (int i : visit.order) reordered.push_back((*poses)[i]);
-  if (CheckPlan(problem, reordered).ok || !CheckPlan(problem, *poses).ok) *poses = std::move(reordered);
+  PlanCheck check = CheckPlan(problem, reordered);
+  if (!check.ok) {
+    PlanCheck as_given = CheckPlan(problem, *poses);
+    if (as_given.ok) return as_given;
+  }
+  *poses = std::move(reordered);
+  return check;
 }
 
 }  // namespace
@@ -504,12 +537,11 @@ PlanResult PlanMeasurements(const PlanningProblem& problem, const std::vector<Ei
   } else {
     PlanExchange(problem, options, &result);
   }
-  OrderAsTour(problem, &result.poses);
+  result.check_final = OrderAsTour(problem, &result.poses);
 
   const std::vector<Eigen::VectorXd> id_final(result.poses.begin(), result.poses.begin() + m_id);
   result.eq39_final = EvaluateEq39(problem.robot, id_final, result.free_columns, options.lambda, false);
   result.fisher_final = FisherOf(problem, result.free_columns, options.fisher, result.poses);
-  result.check_final = CheckPlan(problem, result.poses);
   result.ok = result.check_final.ok;
   std::ostringstream message;
   if (result.ok) {
