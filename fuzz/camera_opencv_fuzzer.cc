@@ -27,9 +27,8 @@ namespace {
 bool Same(const selfcal::Result<selfcal::CameraIntrinsics>& a, const selfcal::Result<selfcal::CameraIntrinsics>& b) {
   if (a.ok() != b.ok()) return false;
   if (!a.ok()) return a.status().code() == b.status().code() && a.status().message() == b.status().message();
-  return a->width_px == b->width_px && a->height_px == b->height_px && a->fx_px == b->fx_px && a->mu == b->mu &&
-         a->cx_px == b->cx_px && a->cy_px == b->cy_px && a->k1 == b->k1 && a->k2 == b->k2 && a->p1 == b->p1 &&
-         a->p2 == b->p2 && a->k3 == b->k3;
+  return a->width_px == b->width_px && a->height_px == b->height_px &&
+         selfcal::IntrinsicsOf(*a) == selfcal::IntrinsicsOf(*b);
 }
 
 }  // namespace

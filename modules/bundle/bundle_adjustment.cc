@@ -317,10 +317,8 @@ void TriangulateStartDots(const Eigen::VectorXd& rho_start, BundleData* data, Bu
 // The rho indices held by request, and the intrinsics estimated after the names (EstimatedIntrinsicsOf).
 // Returns the unknown names, one per line.
 std::string HeldParameters(int num_joints, BundleOptions* options, std::vector<int>* held) {
-  std::vector<int> ignored;
-  std::string problems = ResolveParameterNames(options->held_parameters, num_joints, &ignored);
-  if (!options->free_parameters.empty()) problems += ResolveParameterNames(options->free_parameters, num_joints, &ignored);
-  *held = HeldParameterIndices(*options, num_joints);
+  std::string problems;
+  *held = HeldParameterIndices(*options, num_joints, &problems);
   options->intrinsics = EstimatedIntrinsicsOf(*options, num_joints);
   if (!held->empty()) options->require_generic_rank = false;
   return problems;

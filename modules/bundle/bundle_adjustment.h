@@ -172,8 +172,9 @@ std::string ResolveParameterNames(const std::vector<std::string>& names, int num
 IntrinsicsMask EstimatedIntrinsicsOf(const BundleOptions& options, int num_joints);
 
 // The rho indices a bundle with these options holds by request: those named in held_parameters, and
-// with a free_parameters list every index it does not name (unknown names ignored), ascending.
-std::vector<int> HeldParameterIndices(const BundleOptions& options, int num_joints);
+// with a free_parameters list every index it does not name, ascending. Unknown names are ignored, or
+// listed in *unknown (ResolveParameterNames' words) when given.
+std::vector<int> HeldParameterIndices(const BundleOptions& options, int num_joints, std::string* unknown = nullptr);
 
 // The rho on `target` (same joint count) that gives the same base_from_cam(q) for every q as `source_rho`
 // on `source`: joint parameters copied, base and camera corrections re-expressed against target's

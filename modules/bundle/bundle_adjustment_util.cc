@@ -100,12 +100,12 @@ IntrinsicsMask EstimatedIntrinsicsOf(const BundleOptions& options, int num_joint
   return out;
 }
 
-std::vector<int> HeldParameterIndices(const BundleOptions& options, int num_joints) {
+std::vector<int> HeldParameterIndices(const BundleOptions& options, int num_joints, std::string* unknown) {
   std::vector<int> held;
-  ResolveParameterNames(options.held_parameters, num_joints, &held);
+  std::string problems = ResolveParameterNames(options.held_parameters, num_joints, &held);
   if (!options.free_parameters.empty()) {
     std::vector<int> named_free;
-    ResolveParameterNames(options.free_parameters, num_joints, &named_free);
+    problems += ResolveParameterNames(options.free_parameters, num_joints, &named_free);
     const int n = KinematicParameters(num_joints).size();
     for (int i = 0; i < n; ++i) {
       if (std::find(named_free.begin(), named_free.end(), i) == named_free.end()) held.push_back(i);
@@ -113,6 +113,7 @@ std::vector<int> HeldParameterIndices(const BundleOptions& options, int num_join
     std::sort(held.begin(), held.end());
     held.erase(std::unique(held.begin(), held.end()), held.end());
   }
+  if (unknown != nullptr) *unknown = problems;
   return held;
 }
 

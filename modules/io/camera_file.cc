@@ -288,7 +288,7 @@ std::string Seconds(std::chrono::milliseconds limit) {
 }
 
 // LoadOpenCv in a child process that is killed after `limit`: OpenCV 4.6's YAML reader never returns on
-// some malformed texts (the fuzzer found three; two have signs refused above, the third has none).
+// some malformed texts (the fuzzer found twelve; two have the signs refused above, the others none).
 Result<CameraIntrinsics> LoadOpenCvWithin(const std::string& path, const std::string& contents,
                                           std::chrono::milliseconds limit) {
   const ChildOutput out = RunInTimeLimitedChild([&] { return EncodeCamera(LoadOpenCv(path, contents)); }, limit);

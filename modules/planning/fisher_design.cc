@@ -32,6 +32,16 @@ FisherDesign::FisherDesign(const PlanningProblem& problem, const std::vector<int
   num_global_ = static_cast<int>(free_columns.size()) + 1 + 6;
 }
 
+FisherDesign::Sums FisherDesign::ZeroSums() const {
+  const int nf = static_cast<int>(free_columns_.size());
+  const int dots = static_cast<int>(problem_.scene.dots_in_base.size());
+  Sums zero;
+  zero.h_gg = Eigen::MatrixXd::Zero(num_global_, num_global_);
+  zero.h_jj.assign(dots - 2, Eigen::Matrix3d::Zero());
+  zero.h_gj = Eigen::MatrixXd::Zero(nf + 1, 3 * (dots - 2));
+  return zero;
+}
+
 int FisherDesign::AddCandidate(const Eigen::VectorXd& q) {
   SELFCAL_CHECK(q.size() == problem_.robot.num_joints(), "candidate has " << q.size() << " joints");
   const internal::CameraTwists<double> tw = internal::ComputeCameraTwists<double>(problem_.robot, q.data());
@@ -40,10 +50,7 @@ int FisherDesign::AddCandidate(const Eigen::VectorXd& q) {
   const CameraIntrinsics& cam = problem_.camera;
   const int nf = static_cast<int>(free_columns_.size());
   const int dots = static_cast<int>(problem_.scene.dots_in_base.size());
-  Candidate out;
-  out.h_gg = Eigen::MatrixXd::Zero(num_global_, num_global_);
-  out.h_jj.assign(dots - 2, Eigen::Matrix3d::Zero());
-  out.h_gj = Eigen::MatrixXd::Zero(nf + 1, 3 * (dots - 2));
+  Candidate out = ZeroSums();
   Eigen::Matrix<double, 2, Eigen::Dynamic> a(2, num_global_);
   for (int j = 0; j < dots; ++j) {
     const Eigen::Vector3d x = problem_.scene.dots_in_base[j];
@@ -75,12 +82,8 @@ int FisherDesign::AddCandidate(const Eigen::VectorXd& q) {
 }
 
 FisherDesign::Sums FisherDesign::Sum(const std::vector<int>& design, int skip_position) const {
-  const int nf = static_cast<int>(free_columns_.size());
   const int dots = static_cast<int>(problem_.scene.dots_in_base.size());
-  Sums sums;
-  sums.h_gg = Eigen::MatrixXd::Zero(num_global_, num_global_);
-  sums.h_jj.assign(dots - 2, Eigen::Matrix3d::Zero());
-  sums.h_gj = Eigen::MatrixXd::Zero(nf + 1, 3 * (dots - 2));
+  Sums sums = ZeroSums();
   for (size_t k = 0; k < design.size(); ++k) {
     if (static_cast<int>(k) == skip_position) continue;
     const Candidate& c = candidates_.at(design[k]);

@@ -58,6 +58,7 @@ class FisherDesign {
     Eigen::MatrixXd h_gj;               // (free + f_x) x 3 per eliminated dot, side by side (yardstick rows are 0)
   };
   Sums Sum(const std::vector<int>& design, int skip_position = -1) const;  // without design[skip_position]
+  Sums ZeroSums() const;  // every block zero, sized for this problem
   // The design of `sums` plus candidate `extra` (-1: none). with_variances false: only ok and log_det.
   FisherValue EvaluateSums(const Sums& sums, int extra, bool with_variances) const;
 
