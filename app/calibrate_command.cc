@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "app/cli_output.h"
 #include "app/cli_util.h"
@@ -20,6 +21,7 @@
 #include "report/calibration_report.h"
 #include "session/session_dir.h"
 #include "session/session_observations.h"
+#include "yaml/yaml_reader.h"
 
 namespace selfcal::app {
 
@@ -30,6 +32,9 @@ struct LoadedInput {
   ObservationSet observations;
   report::ReportInput input;
   std::optional<report::SessionContext> session;  // for a session: its counts and findings
+  // For an observations file: how its robot was entered, read from the document parsed for the
+  // observations (the file is parsed once).
+  std::optional<io::RobotOrigin> origin;
 };
 
 // Refuses (kUsage, naming both paths) an output directory that is the session directory or inside it,
@@ -115,9 +120,13 @@ Result<LoadedInput> LoadInput(const CalibrateRequest& request) {
     loaded.input = {"session", request.input, session->manifest_sha256};
     loaded.observations = std::move(session).value().observations;
   } else {
-    Result<ObservationSet> obs = io::LoadObservations(request.input);
+    Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(request.input);
+    if (!doc.ok()) return doc.status();
+    Result<ObservationSet> obs = io::ParseObservations(*doc);
     if (!obs.ok()) return obs.status();
     loaded.observations = std::move(obs).value();
+    Result<io::RobotOrigin> origin = io::RobotOriginOfObservations(*doc);
+    loaded.origin = origin.ok() ? *origin : io::RobotOrigin{};
     loaded.input = {"observations", request.input, FileSha256(request.input)};
   }
   if (Status s = ReplaceCamera(request, &loaded); !s.ok()) return s;
@@ -206,7 +215,9 @@ Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationRep
     if (std::filesystem::exists(html_path)) AddOutputFile("report_html", html_path);
   }
   if (!report.model) return Status::Ok();
-  const io::RobotOrigin origin = OriginOfInput(request.robot_config, request.input, loaded.session.has_value());
+  const io::RobotOrigin origin = request.robot_config.empty() && loaded.origin
+                                     ? *loaded.origin
+                                     : OriginOfInput(request.robot_config, request.input, loaded.session.has_value());
   if (loaded.observations.UsesFlangePoses()) return WriteHandEye(loaded, report, out_dir, origin);
   io::CalibratedModel model;
   model.model = report.model->robot;

@@ -3,7 +3,10 @@
 #include <cmath>
 #include <sstream>
 
+#include <vector>
+
 #include <Eigen/Dense>
+#include <ceres/jet.h>
 
 #include "base/status.h"
 #include "kinematics/autodiff_jacobian.h"
@@ -19,27 +22,52 @@ constexpr double kMinRayAngleRad = 1.745e-4;
 constexpr double kMinReciprocalCondition = 1e-12;
 constexpr int kMaxGaussNewtonIterations = 50;
 
-// Reprojection residuals (px) of a point in the common frame; false if it is not in front of every camera.
+// The reprojection residuals (px) of a point in the common frame, y[2k], y[2k+1] for view k, in any
+// scalar type T (double Jets for the Jacobian).
+template <typename T>
+void ReprojectionResiduals(const CameraIntrinsics& camera, double fx_px, const std::vector<Rigid3>& cam_from_base,
+                           const PointTrack& track, const T* x, T* y) {
+  const Vec3T<T> p(x[0], x[1], x[2]);
+  for (size_t k = 0; k < cam_from_base.size(); ++k) {
+    const Vec3T<T> p_in_cam = cam_from_base[k].Cast<T>() * p;
+    T u, v;
+    ProjectPoint<T>(camera, T(fx_px), T(camera.k1), p_in_cam, &u, &v);
+    y[2 * k] = u - track.pixels[k].x();
+    y[2 * k + 1] = v - track.pixels[k].y();
+  }
+}
+
+bool InFrontOfEveryCamera(const std::vector<Rigid3>& cam_from_base, const Eigen::Vector3d& point) {
+  for (const Rigid3& cam : cam_from_base) {
+    if (!((cam * point).z() > 0)) return false;
+  }
+  return true;
+}
+
+// Reprojection residuals (px) and their Jacobian; false if the point is not in front of every camera.
 bool Reproject(const CameraIntrinsics& camera, double fx_px, const std::vector<Rigid3>& cam_from_base,
                const PointTrack& track, const Eigen::Vector3d& point, Eigen::VectorXd* residuals,
                Eigen::MatrixXd* jacobian) {
-  const int num_views = static_cast<int>(cam_from_base.size());
-  for (int k = 0; k < num_views; ++k) {
-    if (!((cam_from_base[k] * point).z() > 0)) return false;
-  }
-  auto f = [&](const auto* x, auto* y) {
-    using T = std::remove_const_t<std::remove_pointer_t<decltype(x)>>;
-    const Vec3T<T> p(x[0], x[1], x[2]);
-    for (int k = 0; k < num_views; ++k) {
-      const Vec3T<T> p_in_cam = cam_from_base[k].Cast<T>() * p;
-      T u, v;
-      ProjectPoint<T>(camera, T(fx_px), T(camera.k1), p_in_cam, &u, &v);
-      y[2 * k] = u - track.pixels[k].x();
-      y[2 * k + 1] = v - track.pixels[k].y();
-    }
-  };
-  *jacobian = AutodiffJacobian<3>(f, point, 2 * num_views, residuals);
+  if (!InFrontOfEveryCamera(cam_from_base, point)) return false;
+  auto f = [&](const auto* x, auto* y) { ReprojectionResiduals(camera, fx_px, cam_from_base, track, x, y); };
+  *jacobian = AutodiffJacobian<3>(f, point, 2 * static_cast<int>(cam_from_base.size()), residuals);
   return residuals->allFinite() && jacobian->allFinite();
+}
+
+// The residuals alone, the same numbers as Reproject's to the bit: evaluated on one-wide Jets, whose
+// values follow the same operations as the three-wide Jets of the Jacobian (a Jet divides by multiplying
+// with the reciprocal, which plain doubles would not). For the step halvings, most of which are
+// refused at round-off once the point has converged.
+bool ReprojectResidualsOnly(const CameraIntrinsics& camera, double fx_px, const std::vector<Rigid3>& cam_from_base,
+                            const PointTrack& track, const Eigen::Vector3d& point, Eigen::VectorXd* residuals) {
+  if (!InFrontOfEveryCamera(cam_from_base, point)) return false;
+  using Jet1 = ceres::Jet<double, 1>;
+  const Jet1 x[3] = {Jet1(point.x()), Jet1(point.y()), Jet1(point.z())};
+  std::vector<Jet1> y(2 * cam_from_base.size());
+  ReprojectionResiduals(camera, fx_px, cam_from_base, track, x, y.data());
+  residuals->resize(static_cast<Eigen::Index>(y.size()));
+  for (size_t i = 0; i < y.size(); ++i) (*residuals)[static_cast<Eigen::Index>(i)] = y[i].a;
+  return residuals->allFinite();
 }
 
 }  // namespace
@@ -136,8 +164,9 @@ TriangulationResult TriangulatePoint(const CameraIntrinsics& camera, double fx_p
       Eigen::VectorXd r_new;
       Eigen::MatrixXd j_new;
       const Eigen::Vector3d candidate = point + scale * step;
-      if (Reproject(camera, fx_px, cam_from_base, track, candidate, &r_new, &j_new) &&
-          r_new.squaredNorm() <= r.squaredNorm()) {
+      // The Jacobian only for a candidate that is taken (and must be finite to be taken, as before).
+      if (ReprojectResidualsOnly(camera, fx_px, cam_from_base, track, candidate, &r_new) &&
+          r_new.squaredNorm() <= r.squaredNorm() && Reproject(camera, fx_px, cam_from_base, track, candidate, &r_new, &j_new)) {
         point = candidate;
         r = r_new;
         j = j_new;

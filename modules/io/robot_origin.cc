@@ -90,15 +90,20 @@ Result<RobotOrigin> RobotOriginOfConfig(const std::string& path) {
   return RobotOriginOfConfigText(*text, path);
 }
 
+Result<RobotOrigin> RobotOriginOfObservations(const yaml::YamlDocument& doc) {
+  const std::string& path = doc.path;
+  if (!doc.root.IsMap()) return Status::Error(ErrorCode::kInvalidInput, path + ": not an observations file");
+  const std::string robot_file = ScalarOf(doc.root, "robot_file");
+  if (!robot_file.empty()) return RobotOriginOfConfig(ResolveBesideConfig(robot_file, path));
+  const yaml::YamlNode* robot = doc.root.Find("robot");
+  if (robot == nullptr) return Status::Error(ErrorCode::kInvalidInput, path + ": no robot");
+  return OriginOfNode(*robot, path);
+}
+
 Result<RobotOrigin> RobotOriginOfObservations(const std::string& path) {
   Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(path);
   if (!doc.ok()) return doc.status();
-  if (!doc->root.IsMap()) return Status::Error(ErrorCode::kInvalidInput, path + ": not an observations file");
-  const std::string robot_file = ScalarOf(doc->root, "robot_file");
-  if (!robot_file.empty()) return RobotOriginOfConfig(ResolveBesideConfig(robot_file, path));
-  const yaml::YamlNode* robot = doc->root.Find("robot");
-  if (robot == nullptr) return Status::Error(ErrorCode::kInvalidInput, path + ": no robot");
-  return OriginOfNode(*robot, path);
+  return RobotOriginOfObservations(*doc);
 }
 
 }  // namespace selfcal::io

@@ -39,7 +39,9 @@ std::string EnteredAsYaml(const RobotOrigin& origin);
 Result<RobotOrigin> RobotOriginOfConfig(const std::string& path);
 Result<RobotOrigin> RobotOriginOfConfigText(const std::string& text, const std::string& path);
 
-// Of an observations file's robot: its robot_file's origin, or its robot block's.
+// Of an observations file's robot: its robot_file's origin, or its robot block's; also of the file's
+// document already parsed (robot_file resolved beside doc.path), so that a reader parses it once.
 Result<RobotOrigin> RobotOriginOfObservations(const std::string& path);
+Result<RobotOrigin> RobotOriginOfObservations(const yaml::YamlDocument& doc);
 
 }  // namespace selfcal::io
