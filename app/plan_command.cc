@@ -222,7 +222,7 @@ int CheckOnly(const PlanArgs& args, const RobotModel& robot, const io::Trajector
 void PrintPlanned(const PlanArgs& args, planning::Criterion criterion, const planning::PlanResult& r) {
   std::cout << "planned (" << planning::CriterionName(criterion) << ", " << Fixed(r.seconds * 1e3, 1) << " ms, "
             << r.iterations << " iterations, " << r.evaluations << " evaluations"
-            << (r.solver_message.empty() ? "" : "; " + r.solver_message) << "):\n";
+            << (r.solver_message.empty() ? "" : "; " + r.solver_message) << "):\n  " << r.stop_rule << "\n";
   PrintCheck(r.check_final, std::cout);
   std::cout << "criteria, start -> planned:\n  eq. (39) " << r.eq39_start.total << " -> " << r.eq39_final.total
             << " (ratio term " << r.eq39_start.ratio_term << " -> " << r.eq39_final.ratio_term << ", Cond(J) "

@@ -9,10 +9,10 @@
 #include <ceres/gradient_problem.h>
 #include <ceres/gradient_problem_solver.h>
 #include <ceres/iteration_callback.h>
-#include <ceres/jet.h>
 
 #include "base/status.h"
 #include "identification/identifiability.h"
+#include "planning/barrier_objective.h"
 #include "planning/candidate_pool.h"
 #include "planning/view_geometry.h"
 #include "planning/visit_order.h"
@@ -21,177 +21,8 @@ namespace selfcal::planning {
 
 namespace {
 
-// Robots up to 7 joints (the Panda); unused derivative slots stay zero.
+// Robots up to 7 joints (the Panda): eq. (39) and its barrier carry the joints in fixed-size Jets.
 constexpr int kMaxJoints = 7;
-using JointJet = ceres::Jet<double, kMaxJoints>;
-using PairJet = ceres::Jet<double, 2 * kMaxJoints>;
-
-// A pose's camera centre and optical axis with their derivatives with respect to its own joints.
-struct ViewJets {
-  Vec3T<JointJet> centre, axis;
-};
-
-PairJet Promote(const JointJet& x, int offset) {
-  PairJet y(x.a);
-  for (int k = 0; k < kMaxJoints; ++k) y.v[offset + k] = x.v[k];
-  return y;
-}
-
-Vec3T<PairJet> Promote(const Vec3T<JointJet>& x, int offset) {
-  return Vec3T<PairJet>(Promote(x[0], offset), Promote(x[1], offset), Promote(x[2], offset));
-}
-
-// Eq. (39) plus the log barrier of every constraint that involves an optimised (identification) pose.
-class BarrierObjective final : public ceres::FirstOrderFunction {
- public:
-  BarrierObjective(const PlanningProblem& problem, const std::vector<Eigen::VectorXd>& poses,
-                   const std::vector<int>& free_columns, double lambda)
-      : problem_(problem), poses_(poses), free_columns_(free_columns), lambda_(lambda) {
-    const Eigen::VectorXd rho = KinematicParameters::Nominal(problem.robot);
-    rho_.resize(rho.size());
-    for (int k = 0; k < rho.size(); ++k) rho_[k] = JointJet(rho[k]);
-  }
-
-  void set_mu(double mu) { mu_ = mu; }
-  int evaluations() const { return evaluations_; }
-  int NumParameters() const override { return problem_.num_identification_poses * problem_.robot.num_joints(); }
-
-  // Sum of -log(slack) over the constraints (and its gradient when asked); false when one is violated.
-  bool Barrier(const std::vector<Eigen::VectorXd>& poses, double* value, Eigen::VectorXd* gradient,
-               int* num_constraints) const {
-    const RobotModel& robot = problem_.robot;
-    const PlanConstraints& c = problem_.constraints;
-    const int n = robot.num_joints(), m = static_cast<int>(poses.size()), m_id = problem_.num_identification_poses;
-    double sum = 0;
-    int count = 0;
-    Eigen::VectorXd grad = Eigen::VectorXd::Zero(m_id * n);
-    auto term = [&](double slack) {
-      ++count;
-      if (!(slack > 0)) return false;
-      sum -= std::log(slack);
-      return true;
-    };
-    // Adds -d log(slack) = -d slack / slack for the joints of pose `pose` (an identification pose).
-    auto push = [&](int pose, double slack, const double* d_slack) {
-      if (pose >= m_id) return;
-      for (int j = 0; j < n; ++j) grad[pose * n + j] -= d_slack[j] / slack;
-    };
-    // Joint limits less the margin (identification poses).
-    for (int i = 0; i < m_id; ++i) {
-      for (int j = 0; j < n; ++j) {
-        const double lo = poses[i][j] - (robot.limits[j].min_rad + c.joint_margin_rad);
-        const double hi = (robot.limits[j].max_rad - c.joint_margin_rad) - poses[i][j];
-        if (!term(lo) || !term(hi)) return false;
-        grad[i * n + j] += -1.0 / lo + 1.0 / hi;
-      }
-    }
-    // Every scene point in every identification image, in the depth range.
-    std::vector<ViewJets> views(m);
-    double d[kMaxJoints];
-    for (int i = 0; i < m; ++i) {
-      std::vector<JointJet> q(n);
-      for (int j = 0; j < n; ++j) {
-        q[j] = JointJet(poses[i][j]);
-        if (i < m_id) q[j].v[j] = 1.0;
-      }
-      const Rigid3T<JointJet> base_from_cam = BaseFromCam<JointJet>(robot, rho_.data(), q.data());
-      views[i].centre = base_from_cam.translation;
-      views[i].axis = base_from_cam.rotation.col(2);
-      if (i >= m_id) continue;
-      const Rigid3T<JointJet> cam_from_base = base_from_cam.Inverse();
-      for (const Eigen::Vector3d& x : problem_.scene.extent_in_base) {
-        const Vec3T<JointJet> p = cam_from_base * x.cast<JointJet>();
-        const JointJet slacks[2] = {p.z() - JointJet(c.min_depth_m), JointJet(c.max_depth_m) - p.z()};
-        for (const JointJet& s : slacks) {
-          if (!term(s.a)) return false;
-          for (int j = 0; j < n; ++j) d[j] = s.v[j];
-          push(i, s.a, d);
-        }
-        JointJet u, v;
-        if (!ProjectPoint<JointJet>(problem_.camera, JointJet(problem_.camera.fx_px), JointJet(problem_.camera.k1), p, &u, &v)) {
-          return false;
-        }
-        const JointJet margin(c.image_margin_px);
-        const JointJet image[4] = {u - margin, JointJet(problem_.camera.width_px - 1) - margin - u, v - margin,
-                               JointJet(problem_.camera.height_px - 1) - margin - v};
-        for (const JointJet& s : image) {
-          if (!term(s.a)) return false;
-          for (int j = 0; j < n; ++j) d[j] = s.v[j];
-          push(i, s.a, d);
-        }
-      }
-    }
-    // Camera centres apart: |c_a - c_b|^2 - d_min^2 > 0 for pairs with an identification pose.
-    const double d2 = c.min_spread_m * c.min_spread_m;
-    for (int a = 0; a < m_id; ++a) {
-      for (int b = a + 1; b < m; ++b) {
-        const Vec3T<PairJet> diff = Promote(views[a].centre, 0) - Promote(views[b].centre, kMaxJoints);
-        const PairJet s = diff.squaredNorm() - PairJet(d2);
-        if (!term(s.a)) return false;
-        push(a, s.a, s.v.data());
-        push(b, s.a, s.v.data() + kMaxJoints);
-      }
-    }
-    // Optical axes of (reference, i) apart: tau^2 - s^2 |d x z|^2 > 0 for both axes, over |d|^2.
-    const double s2 = c.min_axis_sine * c.min_axis_sine;
-    for (int i = 1; c.min_axis_sine > 0 && i < m_id; ++i) {
-      const Vec3T<PairJet> c0 = Promote(views[0].centre, kMaxJoints), z0 = Promote(views[0].axis, kMaxJoints);
-      const Vec3T<PairJet> ci = Promote(views[i].centre, 0), zi = Promote(views[i].axis, 0);
-      const Vec3T<PairJet> dd = ci - c0;
-      const PairJet tau = zi.dot(dd.cross(z0));
-      const PairJet inv = PairJet(1.0) / dd.squaredNorm();
-      const PairJet slacks[2] = {(tau * tau - PairJet(s2) * dd.cross(z0).squaredNorm()) * inv,
-                               (tau * tau - PairJet(s2) * dd.cross(zi).squaredNorm()) * inv};
-      for (const PairJet& s : slacks) {
-        if (!term(s.a)) return false;
-        push(i, s.a, s.v.data());
-        push(0, s.a, s.v.data() + kMaxJoints);
-      }
-    }
-    // Joint travel between consecutive poses.
-    for (int i = 1; i < m && i <= m_id; ++i) {
-      for (int j = 0; j < n; ++j) {
-        const double delta = poses[i][j] - poses[i - 1][j];
-        const double up = c.max_joint_travel_rad - delta, down = c.max_joint_travel_rad + delta;
-        if (!term(up) || !term(down)) return false;
-        // d(-log up)/d q_i = 1/up, d/d q_{i-1} = -1/up; d(-log down)/d q_i = -1/down, d/d q_{i-1} = 1/down.
-        if (i < m_id) grad[i * n + j] += 1.0 / up - 1.0 / down;
-        grad[(i - 1) * n + j] += -1.0 / up + 1.0 / down;
-      }
-    }
-    *value = sum;
-    if (gradient) *gradient = grad;
-    if (num_constraints) *num_constraints = count;
-    return true;
-  }
-
-  bool Evaluate(const double* x, double* cost, double* gradient) const override {
-    ++evaluations_;
-    const int n = problem_.robot.num_joints(), m_id = problem_.num_identification_poses;
-    std::vector<Eigen::VectorXd> poses = poses_;
-    for (int i = 0; i < m_id; ++i) poses[i] = Eigen::Map<const Eigen::VectorXd>(x + i * n, n);
-    double barrier = 0;
-    Eigen::VectorXd barrier_gradient;
-    if (!Barrier(poses, &barrier, gradient ? &barrier_gradient : nullptr, nullptr)) return false;
-    const std::vector<Eigen::VectorXd> id(poses.begin(), poses.begin() + m_id);
-    const Eq39Value e = EvaluateEq39(problem_.robot, id, free_columns_, lambda_, gradient != nullptr);
-    if (!std::isfinite(e.total)) return false;
-    *cost = e.total + mu_ * barrier;
-    if (gradient) {
-      for (int k = 0; k < m_id * n; ++k) gradient[k] = e.gradient[k] + mu_ * barrier_gradient[k];
-    }
-    return true;
-  }
-
- private:
-  const PlanningProblem& problem_;
-  std::vector<Eigen::VectorXd> poses_;
-  std::vector<int> free_columns_;
-  double lambda_;
-  std::vector<JointJet> rho_;
-  double mu_ = 0;
-  mutable int evaluations_ = 0;
-};
 
 double Seconds(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -289,7 +120,7 @@ class IterationProgress : public ceres::IterationCallback {
 
 void PlanEq39(const PlanningProblem& problem, const PlannerOptions& options, PlanResult* result) {
   const int n = problem.robot.num_joints(), m_id = problem.num_identification_poses;
-  BarrierObjective* objective = new BarrierObjective(problem, result->poses, result->free_columns, options.lambda);
+  internal::BarrierObjective* objective = new internal::BarrierObjective(problem, result->poses, result->free_columns, options.lambda);
   double barrier = 0;
   int num_constraints = 0;
   objective->Barrier(result->poses, &barrier, nullptr, &num_constraints);
@@ -300,9 +131,9 @@ void PlanEq39(const PlanningProblem& problem, const PlannerOptions& options, Pla
   ceres::GradientProblemSolver::Options solver_options;
   solver_options.line_search_direction_type = ceres::LBFGS;
   solver_options.max_num_iterations = options.max_iterations_per_round;
-  // No relative-cost test: near an active constraint the barrier makes the first steps tiny, which a cost
-  // tolerance would take for convergence.
-  solver_options.function_tolerance = 0;
+  // The stated test (planner.h): an iteration that lowers eq. (39) plus the barrier by less than
+  // relative_decrease_tolerance of its value ends the round (Ceres' function tolerance).
+  solver_options.function_tolerance = options.relative_decrease_tolerance;
   solver_options.gradient_tolerance = 1e-10;
   solver_options.parameter_tolerance = 0;
   solver_options.logging_type = ceres::SILENT;
@@ -319,9 +150,15 @@ void PlanEq39(const PlanningProblem& problem, const PlannerOptions& options, Pla
     counter.Complete();
     result->iterations += static_cast<int>(summary.iterations.size());
     result->solver_message = summary.message;
+    result->converged = summary.termination_type == ceres::CONVERGENCE &&
+                        summary.message.find("Function tolerance") != std::string::npos;
     mu /= options.barrier_decrease;
   }
   result->evaluations = objective->evaluations();
+  std::ostringstream stop;
+  stop << (result->converged ? "converged: " : "not converged: ") << "the stated test is a relative decrease of eq. (39) "
+       << "plus the barrier below " << options.relative_decrease_tolerance << " over an iteration";
+  result->stop_rule = stop.str();
   for (int i = 0; i < m_id; ++i) result->poses[i] = x.segment(i * n, n);
 }
 
@@ -404,10 +241,14 @@ void PlanExchange(const PlanningProblem& problem, const PlannerOptions& options,
   // One unit per slot of a pass; a design that stops changing ends the step early.
   ProgressScope progress(options.progress, static_cast<int64_t>(options.max_exchange_sweeps) * std::max(m_id - 1, 0),
                          "exchange passes");
+  // A slot exchanged with the design as it is now would keep its pose (same rest, candidates, best): skipped.
+  int changes = 0;  // exchanges made so far; each slot records the count after its own exchange
+  std::vector<int> changes_when_exchanged(m_id, -1);
   for (int sweep = 0; sweep < options.max_exchange_sweeps; ++sweep) {
     ++result->iterations;
     bool changed = false;
     for (int slot = 1; slot < m_id; ++slot) {  // pose 0 stays: it is the reference of every pair
+      if (changes_when_exchanged[slot] == changes && (progress.Advance(), true)) continue;
       const int current = chosen[slot];
       int best_candidate = current;
       // Every pose but the slot's summed once; each candidate then costs one EvaluateSums.
@@ -424,11 +265,20 @@ void PlanExchange(const PlanningProblem& problem, const PlannerOptions& options,
         }
       }
       chosen[slot] = best_candidate;
-      changed = changed || best_candidate != current;
+      if (best_candidate != current) {
+        changed = true;
+        ++changes;
+      }
+      changes_when_exchanged[slot] = changes;
       progress.Advance();
     }
-    if (!changed) break;
+    if (!changed) {
+      result->converged = true;
+      break;
+    }
   }
+  result->stop_rule = std::string(result->converged ? "converged: " : "not converged (the pass limit): ") +
+                      "the stated test is a full pass over the slots that changes no pose";
   for (int i = 0; i < m_id; ++i) result->poses[i] = candidates[chosen[i]];
 }
 
@@ -473,6 +323,9 @@ std::string PlannerOptions::Validate() const {
   std::ostringstream out;
   if (!(std::isfinite(lambda) && lambda >= 0)) out << "lambda = " << lambda << " must be >= 0\n";
   if (barrier_rounds < 1) out << "barrier_rounds = " << barrier_rounds << " must be >= 1\n";
+  if (!(relative_decrease_tolerance >= 0 && relative_decrease_tolerance < 1)) {
+    out << "relative_decrease_tolerance = " << relative_decrease_tolerance << " must lie in [0, 1)\n";
+  }
   if (!(barrier_start > 0)) out << "barrier_start = " << barrier_start << " must be > 0\n";
   if (!(barrier_decrease > 1)) out << "barrier_decrease = " << barrier_decrease << " must exceed 1\n";
   if (max_iterations_per_round < 1) out << "max_iterations_per_round must be >= 1\n";

@@ -216,7 +216,10 @@ TEST(Planning, Eq39PlannerLowersTheCostFromTheStartAndStaysFeasible) {
             << " evaluations, " << r.seconds << " s; D " << r.fisher_start.log_det << " -> " << r.fisher_final.log_det
             << "\n";
   ASSERT_TRUE(r.ok) << r.message;
-  EXPECT_LT(r.eq39_final.total, 0.8 * r.eq39_start.total);
+  // Stopped by the stated relative-decrease test (deliberately loose, planner.h), not by a zero step.
+  EXPECT_LT(r.eq39_final.total, 0.99 * r.eq39_start.total);
+  EXPECT_TRUE(r.converged) << r.solver_message;
+  EXPECT_NE(r.stop_rule.find("relative decrease"), std::string::npos) << r.stop_rule;
   EXPECT_TRUE(CheckPlan(w.problem, r.poses).ok);
   for (size_t i = 15; i < r.poses.size(); ++i) EXPECT_EQ(r.poses[i], w.start[i]) << "verification pose " << i;
   // Deterministic: the same plan to the bit.

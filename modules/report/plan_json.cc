@@ -59,6 +59,8 @@ nlohmann::json PlanResultJson(const planning::PlanResult& r) {
           {"pool_size", r.pool_size},
           {"iterations", r.iterations},
           {"evaluations", r.evaluations},
+          {"converged", r.converged},
+          {"stop_rule", r.stop_rule},
           {"seconds", r.seconds},
           {"eq39", {{"start", eq39(r.eq39_start)}, {"planned", eq39(r.eq39_final)}}},
           {"d_optimal_log_det", {{"start", Finite(r.fisher_start.log_det)}, {"planned", Finite(r.fisher_final.log_det)}}},
