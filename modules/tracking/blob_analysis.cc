@@ -28,49 +28,43 @@ struct Window {
   std::uint8_t At(int u, int v) const { return cells[static_cast<size_t>((v - v0) * w + (u - u0))]; }
 };
 
+// Grey levels counted for their median (the mean of the middle two for an even count): the same order
+// statistics as sorting them, without the sort.
+struct GreyHistogram {
+  std::array<int, 256> counts{};
+  size_t n = 0;
+  void Clear() {
+    counts.fill(0);
+    n = 0;
+  }
+  void Add(unsigned char level) {
+    ++counts[level];
+    ++n;
+  }
+  double Median() const {
+    if (n == 0) return std::nan("");
+    auto at_rank = [&](size_t rank) {  // the value sorted to index `rank`
+      size_t seen = 0;
+      int level = 0;
+      for (; level < 255; ++level) {
+        seen += static_cast<size_t>(counts[static_cast<size_t>(level)]);
+        if (seen > rank) break;
+      }
+      return static_cast<double>(level);
+    };
+    const size_t mid = n / 2;
+    const double m = at_rank(mid);
+    return n % 2 == 0 ? 0.5 * (m + at_rank(mid - 1)) : m;
+  }
+};
+
 // Buffers reused from blob to blob (MeasureBlob runs for every candidate and every tracked dot of a
 // frame); each user clears what it fills.
 struct Scratch {
   Window win;
   std::vector<std::pair<int, int>> seeds, stack, filled;
-  std::vector<double> values, ring;
+  GreyHistogram values, ring;
 };
-
-// The median (the mean of the middle two for an even count). Grey levels (integers in [0, 255]) are
-// counted in a histogram: the same order statistics as sorting, without the sort.
-double Median(std::vector<double>* values) {
-  if (values->empty()) return std::nan("");
-  const size_t mid = values->size() / 2;
-  std::array<int, 256> hist{};
-  bool grey_levels = true;
-  for (double x : *values) {
-    const int level = static_cast<int>(x);
-    if (!(x >= 0 && x <= 255) || level != x) {
-      grey_levels = false;
-      break;
-    }
-    ++hist[static_cast<size_t>(level)];
-  }
-  if (grey_levels) {
-    auto at_rank = [&](size_t rank) {  // the value sorted to index `rank`
-      size_t seen = 0;
-      int level = 0;
-      for (; level < 255; ++level) {
-        seen += static_cast<size_t>(hist[static_cast<size_t>(level)]);
-        if (seen > rank) break;
-      }
-      return static_cast<double>(level);
-    };
-    const double m = at_rank(mid);
-    return values->size() % 2 == 0 ? 0.5 * (m + at_rank(mid - 1)) : m;
-  }
-  std::nth_element(values->begin(), values->begin() + static_cast<std::ptrdiff_t>(mid), values->end());
-  double m = (*values)[mid];
-  if (values->size() % 2 == 0) {
-    m = 0.5 * (m + *std::max_element(values->begin(), values->begin() + static_cast<std::ptrdiff_t>(mid)));
-  }
-  return m;
-}
 
 // Blob pixels: the 8-connected dark pixels, inside the bbox, of the first seed whose component spans
 // exactly the bbox vpDot2 reported (other blobs may reach into that box). Every other dark pixel of the
@@ -183,7 +177,7 @@ void BlobSeeds(const vpDot2& dot, const PixelBox& bbox, const std::pair<int, int
 
 // The blob's grey levels and the raw sums of its pixel centres, relative to the bbox corner (px).
 struct BlobSums {
-  std::vector<double>& values;
+  GreyHistogram& values;
   double su = 0, sv = 0, suu = 0, suv = 0, svv = 0;
 };
 
@@ -191,13 +185,13 @@ struct BlobSums {
 // moments are accumulated from float increments such as u^3 / 3 and lose most of their digits for
 // small blobs far from the image origin; a 3 px disc at u = 512 came out with an axis ratio of 0.7).
 BlobSums SumBlob(const vpImage<unsigned char>& image, const Window& win, const PixelBox& bbox,
-                 std::vector<double>* values) {
-  values->clear();
+                 GreyHistogram* values) {
+  values->Clear();
   BlobSums b{*values};
   for (int v = bbox.v_min; v <= bbox.v_max; ++v) {
     for (int u = bbox.u_min; u <= bbox.u_max; ++u) {
       if (win.At(u, v) != kBlob) continue;
-      b.values.push_back(image[v][u]);
+      b.values.Add(image[v][u]);
       const double x = u - bbox.u_min, y = v - bbox.v_min;  // local, to keep the sums small
       b.su += x;
       b.sv += y;
@@ -211,15 +205,17 @@ BlobSums SumBlob(const vpImage<unsigned char>& image, const Window& win, const P
 
 // Background: the free pixels of the ring between the bbox dilated by gap and by gap + width.
 void BackgroundRing(const vpImage<unsigned char>& image, const Window& win, const PixelBox& bbox,
-                    const DotAcceptanceOptions& options, std::vector<double>* ring_out) {
-  std::vector<double>& ring = *ring_out;
-  ring.clear();
+                    const DotAcceptanceOptions& options, GreyHistogram* ring_out) {
+  GreyHistogram& ring = *ring_out;
+  ring.Clear();
   const int g = options.ring_gap_px, r = options.ring_gap_px + options.ring_width_px;
   for (int v = bbox.v_min - r; v <= bbox.v_max + r; ++v) {
+    const bool inner_row = v >= bbox.v_min - g && v <= bbox.v_max + g;  // skips the gap and the bbox
     for (int u = bbox.u_min - r; u <= bbox.u_max + r; ++u) {
-      if (u >= bbox.u_min - g && u <= bbox.u_max + g && v >= bbox.v_min - g && v <= bbox.v_max + g) continue;
+      if (inner_row && u == bbox.u_min - g) u = bbox.u_max + g + 1;
+      if (u > bbox.u_max + r) break;
       if (!win.Contains(u, v) || win.At(u, v) != kFree) continue;
-      ring.push_back(image[v][u]);
+      ring.Add(image[v][u]);
     }
   }
 }
@@ -416,7 +412,7 @@ BlobVerdict MeasureBlob(const vpImage<unsigned char>& image, int threshold, cons
   const Window& win = scratch.win;
 
   BlobSums blob = SumBlob(image, win, d.bbox, &scratch.values);
-  d.area_px2 = static_cast<double>(blob.values.size());
+  d.area_px2 = static_cast<double>(blob.values.n);
   if (d.area_px2 < options.min_area_px2) {
     return Reject(RejectReason::kTooSmall, Describe("area", d.area_px2, "min", options.min_area_px2));
   }
@@ -424,13 +420,13 @@ BlobVerdict MeasureBlob(const vpImage<unsigned char>& image, int threshold, cons
     return Reject(RejectReason::kTooLarge, Describe("area", d.area_px2, "max", options.max_area_px2));
   }
 
-  std::vector<double>& ring = scratch.ring;
+  GreyHistogram& ring = scratch.ring;
   BackgroundRing(image, win, d.bbox, options, &ring);
-  if (ring.size() < 8) {
+  if (ring.n < 8) {
     return Reject(RejectReason::kLowContrast, "fewer than 8 background pixels around the blob");
   }
-  d.background_level = Median(&ring);
-  d.dot_level = Median(&blob.values);
+  d.background_level = ring.Median();
+  d.dot_level = blob.values.Median();
   d.contrast = d.background_level - d.dot_level;
 
   const std::optional<double> worst = WorstBorderCoverage(image, win, d, options.border_margin_px);
