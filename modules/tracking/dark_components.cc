@@ -4,6 +4,11 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <type_traits>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace selfcal::tracking::internal {
 namespace {
@@ -18,6 +23,38 @@ int NextDark(const std::uint8_t* row, int u, int w) {
   }
   while (u < w && row[u] == 0) ++u;
   return u;
+}
+
+// p[u + 1] = col[0] + ... + col[u], p[0] = 0. With SSE2 (every x86-64), eight sums at a time: the one
+// serial loop of the mask, otherwise a third of its time. Exact integers either way.
+template <typename Column, typename Sum>
+void PrefixSums(const Column* col, int w, Sum* p) {
+  p[0] = 0;
+  int u = 0;
+#if defined(__SSE2__)
+  if constexpr (std::is_same_v<Column, std::uint16_t> && std::is_same_v<Sum, std::int32_t>) {
+    const __m128i zero = _mm_setzero_si128();
+    __m128i carry = zero;  // every lane: the sum so far
+    for (; u + 8 <= w; u += 8) {
+      const __m128i c = _mm_loadu_si128(reinterpret_cast<const __m128i*>(col + u));
+      __m128i lo = _mm_unpacklo_epi16(c, zero), hi = _mm_unpackhi_epi16(c, zero);
+      lo = _mm_add_epi32(lo, _mm_slli_si128(lo, 4));
+      lo = _mm_add_epi32(lo, _mm_slli_si128(lo, 8));
+      hi = _mm_add_epi32(hi, _mm_slli_si128(hi, 4));
+      hi = _mm_add_epi32(hi, _mm_slli_si128(hi, 8));
+      lo = _mm_add_epi32(lo, carry);
+      hi = _mm_add_epi32(hi, _mm_shuffle_epi32(lo, _MM_SHUFFLE(3, 3, 3, 3)));
+      carry = _mm_shuffle_epi32(hi, _MM_SHUFFLE(3, 3, 3, 3));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(p + u + 1), lo);
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(p + u + 5), hi);
+    }
+  }
+#endif
+  Sum running = p[u];
+  for (; u < w; ++u) {
+    running += static_cast<Sum>(col[u]);
+    p[u + 1] = running;
+  }
 }
 
 // from's pixels join to's; the darkest pixel stays the first in raster order.
@@ -145,11 +182,7 @@ std::vector<Component> AdaptiveComponents(const vpImage<unsigned char>& image, i
       for (int u = 0; u < w; ++u) col[u] = static_cast<Column>(col[u] - row[u]);
     }
     Sum* p = prefix.data();
-    Sum running = 0;
-    for (int u = 0; u < w; ++u) {
-      running += static_cast<Sum>(col[u]);
-      p[u + 1] = running;
-    }
+    PrefixSums(col, w, p);
     const unsigned char* pixels = image[v];
     std::uint8_t* out = dark.data();
     const Sum rows = static_cast<Sum>(v1 - v0);
