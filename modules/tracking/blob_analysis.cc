@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <list>
 #include <optional>
 #include <sstream>
 #include <vector>
@@ -156,21 +155,19 @@ std::string Describe(const char* what, double value, const char* limit_name, dou
   return s.str();
 }
 
-// Seeds for the blob's pixels: the required one alone if given; else vpDot2's first border pixel (its
-// border list is empty when track() fell back to a window search), then every dark pixel of the box's
-// top row, which the blob touches.
-void BlobSeeds(const vpDot2& dot, const PixelBox& bbox, const std::pair<int, int>* required_seed,
+// Seeds for the blob's pixels: the required one alone if given; else every pixel of the box's top row,
+// which the blob touches. That is enough, and the first border pixel of vpDot2's trace (a copy of its
+// border list) is not needed: at most one 8-connected dark component can span the box. Two would hold a
+// left-right 8-path (A) and a top-bottom 8-path (B) that share no pixel and are nowhere 8-adjacent; B's
+// diagonal steps then each have a corner pixel outside A, so B widens to a top-bottom 4-path outside A,
+// which the left-right 8-path A rules out (the Hex theorem). Whichever seed reaches it, the blob is the same.
+void BlobSeeds(const PixelBox& bbox, const std::pair<int, int>* required_seed,
                std::vector<std::pair<int, int>>* seeds_out) {
   std::vector<std::pair<int, int>>& seeds = *seeds_out;
   seeds.clear();
   if (required_seed != nullptr) {
     seeds.push_back(*required_seed);
     return;
-  }
-  const std::list<vpImagePoint> edges = dot.getEdges();
-  if (!edges.empty()) {
-    seeds.emplace_back(static_cast<int>(std::lround(edges.front().get_u())),
-                       static_cast<int>(std::lround(edges.front().get_v())));
   }
   for (int u = bbox.u_min; u <= bbox.u_max; ++u) seeds.emplace_back(u, bbox.v_min);
 }
@@ -402,7 +399,7 @@ BlobVerdict MeasureBlob(const vpImage<unsigned char>& image, int threshold, cons
     return Reject(RejectReason::kTrackerFailed, "vpDot2 returned a bounding box outside the image");
   }
   thread_local Scratch scratch;
-  BlobSeeds(dot, d.bbox, required_seed, &scratch.seeds);
+  BlobSeeds(d.bbox, required_seed, &scratch.seeds);
   const int margin = std::max(options.refine_margin_px, options.ring_gap_px + options.ring_width_px);
   if (!ClassifyWindow(image, threshold, d.bbox, margin, &scratch)) {
     return Reject(RejectReason::kTrackerFailed, required_seed != nullptr
