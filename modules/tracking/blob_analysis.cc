@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <list>
 #include <optional>
 #include <sstream>
 #include <vector>
@@ -28,107 +27,118 @@ struct Window {
   std::uint8_t At(int u, int v) const { return cells[static_cast<size_t>((v - v0) * w + (u - u0))]; }
 };
 
-// The median (the mean of the middle two for an even count). Grey levels (integers in [0, 255]) are
-// counted in a histogram: the same order statistics as sorting, without the sort.
-double Median(std::vector<double>* values) {
-  if (values->empty()) return std::nan("");
-  const size_t mid = values->size() / 2;
-  std::array<int, 256> hist{};
-  bool grey_levels = true;
-  for (double x : *values) {
-    const int level = static_cast<int>(x);
-    if (!(x >= 0 && x <= 255) || level != x) {
-      grey_levels = false;
-      break;
-    }
-    ++hist[static_cast<size_t>(level)];
+// Grey levels counted for their median (the mean of the middle two for an even count): the same order
+// statistics as sorting them, without the sort.
+struct GreyHistogram {
+  std::array<int, 256> counts{};
+  size_t n = 0;
+  void Clear() {
+    counts.fill(0);
+    n = 0;
   }
-  if (grey_levels) {
+  void Add(unsigned char level) {
+    ++counts[level];
+    ++n;
+  }
+  double Median() const {
+    if (n == 0) return std::nan("");
     auto at_rank = [&](size_t rank) {  // the value sorted to index `rank`
       size_t seen = 0;
       int level = 0;
       for (; level < 255; ++level) {
-        seen += static_cast<size_t>(hist[static_cast<size_t>(level)]);
+        seen += static_cast<size_t>(counts[static_cast<size_t>(level)]);
         if (seen > rank) break;
       }
       return static_cast<double>(level);
     };
+    const size_t mid = n / 2;
     const double m = at_rank(mid);
-    return values->size() % 2 == 0 ? 0.5 * (m + at_rank(mid - 1)) : m;
+    return n % 2 == 0 ? 0.5 * (m + at_rank(mid - 1)) : m;
   }
-  std::nth_element(values->begin(), values->begin() + static_cast<std::ptrdiff_t>(mid), values->end());
-  double m = (*values)[mid];
-  if (values->size() % 2 == 0) {
-    m = 0.5 * (m + *std::max_element(values->begin(), values->begin() + static_cast<std::ptrdiff_t>(mid)));
-  }
-  return m;
-}
+};
+
+// Buffers reused from blob to blob (MeasureBlob runs for every candidate and every tracked dot of a
+// frame); each user clears what it fills.
+struct Scratch {
+  Window win;
+  std::vector<std::pair<int, int>> seeds, stack, filled;
+  GreyHistogram values, ring;
+};
 
 // Blob pixels: the 8-connected dark pixels, inside the bbox, of the first seed whose component spans
 // exactly the bbox vpDot2 reported (other blobs may reach into that box). Every other dark pixel of the
 // window, dilated by one pixel (their anti-aliased rim), is "other" and stays out of the background ring
 // and of the weighted centroid. nullopt when no seed gives vpDot2's blob.
-std::optional<Window> ClassifyWindow(const vpImage<unsigned char>& image, int threshold, const PixelBox& bbox,
-                                     int margin, const std::vector<std::pair<int, int>>& seeds) {
-  Window win;
+bool ClassifyWindow(const vpImage<unsigned char>& image, int threshold, const PixelBox& bbox, int margin,
+                    Scratch* scratch) {
+  constexpr std::uint8_t kDarkUnassigned = 3;  // a dark pixel not yet given to the blob or the others
+  Window& win = scratch->win;
   const int width = static_cast<int>(image.getWidth());
   const int height = static_cast<int>(image.getHeight());
   win.u0 = std::max(0, bbox.u_min - margin);
   win.v0 = std::max(0, bbox.v_min - margin);
   win.w = std::min(width - 1, bbox.u_max + margin) - win.u0 + 1;
   win.h = std::min(height - 1, bbox.v_max + margin) - win.v0 + 1;
-  win.cells.assign(static_cast<size_t>(win.w * win.h), kFree);
-  auto dark = [&](int u, int v) { return static_cast<int>(image[v][u]) <= threshold; };
-
+  win.cells.resize(static_cast<size_t>(win.w * win.h));
+  for (int y = 0; y < win.h; ++y) {
+    const unsigned char* row = image[win.v0 + y] + win.u0;
+    std::uint8_t* cells = &win.cells[static_cast<size_t>(y * win.w)];
+    for (int x = 0; x < win.w; ++x) cells[x] = static_cast<int>(row[x]) <= threshold ? kDarkUnassigned : std::uint8_t{kFree};
+  }
+  // The fill stays inside the bbox; window coordinates from here on.
+  const int x0 = bbox.u_min - win.u0, y0 = bbox.v_min - win.v0, x1 = bbox.u_max - win.u0, y1 = bbox.v_max - win.v0;
+  const PixelBox local_bbox{x0, y0, x1, y1};
+  std::uint8_t* cells = win.cells.data();
+  const int w = win.w;
   bool found = false;
-  std::vector<std::pair<int, int>> stack, filled;
-  for (const auto& [seed_u, seed_v] : seeds) {
-    if (seed_u < bbox.u_min || seed_u > bbox.u_max || seed_v < bbox.v_min || seed_v > bbox.v_max) continue;
-    if (win.At(seed_u, seed_v) != kFree || !dark(seed_u, seed_v)) continue;
-    PixelBox span{seed_u, seed_v, seed_u, seed_v};
+  std::vector<std::pair<int, int>>& stack = scratch->stack;
+  std::vector<std::pair<int, int>>& filled = scratch->filled;
+  stack.clear();
+  for (const auto& [seed_u, seed_v] : scratch->seeds) {
+    const int sx = seed_u - win.u0, sy = seed_v - win.v0;
+    if (sx < x0 || sx > x1 || sy < y0 || sy > y1) continue;
+    if (cells[sy * w + sx] != kDarkUnassigned) continue;
+    PixelBox span{sx, sy, sx, sy};
     filled.clear();
-    win.At(seed_u, seed_v) = kBlob;
-    stack.emplace_back(seed_u, seed_v);
+    cells[sy * w + sx] = kBlob;
+    stack.emplace_back(sx, sy);
     while (!stack.empty()) {
-      const auto [u, v] = stack.back();
+      const auto [x, y] = stack.back();
       stack.pop_back();
-      filled.emplace_back(u, v);
-      span.u_min = std::min(span.u_min, u);
-      span.v_min = std::min(span.v_min, v);
-      span.u_max = std::max(span.u_max, u);
-      span.v_max = std::max(span.v_max, v);
-      for (int dv = -1; dv <= 1; ++dv) {
-        for (int du = -1; du <= 1; ++du) {
-          const int nu = u + du, nv = v + dv;
-          if (nu < bbox.u_min || nu > bbox.u_max || nv < bbox.v_min || nv > bbox.v_max) continue;
-          if (win.At(nu, nv) != kFree || !dark(nu, nv)) continue;
-          win.At(nu, nv) = kBlob;
-          stack.emplace_back(nu, nv);
+      filled.emplace_back(x, y);
+      span.u_min = std::min(span.u_min, x);
+      span.v_min = std::min(span.v_min, y);
+      span.u_max = std::max(span.u_max, x);
+      span.v_max = std::max(span.v_max, y);
+      for (int ny = std::max(y0, y - 1); ny <= std::min(y1, y + 1); ++ny) {
+        for (int nx = std::max(x0, x - 1); nx <= std::min(x1, x + 1); ++nx) {
+          if (cells[ny * w + nx] != kDarkUnassigned) continue;
+          cells[ny * w + nx] = kBlob;
+          stack.emplace_back(nx, ny);
         }
       }
     }
-    if (span == bbox) {
+    if (span == local_bbox) {
       found = true;
       break;
     }
-    for (const auto& [u, v] : filled) win.At(u, v) = kFree;  // another blob reaching into the box
+    for (const auto& [x, y] : filled) cells[y * w + x] = kDarkUnassigned;  // another blob reaching into the box
   }
-  if (!found) return std::nullopt;
-  std::vector<std::pair<int, int>> others;
-  for (int v = win.v0; v < win.v0 + win.h; ++v) {
-    for (int u = win.u0; u < win.u0 + win.w; ++u) {
-      if (win.At(u, v) == kFree && dark(u, v)) others.emplace_back(u, v);
-    }
-  }
-  for (const auto& [u, v] : others) {
-    for (int dv = -1; dv <= 1; ++dv) {
-      for (int du = -1; du <= 1; ++du) {
-        if (win.Contains(u + du, v + dv) && win.At(u + du, v + dv) == kFree) win.At(u + du, v + dv) = kOther;
+  if (!found) return false;
+  // Every other dark pixel and its free neighbours are "other" (a neighbour made other here is not dark, so
+  // it does not spread further).
+  for (int y = 0; y < win.h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      if (cells[y * w + x] != kDarkUnassigned) continue;
+      for (int ny = std::max(0, y - 1); ny <= std::min(win.h - 1, y + 1); ++ny) {
+        for (int nx = std::max(0, x - 1); nx <= std::min(w - 1, x + 1); ++nx) {
+          if (cells[ny * w + nx] == kFree) cells[ny * w + nx] = kOther;
+        }
       }
+      cells[y * w + x] = kOther;
     }
-    win.At(u, v) = kOther;
   }
-  return win;
+  return true;
 }
 
 BlobVerdict Reject(RejectReason reason, const std::string& detail) {
@@ -145,40 +155,40 @@ std::string Describe(const char* what, double value, const char* limit_name, dou
   return s.str();
 }
 
-// Seeds for the blob's pixels: the required one alone if given; else vpDot2's first border pixel (its
-// border list is empty when track() fell back to a window search), then every dark pixel of the box's
-// top row, which the blob touches.
-std::vector<std::pair<int, int>> BlobSeeds(const vpDot2& dot, const PixelBox& bbox,
-                                           const std::pair<int, int>* required_seed) {
-  std::vector<std::pair<int, int>> seeds;
+// Seeds for the blob's pixels: the required one alone if given; else every pixel of the box's top row,
+// which the blob touches. That is enough, and the first border pixel of vpDot2's trace (a copy of its
+// border list) is not needed: at most one 8-connected dark component can span the box. Two would hold a
+// left-right 8-path (A) and a top-bottom 8-path (B) that share no pixel and are nowhere 8-adjacent; B's
+// diagonal steps then each have a corner pixel outside A, so B widens to a top-bottom 4-path outside A,
+// which the left-right 8-path A rules out (the Hex theorem). Whichever seed reaches it, the blob is the same.
+void BlobSeeds(const PixelBox& bbox, const std::pair<int, int>* required_seed,
+               std::vector<std::pair<int, int>>* seeds_out) {
+  std::vector<std::pair<int, int>>& seeds = *seeds_out;
+  seeds.clear();
   if (required_seed != nullptr) {
     seeds.push_back(*required_seed);
-    return seeds;
-  }
-  const std::list<vpImagePoint> edges = dot.getEdges();
-  if (!edges.empty()) {
-    seeds.emplace_back(static_cast<int>(std::lround(edges.front().get_u())),
-                       static_cast<int>(std::lround(edges.front().get_v())));
+    return;
   }
   for (int u = bbox.u_min; u <= bbox.u_max; ++u) seeds.emplace_back(u, bbox.v_min);
-  return seeds;
 }
 
 // The blob's grey levels and the raw sums of its pixel centres, relative to the bbox corner (px).
 struct BlobSums {
-  std::vector<double> values;
+  GreyHistogram& values;
   double su = 0, sv = 0, suu = 0, suv = 0, svv = 0;
 };
 
 // Area, dot level and second moments from the blob's own pixels (pixel centres, in double: vpDot2's
 // moments are accumulated from float increments such as u^3 / 3 and lose most of their digits for
 // small blobs far from the image origin; a 3 px disc at u = 512 came out with an axis ratio of 0.7).
-BlobSums SumBlob(const vpImage<unsigned char>& image, const Window& win, const PixelBox& bbox) {
-  BlobSums b;
+BlobSums SumBlob(const vpImage<unsigned char>& image, const Window& win, const PixelBox& bbox,
+                 GreyHistogram* values) {
+  values->Clear();
+  BlobSums b{*values};
   for (int v = bbox.v_min; v <= bbox.v_max; ++v) {
     for (int u = bbox.u_min; u <= bbox.u_max; ++u) {
       if (win.At(u, v) != kBlob) continue;
-      b.values.push_back(image[v][u]);
+      b.values.Add(image[v][u]);
       const double x = u - bbox.u_min, y = v - bbox.v_min;  // local, to keep the sums small
       b.su += x;
       b.sv += y;
@@ -191,18 +201,20 @@ BlobSums SumBlob(const vpImage<unsigned char>& image, const Window& win, const P
 }
 
 // Background: the free pixels of the ring between the bbox dilated by gap and by gap + width.
-std::vector<double> BackgroundRing(const vpImage<unsigned char>& image, const Window& win, const PixelBox& bbox,
-                                   const DotAcceptanceOptions& options) {
-  std::vector<double> ring;
+void BackgroundRing(const vpImage<unsigned char>& image, const Window& win, const PixelBox& bbox,
+                    const DotAcceptanceOptions& options, GreyHistogram* ring_out) {
+  GreyHistogram& ring = *ring_out;
+  ring.Clear();
   const int g = options.ring_gap_px, r = options.ring_gap_px + options.ring_width_px;
   for (int v = bbox.v_min - r; v <= bbox.v_max + r; ++v) {
+    const bool inner_row = v >= bbox.v_min - g && v <= bbox.v_max + g;  // skips the gap and the bbox
     for (int u = bbox.u_min - r; u <= bbox.u_max + r; ++u) {
-      if (u >= bbox.u_min - g && u <= bbox.u_max + g && v >= bbox.v_min - g && v <= bbox.v_max + g) continue;
+      if (inner_row && u == bbox.u_min - g) u = bbox.u_max + g + 1;
+      if (u > bbox.u_max + r) break;
       if (!win.Contains(u, v) || win.At(u, v) != kFree) continue;
-      ring.push_back(image[v][u]);
+      ring.Add(image[v][u]);
     }
   }
-  return ring;
 }
 
 // D2: the largest coverage by the dot of a blob pixel within `margin` px of the image border; nullopt
@@ -250,15 +262,23 @@ std::string EllipseTestFailure(const vpImage<unsigned char>& image, int threshol
   const double c = std::cos(d.angle_rad), s = std::sin(d.angle_rad);
   const int max_bad = static_cast<int>(kEllipseSamples * options.ellipse_bad_points_fraction);
   int inner_bad = 0, outer_bad = 0;
+  static const std::array<std::pair<double, double>, kEllipseSamples> kCosSin = [] {
+    std::array<std::pair<double, double>, kEllipseSamples> table;
+    for (int k = 0; k < kEllipseSamples; ++k) {
+      const double t = 2.0 * M_PI * k / kEllipseSamples;
+      table[static_cast<size_t>(k)] = {std::cos(t), std::sin(t)};
+    }
+    return table;
+  }();
   for (int k = 0; k < kEllipseSamples; ++k) {
-    const double t = 2.0 * M_PI * k / kEllipseSamples;
-    const double ai = p * std::max(0.0, d.semi_major_px - 1.0) * std::cos(t);
-    const double bi = p * std::max(0.0, d.semi_minor_px - 1.0) * std::sin(t);
+    const auto [cos_t, sin_t] = kCosSin[static_cast<size_t>(k)];
+    const double ai = p * std::max(0.0, d.semi_major_px - 1.0) * cos_t;
+    const double bi = p * std::max(0.0, d.semi_minor_px - 1.0) * sin_t;
     const int ui = static_cast<int>(std::lround(d.cog_binary_px.x() + c * ai - s * bi));
     const int vi = static_cast<int>(std::lround(d.cog_binary_px.y() + s * ai + c * bi));
     if (ui < 0 || vi < 0 || ui >= width || vi >= height || static_cast<int>(image[vi][ui]) > threshold) ++inner_bad;
-    const double ao = (2.0 - p) * (d.semi_major_px + 1.0) * std::cos(t);
-    const double bo = (2.0 - p) * (d.semi_minor_px + 1.0) * std::sin(t);
+    const double ao = (2.0 - p) * (d.semi_major_px + 1.0) * cos_t;
+    const double bo = (2.0 - p) * (d.semi_minor_px + 1.0) * sin_t;
     const int uo = static_cast<int>(std::lround(d.cog_binary_px.x() + c * ao - s * bo));
     const int vo = static_cast<int>(std::lround(d.cog_binary_px.y() + s * ao + c * bo));
     if (uo < 0 || vo < 0 || uo >= width || vo >= height) continue;
@@ -307,23 +327,35 @@ Levels DarkestAndMedian(const vpImage<unsigned char>& image, const PixelBox& box
 Levels DarkestAndMedian(const vpImage<unsigned char>& image, const PixelBox& darkest_box, const PixelBox& median_box) {
   const int w = static_cast<int>(image.getWidth()), h = static_cast<int>(image.getHeight());
   Levels levels;
-  std::array<int, 256> hist{};
+  // Four histograms filled in turn, then added: runs of one grey level do not wait on one counter.
+  std::array<std::array<int, 256>, 4> parts{};
+  const int mu0 = std::max(0, median_box.u_min), mu1 = std::min(w - 1, median_box.u_max);
   int n = 0;
   for (int v = std::max(0, median_box.v_min); v <= std::min(h - 1, median_box.v_max); ++v) {
-    for (int u = std::max(0, median_box.u_min); u <= std::min(w - 1, median_box.u_max); ++u) {
-      ++hist[image[v][u]];
-      ++n;
+    const unsigned char* row = image[v];
+    int u = mu0;
+    for (; u + 3 <= mu1; u += 4) {
+      ++parts[0][row[u]];
+      ++parts[1][row[u + 1]];
+      ++parts[2][row[u + 2]];
+      ++parts[3][row[u + 3]];
     }
+    for (; u <= mu1; ++u) ++parts[0][row[u]];
+    n += std::max(0, mu1 - mu0 + 1);
   }
+  std::array<int, 256> hist;
+  for (size_t i = 0; i < 256; ++i) hist[i] = parts[0][i] + parts[1][i] + parts[2][i] + parts[3][i];
   for (int seen = 0; levels.median < 255; ++levels.median) {
     seen += hist[static_cast<size_t>(levels.median)];
     if (2 * seen >= n) break;
   }
+  const int u0 = std::max(0, darkest_box.u_min), u1 = std::min(w - 1, darkest_box.u_max);
+  unsigned char darkest = 255;
   for (int v = std::max(0, darkest_box.v_min); v <= std::min(h - 1, darkest_box.v_max); ++v) {
-    for (int u = std::max(0, darkest_box.u_min); u <= std::min(w - 1, darkest_box.u_max); ++u) {
-      levels.darkest = std::min<int>(levels.darkest, image[v][u]);
-    }
+    const unsigned char* row = image[v];
+    for (int u = u0; u <= u1; ++u) darkest = std::min(darkest, row[u]);
   }
+  levels.darkest = darkest;
   return levels;
 }
 
@@ -366,18 +398,18 @@ BlobVerdict MeasureBlob(const vpImage<unsigned char>& image, int threshold, cons
       d.bbox.width() <= 0 || d.bbox.height() <= 0) {
     return Reject(RejectReason::kTrackerFailed, "vpDot2 returned a bounding box outside the image");
   }
-  const std::vector<std::pair<int, int>> seeds = BlobSeeds(dot, d.bbox, required_seed);
+  thread_local Scratch scratch;
+  BlobSeeds(d.bbox, required_seed, &scratch.seeds);
   const int margin = std::max(options.refine_margin_px, options.ring_gap_px + options.ring_width_px);
-  const std::optional<Window> classified = ClassifyWindow(image, threshold, d.bbox, margin, seeds);
-  if (!classified) {
+  if (!ClassifyWindow(image, threshold, d.bbox, margin, &scratch)) {
     return Reject(RejectReason::kTrackerFailed, required_seed != nullptr
                                                     ? "vpDot2 traced a blob without the seed pixel"
                                                     : "no 8-connected dark blob spans vpDot2's bounding box");
   }
-  const Window& win = *classified;
+  const Window& win = scratch.win;
 
-  BlobSums blob = SumBlob(image, win, d.bbox);
-  d.area_px2 = static_cast<double>(blob.values.size());
+  BlobSums blob = SumBlob(image, win, d.bbox, &scratch.values);
+  d.area_px2 = static_cast<double>(blob.values.n);
   if (d.area_px2 < options.min_area_px2) {
     return Reject(RejectReason::kTooSmall, Describe("area", d.area_px2, "min", options.min_area_px2));
   }
@@ -385,12 +417,13 @@ BlobVerdict MeasureBlob(const vpImage<unsigned char>& image, int threshold, cons
     return Reject(RejectReason::kTooLarge, Describe("area", d.area_px2, "max", options.max_area_px2));
   }
 
-  std::vector<double> ring = BackgroundRing(image, win, d.bbox, options);
-  if (ring.size() < 8) {
+  GreyHistogram& ring = scratch.ring;
+  BackgroundRing(image, win, d.bbox, options, &ring);
+  if (ring.n < 8) {
     return Reject(RejectReason::kLowContrast, "fewer than 8 background pixels around the blob");
   }
-  d.background_level = Median(&ring);
-  d.dot_level = Median(&blob.values);
+  d.background_level = ring.Median();
+  d.dot_level = blob.values.Median();
   d.contrast = d.background_level - d.dot_level;
 
   const std::optional<double> worst = WorstBorderCoverage(image, win, d, options.border_margin_px);

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <numeric>
 #include <sstream>
 
@@ -12,155 +11,10 @@
 #include <visp3/core/vpImagePoint.h>
 
 #include "tracking/blob_analysis.h"
+#include "tracking/dark_components.h"
 
 namespace selfcal::tracking {
 namespace {
-
-// One 8-connected component of dark pixels.
-struct Component {
-  int count = 0;
-  PixelBox bbox{1 << 30, 1 << 30, -1, -1};
-  int darkest_u = -1, darkest_v = -1;  // first darkest pixel in raster order
-  int darkest = 256;
-};
-
-int Find(std::vector<int>* parent, int x) {
-  while ((*parent)[static_cast<size_t>(x)] != x) {
-    (*parent)[static_cast<size_t>(x)] = (*parent)[static_cast<size_t>((*parent)[static_cast<size_t>(x)])];
-    x = (*parent)[static_cast<size_t>(x)];
-  }
-  return x;
-}
-
-void Union(std::vector<int>* parent, int a, int b) {
-  a = Find(parent, a);
-  b = Find(parent, b);
-  if (a == b) return;
-  if (a < b) std::swap(a, b);
-  (*parent)[static_cast<size_t>(a)] = b;  // the smaller label (earlier in raster order) is the root
-}
-
-// The first u' >= u with row[u'] != 0, or w: background runs are skipped 8 bytes at a time.
-int NextDark(const std::uint8_t* row, int u, int w) {
-  while (u + 8 <= w) {
-    std::uint64_t bytes = 0;
-    std::memcpy(&bytes, row + u, sizeof bytes);
-    if (bytes != 0) break;
-    u += 8;
-  }
-  while (u < w && row[u] == 0) ++u;
-  return u;
-}
-
-// Two-pass labelling of the dark pixels (dark[v * width + u] != 0), 8-connected. Components in raster
-// order of their first pixel.
-std::vector<Component> LabelDarkComponents(const vpImage<unsigned char>& image, const std::vector<std::uint8_t>& dark) {
-  const int w = static_cast<int>(image.getWidth());
-  const int h = static_cast<int>(image.getHeight());
-  std::vector<int> labels(static_cast<size_t>(w * h), -1);
-  std::vector<int> parent;
-  for (int v = 0; v < h; ++v) {
-    const std::uint8_t* row = &dark[static_cast<size_t>(v * w)];
-    int* lab = &labels[static_cast<size_t>(v * w)];
-    const int* up = v > 0 ? &labels[static_cast<size_t>((v - 1) * w)] : nullptr;
-    for (int u = NextDark(row, 0, w); u < w; u = NextDark(row, u + 1, w)) {
-      int label = -1;
-      auto take = [&](int l) {
-        if (l < 0) return;
-        if (label < 0) {
-          label = l;
-        } else if (l != label) {
-          Union(&parent, label, l);
-        }
-      };
-      if (u > 0) take(lab[u - 1]);
-      if (up != nullptr) {
-        if (u > 0) take(up[u - 1]);
-        take(up[u]);
-        if (u + 1 < w) take(up[u + 1]);
-      }
-      if (label < 0) {
-        label = static_cast<int>(parent.size());
-        parent.push_back(label);
-      }
-      lab[u] = label;
-    }
-  }
-  // Roots are the smallest label of each set, and labels are created in raster order, so numbering the
-  // roots in label order gives the raster order of first pixels.
-  std::vector<int> index(parent.size(), -1);
-  std::vector<Component> components;
-  for (size_t l = 0; l < parent.size(); ++l) {
-    if (Find(&parent, static_cast<int>(l)) == static_cast<int>(l)) {
-      index[l] = static_cast<int>(components.size());
-      components.emplace_back();
-    }
-  }
-  for (int v = 0; v < h; ++v) {
-    const std::uint8_t* row = &dark[static_cast<size_t>(v * w)];
-    for (int u = NextDark(row, 0, w); u < w; u = NextDark(row, u + 1, w)) {
-      const int l = labels[static_cast<size_t>(v * w + u)];
-      Component& c = components[static_cast<size_t>(index[static_cast<size_t>(Find(&parent, l))])];
-      if (static_cast<int>(image[v][u]) < c.darkest) {
-        c.darkest = image[v][u];
-        c.darkest_u = u;
-        c.darkest_v = v;
-      }
-      ++c.count;
-      c.bbox.u_min = std::min(c.bbox.u_min, u);
-      c.bbox.v_min = std::min(c.bbox.v_min, v);
-      c.bbox.u_max = std::max(c.bbox.u_max, u);
-      c.bbox.v_max = std::max(c.bbox.v_max, v);
-    }
-  }
-  return components;
-}
-
-std::vector<std::uint8_t> GlobalDarkMask(const vpImage<unsigned char>& image, int threshold) {
-  std::vector<std::uint8_t> dark(image.getSize());
-  for (unsigned int i = 0; i < image.getSize(); ++i) dark[i] = static_cast<int>(image.bitmap[i]) <= threshold ? 1 : 0;
-  return dark;
-}
-
-// I <= box mean - offset, the box (side 2 half + 1) clipped to the image, in integers: n I + n offset <=
-// sum. The box sums come from column sums over the box's rows, slid down the image, and their prefix
-// along each row (exact integers, in cache); boxes not clipped left or right share one n.
-std::vector<std::uint8_t> AdaptiveDarkMask(const vpImage<unsigned char>& image, int window, int offset) {
-  const int w = static_cast<int>(image.getWidth()), h = static_cast<int>(image.getHeight());
-  const int half = window / 2;
-  std::vector<std::int64_t> column(static_cast<size_t>(w), 0), prefix(static_cast<size_t>(w) + 1, 0);
-  std::vector<std::uint8_t> dark(static_cast<size_t>(w) * h, 0);
-  int top = 0, bottom = 0;  // the column sums hold rows [top, bottom)
-  for (int v = 0; v < h; ++v) {
-    const int v0 = std::max(0, v - half), v1 = std::min(h, v + half + 1);
-    for (; bottom < v1; ++bottom) {
-      const unsigned char* row = image[bottom];
-      for (int u = 0; u < w; ++u) column[static_cast<size_t>(u)] += row[u];
-    }
-    for (; top < v0; ++top) {
-      const unsigned char* row = image[top];
-      for (int u = 0; u < w; ++u) column[static_cast<size_t>(u)] -= row[u];
-    }
-    for (int u = 0; u < w; ++u) prefix[static_cast<size_t>(u) + 1] = prefix[static_cast<size_t>(u)] + column[static_cast<size_t>(u)];
-    const unsigned char* pixels = image[v];
-    std::uint8_t* out = &dark[static_cast<size_t>(v) * w];
-    const std::int64_t rows = v1 - v0;
-    auto test = [&](int u) {
-      const int u0 = std::max(0, u - half), u1 = std::min(w, u + half + 1);
-      const std::int64_t sum = prefix[static_cast<size_t>(u1)] - prefix[static_cast<size_t>(u0)];
-      out[u] = (u1 - u0) * rows * (pixels[u] + offset) <= sum ? 1 : 0;
-    };
-    const int inner_begin = std::min(w, half), inner_end = std::max(inner_begin, w - half - 1);
-    for (int u = 0; u < inner_begin; ++u) test(u);
-    const std::int64_t n = static_cast<std::int64_t>(2 * half + 1) * rows;
-    const std::int64_t* p = prefix.data();
-    for (int u = inner_begin; u < inner_end; ++u) {
-      out[u] = n * (pixels[u] + offset) <= p[u + half + 1] - p[u - half] ? 1 : 0;
-    }
-    for (int u = inner_end; u < w; ++u) test(u);
-  }
-  return dark;
-}
 
 void AddProblem(std::ostringstream* s, bool bad, const std::string& text) {
   if (bad) *s << text << "\n";
@@ -282,12 +136,12 @@ DetectionReport DetectDots(const vpImage<unsigned char>& image, const DotDetecto
   DetectionReport report;
   report.threshold = ChooseThreshold(image, options.threshold_mode, options.fixed_threshold);
   const bool local = options.threshold_mode == ThresholdMode::kLocal;
-  const std::vector<Component> components = LabelDarkComponents(
-      image, local ? AdaptiveDarkMask(image, options.adaptive_window_px, options.adaptive_offset)
-                   : GlobalDarkMask(image, report.threshold));
+  const std::vector<internal::Component> components =
+      local ? internal::AdaptiveDarkComponents(image, options.adaptive_window_px, options.adaptive_offset)
+            : internal::GlobalDarkComponents(image, report.threshold);
   report.candidates = static_cast<int>(components.size());
 
-  for (const Component& c : components) {
+  for (const internal::Component& c : components) {
     // Cheap checks first, on the component, so that vpDot2 never traces the background. With kLocal the
     // component also holds the dot's anti-aliased rim, so only a component far above max_area is refused.
     if (c.count < acc.min_area_px2) {
