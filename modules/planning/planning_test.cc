@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 
@@ -5,6 +6,7 @@
 
 #include "identification/identifiability.h"
 #include "kinematics/autodiff_jacobian.h"
+#include "planning/barrier_objective.h"
 #include "planning/candidate_pool.h"
 #include "planning/eq39.h"
 #include "planning/fisher_design.h"
@@ -85,6 +87,36 @@ TEST(Planning, Eq39GradientMatchesCentralDifferences) {
                            (2 * h);
     EXPECT_NEAR(e.gradient[k], numeric, 1e-5 * std::max(1.0, std::abs(numeric))) << "variable " << k;
   }
+}
+
+// The barrier's analytic gradient (joint twists in double) against central differences of its value, on the
+// shipped start (feasible, every constraint kind active: limits, depth, image, spread, axes, travel).
+TEST(Planning, BarrierGradientMatchesCentralDifferences) {
+  const World w = MakeWorld();
+  const internal::BarrierObjective objective(w.problem, w.start, FreeColumns(w), 1e-7);
+  const int n = w.problem.robot.num_joints(), m_id = w.problem.num_identification_poses;
+  double value = 0;
+  Eigen::VectorXd gradient;
+  int count = 0;
+  ASSERT_TRUE(objective.Barrier(w.start, &value, &gradient, &count));
+  ASSERT_EQ(gradient.size(), m_id * n);
+  EXPECT_GT(count, m_id * 2 * n);
+  double worst = 0;
+  for (int k = 0; k < m_id * n; ++k) {
+    std::vector<Eigen::VectorXd> plus = w.start, minus = w.start;
+    const double h = 1e-6;
+    plus[k / n][k % n] += h;
+    minus[k / n][k % n] -= h;
+    double f_plus = 0, f_minus = 0;
+    ASSERT_TRUE(objective.Barrier(plus, &f_plus, nullptr, nullptr));
+    ASSERT_TRUE(objective.Barrier(minus, &f_minus, nullptr, nullptr));
+    const double numeric = (f_plus - f_minus) / (2 * h);
+    // Round-off of the differences: about 1e-16 |value| / h.
+    EXPECT_NEAR(gradient[k], numeric, 1e-6 * std::abs(numeric) + 1e-9 * std::abs(value) / h) << "variable " << k;
+    worst = std::max(worst, std::abs(gradient[k] - numeric) / std::max(1.0, std::abs(numeric)));
+  }
+  std::cout << "barrier " << value << " over " << count << " constraints; largest relative difference " << worst
+            << "\n";
 }
 
 // The shipped initial arc (the paper's "initial" trajectory) has optical axes that nearly intersect the
