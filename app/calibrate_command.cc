@@ -105,6 +105,10 @@ Status ReplaceCamera(const CalibrateRequest& request, LoadedInput* loaded) {
 
 Result<LoadedInput> LoadInput(const CalibrateRequest& request) {
   LoadedInput loaded;
+  // The camera files asked for are written last: what writes them must be there before anything is solved.
+  if (!request.write_camera_opencv.empty() || !request.write_camera_visp.empty()) {
+    if (Status s = io::CheckCameraFileSupport(); !s.ok()) return s;
+  }
   if (session::IsSessionDirectory(request.input)) {
     if (Status s = CheckOutputOutsideSession(request.out_dir, request.input); !s.ok()) return s;
     Result<session::SessionObservations> session = session::LoadSessionObservations(request.input);

@@ -2,23 +2,21 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <iostream>
 #include <regex>
 #include <sstream>
 #include <vector>
 
-#include <opencv2/core.hpp>
-#include <visp3/core/vpXmlParserCamera.h>
-
 #include "base/atomic_file.h"
 #include "base/terminal_text.h"
 #include "base/time_limited_child.h"
+#include "io/camera_formats.h"
 #include "io/camera_xml.h"
 #include "io/opencv_lines.h"
 #include "io/yaml_schema.h"
@@ -82,90 +80,85 @@ const std::vector<std::string> kOpenCvKeys = {
     "flags", "flagValue", "fisheye_model", "avg_reprojection_error", "per_view_reprojection_errors",
     "extrinsic_parameters", "image_points", "grid_points"};
 
-bool ReadOpenCvInt(const cv::FileNode& node, const std::string& key, const std::string& file, Problems* problems,
-                   int* out) {
-  if (node.empty() || node.isNone()) {
+bool ReadOpenCvInt(const internal::FileStorageScalar& node, const std::string& key, const std::string& file,
+                   Problems* problems, int* out) {
+  if (!node.present) {
     problems->Add("missing key `" + key + "` in the document at " + file);
     return false;
   }
-  if (!node.isInt() || static_cast<int>(node) < 1 || static_cast<int>(node) > 100000) {
+  if (!node.is_int || node.value < 1 || node.value > 100000) {
     problems->Add("`" + key + "` at " + file + " must be an integer in [1, 100000]");
     return false;
   }
-  *out = static_cast<int>(node);
+  *out = node.value;
   return true;
 }
 
-bool ReadOpenCvMatrix(const cv::FileNode& node, const std::string& key, const std::string& file, Problems* problems,
-                      cv::Mat* out) {
-  if (node.empty() || node.isNone()) {
+// A matrix's entries as cv::FileStorage read them (io/camera_formats.h), row by row.
+struct Matrix {
+  int rows = 0, cols = 0;
+  std::vector<double> data;
+  double at(int r, int c) const { return data[static_cast<size_t>(r * cols + c)]; }
+};
+
+bool ReadOpenCvMatrix(const internal::FileStorageMatrix& node, const std::string& key, const std::string& file,
+                      Problems* problems, Matrix* out) {
+  if (!node.present) {
     problems->Add("missing key `" + key + "` in the document at " + file);
     return false;
   }
-  // rows, cols and data checked before cv::FileStorage allocates rows x cols: a mistyped `cols` (or a
-  // repeated key) can make it ask for tens of gigabytes. The intrinsics' matrices have at most 16 entries.
-  const auto small_int = [](const cv::FileNode& n) { return n.isInt() && int(n) >= 1 && int(n) <= 16; };
-  if (!node.isMap() || !small_int(node["rows"]) || !small_int(node["cols"]) || !node["data"].isSeq() ||
-      node["data"].size() != static_cast<size_t>(int(node["rows"]) * int(node["cols"]))) {
+  if (!node.header_ok) {
     problems->Add("`" + key + "` at " + file + " must be an opencv-matrix (rows, cols, dt, data) of at most 16 " +
                   "entries, with rows x cols values in data");
     return false;
   }
-  cv::Mat m;
-  try {
-    node >> m;
-  } catch (const std::exception& e) {  // cv::Exception, or a std::exception of FileStorage
-    m = cv::Mat();
-  }
-  if (m.empty() || m.channels() != 1) {
+  if (!node.read_ok) {
     problems->Add("`" + key + "` at " + file + " must be an opencv-matrix (rows, cols, dt, data)");
     return false;
   }
-  m.convertTo(*out, CV_64F);
-  for (int r = 0; r < out->rows; ++r) {
-    for (int c = 0; c < out->cols; ++c) {
-      if (!std::isfinite(out->at<double>(r, c))) {
-        problems->Add("`" + key + "` at " + file + " has a non-finite entry");
-        return false;
-      }
+  for (double v : node.data) {
+    if (!std::isfinite(v)) {
+      problems->Add("`" + key + "` at " + file + " has a non-finite entry");
+      return false;
     }
   }
+  *out = Matrix{node.rows, node.cols, node.data};
   return true;
 }
 
 // K = [fx 0 cx; 0 fy cy; 0 0 1] exactly (no skew: selfcal's model has none).
-void ReadCameraMatrix(const cv::Mat& k, const std::string& file, Problems* problems, CameraIntrinsics* camera) {
+void ReadCameraMatrix(const Matrix& k, const std::string& file, Problems* problems, CameraIntrinsics* camera) {
   if (k.rows != 3 || k.cols != 3) {
     problems->Add("`camera_matrix` at " + file + " is " + std::to_string(k.rows) + "x" + std::to_string(k.cols) +
                   ", must be 3x3");
     return;
   }
-  if (k.at<double>(0, 1) != 0) {
-    problems->Add("`camera_matrix` at " + file + " has skew " + Num(k.at<double>(0, 1)) +
+  if (k.at(0, 1) != 0) {
+    problems->Add("`camera_matrix` at " + file + " has skew " + Num(k.at(0, 1)) +
                   " (entry [0][1]); selfcal's camera model has none and cannot represent it");
   }
-  if (k.at<double>(1, 0) != 0 || k.at<double>(2, 0) != 0 || k.at<double>(2, 1) != 0 || k.at<double>(2, 2) != 1) {
+  if (k.at(1, 0) != 0 || k.at(2, 0) != 0 || k.at(2, 1) != 0 || k.at(2, 2) != 1) {
     problems->Add("`camera_matrix` at " + file + " must be [fx 0 cx; 0 fy cy; 0 0 1]");
   }
-  camera->fx_px = k.at<double>(0, 0);
-  camera->cx_px = k.at<double>(0, 2);
-  camera->cy_px = k.at<double>(1, 2);
-  if (!(camera->fx_px > 0) || !(k.at<double>(1, 1) > 0)) {
+  camera->fx_px = k.at(0, 0);
+  camera->cx_px = k.at(0, 2);
+  camera->cy_px = k.at(1, 2);
+  if (!(camera->fx_px > 0) || !(k.at(1, 1) > 0)) {
     problems->Add("`camera_matrix` at " + file + ": fx and fy must be > 0");
     return;
   }
-  camera->mu = k.at<double>(1, 1) / camera->fx_px;
+  camera->mu = k.at(1, 1) / camera->fx_px;
 }
 
 // OpenCV's order k1, k2, p1, p2[, k3[, k4, k5, k6[, s1..s4[, tx, ty]]]]: the terms after k3 must be zero.
-void ReadDistortion(const cv::Mat& d, const std::string& file, Problems* problems, CameraIntrinsics* camera) {
-  const int n = static_cast<int>(d.total());
+void ReadDistortion(const Matrix& d, const std::string& file, Problems* problems, CameraIntrinsics* camera) {
+  const int n = static_cast<int>(d.data.size());
   if ((d.rows != 1 && d.cols != 1) || (n != 4 && n != 5 && n != 8 && n != 12 && n != 14)) {
     problems->Add("`distortion_coefficients` at " + file + " is " + std::to_string(d.rows) + "x" +
                   std::to_string(d.cols) + ", must be a vector of 4, 5, 8, 12 or 14 coefficients");
     return;
   }
-  const double* v = d.ptr<double>();
+  const double* v = d.data.data();
   camera->k1 = v[0];
   camera->k2 = v[1];
   camera->p1 = v[2];
@@ -214,40 +207,38 @@ Result<CameraIntrinsics> LoadOpenCv(const std::string& path, const std::string& 
                                                        ":" + std::to_string(line) +
                                                        ": a second `%YAML` directive inside the document");
   }
-  cv::FileStorage fs;
-  try {
-    if (!fs.open(contents, cv::FileStorage::READ | cv::FileStorage::MEMORY)) {
-      return OpenCvReadError(path, "not a FileStorage text");
-    }
-  } catch (const std::exception& e) {  // cv::Exception, or e.g. std::length_error from FileStorage::open
-    return OpenCvReadError(path, contents.empty() ? "the file is empty" : e.what());
+  const Result<const internal::CameraFormatBackend*> backend = internal::CameraFormats();
+  if (!backend.ok()) return backend.status();
+  const internal::FileStorageCamera fs = (*backend)->read_opencv(contents);
+  if (fs.open == internal::FileStorageCamera::Open::kRefused) return OpenCvReadError(path, "not a FileStorage text");
+  if (fs.open == internal::FileStorageCamera::Open::kThrew) {
+    return OpenCvReadError(path, contents.empty() ? "the file is empty" : fs.what);
   }
-  const cv::FileNode root = fs.root();
-  const OpenCvLines lines(contents, root.isMap() ? root.keys() : std::vector<std::string>{});
+  const OpenCvLines lines(contents, fs.keys);
   const auto at = [&](const std::string& key) { return path + ":" + std::to_string(lines.Key(key)); };
-  if (!root.isMap()) {
+  if (!fs.root_is_map) {
     return Status::Error(ErrorCode::kInvalidInput, path + ":" + std::to_string(lines.Document()) +
                                                        ": the top level must be a map of keys");
   }
-  for (const std::string& key : root.keys()) {
+  for (const std::string& key : fs.keys) {
     if (std::find(kOpenCvKeys.begin(), kOpenCvKeys.end(), key) == kOpenCvKeys.end()) {
       problems.Add("unknown key `" + TerminalSafe(key) + "` at " + at(key) +
                    Suggestion(key, {kOpenCvKeys.begin(), kOpenCvKeys.begin() + 4}));
     }
   }
   CameraIntrinsics camera;
-  bool ok = ReadOpenCvInt(root["image_width"], "image_width", at("image_width"), &problems, &camera.width_px);
-  ok &= ReadOpenCvInt(root["image_height"], "image_height", at("image_height"), &problems, &camera.height_px);
-  cv::Mat k, d;
-  if (ReadOpenCvMatrix(root["camera_matrix"], "camera_matrix", at("camera_matrix"), &problems, &k)) {
+  bool ok = ReadOpenCvInt(fs.image_width, "image_width", at("image_width"), &problems, &camera.width_px);
+  ok &= ReadOpenCvInt(fs.image_height, "image_height", at("image_height"), &problems, &camera.height_px);
+  Matrix k, d;
+  if (ReadOpenCvMatrix(fs.camera_matrix, "camera_matrix", at("camera_matrix"), &problems, &k)) {
     ReadCameraMatrix(k, at("camera_matrix"), &problems, &camera);
   }
-  if (ReadOpenCvMatrix(root["distortion_coefficients"], "distortion_coefficients", at("distortion_coefficients"),
+  if (ReadOpenCvMatrix(fs.distortion_coefficients, "distortion_coefficients", at("distortion_coefficients"),
                        &problems, &d)) {
     ReadDistortion(d, at("distortion_coefficients"), &problems, &camera);
   }
-  const cv::FileNode fisheye = root["fisheye_model"];
-  if (!fisheye.empty() && !fisheye.isNone() && (!fisheye.isInt() || static_cast<int>(fisheye) != 0)) {
+  const internal::FileStorageScalar& fisheye = fs.fisheye_model;
+  if (fisheye.present && (!fisheye.is_int || fisheye.value != 0)) {
     problems.Add("`fisheye_model` at " + at("fisheye_model") +
                  " is set: OpenCV's fisheye model is not selfcal's and is refused");
   }
@@ -291,6 +282,8 @@ std::string Seconds(std::chrono::milliseconds limit) {
 // some malformed texts (the fuzzer found twelve; two have the signs refused above, the others none).
 Result<CameraIntrinsics> LoadOpenCvWithin(const std::string& path, const std::string& contents,
                                           std::chrono::milliseconds limit) {
+  // Loaded here, not in the child: once for the process, and a missing backend is this process's error.
+  if (Status s = CheckCameraFileSupport(); !s.ok()) return s;
   const ChildOutput out = RunInTimeLimitedChild([&] { return EncodeCamera(LoadOpenCv(path, contents)); }, limit);
   switch (out.end) {
     case ChildEnd::kFinished:
@@ -310,16 +303,6 @@ Result<CameraIntrinsics> LoadOpenCvWithin(const std::string& path, const std::st
 
 // --- ViSP XML -------------------------------------------------------------------------------------------
 
-// Silences std::cout while ViSP's parser talks ("Found camera with name ...").
-class QuietCout {
- public:
-  QuietCout() : saved_(std::cout.rdbuf(nullptr)) {}
-  ~QuietCout() { std::cout.rdbuf(saved_); }
-
- private:
-  std::streambuf* saved_;
-};
-
 std::string TempPathFor(const std::string& path) {
   static std::atomic<int> counter{0};
   const std::filesystem::path dir = std::filesystem::temp_directory_path();
@@ -328,6 +311,11 @@ std::string TempPathFor(const std::string& path) {
 }
 
 }  // namespace
+
+Status CheckCameraFileSupport() {
+  const Result<const internal::CameraFormatBackend*> backend = internal::CameraFormats();
+  return backend.ok() ? Status::Ok() : backend.status();
+}
 
 Result<CameraIntrinsics> ParseOpenCvCameraText(const std::string& path, const std::string& contents) {
   return LoadOpenCv(path, contents);
@@ -358,17 +346,19 @@ Status SaveCameraOpenCv(const CameraIntrinsics& camera, const std::string& path)
   if (const std::string invalid = camera.Validate(); !invalid.empty()) {
     return Status::Error(ErrorCode::kInvalidInput, "refusing to write invalid intrinsics to " + path + ":\n" + invalid);
   }
-  std::string text;
-  try {
-    cv::FileStorage fs(".yaml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
-    fs.writeComment(" written by selfcal (docs/camera-files.md); pixels: the centre of the top-left pixel is (0, 0)");
-    fs << "image_width" << camera.width_px << "image_height" << camera.height_px;
-    const cv::Mat k = (cv::Mat_<double>(3, 3) << camera.fx_px, 0, camera.cx_px, 0, camera.fy_px(), camera.cy_px, 0, 0, 1);
-    const cv::Mat d = (cv::Mat_<double>(5, 1) << camera.k1, camera.k2, camera.p1, camera.p2, camera.k3);
-    fs << "camera_matrix" << k << "distortion_coefficients" << d;
-    text = fs.releaseAndGetString();
-  } catch (const std::exception& e) {
-    return Status::Error(ErrorCode::kInternal, "cannot format " + path + ": " + std::string(e.what()));
+  const Result<const internal::CameraFormatBackend*> backend = internal::CameraFormats();
+  if (!backend.ok()) return backend.status();
+  internal::OpenCvCameraValues values;
+  values.width_px = camera.width_px;
+  values.height_px = camera.height_px;
+  const double k[9] = {camera.fx_px, 0, camera.cx_px, 0, camera.fy_px(), camera.cy_px, 0, 0, 1};
+  const double d[5] = {camera.k1, camera.k2, camera.p1, camera.p2, camera.k3};
+  std::copy(std::begin(k), std::end(k), values.camera_matrix);
+  std::copy(std::begin(d), std::end(d), values.distortion_coefficients);
+  values.comment = " written by selfcal (docs/camera-files.md); pixels: the centre of the top-left pixel is (0, 0)";
+  std::string text, error;
+  if (!(*backend)->format_opencv(values, &text, &error)) {
+    return Status::Error(ErrorCode::kInternal, "cannot format " + path + ": " + error);
   }
   return WriteFileAtomically(path, text);
 }
@@ -406,28 +396,28 @@ Status SaveCameraVisp(const CameraIntrinsics& camera, const std::string& path, c
   if (!problems.empty()) {
     return Status::Error(ErrorCode::kInvalidInput, "refusing to write " + path + " as a ViSP camera file:\n" + problems);
   }
-  vpCameraParameters cam;
-  if (camera.k1 != 0) {
-    cam.initPersProjWithDistortion(camera.fx_px, camera.fy_px(), camera.cx_px, camera.cy_px, camera.k1,
-                                   FitVispKdu(camera));
-  } else {
-    cam.initPersProjWithoutDistortion(camera.fx_px, camera.fy_px(), camera.cx_px, camera.cy_px);
+  const Result<const internal::CameraFormatBackend*> backend = internal::CameraFormats();
+  if (!backend.ok()) return backend.status();
+  internal::VispCameraValues values;
+  values.name = camera_name;
+  values.width_px = static_cast<unsigned>(camera.width_px);
+  values.height_px = static_cast<unsigned>(camera.height_px);
+  values.px = camera.fx_px;
+  values.py = camera.fy_px();
+  values.u0 = camera.cx_px;
+  values.v0 = camera.cy_px;
+  values.with_distortion = camera.k1 != 0;
+  if (values.with_distortion) {
+    values.kud = camera.k1;
+    values.kdu = FitVispKdu(camera);
   }
   // vpXmlParserCamera::save adds to an existing file; it writes a fresh temporary one, published atomically.
   const std::string temp = TempPathFor(path);
-  int code = vpXmlParserCamera::SEQUENCE_ERROR;
-  try {
-    QuietCout quiet;
-    vpXmlParserCamera parser;
-    code = parser.save(cam, temp, camera_name, static_cast<unsigned>(camera.width_px),
-                       static_cast<unsigned>(camera.height_px));
-  } catch (const std::exception& e) {
-    code = vpXmlParserCamera::SEQUENCE_ERROR;
-  }
+  const bool saved = (*backend)->save_visp(values, temp);
   Result<std::string> text = ReadFileCapped(temp, kMaxCameraFileBytes);
   std::error_code ignored;
   std::filesystem::remove(temp, ignored);
-  if (code != vpXmlParserCamera::SEQUENCE_OK || !text.ok()) {
+  if (!saved || !text.ok()) {
     return Status::Error(ErrorCode::kInternal, "vpXmlParserCamera could not format " + path);
   }
   return WriteFileAtomically(path, *text);

@@ -38,6 +38,10 @@ Result<CameraIntrinsics> LoadCameraFile(const std::string& path, const std::stri
 // time limit: for the fuzz harness, whose coverage a child process would hide.
 Result<CameraIntrinsics> ParseOpenCvCameraText(const std::string& path, const std::string& contents);
 
+// OK when this program can read and write OpenCV and ViSP camera files: always where the backend is
+// linked; where it is loaded when first needed (io/camera_formats.h, `selfcal`), once it has loaded. For
+// callers that refuse before they compute or write anything.
+Status CheckCameraFileSupport();
 // Writes cv::FileStorage YAML (image_width, image_height, camera_matrix, distortion_coefficients with
 // all five coefficients), atomically.
 Status SaveCameraOpenCv(const CameraIntrinsics& camera, const std::string& path);

@@ -200,5 +200,39 @@ TEST(CameraFilesCli, BadCameraFilesAreRefusedNamingTheFileAndNothingIsWritten) {
   EXPECT_FALSE(fs::exists(dir / "franka.yaml"));
 }
 
+// `selfcal` loads OpenCV and ViSP only for a camera file (libselfcal_camera_formats.so beside it): a copy
+// without that library calibrates a set without camera files as the built one does, byte for byte, and
+// refuses a camera file to read or write naming the library, with exit 70 and before anything is written.
+TEST(CameraFilesCli, SelfcalLoadsTheCameraFormatsOnlyForACameraFile) {
+  const fs::path dir = FreshDir("camera_files", "lone");
+  const sim::SimResult world = testing::PumaArcWorld(0.2);
+  const std::string obs_path = (dir / "obs.yaml").string(), camera = (dir / "camera.yaml").string();
+  ASSERT_TRUE(io::SaveObservations(world.observations, obs_path).ok());
+  ASSERT_TRUE(io::SaveCameraOpenCv(world.observations.camera, camera).ok());
+  const fs::path lone = dir / "selfcal";
+  fs::copy_file(SELFCAL_BINARY, lone);
+  std::string output;
+  const std::string calibrate = " calibrate " + obs_path + " --no-html --quiet --out ";
+  ASSERT_EQ(testing::RunBinary(lone.string(), calibrate + (dir / "lone").string(), &output), 0) << output;
+  ASSERT_EQ(RunSelfcal(calibrate + (dir / "built").string(), &output), 0) << output;
+  for (const char* name : {"calibrated_model.yaml", "calibrated.urdf"}) {
+    std::ifstream a(dir / "lone" / name), b(dir / "built" / name);
+    std::stringstream text_a, text_b;
+    text_a << a.rdbuf();
+    text_b << b.rdbuf();
+    EXPECT_EQ(text_a.str(), text_b.str()) << name;
+  }
+  const std::string library = (dir / "libselfcal_camera_formats.so").string();
+  const std::string cases[] = {" --camera-file " + camera, " --write-camera-opencv " + (dir / "w.yaml").string(),
+                               " --write-camera-visp " + (dir / "w.xml").string()};
+  for (const std::string& c : cases) {
+    EXPECT_EQ(testing::RunBinary(lone.string(), calibrate + (dir / "out").string() + c, &output), 70) << c << output;
+    EXPECT_NE(output.find(library + ", which could not be loaded"), std::string::npos) << c << "\n" << output;
+    EXPECT_FALSE(fs::exists(dir / "out")) << c;
+  }
+  EXPECT_FALSE(fs::exists(dir / "w.yaml"));
+  EXPECT_FALSE(fs::exists(dir / "w.xml"));
+}
+
 }  // namespace
 }  // namespace selfcal
