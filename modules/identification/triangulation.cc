@@ -54,14 +54,14 @@ bool Reproject(const CameraIntrinsics& camera, double fx_px, const std::vector<R
   return residuals->allFinite() && jacobian->allFinite();
 }
 
-// The residuals alone, the same numbers as Reproject's to the bit: evaluated on one-wide Jets, whose
-// values follow the same operations as the three-wide Jets of the Jacobian (a Jet divides by multiplying
-// with the reciprocal, which plain doubles would not). For the step halvings, most of which are
-// refused at round-off once the point has converged.
+// The residuals alone, the same numbers as Reproject's to the bit: evaluated on Jets without derivative
+// parts (Jet<double, 0>), whose values follow the same operations as the three-wide Jets of the Jacobian
+// (a Jet divides by multiplying with the reciprocal, which plain doubles would not) at the cost of
+// doubles. For the step halvings, most of which are refused at round-off once the point has converged.
 bool ReprojectResidualsOnly(const CameraIntrinsics& camera, double fx_px, const std::vector<Rigid3>& cam_from_base,
                             const PointTrack& track, const Eigen::Vector3d& point, Eigen::VectorXd* residuals) {
   if (!InFrontOfEveryCamera(cam_from_base, point)) return false;
-  using Jet1 = ceres::Jet<double, 1>;
+  using Jet1 = ceres::Jet<double, 0>;
   const Jet1 x[3] = {Jet1(point.x()), Jet1(point.y()), Jet1(point.z())};
   std::vector<Jet1> y(2 * cam_from_base.size());
   ReprojectionResiduals(camera, fx_px, cam_from_base, track, x, y.data());
