@@ -233,8 +233,8 @@ TEST(MalformedFiles, C8DeepNestingIsRefusedWithoutRecursion) {
   std::string flow_maps = "a: ";
   for (int i = 0; i < deep; ++i) flow_maps += "{b: ";
   EXPECT_TRUE(CleanRefusal(LoadRobotText(dir, flow_maps + "1" + std::string(deep, '}'), &path), path, "nested deeper"));
-  // Block sequences nest through "- - - ...", which the flow pre-scan does not see: the tree builder
-  // refuses them before yaml-cpp recurses further.
+  // Block sequences nest through "- - - ...": the tree builder refuses them at the limit, as it does flow
+  // collections.
   std::string block = "a:\n  ";
   for (int i = 0; i < deep; ++i) block += "- ";
   EXPECT_TRUE(CleanRefusal(LoadRobotText(dir, block + "1\n", &path), path, "nested deeper than 64 levels"));

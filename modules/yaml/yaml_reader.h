@@ -3,14 +3,15 @@
 //
 // Two layers:
 //  1. LoadYamlFile / ParseYamlText turn bytes into a YamlNode tree with 1-based line numbers. Before
-//     yaml-cpp sees the text, the file is checked for size (<= kMaxYamlBytes, from stat, before
-//     reading), UTF-8 validity and control bytes; a UTF-8 BOM is dropped and CRLF / CR line ends become
-//     LF. A pre-scan refuses flow nesting deeper than kMaxYamlDepth, and the event handler that builds
-//     the tree refuses deeper block nesting before yaml-cpp recurses further, anchors and aliases (no
-//     alias bombs), explicit tags, non-scalar or duplicate map keys, more than kMaxYamlNodes nodes, and
-//     more than one document. Every yaml-cpp exception becomes a Status; the code is always
-//     ErrorCode::kInvalidInput and the message names the file (and the line when known). YamlRules sets the
-//     limits and the wording of the refusals.
+//     libyaml sees the text, the file is checked for size (<= kMaxYamlBytes, from stat, before
+//     reading), UTF-8 validity and control bytes (also U+0085, U+2028 and U+2029, which libyaml would
+//     count as line breaks); a UTF-8 BOM is dropped and CRLF / CR line ends become LF; an OpenCV
+//     `%YAML:1.0` first line is read as a comment. The tree is built from libyaml's events, refusing as
+//     its event arrives: nesting deeper than kMaxYamlDepth, anchors and aliases (no alias bombs), explicit
+//     tags, non-scalar or duplicate map keys, more than kMaxYamlNodes nodes, and more than one document.
+//     A plain ~, null, Null, NULL or empty value is a kNull node. Every refusal is a Status; the code is
+//     always ErrorCode::kInvalidInput and the message names the file (and the line when known). YamlRules
+//     sets the limits and the wording of the refusals.
 //  2. Problems and MapReader (io/yaml_schema.h) check a tree against a schema.
 #pragma once
 

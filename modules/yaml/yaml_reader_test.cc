@@ -68,11 +68,66 @@ TEST(YamlReader, UserFileRefusalsSayWhereAfterTheProblem) {
   EXPECT_EQ(Refusal("a: 1\nb: 2\nc: 3\n", YamlRules{9, kMaxYamlDepth, kMaxYamlNodes, YamlWording::kUserFile}),
             "the file is larger than 9 bytes (the limit falls at f.yaml:2)");
   EXPECT_NE(Refusal("a: {\n").find("malformed YAML at f.yaml:"), std::string::npos);
+  EXPECT_EQ(Refusal("a: 1\nb: *x\n"), "YAML aliases (*name) are not supported; write the values out at f.yaml:2");
+}
+
+TEST(YamlReader, NullsAreEmptyValuesWithTheirLines) {
+  Result<YamlDocument> doc = ParseYamlText("a: ~\nb: null\nc: 'null'\nd: NULL\ne:\n  -\n  - Null\n  - ! ~\n", "f.yaml");
+  ASSERT_TRUE(doc.ok()) << doc.status().ToString();
+  const YamlNode& root = doc->root;
+  EXPECT_TRUE(root.Find("a")->IsNull());
+  EXPECT_TRUE(root.Find("b")->IsNull());
+  EXPECT_EQ(root.Find("c")->scalar, "null");  // quoted: a string
+  EXPECT_FALSE(root.Find("c")->plain);
+  EXPECT_TRUE(root.Find("d")->IsNull());
+  const YamlNode& e = *root.Find("e");
+  ASSERT_EQ(e.items.size(), 3u);
+  EXPECT_TRUE(e.items[0].IsNull());
+  EXPECT_EQ(e.items[0].line, 6);  // the line of its `-`
+  EXPECT_TRUE(e.items[1].IsNull());
+  EXPECT_EQ(e.items[1].line, 7);
+  EXPECT_EQ(e.items[2].scalar, "~");  // the non-specific tag makes it a string
+  EXPECT_FALSE(e.items[2].plain);
+  EXPECT_EQ(Refusal("~: 1\n"), "empty map key at f.yaml:1");
+}
+
+TEST(YamlReader, MalformedTextNamesTheLineOfItsProblem) {
+  // A line that is neither `key: value` nor part of the value before it (yaml-cpp read it as a key).
+  EXPECT_EQ(Refusal("a:\n  b\nc\nd: 1\n"),
+            "malformed YAML at f.yaml:3: could not find expected ':' (while scanning a simple key)");
+  EXPECT_EQ(Refusal("a: [1, , 2]\n"),
+            "malformed YAML at f.yaml:1: did not find expected node content (while parsing a flow node)");
+  EXPECT_EQ(Refusal("a: 1\nb: \"open\n"),
+            "malformed YAML at f.yaml:3: found unexpected end of stream (while scanning a quoted scalar at line 2)");
+  EXPECT_EQ(Refusal("a:\n  - 1\n  -\t2\n"), "malformed YAML at f.yaml:3: found character that cannot start any token "
+                                                 "(while scanning for the next token); a tab where YAML wants spaces");
+  EXPECT_EQ(Refusal("a: 1\n...\nb: 2\n"), "more than one YAML document (text after the end of the first) at f.yaml:3");
+  EXPECT_EQ(Refusal("a: 1\n...\nb: 2\n", IndexRules()), "f.yaml:3: more than one YAML document");
+  // A tab separating a value is fine.
+  EXPECT_TRUE(ParseYamlText("a:\t1\nb: [1,\t2]\n", "f.yaml").ok());
+}
+
+TEST(YamlReader, UnicodeLineBreaksAreRefusedAndEscapesAreUtf8) {
+  EXPECT_EQ(Refusal("a: 1\nb: x\xE2\x80\xA8y\n"), "a line separator U+2028 at f.yaml:2: YAML would read it as a line "
+                                                  "break that editors do not show; end lines with LF");
+  EXPECT_EQ(Refusal("a: \"\xE2\x80\xA9\"\n"), "a paragraph separator U+2029 at f.yaml:1: YAML would read it as a line "
+                                               "break that editors do not show; end lines with LF");
+  EXPECT_NE(Refusal("a: \xC2\x85\n").find("control character U+0085 at f.yaml:1"), std::string::npos);
+  Result<YamlDocument> doc = ParseYamlText("a: \"\\_\\N\\u00e9\"\n", "f.yaml");
+  ASSERT_TRUE(doc.ok()) << doc.status().ToString();
+  EXPECT_EQ(doc->root.Find("a")->scalar, "\xC2\xA0\xC2\x85\xC3\xA9");
+}
+
+TEST(YamlReader, OpenCvFirstLineIsAComment) {
+  Result<YamlDocument> doc = ParseYamlText("%YAML:1.0\n---\nx: 1\n", "f.yaml");
+  ASSERT_TRUE(doc.ok()) << doc.status().ToString();
+  EXPECT_EQ(doc->root.key_lines, (std::vector<int>{3}));
+  EXPECT_NE(Refusal("%FOO bar\n---\nx: 1\n").find("malformed YAML at f.yaml:1"), std::string::npos);
 }
 
 TEST(YamlReader, SequenceIndexRefusalsSayWhereFirst) {
   EXPECT_EQ(Refusal("a: 1\nb: &x 2\n", IndexRules()), "f.yaml:2: YAML anchors are not allowed in a sequence index");
-  EXPECT_EQ(Refusal("a: *x\n", IndexRules()), "malformed YAML at f.yaml:1: the referenced anchor is not defined");
+  EXPECT_EQ(Refusal("a: *x\n", IndexRules()), "f.yaml:1: YAML aliases are not allowed in a sequence index");
   EXPECT_EQ(Refusal("a: 1\na: 2\n", IndexRules()), "f.yaml:2: duplicate key `a`");
   EXPECT_EQ(Refusal("a: [[[[[[[[[[]]]]]]]]]]\n", IndexRules()), "f.yaml:1: YAML nested deeper than 8 levels");
   EXPECT_EQ(Refusal("a:\n- - - 1\n", IndexRules(2)), "f.yaml:2: YAML nested deeper than 2 levels");
