@@ -136,73 +136,89 @@ std::map<int, DotInformation> IdentificationInformation(const ObservationSet& ob
 }
 
 // One verification residual: detection - prediction, and its rows of U (C = sigma^2 I + U U^T, U in px):
-// U = [G | D] with G (2 x theta) dense and D zero except the 2 x 3 block of its dot.
+// U = [G | D] with G (2 x theta) dense, its two rows at 2 k and 2 k + 1 of Residuals::g for residual k,
+// and D zero except the 2 x 3 block of its dot.
 struct Residual {
   int slot = -1;  // index into HeldOutReprojection::poses
   Eigen::Vector2d r = Eigen::Vector2d::Zero();
-  Eigen::MatrixXd g;                           // 2 x theta
   Eigen::Matrix<double, 2, 3> d = Eigen::Matrix<double, 2, 3>::Zero();
   int dot = -1;                                // index of its dot's block
 };
+using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+struct Residuals {
+  int num_theta = 0;
+  std::vector<Residual> rows;
+  std::vector<double> g;  // 2 x num_theta per residual, row by row
+};
 
-// r^T C^-1 r over the given residuals, C = sigma^2 I + U U^T, by the Woodbury identity:
+// r^T C^-1 r over the residuals [begin, end), C = sigma^2 I + U U^T, by the Woodbury identity:
 // (r^T r - b^T M^-1 b) / sigma^2 with M = U^T U + sigma^2 I and b = U^T r. M's dot part is block
 // diagonal (3 x 3 per dot), so M^-1 b comes from the Schur complement on the theta block:
-// O(residuals x theta^2 + theta^3), not O(dots^3) (the dense M had 3 x dots + theta rows).
-double ChiSquareOf(const std::vector<int>& rows, const std::vector<Residual>& residuals, int num_dots, double sigma) {
-  if (rows.empty()) return 0;
-  const int nt = static_cast<int>(residuals[rows.front()].g.cols());
+// O(residuals x theta^2 + theta^3), not O(dots^3) (the dense M had 3 x dots + theta rows); G^T G is one
+// symmetric rank update over the range's rows, the dots' correction one product over the dots.
+double ChiSquareOf(int begin, int end, const Residuals& residuals, int num_dots, double sigma) {
+  if (begin >= end) return 0;
+  const int nt = residuals.num_theta;
   const double s2 = sigma * sigma;
+  const Eigen::Map<const RowMajor> g_rows(residuals.g.data() + static_cast<size_t>(2 * nt) * begin, 2 * (end - begin), nt);
   std::vector<Eigen::Matrix3d> mdd(num_dots, Eigen::Matrix3d::Zero());
-  std::vector<Eigen::MatrixXd> mdt(num_dots);  // D_j^T G, 3 x theta
+  RowMajor mdt = RowMajor::Zero(3 * num_dots, nt);  // D_j^T G, 3 x theta per dot
   std::vector<Eigen::Vector3d> bd(num_dots, Eigen::Vector3d::Zero());
   std::vector<bool> seen(num_dots, false);
   Eigen::MatrixXd mtt = Eigen::MatrixXd::Zero(nt, nt);
   Eigen::VectorXd bt = Eigen::VectorXd::Zero(nt);
+  Eigen::VectorXd r_rows(2 * (end - begin));
   double rr = 0;
-  for (int k : rows) {
-    const Residual& e = residuals[k];
-    if (!seen[e.dot]) mdt[e.dot] = Eigen::MatrixXd::Zero(3, nt);
+  for (int k = begin; k < end; ++k) {
+    const Residual& e = residuals.rows[k];
     seen[e.dot] = true;
     mdd[e.dot] += e.d.transpose() * e.d;
-    mdt[e.dot] += e.d.transpose() * e.g;
+    mdt.middleRows<3>(3 * e.dot).noalias() += e.d.transpose().lazyProduct(g_rows.middleRows<2>(2 * (k - begin)));
     bd[e.dot] += e.d.transpose() * e.r;
-    mtt += e.g.transpose() * e.g;
-    bt += e.g.transpose() * e.r;
+    r_rows.segment<2>(2 * (k - begin)) = e.r;
     rr += e.r.squaredNorm();
+  }
+  if (nt > 0) {
+    mtt.selfadjointView<Eigen::Lower>().rankUpdate(g_rows.transpose());
+    bt.noalias() = g_rows.transpose() * r_rows;
   }
   mtt.diagonal().array() += s2;
   double quadratic = 0;  // b^T M^-1 b
+  RowMajor k_all = RowMajor::Zero(3 * num_dots, nt);  // M_dd^-1 M_dt per dot
+  Eigen::VectorXd y_all = Eigen::VectorXd::Zero(3 * num_dots);
   for (int j = 0; j < num_dots; ++j) {
     if (!seen[j]) continue;
     mdd[j].diagonal().array() += s2;
     const Eigen::LDLT<Eigen::Matrix3d> block(mdd[j]);
-    const Eigen::MatrixXd k = block.solve(mdt[j]);  // M_dd^-1 M_dt
+    k_all.middleRows<3>(3 * j) = block.solve(mdt.middleRows<3>(3 * j));
     const Eigen::Vector3d y = block.solve(bd[j]);
+    y_all.segment<3>(3 * j) = y;
     quadratic += bd[j].dot(y);
-    mtt -= mdt[j].transpose() * k;
-    bt -= mdt[j].transpose() * y;
   }
-  if (nt > 0) quadratic += bt.dot(mtt.ldlt().solve(bt));
+  if (nt > 0) {
+    mtt.triangularView<Eigen::Lower>() -= mdt.transpose() * k_all;
+    bt.noalias() -= mdt.transpose() * y_all;
+    quadratic += bt.dot(mtt.selfadjointView<Eigen::Lower>().ldlt().solve(bt));
+  }
   return (rr - quadratic) / s2;
 }
 
-HeldOutFigure FigureOf(const std::string& pose_id, const std::vector<int>& rows, const std::vector<Residual>& residuals,
-                       int num_dots, double sigma, int noise_dof) {
+HeldOutFigure FigureOf(const std::string& pose_id, int begin, int end, const Residuals& residuals, int num_dots,
+                       double sigma, int noise_dof) {
   HeldOutFigure f;
   f.pose_id = pose_id;
   f.noise_dof = noise_dof;
-  f.num_residuals = static_cast<int>(rows.size());
+  f.num_residuals = end - begin;
   f.dof = 2 * f.num_residuals;
-  if (rows.empty()) return f;
+  if (begin >= end) return f;
   double sum2 = 0, worst = 0;
-  for (int k : rows) {
-    sum2 += residuals[k].r.squaredNorm();
-    worst = std::max(worst, residuals[k].r.norm());
+  for (int k = begin; k < end; ++k) {
+    sum2 += residuals.rows[k].r.squaredNorm();
+    worst = std::max(worst, residuals.rows[k].r.norm());
   }
   f.rms_px = std::sqrt(sum2 / f.dof);
   f.max_px = worst;
-  f.chi_square = ChiSquareOf(rows, residuals, num_dots, sigma);
+  f.chi_square = ChiSquareOf(begin, end, residuals, num_dots, sigma);
   f.chi_square_limit = ChiSquareQuantile(kHeldOutTestLevel, f.dof, noise_dof);
   f.p_value = ChiSquareUpperTail(f.chi_square, f.dof, noise_dof);
   f.test_passed = f.chi_square <= f.chi_square_limit;
@@ -235,12 +251,14 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
   for (auto& [id, d] : info) {
     if (d.usable) d.column = num_dots++;
   }
-  std::vector<Residual> residuals;
-  std::vector<std::vector<int>> rows_of_pose;
+  Residuals residuals;
+  residuals.num_theta = nt;
+  std::vector<int> first_row_of_pose;  // per report.poses entry, and one past the end
+  Eigen::Matrix<double, 2, Eigen::Dynamic> g(2, nt);
   for (int v : obs.PosesWithRole(PoseRole::kVerification)) {
     const PoseObservation& pose = obs.poses[v];
     const PoseFrames frames = projector.Frames(pose);
-    std::vector<int> rows;
+    const int first = static_cast<int>(residuals.rows.size());
     for (const auto& [id, pixel] : pose.dots_px) {
       const auto d = info.find(id);
       Eigen::Vector2d uv;
@@ -251,30 +269,34 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
         continue;
       }
       Residual e;
-      e.slot = static_cast<int>(rows_of_pose.size());
+      e.slot = static_cast<int>(report.poses.size());
       e.r = pixel - uv;
-      e.g = nt > 0 ? Eigen::MatrixXd((jt - jd * d->second.k) * theta_root) : Eigen::MatrixXd(2, 0);
+      if (nt > 0) {
+        g.noalias() = (jt - jd * d->second.k) * theta_root;
+        for (int i = 0; i < 2; ++i) {
+          for (int c = 0; c < nt; ++c) residuals.g.push_back(g(i, c));
+        }
+      }
       e.d = jd * d->second.sqrt_inverse * noise_px;
       e.dot = d->second.column;
-      rows.push_back(static_cast<int>(residuals.size()));
-      residuals.push_back(std::move(e));
+      residuals.rows.push_back(e);
       report.residuals.push_back({pose.id, id, pixel, pixel - uv});
     }
-    if (!rows.empty()) {
+    if (static_cast<int>(residuals.rows.size()) > first) {
       report.poses.push_back({pose.id});
-      rows_of_pose.push_back(std::move(rows));
+      first_row_of_pose.push_back(first);
     }
   }
-  if (residuals.empty()) {
+  if (residuals.rows.empty()) {
     report.message = "no verification image sees a dot that the identification images place";
     return report;
   }
-  std::vector<int> all(residuals.size());
-  for (size_t k = 0; k < all.size(); ++k) all[k] = static_cast<int>(k);
+  first_row_of_pose.push_back(static_cast<int>(residuals.rows.size()));
   for (size_t s = 0; s < report.poses.size(); ++s) {
-    report.poses[s] = FigureOf(report.poses[s].pose_id, rows_of_pose[s], residuals, num_dots, noise_px, noise_dof);
+    report.poses[s] = FigureOf(report.poses[s].pose_id, first_row_of_pose[s], first_row_of_pose[s + 1], residuals,
+                               num_dots, noise_px, noise_dof);
   }
-  report.overall = FigureOf("", all, residuals, num_dots, noise_px, noise_dof);
+  report.overall = FigureOf("", 0, static_cast<int>(residuals.rows.size()), residuals, num_dots, noise_px, noise_dof);
   report.ok = true;
   return report;
 }
