@@ -6,10 +6,8 @@
 #include <vector>
 
 #include <Eigen/Dense>
-#include <ceres/jet.h>
 
 #include "base/status.h"
-#include "kinematics/autodiff_jacobian.h"
 
 namespace selfcal::identification {
 
@@ -22,52 +20,38 @@ constexpr double kMinRayAngleRad = 1.745e-4;
 constexpr double kMinReciprocalCondition = 1e-12;
 constexpr int kMaxGaussNewtonIterations = 50;
 
-// The reprojection residuals (px) of a point in the common frame, y[2k], y[2k+1] for view k, in any
-// scalar type T (double Jets for the Jacobian).
-template <typename T>
-void ReprojectionResiduals(const CameraIntrinsics& camera, double fx_px, const std::vector<Rigid3>& cam_from_base,
-                           const PointTrack& track, const T* x, T* y) {
-  const Vec3T<T> p(x[0], x[1], x[2]);
-  for (size_t k = 0; k < cam_from_base.size(); ++k) {
-    const Vec3T<T> p_in_cam = cam_from_base[k].Cast<T>() * p;
-    T u, v;
-    ProjectPoint<T>(camera, T(fx_px), T(camera.k1), p_in_cam, &u, &v);
-    y[2 * k] = u - track.pixels[k].x();
-    y[2 * k + 1] = v - track.pixels[k].y();
-  }
-}
-
-bool InFrontOfEveryCamera(const std::vector<Rigid3>& cam_from_base, const Eigen::Vector3d& point) {
-  for (const Rigid3& cam : cam_from_base) {
-    if (!((cam * point).z() > 0)) return false;
-  }
-  return true;
-}
-
-// Reprojection residuals (px) and their Jacobian; false if the point is not in front of every camera.
+// The Gauss-Newton system of a point: the sum of squared reprojection residuals (px) and, when asked,
+// J^T J and J^T r of the 2 x 3 Jacobians (analytic: the lens's own Jacobian, camera.h's Distort). False
+// when the point is not in front of every camera or anything is not finite.
+struct Normal {
+  double cost = 0;
+  Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d jtr = Eigen::Vector3d::Zero();
+};
 bool Reproject(const CameraIntrinsics& camera, double fx_px, const std::vector<Rigid3>& cam_from_base,
-               const PointTrack& track, const Eigen::Vector3d& point, Eigen::VectorXd* residuals,
-               Eigen::MatrixXd* jacobian) {
-  if (!InFrontOfEveryCamera(cam_from_base, point)) return false;
-  auto f = [&](const auto* x, auto* y) { ReprojectionResiduals(camera, fx_px, cam_from_base, track, x, y); };
-  *jacobian = AutodiffJacobian<3>(f, point, 2 * static_cast<int>(cam_from_base.size()), residuals);
-  return residuals->allFinite() && jacobian->allFinite();
-}
-
-// The residuals alone, the same numbers as Reproject's to the bit: evaluated on Jets without derivative
-// parts (Jet<double, 0>), whose values follow the same operations as the three-wide Jets of the Jacobian
-// (a Jet divides by multiplying with the reciprocal, which plain doubles would not) at the cost of
-// doubles. For the step halvings, most of which are refused at round-off once the point has converged.
-bool ReprojectResidualsOnly(const CameraIntrinsics& camera, double fx_px, const std::vector<Rigid3>& cam_from_base,
-                            const PointTrack& track, const Eigen::Vector3d& point, Eigen::VectorXd* residuals) {
-  if (!InFrontOfEveryCamera(cam_from_base, point)) return false;
-  using Jet1 = ceres::Jet<double, 0>;
-  const Jet1 x[3] = {Jet1(point.x()), Jet1(point.y()), Jet1(point.z())};
-  std::vector<Jet1> y(2 * cam_from_base.size());
-  ReprojectionResiduals(camera, fx_px, cam_from_base, track, x, y.data());
-  residuals->resize(static_cast<Eigen::Index>(y.size()));
-  for (size_t i = 0; i < y.size(); ++i) (*residuals)[static_cast<Eigen::Index>(i)] = y[i].a;
-  return residuals->allFinite();
+               const PointTrack& track, const Eigen::Vector3d& point, bool jacobian, Normal* out) {
+  *out = Normal();
+  const double fy_px = fx_px * camera.mu;
+  for (size_t k = 0; k < cam_from_base.size(); ++k) {
+    const Eigen::Vector3d p = cam_from_base[k] * point;
+    if (!(p.z() > 0)) return false;
+    const double inv_z = 1.0 / p.z();
+    const Eigen::Vector2d xy(p.x() * inv_z, p.y() * inv_z);
+    Eigen::Matrix2d d_distort;
+    const Eigen::Vector2d xy_d = Distort(camera, xy, jacobian ? &d_distort : nullptr);
+    const Eigen::Vector2d r(fx_px * xy_d.x() + camera.cx_px - track.pixels[k].x(),
+                            fy_px * xy_d.y() + camera.cy_px - track.pixels[k].y());
+    out->cost += r.squaredNorm();
+    if (!jacobian) continue;
+    Eigen::Matrix<double, 2, 3> d_xy;
+    d_xy << inv_z, 0, -xy.x() * inv_z, 0, inv_z, -xy.y() * inv_z;
+    Eigen::Matrix<double, 2, 3> j = d_distort * d_xy * cam_from_base[k].rotation;
+    j.row(0) *= fx_px;
+    j.row(1) *= fy_px;
+    out->jtj.noalias() += j.transpose() * j;
+    out->jtr.noalias() += j.transpose() * r;
+  }
+  return std::isfinite(out->cost) && out->jtj.allFinite() && out->jtr.allFinite();
 }
 
 }  // namespace
@@ -126,16 +110,18 @@ TriangulationResult TriangulatePoint(const CameraIntrinsics& camera, double fx_p
     return result;
   }
 
-  // DLT on normalised coordinates: x (P3 X) - P1 X = 0, y (P3 X) - P2 X = 0.
-  Eigen::MatrixXd a(2 * num_views, 4);
+  // DLT on normalised coordinates: x (P3 X) - P1 X = 0, y (P3 X) - P2 X = 0; the null vector of the rows
+  // as the smallest eigenvector of their 4 x 4 Gram matrix.
+  Eigen::Matrix4d gram = Eigen::Matrix4d::Zero();
   for (int k = 0; k < num_views; ++k) {
     Eigen::Matrix<double, 3, 4> p;
     p << cam_from_base[k].rotation, cam_from_base[k].translation;
     const Eigen::Vector2d xy = PixelToNormalized(camera, fx_px, track.pixels[k]);
-    a.row(2 * k) = xy.x() * p.row(2) - p.row(0);
-    a.row(2 * k + 1) = xy.y() * p.row(2) - p.row(1);
+    const Eigen::Vector4d row_x = (xy.x() * p.row(2) - p.row(0)).transpose();
+    const Eigen::Vector4d row_y = (xy.y() * p.row(2) - p.row(1)).transpose();
+    gram.noalias() += row_x * row_x.transpose() + row_y * row_y.transpose();
   }
-  const Eigen::Vector4d h = Eigen::JacobiSVD<Eigen::MatrixXd>(a, Eigen::ComputeFullV).matrixV().col(3);
+  const Eigen::Vector4d h = Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d>(gram).eigenvectors().col(0);
   if (!(std::abs(h[3]) > 1e-12 * h.head<3>().norm())) {
     result.message = "the linear solution lies at infinity";
     return result;
@@ -149,35 +135,31 @@ TriangulationResult TriangulatePoint(const CameraIntrinsics& camera, double fx_p
   }
 
   // Gauss-Newton on the reprojection error, halving steps that do not decrease it.
-  Eigen::VectorXd r;
-  Eigen::MatrixXd j;
-  if (!Reproject(camera, fx_px, cam_from_base, track, point, &r, &j)) {
+  Normal normal;
+  if (!Reproject(camera, fx_px, cam_from_base, track, point, true, &normal)) {
     result.message = "non-finite reprojection at the linear solution";
     return result;
   }
   for (int iter = 0; iter < kMaxGaussNewtonIterations; ++iter) {
-    const Eigen::Vector3d step = (j.transpose() * j).ldlt().solve(-j.transpose() * r);
+    const Eigen::Vector3d step = normal.jtj.ldlt().solve(-normal.jtr);
     if (!step.allFinite()) break;
     bool accepted = false;
     double scale = 1.0;
     for (int halving = 0; halving < 20 && !accepted; ++halving, scale *= 0.5) {
-      Eigen::VectorXd r_new;
-      Eigen::MatrixXd j_new;
       const Eigen::Vector3d candidate = point + scale * step;
-      // The Jacobian only for a candidate that is taken (and must be finite to be taken, as before).
-      if (ReprojectResidualsOnly(camera, fx_px, cam_from_base, track, candidate, &r_new) &&
-          r_new.squaredNorm() <= r.squaredNorm() && Reproject(camera, fx_px, cam_from_base, track, candidate, &r_new, &j_new)) {
+      Normal trial;
+      // The Jacobian only for a candidate that is taken (and must be finite to be taken).
+      if (Reproject(camera, fx_px, cam_from_base, track, candidate, false, &trial) && trial.cost <= normal.cost &&
+          Reproject(camera, fx_px, cam_from_base, track, candidate, true, &trial)) {
         point = candidate;
-        r = r_new;
-        j = j_new;
+        normal = trial;
         accepted = true;
       }
     }
     if (!accepted || scale * step.norm() <= 1e-15 * (1.0 + point.norm())) break;
   }
 
-  const Eigen::Matrix3d normal = j.transpose() * j;
-  const Eigen::Vector3d eig = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(normal).eigenvalues();
+  const Eigen::Vector3d eig = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(normal.jtj).eigenvalues();
   if (!(eig[0] > kMinReciprocalCondition * eig[2])) {
     result.message = "ill-conditioned ray configuration: the normal matrix is singular";
     return result;
@@ -185,8 +167,8 @@ TriangulationResult TriangulatePoint(const CameraIntrinsics& camera, double fx_p
   result.ok = true;
   result.message = "ok";
   result.point = point;
-  result.covariance = sigma_px * sigma_px * normal.inverse();
-  result.rms_reprojection_px = std::sqrt(r.squaredNorm() / num_views);
+  result.covariance = sigma_px * sigma_px * normal.jtj.inverse();
+  result.rms_reprojection_px = std::sqrt(normal.cost / num_views);
   return result;
 }
 
