@@ -19,7 +19,10 @@ namespace {
 std::string FormatCombination(const Eigen::VectorXd& v, const std::vector<std::string>& names) {
   std::vector<int> order(v.size());
   std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return std::abs(v[a]) > std::abs(v[b]); });
+  // Terms by their printed weight, ties in column order, the first positive: a combination reads the same
+  // whatever the round-off of its weights (0.71 a - 0.71 b, never flipping to 0.71 b - 0.71 a).
+  const auto printed = [&](int i) { return std::lround(std::abs(v[i]) * 100.0); };
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return printed(a) > printed(b); });
   const double sign = (!order.empty() && v[order[0]] < 0) ? -1.0 : 1.0;
   std::string out;
   for (int idx : order) {
