@@ -68,11 +68,15 @@ TEST(SessionKillTest, SigkillAtRandomMomentsKeepsEveryAcknowledgedRecord) {
   std::uniform_int_distribution<long> delay_ns(0, 20'000'000);
   std::size_t durable = 0;  // records known durable before the current child started
   int kills_with_progress = 0;
-  for (int run = 0; run < 30; ++run) {
+  // 30 kills, and more (with longer delays) until one came after acknowledged records: on a loaded machine
+  // a child may not write anything within 20 ms thirty times in a row.
+  for (int run = 0; run < 300 && (run < 30 || durable == 0 || kills_with_progress == 0); ++run) {
     SCOPED_TRACE("run " + std::to_string(run));
     int pipe_fds[2];
     ASSERT_EQ(::pipe2(pipe_fds, O_CLOEXEC), 0);
-    const timespec delay{0, delay_ns(rng)};
+    const long stretch = 1 + run / 30;  // up to 200 ms after 270 kills without progress
+    const long ns = delay_ns(rng) * stretch;
+    const timespec delay{ns / 1'000'000'000, ns % 1'000'000'000};
     const pid_t child = ::fork();
     ASSERT_GE(child, 0);
     if (child == 0) {
