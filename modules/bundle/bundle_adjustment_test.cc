@@ -5,6 +5,7 @@
 #include <random>
 #include <set>
 
+#include <ceres/jet.h>
 #include <gtest/gtest.h>
 
 #include "bundle/bundle_problem.h"
@@ -169,6 +170,50 @@ TEST(BundleAdjustment, ReprojectionJacobianMatchesNumericDifferentiation) {
       const double expected = numeric(r, n + kNumIntrinsics + c);
       EXPECT_NEAR(d_dot[3 * r + c], expected, 1e-4 * (1 + std::abs(expected)));
     }
+  }
+}
+
+// The pose cache's derivatives (spatial twists, the right Jacobian of SO(3) for the base and camera
+// corrections) against forward-mode autodiff of the chain, at corrections far from zero (0.3 rad, 5 cm):
+// joint angles and a flange-pose set.
+TEST(BundleAdjustment, PoseCacheDerivativesAreTheChainsDerivativesAtAnyCorrection) {
+  const RobotModel robot = selfcal::testing::Puma560();
+  const int n = robot.num_parameters();
+  std::vector<int> columns(n);
+  for (int i = 0; i < n; ++i) columns[i] = i;
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::VectorXd rho = KinematicParameters::Nominal(robot);
+  for (int i = 0; i < n; ++i) rho[i] += (i % 6 < 3 ? 0.05 : 0.3) * u(rng);
+  internal::BundleData joints, flange;
+  joints.robot = flange.robot = robot;
+  Eigen::VectorXd q(6);
+  q << 0.1, 0.4, 2.6, 0.2, 0.7, -0.3;
+  joints.joints = {q};
+  flange.joints = {Eigen::VectorXd()};
+  flange.base_from_flange = {BaseFromFlange(robot, KinematicParameters::Nominal(robot), q)};
+  using Jet = ceres::Jet<double, 1>;
+  for (const internal::BundleData* data : {&joints, &flange}) {
+    internal::PoseCache cache;
+    internal::ComputePoseCache(*data, 0, rho.data(), columns, true, &cache);
+    double worst = 0;
+    for (int k = 0; k < n; ++k) {
+      std::vector<Jet> rho_jet(n), q_jet(q.size());
+      for (int i = 0; i < n; ++i) rho_jet[i] = Jet(rho[i]);
+      rho_jet[k].v[0] = 1.0;
+      for (int j = 0; j < q.size(); ++j) q_jet[j] = Jet(q[j]);
+      const Rigid3T<Jet> base_from_cam = data->base_from_flange.empty()
+                                             ? BaseFromCam<Jet>(robot, rho_jet.data(), q_jet.data())
+                                             : BaseFromCamGivenFlange<Jet>(robot, rho_jet.data(), data->base_from_flange[0]);
+      const Rigid3T<Jet> cam_from_base = base_from_cam.Inverse();
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) {
+          worst = std::max(worst, std::abs(cache.d_rotation[k](r, c) - cam_from_base.rotation(r, c).v[0]));
+        }
+        worst = std::max(worst, std::abs(cache.d_translation[k][r] - cam_from_base.translation[r].v[0]));
+      }
+    }
+    EXPECT_LT(worst, 1e-12) << (data == &joints ? "joint angles" : "flange poses");
   }
 }
 

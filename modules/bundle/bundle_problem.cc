@@ -26,9 +26,90 @@ Rigid3 BaseFromCamOfPose(const BundleData& data, int pose, const Eigen::VectorXd
   return BaseFromCamOf<double>(data, pose, rho.data(), data.joints[pose].data());
 }
 
+namespace {
+
+// The spatial twist (omega, v) of one parameter: d R / d rho = [omega]x R, d p / d rho = omega x p + v for
+// the camera pose (R, p) = base_from_cam, in the base frame.
+struct Twist {
+  Eigen::Vector3d omega = Eigen::Vector3d::Zero(), v = Eigen::Vector3d::Zero();
+};
+
+// d Exp(r + delta) = Exp(r) [J_r(r) delta]x: the right Jacobian of SO(3).
+Eigen::Matrix3d RightJacobianSO3(const Eigen::Vector3d& r) {
+  const double theta2 = r.squaredNorm();
+  const Eigen::Matrix3d k = Skew<double>(r);
+  double a, b;  // (1 - cos t) / t^2, (t - sin t) / t^3
+  if (theta2 < 1e-8) {
+    a = 0.5 - theta2 / 24.0;
+    b = 1.0 / 6.0 - theta2 / 120.0;
+  } else {
+    const double theta = std::sqrt(theta2);
+    a = (1.0 - std::cos(theta)) / theta2;
+    b = (theta - std::sin(theta)) / (theta2 * theta);
+  }
+  return Eigen::Matrix3d::Identity() - a * k + b * k * k;
+}
+
+// Appends a correction [Exp(r) | t] (rho[0..2] = t, rho[3..5] = r) to the chain `frame`, and the twists of its
+// six parameters to twists[0..5].
+void AppendCorrection(const double* rho, Rigid3* frame, Twist* twists) {
+  for (int k = 0; k < 3; ++k) twists[k].v = frame->rotation.col(k);
+  *frame = *frame * Rigid3::FromTranslation(Eigen::Vector3d(rho[0], rho[1], rho[2]));
+  const Eigen::Vector3d r(rho[3], rho[4], rho[5]);
+  const Eigen::Matrix3d exp_r = ExpSO3<double>(r);
+  const Eigen::Matrix3d axes = frame->rotation * exp_r * RightJacobianSO3(r);
+  for (int k = 0; k < 3; ++k) {
+    twists[3 + k].omega = axes.col(k);
+    twists[3 + k].v = frame->translation.cross(twists[3 + k].omega);
+  }
+  *frame = *frame * Rigid3::FromRotation(exp_r);
+}
+
+// Appends a rotation about the chain's current `axis` (0 x, 1 y, 2 z) by `angle`, its twist in *twist.
+void AppendRotation(int axis, double angle, Rigid3* frame, Twist* twist) {
+  twist->omega = frame->rotation.col(axis);
+  twist->v = frame->translation.cross(twist->omega);
+  const Eigen::Matrix3d r = axis == 0 ? RotX(angle) : axis == 1 ? RotY(angle) : RotZ(angle);
+  *frame = *frame * Rigid3::FromRotation(r);
+}
+
+void AppendTranslation(int axis, double length, Rigid3* frame, Twist* twist) {
+  twist->v = frame->rotation.col(axis);
+  *frame = *frame * Rigid3::FromTranslation(length * Eigen::Vector3d::Unit(axis));
+}
+
+// The twist of every rho entry at one pose (zero for a link entry of a flange-pose set, which takes no
+// part), composing base_from_cam (BaseFromCam, or BaseFromCamGivenFlange for a flange-pose set) on the way.
+void CameraPoseAndTwists(const BundleData& data, int pose, const double* rho, std::vector<Twist>* twists) {
+  const RobotModel& model = data.robot;
+  twists->assign(model.num_parameters(), Twist());
+  Rigid3 frame = model.base_from_link0;
+  AppendCorrection(rho, &frame, twists->data());
+  if (!data.base_from_flange.empty()) {
+    frame = frame * data.base_from_flange[pose];
+  } else {
+    const Eigen::VectorXd& q = data.joints[pose];
+    for (int i = 0; i < model.num_joints(); ++i) {
+      const int o = KinematicParameters::JointOffset(i);
+      const double* p = rho + o;
+      Twist* t = twists->data() + o;
+      AppendRotation(0, p[0], &frame, &t[0]);
+      AppendTranslation(0, p[1], &frame, &t[1]);
+      AppendRotation(1, p[2], &frame, &t[2]);
+      AppendRotation(2, q[i] + p[3], &frame, &t[3]);
+      AppendTranslation(2, p[4], &frame, &t[4]);
+    }
+    frame = frame * model.link_n_from_flange;
+  }
+  frame = frame * model.flange_from_cam;
+  const int cam = KinematicParameters(model.num_joints()).CamOffset();
+  AppendCorrection(rho + cam, &frame, twists->data() + cam);
+}
+
+}  // namespace
+
 void ComputePoseCache(const BundleData& data, int pose, const double* rho, const std::vector<int>& columns,
                       bool derivatives, PoseCache* out) {
-  const RobotModel& model = data.robot;
   const Eigen::VectorXd& q = data.joints[pose];
   const int m = static_cast<int>(columns.size());
   if (!derivatives || m == 0) {
@@ -39,32 +120,22 @@ void ComputePoseCache(const BundleData& data, int pose, const double* rho, const
     out->d_translation.assign(derivatives ? m : 0, Eigen::Vector3d::Zero());
     return;
   }
-  // Only the requested columns carry derivatives: 8 per pass of the forward kinematics, so ~24 free
-  // parameters cost three passes per pose and evaluation, shared by every dot that pose sees.
-  constexpr int kStride = 8;
-  using Jet = ceres::Jet<double, kStride>;
-  const int n = model.num_parameters();
-  std::vector<Jet> rho_jet(n), q_jet(q.size());
-  for (int j = 0; j < q.size(); ++j) q_jet[j] = Jet(q[j]);
+  // cam_from_base = (R^T, -R^T p) of base_from_cam = (R, p); a parameter with twist (omega, v) moves it by
+  // d R^T = -R^T [omega]x and d(-R^T p) = -R^T v.
+  // The pose itself as the cost's evaluation computes it, to the bit (the chain of the twists composes it
+  // in another order).
+  std::vector<Twist> twists;
+  CameraPoseAndTwists(data, pose, rho, &twists);
+  const Rigid3 cam_from_base = BaseFromCamOf<double>(data, pose, rho, q.data()).Inverse();
+  const Eigen::Matrix3d& rt = cam_from_base.rotation;
+  out->rotation = rt;
+  out->translation = cam_from_base.translation;
   out->d_rotation.resize(m);
   out->d_translation.resize(m);
-  for (int start = 0; start < m; start += kStride) {
-    for (int i = 0; i < n; ++i) rho_jet[i] = Jet(rho[i]);
-    const int count = std::min(kStride, m - start);
-    for (int k = 0; k < count; ++k) rho_jet[columns[start + k]].v[k] = 1.0;
-    const Rigid3T<Jet> cam_from_base = BaseFromCamOf<Jet>(data, pose, rho_jet.data(), q_jet.data()).Inverse();
-    if (start == 0) {
-      for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c) out->rotation(r, c) = cam_from_base.rotation(r, c).a;
-        out->translation[r] = cam_from_base.translation[r].a;
-      }
-    }
-    for (int k = 0; k < count; ++k) {
-      for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c) out->d_rotation[start + k](r, c) = cam_from_base.rotation(r, c).v[k];
-        out->d_translation[start + k][r] = cam_from_base.translation[r].v[k];
-      }
-    }
+  for (int k = 0; k < m; ++k) {
+    const Twist& t = twists[columns[k]];
+    out->d_rotation[k] = -(rt * Skew<double>(t.omega));
+    out->d_translation[k] = -(rt * t.v);
   }
 }
 
