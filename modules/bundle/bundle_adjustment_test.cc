@@ -206,11 +206,14 @@ TEST(BundleAdjustment, PoseCacheDerivativesAreTheChainsDerivativesAtAnyCorrectio
                                              ? BaseFromCam<Jet>(robot, rho_jet.data(), q_jet.data())
                                              : BaseFromCamGivenFlange<Jet>(robot, rho_jet.data(), data->base_from_flange[0]);
       const Rigid3T<Jet> cam_from_base = base_from_cam.Inverse();
+      // The twist's derivatives of cam_from_base = (R, t): d R = -R [omega]x, d t = -R v.
+      const Eigen::Matrix3d d_rotation = -cache.rotation * Skew<double>(cache.omega[k]);
+      const Eigen::Vector3d d_translation = -cache.rotation * cache.v[k];
       for (int r = 0; r < 3; ++r) {
         for (int c = 0; c < 3; ++c) {
-          worst = std::max(worst, std::abs(cache.d_rotation[k](r, c) - cam_from_base.rotation(r, c).v[0]));
+          worst = std::max(worst, std::abs(d_rotation(r, c) - cam_from_base.rotation(r, c).v[0]));
         }
-        worst = std::max(worst, std::abs(cache.d_translation[k][r] - cam_from_base.translation[r].v[0]));
+        worst = std::max(worst, std::abs(d_translation[r] - cam_from_base.translation[r].v[0]));
       }
     }
     EXPECT_LT(worst, 1e-12) << (data == &joints ? "joint angles" : "flange poses");

@@ -116,26 +116,22 @@ void ComputePoseCache(const BundleData& data, int pose, const double* rho, const
     const Rigid3 cam_from_base = BaseFromCamOf<double>(data, pose, rho, q.data()).Inverse();
     out->rotation = cam_from_base.rotation;
     out->translation = cam_from_base.translation;
-    out->d_rotation.assign(derivatives ? m : 0, Eigen::Matrix3d::Zero());
-    out->d_translation.assign(derivatives ? m : 0, Eigen::Vector3d::Zero());
+    out->omega.assign(derivatives ? m : 0, Eigen::Vector3d::Zero());
+    out->v.assign(derivatives ? m : 0, Eigen::Vector3d::Zero());
     return;
   }
-  // cam_from_base = (R^T, -R^T p) of base_from_cam = (R, p); a parameter with twist (omega, v) moves it by
-  // d R^T = -R^T [omega]x and d(-R^T p) = -R^T v.
   // The pose itself as the cost's evaluation computes it, to the bit (the chain of the twists composes it
   // in another order).
   std::vector<Twist> twists;
   CameraPoseAndTwists(data, pose, rho, &twists);
   const Rigid3 cam_from_base = BaseFromCamOf<double>(data, pose, rho, q.data()).Inverse();
-  const Eigen::Matrix3d& rt = cam_from_base.rotation;
-  out->rotation = rt;
+  out->rotation = cam_from_base.rotation;
   out->translation = cam_from_base.translation;
-  out->d_rotation.resize(m);
-  out->d_translation.resize(m);
+  out->omega.resize(m);
+  out->v.resize(m);
   for (int k = 0; k < m; ++k) {
-    const Twist& t = twists[columns[k]];
-    out->d_rotation[k] = -(rt * Skew<double>(t.omega));
-    out->d_translation[k] = -(rt * t.v);
+    out->omega[k] = twists[columns[k]].omega;
+    out->v[k] = twists[columns[k]].v;
   }
 }
 
@@ -198,9 +194,12 @@ bool EvaluateReprojection(const IntrinsicsVector& in, double sigma_px, const Pos
     out = d_p * cache.rotation;
   }
   if (d_columns != nullptr) {
-    const int m = static_cast<int>(cache.d_rotation.size());
+    // With A = d_p R: d(R p + t) = -R (omega x p + v), so the column is (A [p]x) omega - A v.
+    const int m = static_cast<int>(cache.omega.size());
+    const Eigen::Matrix<double, 2, 3> a = d_p * cache.rotation;
+    const Eigen::Matrix<double, 2, 3> g = a * Skew<double>(dot);
     for (int c = 0; c < m; ++c) {
-      const Eigen::Vector2d d = d_p * (cache.d_rotation[c] * dot + cache.d_translation[c]);
+      const Eigen::Vector2d d = g * cache.omega[c] - a * cache.v[c];
       d_columns[c] = d[0];
       d_columns[m + c] = d[1];
     }

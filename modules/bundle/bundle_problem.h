@@ -59,13 +59,13 @@ struct GlobalColumns {
   int size() const { return static_cast<int>(kinematic.size() + intrinsics.size()); }
 };
 
-// cam_from_base of one pose and its derivative with respect to rho[columns[c]] (forward-mode autodiff
-// through BaseFromCam, or BaseFromCamGivenFlange for a flange-pose set, 8 columns per pass).
+// cam_from_base = (R, t) of one pose (BaseFromCam, or BaseFromCamGivenFlange for a flange-pose set) and
+// its derivative with respect to rho[columns[c]] as the spatial twist (omega[c], v[c]) of the camera in the
+// base frame: d R = -R [omega]x, d t = -R v.
 struct PoseCache {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
-  std::vector<Eigen::Matrix3d> d_rotation;
-  std::vector<Eigen::Vector3d> d_translation;
+  std::vector<Eigen::Vector3d> omega, v;
 };
 Rigid3 BaseFromCamOfPose(const BundleData& data, int pose, const Eigen::VectorXd& rho);
 void ComputePoseCache(const BundleData& data, int pose, const double* rho, const std::vector<int>& columns,
@@ -73,7 +73,7 @@ void ComputePoseCache(const BundleData& data, int pose, const double* rho, const
 
 // Whitened residual (project(intrinsics, R p + t) - pixel) / sigma of one observation, the projection of
 // camera/camera.h (ProjectWithIntrinsics, the same bits). Derivatives (each optional, row-major):
-// d_columns 2 x cache.d_rotation.size(), d_intrinsics 2 x kNumIntrinsics, d_dot 2 x 3. Returns false
+// d_columns 2 x cache.omega.size(), d_intrinsics 2 x kNumIntrinsics, d_dot 2 x 3. Returns false
 // (outputs untouched) when the point is not in front of the camera or anything is non-finite.
 bool EvaluateReprojection(const IntrinsicsVector& intrinsics, double sigma_px, const PoseCache& cache,
                           const Eigen::Vector3d& dot, const Eigen::Vector2d& pixel, double* residual, double* d_columns,
