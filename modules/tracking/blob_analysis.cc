@@ -8,9 +8,6 @@
 #include <sstream>
 #include <vector>
 
-#include <visp3/core/vpImagePoint.h>
-#include <visp3/core/vpRect.h>
-
 namespace selfcal::tracking::internal {
 namespace {
 
@@ -359,29 +356,7 @@ Levels DarkestAndMedian(const vpImage<unsigned char>& image, const PixelBox& dar
   return levels;
 }
 
-PixelBox BoxOf(const vpDot2& dot) {
-  const vpRect rect = dot.getBBox();
-  PixelBox box;
-  box.u_min = static_cast<int>(std::lround(rect.getLeft()));
-  box.v_min = static_cast<int>(std::lround(rect.getTop()));
-  box.u_max = static_cast<int>(std::lround(rect.getRight()));
-  box.v_max = static_cast<int>(std::lround(rect.getBottom()));
-  return box;
-}
-
-vpDot2 MakeDarkDot(int threshold) {
-  vpDot2 dot;
-  dot.setGraphics(false);
-  dot.setComputeMoments(true);
-  dot.setGrayLevelMin(0);
-  dot.setGrayLevelMax(static_cast<unsigned int>(std::clamp(threshold, 0, 255)));
-  dot.setSizePrecision(0.0);
-  dot.setEllipsoidShapePrecision(0.0);
-  dot.setEllipsoidBadPointsPercentage(1.0);
-  return dot;
-}
-
-BlobVerdict MeasureBlob(const vpImage<unsigned char>& image, int threshold, const vpDot2& dot,
+BlobVerdict MeasureBlob(const vpImage<unsigned char>& image, int threshold, const TracedBlob& dot,
                         const DotAcceptanceOptions& options, DotDetection* out,
                         const std::pair<int, int>* required_seed) {
   DotDetection& d = *out;
@@ -389,11 +364,11 @@ BlobVerdict MeasureBlob(const vpImage<unsigned char>& image, int threshold, cons
   const int width = static_cast<int>(image.getWidth());
   const int height = static_cast<int>(image.getHeight());
 
-  d.bbox = BoxOf(dot);
+  d.bbox = dot.bbox;
   d.threshold = threshold;
-  d.cog_binary_px = Eigen::Vector2d(dot.getCog().get_u(), dot.getCog().get_v());
+  d.cog_binary_px = dot.cog_px;
   d.centroid_px = d.cog_binary_px;
-  d.polygon_area_px2 = dot.getArea();
+  d.polygon_area_px2 = dot.polygon_area_px2;
   if (d.bbox.u_min < 0 || d.bbox.v_min < 0 || d.bbox.u_max >= width || d.bbox.v_max >= height ||
       d.bbox.width() <= 0 || d.bbox.height() <= 0) {
     return Reject(RejectReason::kTrackerFailed, "vpDot2 returned a bounding box outside the image");

@@ -6,11 +6,10 @@
 #include <numeric>
 #include <sstream>
 
-#include <visp3/blob/vpDot2.h>
 #include <visp3/core/vpException.h>
-#include <visp3/core/vpImagePoint.h>
 
 #include "tracking/blob_analysis.h"
+#include "tracking/blob_trace.h"
 #include "tracking/dark_components.h"
 
 namespace selfcal::tracking {
@@ -157,13 +156,11 @@ DetectionReport DetectDots(const vpImage<unsigned char>& image, const DotDetecto
       report.rejections.Add(RejectReason::kLowContrast);
       continue;
     }
-    // vpDot2 seeded at the darkest pixel; the blob it traces must be the one holding that pixel (its
-    // window-search fallback may return another).
-    vpDot2 dot = internal::MakeDarkDot(threshold);
+    // vpDot2 seeded at the darkest pixel (initTracking with size 0); the blob it traces must be the one
+    // holding that pixel (its window-search fallback may return another).
+    internal::TracedBlob dot;
     try {
-      vpImagePoint seed;
-      seed.set_uv(c.darkest_u, c.darkest_v);
-      dot.initTracking(image, seed, 0, static_cast<unsigned int>(threshold));
+      dot = internal::TrackDarkBlob(image, threshold, Eigen::Vector2d(c.darkest_u, c.darkest_v), 0, 0);
     } catch (const vpException&) {
       report.rejections.Add(RejectReason::kTrackerFailed);
       continue;
