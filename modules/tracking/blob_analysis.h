@@ -1,9 +1,10 @@
 // Module-internal: the measurement and the acceptance checks of one blob that vpDot2 has just traced
-// (blob_trace.h),
-// shared by DetectDots (dot_detector.h) and TrackDots (dot_tracker.h) so that a detected and a tracked dot
-// mean the same thing. Pixel conventions and the checks are those of dot_detector.h.
+// (blob_trace.h), shared by DetectDots (dot_detector.h) and TrackDots (dot_tracker.h) so that a detected
+// and a tracked dot mean the same thing. Pixel conventions and the checks are those of dot_detector.h.
 #pragma once
 
+#include <array>
+#include <cmath>
 #include <string>
 #include <utility>
 
@@ -28,6 +29,55 @@ struct BlobVerdict {
 BlobVerdict MeasureBlob(const vpImage<unsigned char>& image, int threshold, const TracedBlob& dot,
                         const DotAcceptanceOptions& options, DotDetection* out,
                         const std::pair<int, int>* required_seed = nullptr);
+
+// Grey levels counted for their median (the mean of the middle two for an even count): the same order
+// statistics as sorting them, without the sort. Sixteen coarse bins of 16 levels each find a rank's bin
+// before its level.
+struct GreyHistogram {
+  std::array<int, 256> counts{};
+  std::array<int, 16> coarse{};
+  size_t n = 0;
+  void Clear() {
+    counts.fill(0);
+    coarse.fill(0);
+    n = 0;
+  }
+  void Add(unsigned char level) {
+    ++counts[level];
+    ++coarse[level >> 4];
+    ++n;
+  }
+  // The level sorted to index `rank` (< n).
+  double AtRank(size_t rank) const {
+    size_t seen = 0;
+    int bin = 0;
+    for (; bin < 15; ++bin) {
+      if (seen + static_cast<size_t>(coarse[static_cast<size_t>(bin)]) > rank) break;
+      seen += static_cast<size_t>(coarse[static_cast<size_t>(bin)]);
+    }
+    int level = 16 * bin;
+    for (; level < 255; ++level) {
+      seen += static_cast<size_t>(counts[static_cast<size_t>(level)]);
+      if (seen > rank) break;
+    }
+    return static_cast<double>(level);
+  }
+  double Median() const {
+    if (n == 0) return std::nan("");
+    const size_t mid = n / 2;
+    const double m = AtRank(mid);
+    return n % 2 == 0 ? 0.5 * (m + AtRank(mid - 1)) : m;
+  }
+};
+
+// lround (half away from zero) without the library call: the same integer for any |x| < 2^63.
+inline long RoundHalfAway(double x) {
+  const long t = static_cast<long>(x);  // towards zero
+  const double frac = x - static_cast<double>(t);  // exact
+  if (frac >= 0.5) return t + 1;
+  if (frac <= -0.5) return t - 1;
+  return t;
+}
 
 // The darkest grey level of `box` and the median of `median_box` (both clipped to the image).
 struct Levels {

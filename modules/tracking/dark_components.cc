@@ -10,6 +10,8 @@
 #include <emmintrin.h>
 #endif
 
+#include "tracking/disjoint_sets.h"
+
 namespace selfcal::tracking::internal {
 namespace {
 
@@ -90,11 +92,10 @@ class RunLabeller {
       while (j < previous_.size() && previous_[j].e < s - 1) ++j;
       int label = -1;
       for (size_t k = j; k < previous_.size() && previous_[k].s <= e + 1; ++k) {
-        label = label < 0 ? Find(previous_[k].label) : Union(label, previous_[k].label);
+        label = label < 0 ? sets_.Find(previous_[k].label) : sets_.Union(label, previous_[k].label).first;
       }
       if (label < 0) {
-        label = static_cast<int>(parent_.size());
-        parent_.push_back(label);
+        label = sets_.Add();
         stats_.emplace_back();
       }
       Component& c = stats_[static_cast<size_t>(label)];
@@ -116,16 +117,16 @@ class RunLabeller {
   }
 
   std::vector<Component> Finish() {
-    std::vector<int> index(parent_.size(), -1);
+    std::vector<int> index(sets_.size(), -1);
     std::vector<Component> components;
-    for (size_t l = 0; l < parent_.size(); ++l) {
-      if (Find(static_cast<int>(l)) == static_cast<int>(l)) {
+    for (size_t l = 0; l < sets_.size(); ++l) {
+      if (sets_.Find(static_cast<int>(l)) == static_cast<int>(l)) {
         index[l] = static_cast<int>(components.size());
         components.emplace_back();
       }
     }
-    for (size_t l = 0; l < parent_.size(); ++l) {
-      Merge(stats_[l], &components[static_cast<size_t>(index[static_cast<size_t>(Find(static_cast<int>(l)))])]);
+    for (size_t l = 0; l < sets_.size(); ++l) {
+      Merge(stats_[l], &components[static_cast<size_t>(index[static_cast<size_t>(sets_.Find(static_cast<int>(l)))])]);
     }
     return components;
   }
@@ -135,26 +136,8 @@ class RunLabeller {
     int s, e, label;  // inclusive columns
   };
 
-  int Find(int x) {
-    while (parent_[static_cast<size_t>(x)] != x) {
-      parent_[static_cast<size_t>(x)] = parent_[static_cast<size_t>(parent_[static_cast<size_t>(x)])];
-      x = parent_[static_cast<size_t>(x)];
-    }
-    return x;
-  }
-
-  // The root of the joined set: the smaller of the two roots.
-  int Union(int a, int b) {
-    a = Find(a);
-    b = Find(b);
-    if (a == b) return a;
-    if (a < b) std::swap(a, b);
-    parent_[static_cast<size_t>(a)] = b;
-    return b;
-  }
-
   int w_;
-  std::vector<int> parent_;
+  DisjointSets sets_;
   std::vector<Component> stats_;  // per label, merged into the roots by Finish
   std::vector<Run> previous_, current_;
 };
