@@ -107,26 +107,28 @@ int SpanningSet(const PixelBox& box, const std::pair<int, int>* seed, Scratch* s
 
 // Other: the dark cells left (not the blob's) and every non-blob cell 8-adjacent to one.
 void MarkOthers(BlobWindow* win, Scratch* scratch) {
+  // Byte loops over raw pointers and local bounds (a byte store may alias anything else), so that they
+  // vectorise.
   const int w = win->w, h = win->h;
-  std::vector<std::uint8_t>& dark = scratch->dark;
-  std::vector<std::uint8_t>& near = scratch->near;  // dark left in the cell or its row neighbours
-  dark.resize(static_cast<size_t>(w));
-  near.resize(static_cast<size_t>(w * h));
+  scratch->dark.resize(static_cast<size_t>(w) + 2);
+  scratch->near.resize(static_cast<size_t>(w * h));
+  std::uint8_t* dark = scratch->dark.data() + 1;  // dark[-1] and dark[w] stay 0
+  std::uint8_t* near = scratch->near.data();      // dark left in the cell or its row neighbours
+  std::uint8_t* cells = win->cells.data();
+  dark[-1] = 0;
+  dark[w] = 0;
   std::uint8_t any = 0;
   for (int y = 0; y < h; ++y) {
-    const std::uint8_t* row = &win->cells[static_cast<size_t>(y * w)];
-    std::uint8_t* n = &near[static_cast<size_t>(y * w)];
-    for (int x = 0; x < w; ++x) dark[static_cast<size_t>(x)] = row[x] == kDark ? 1 : 0;
-    for (int x = 0; x < w; ++x) {
-      n[x] = static_cast<std::uint8_t>(dark[static_cast<size_t>(x)] | (x > 0 ? dark[static_cast<size_t>(x - 1)] : 0) |
-                                       (x + 1 < w ? dark[static_cast<size_t>(x + 1)] : 0));
-      any |= n[x];
-    }
+    const std::uint8_t* row = cells + y * w;
+    std::uint8_t* n = near + y * w;
+    for (int x = 0; x < w; ++x) dark[x] = row[x] == kDark ? 1 : 0;
+    for (int x = 0; x < w; ++x) n[x] = static_cast<std::uint8_t>(dark[x - 1] | dark[x] | dark[x + 1]);
+    for (int x = 0; x < w; ++x) any |= n[x];
   }
   if (any == 0) return;  // blob and free cells only
   for (int y = 0; y < h; ++y) {
-    std::uint8_t* row = &win->cells[static_cast<size_t>(y * w)];
-    const std::uint8_t* mid = &near[static_cast<size_t>(y * w)];
+    std::uint8_t* row = cells + y * w;
+    const std::uint8_t* mid = near + y * w;
     const std::uint8_t* up = y > 0 ? mid - w : mid;
     const std::uint8_t* down = y + 1 < h ? mid + w : mid;
     for (int x = 0; x < w; ++x) {
@@ -151,12 +153,16 @@ bool ClassifyBlobWindow(const vpImage<unsigned char>& image, int threshold, cons
   win.h = std::min(height - 1, bbox.v_max + margin) - win.v0 + 1;
   win.cells.resize(static_cast<size_t>(win.w * win.h));
   const unsigned char t = static_cast<unsigned char>(std::clamp(threshold, 0, 255));
-  const bool none_dark = threshold < 0;
-  for (int y = 0; y < win.h; ++y) {
+  const int w = win.w, h = win.h;  // local: the byte stores below may alias win's fields
+  std::uint8_t* cells = win.cells.data();
+  for (int y = 0; y < h; ++y) {
     const unsigned char* row = image[win.v0 + y] + win.u0;
-    std::uint8_t* cells = &win.cells[static_cast<size_t>(y * win.w)];
-    for (int x = 0; x < win.w; ++x) cells[x] = row[x] <= t ? kDark : std::uint8_t{kFree};
-    if (none_dark) std::fill(cells, cells + win.w, std::uint8_t{kFree});
+    std::uint8_t* out = cells + y * w;
+    if (threshold < 0) {
+      std::fill(out, out + w, std::uint8_t{kFree});
+      continue;
+    }
+    for (int x = 0; x < w; ++x) out[x] = row[x] <= t ? kDark : std::uint8_t{kFree};
   }
   // Window coordinates from here on.
   const PixelBox box{bbox.u_min - win.u0, bbox.v_min - win.v0, bbox.u_max - win.u0, bbox.v_max - win.v0};
