@@ -221,28 +221,14 @@ Levels DarkestAndMedian(const vpImage<unsigned char>& image, const PixelBox& box
 Levels DarkestAndMedian(const vpImage<unsigned char>& image, const PixelBox& darkest_box, const PixelBox& median_box) {
   const int w = static_cast<int>(image.getWidth()), h = static_cast<int>(image.getHeight());
   Levels levels;
-  // Four histograms filled in turn, then added: runs of one grey level do not wait on one counter.
-  std::array<std::array<int, 256>, 4> parts{};
+  LevelCounts counts;
   const int mu0 = std::max(0, median_box.u_min), mu1 = std::min(w - 1, median_box.u_max);
   int n = 0;
   for (int v = std::max(0, median_box.v_min); v <= std::min(h - 1, median_box.v_max); ++v) {
-    const unsigned char* row = image[v];
-    int u = mu0;
-    for (; u + 3 <= mu1; u += 4) {
-      ++parts[0][row[u]];
-      ++parts[1][row[u + 1]];
-      ++parts[2][row[u + 2]];
-      ++parts[3][row[u + 3]];
-    }
-    for (; u <= mu1; ++u) ++parts[0][row[u]];
+    counts.Add(image[v] + mu0, mu1 - mu0 + 1);
     n += std::max(0, mu1 - mu0 + 1);
   }
-  std::array<int, 256> hist;
-  for (size_t i = 0; i < 256; ++i) hist[i] = parts[0][i] + parts[1][i] + parts[2][i] + parts[3][i];
-  for (int seen = 0; levels.median < 255; ++levels.median) {
-    seen += hist[static_cast<size_t>(levels.median)];
-    if (2 * seen >= n) break;
-  }
+  levels.median = counts.HalfLevel(n);
   const int u0 = std::max(0, darkest_box.u_min), u1 = std::min(w - 1, darkest_box.u_max);
   unsigned char darkest = 255;
 #if defined(__SSE2__)
@@ -252,8 +238,14 @@ Levels DarkestAndMedian(const vpImage<unsigned char>& image, const PixelBox& dar
     const unsigned char* row = image[v];
     int u = u0;
 #if defined(__SSE2__)
-    for (; u + 15 <= u1; u += 16) {
-      darkest16 = _mm_min_epu8(darkest16, _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + u)));
+    if (u1 - u0 + 1 >= 16) {
+      for (; u + 15 <= u1; u += 16) {
+        darkest16 = _mm_min_epu8(darkest16, _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + u)));
+      }
+      if (u <= u1) {  // the last sixteen columns, overlapping the ones done
+        darkest16 = _mm_min_epu8(darkest16, _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + u1 - 15)));
+      }
+      continue;
     }
 #endif
     for (; u <= u1; ++u) darkest = std::min(darkest, row[u]);

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <utility>
 
@@ -78,6 +79,48 @@ inline long RoundHalfAway(double x) {
   if (frac <= -0.5) return t - 1;
   return t;
 }
+
+// Grey levels counted in four histograms in turn (runs of one level then do not wait on one counter),
+// added up by Total.
+struct LevelCounts {
+  std::array<std::array<std::uint32_t, 256>, 4> parts{};
+  void Add(const unsigned char* levels, int n) {
+    int i = 0;
+    for (; i + 4 <= n; i += 4) {
+      ++parts[0][levels[i]];
+      ++parts[1][levels[i + 1]];
+      ++parts[2][levels[i + 2]];
+      ++parts[3][levels[i + 3]];
+    }
+    for (; i < n; ++i) ++parts[0][levels[i]];
+  }
+  std::uint32_t Count(int level) const {
+    const size_t l = static_cast<size_t>(level);
+    return parts[0][l] + parts[1][l] + parts[2][l] + parts[3][l];
+  }
+  std::array<std::uint32_t, 256> Total() const {
+    std::array<std::uint32_t, 256> total;
+    for (int l = 0; l < 256; ++l) total[static_cast<size_t>(l)] = Count(l);
+    return total;
+  }
+  // The first level at which the count from level 0 reaches half of n (of n levels added), 255 if none
+  // below: whole bins of 16 levels are passed before the level is looked for.
+  int HalfLevel(std::int64_t n) const {
+    std::int64_t seen = 0;
+    int level = 0;
+    for (; level < 240; level += 16) {
+      std::int64_t bin = 0;
+      for (int l = level; l < level + 16; ++l) bin += Count(l);
+      if (2 * (seen + bin) >= n) break;
+      seen += bin;
+    }
+    for (; level < 255; ++level) {
+      seen += Count(level);
+      if (2 * seen >= n) break;
+    }
+    return level;
+  }
+};
 
 // The darkest grey level of `box` and the median of `median_box` (both clipped to the image).
 struct Levels {

@@ -50,5 +50,43 @@ TEST(BlobAnalysis, GreyHistogramMedianIsTheSortedMedian) {
   EXPECT_TRUE(std::isnan(histogram.Median()));
 }
 
+// DarkestAndMedian against its definition, pixel by pixel: the darkest level of one box, and the first
+// level whose count from 0 reaches half of the other box's pixels; boxes narrow and wide (the sixteen-
+// column steps and their overlapping last step), clipped by the image edges or wholly outside.
+TEST(BlobAnalysis, DarkestAndMedianMatchTheirDefinition) {
+  std::mt19937_64 rng(9);
+  vpImage<unsigned char> image(97, 131);
+  std::uniform_int_distribution<int> level(0, 255), coordinate(-20, 150), spread(0, 40);
+  for (unsigned i = 0; i < image.getSize(); ++i) image.bitmap[i] = static_cast<unsigned char>(180 + spread(rng) / 3 - (i % 11 == 0 ? level(rng) / 2 : 0));
+  auto box_at = [&] {
+    const int a = coordinate(rng), b = coordinate(rng), c = coordinate(rng), d = coordinate(rng);
+    return PixelBox{std::min(a, b), std::min(c, d), std::max(a, b), std::max(c, d)};
+  };
+  for (int trial = 0; trial < 4000; ++trial) {
+    const PixelBox darkest_box = box_at(), median_box = box_at();
+    int darkest = 255;
+    std::vector<int> counts(256, 0);
+    int n = 0;
+    for (int v = 0; v < 97; ++v) {
+      for (int u = 0; u < 131; ++u) {
+        const int l = image[v][u];
+        if (u >= darkest_box.u_min && u <= darkest_box.u_max && v >= darkest_box.v_min && v <= darkest_box.v_max) darkest = std::min(darkest, l);
+        if (u >= median_box.u_min && u <= median_box.u_max && v >= median_box.v_min && v <= median_box.v_max) {
+          ++counts[static_cast<size_t>(l)];
+          ++n;
+        }
+      }
+    }
+    int median = 0;
+    for (int seen = 0; median < 255; ++median) {
+      seen += counts[static_cast<size_t>(median)];
+      if (2 * seen >= n) break;
+    }
+    const Levels levels = DarkestAndMedian(image, darkest_box, median_box);
+    ASSERT_EQ(levels.darkest, darkest) << "trial " << trial;
+    ASSERT_EQ(levels.median, median) << "trial " << trial;
+  }
+}
+
 }  // namespace
 }  // namespace selfcal::tracking::internal

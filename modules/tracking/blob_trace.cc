@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 
 #include <visp3/core/vpImagePoint.h>
@@ -22,7 +23,9 @@ class DarkPixels {
  public:
   DarkPixels(const vpImage<unsigned char>& image, int threshold)
       : image_(image), w_(static_cast<int>(image.getWidth())), h_(static_cast<int>(image.getHeight())),
-        threshold_(std::clamp(threshold, 0, 255)) {}
+        threshold_(std::clamp(threshold, 0, 255)) {
+    for (int d = 0; d < 8; ++d) step_[d] = kDu[d] + kDv[d] * static_cast<std::ptrdiff_t>(w_);
+  }
   bool InImage(int u, int v) const { return u >= 0 && v >= 0 && u < w_ && v < h_; }
   bool Dark(int u, int v) const { return InImage(u, v) && static_cast<int>(image_[v][u]) <= threshold_; }
   int width() const { return w_; }
@@ -31,6 +34,18 @@ class DarkPixels {
   // vpDot2::computeFreemanChainElement: false (element unchanged) when (u, v) is not dark or has no dark
   // neighbour.
   bool NextElement(int u, int v, int* element) const {
+    if (u > 0 && v > 0 && u < w_ - 1 && v < h_ - 1) {  // every neighbour inside: no bounds to test
+      const unsigned char* pixel = image_.bitmap + static_cast<std::ptrdiff_t>(v) * w_ + u;
+      if (static_cast<int>(*pixel) > threshold_) return false;
+      for (int turn : kTurns) {
+        const int d = (*element + turn) % 8;
+        if (static_cast<int>(pixel[step_[d]]) <= threshold_) {
+          *element = d;
+          return true;
+        }
+      }
+      return false;
+    }
     if (!Dark(u, v)) return false;
     for (int turn : kTurns) {
       const int d = (*element + turn) % 8;
@@ -45,6 +60,7 @@ class DarkPixels {
  private:
   const vpImage<unsigned char>& image_;
   int w_, h_, threshold_;
+  std::ptrdiff_t step_[8];  // the neighbour along each direction in the bitmap
 };
 
 // vpDot2::computeFreemanParameters' area and first-moment increments of one step from (u_p, v_p) along

@@ -115,17 +115,17 @@ void MarkOthers(BlobWindow* win, Scratch* scratch) {
   std::uint8_t* dark = scratch->dark.data() + 1;  // dark[-1] and dark[w] stay 0
   std::uint8_t* near = scratch->near.data();      // dark left in the cell or its row neighbours
   std::uint8_t* cells = win->cells.data();
+  std::uint8_t any = 0;
+  for (int i = 0; i < w * h; ++i) any |= cells[i] == kDark ? 1 : 0;
+  if (any == 0) return;  // blob and free cells only (an isolated dot)
   dark[-1] = 0;
   dark[w] = 0;
-  std::uint8_t any = 0;
   for (int y = 0; y < h; ++y) {
     const std::uint8_t* row = cells + y * w;
     std::uint8_t* n = near + y * w;
     for (int x = 0; x < w; ++x) dark[x] = row[x] == kDark ? 1 : 0;
     for (int x = 0; x < w; ++x) n[x] = static_cast<std::uint8_t>(dark[x - 1] | dark[x] | dark[x + 1]);
-    for (int x = 0; x < w; ++x) any |= n[x];
   }
-  if (any == 0) return;  // blob and free cells only
   for (int y = 0; y < h; ++y) {
     std::uint8_t* row = cells + y * w;
     const std::uint8_t* mid = near + y * w;

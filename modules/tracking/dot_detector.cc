@@ -87,10 +87,12 @@ Status DotDetectorOptions::Validate() const {
 }
 
 int OtsuThreshold(const vpImage<unsigned char>& image) {
-  std::array<double, 256> hist{};
   const unsigned int n = image.getSize();
-  const unsigned char* bitmap = image.bitmap;
-  for (unsigned int i = 0; i < n; ++i) hist[bitmap[i]] += 1.0;
+  internal::LevelCounts counts;  // integer counts: the same values as counting in double, faster
+  for (unsigned int i = 0; i < n; i += 1u << 30) counts.Add(image.bitmap + i, static_cast<int>(std::min(n - i, 1u << 30)));
+  const std::array<std::uint32_t, 256> total = counts.Total();
+  std::array<double, 256> hist;
+  for (size_t l = 0; l < 256; ++l) hist[l] = static_cast<double>(total[l]);
   double total_sum = 0;
   for (int t = 0; t < 256; ++t) total_sum += t * hist[static_cast<size_t>(t)];
   double w0 = 0, sum0 = 0, best = -1;
