@@ -8,138 +8,25 @@
 #include <sstream>
 #include <vector>
 
-#include <visp3/core/vpImagePoint.h>
-#include <visp3/core/vpRect.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include "tracking/blob_window.h"
 
 namespace selfcal::tracking::internal {
 namespace {
 
 constexpr int kEllipseSamples = 20;  // as vpDot2::isValid
 
-// Window-local classification of pixels around the blob.
-enum Cell : std::uint8_t { kFree = 0, kBlob = 1, kOther = 2 };
-
-struct Window {
-  int u0 = 0, v0 = 0, w = 0, h = 0;
-  std::vector<std::uint8_t> cells;
-  bool Contains(int u, int v) const { return u >= u0 && v >= v0 && u < u0 + w && v < v0 + h; }
-  std::uint8_t& At(int u, int v) { return cells[static_cast<size_t>((v - v0) * w + (u - u0))]; }
-  std::uint8_t At(int u, int v) const { return cells[static_cast<size_t>((v - v0) * w + (u - u0))]; }
-};
-
-// Grey levels counted for their median (the mean of the middle two for an even count): the same order
-// statistics as sorting them, without the sort.
-struct GreyHistogram {
-  std::array<int, 256> counts{};
-  size_t n = 0;
-  void Clear() {
-    counts.fill(0);
-    n = 0;
-  }
-  void Add(unsigned char level) {
-    ++counts[level];
-    ++n;
-  }
-  double Median() const {
-    if (n == 0) return std::nan("");
-    auto at_rank = [&](size_t rank) {  // the value sorted to index `rank`
-      size_t seen = 0;
-      int level = 0;
-      for (; level < 255; ++level) {
-        seen += static_cast<size_t>(counts[static_cast<size_t>(level)]);
-        if (seen > rank) break;
-      }
-      return static_cast<double>(level);
-    };
-    const size_t mid = n / 2;
-    const double m = at_rank(mid);
-    return n % 2 == 0 ? 0.5 * (m + at_rank(mid - 1)) : m;
-  }
-};
-
 // Buffers reused from blob to blob (MeasureBlob runs for every candidate and every tracked dot of a
 // frame); each user clears what it fills.
 struct Scratch {
-  Window win;
-  std::vector<std::pair<int, int>> seeds, stack, filled;
+  BlobWindow win;
+  std::vector<PixelRun> runs;
   GreyHistogram values, ring;
 };
 
-// Blob pixels: the 8-connected dark pixels, inside the bbox, of the first seed whose component spans
-// exactly the bbox vpDot2 reported (other blobs may reach into that box). Every other dark pixel of the
-// window, dilated by one pixel (their anti-aliased rim), is "other" and stays out of the background ring
-// and of the weighted centroid. nullopt when no seed gives vpDot2's blob.
-bool ClassifyWindow(const vpImage<unsigned char>& image, int threshold, const PixelBox& bbox, int margin,
-                    Scratch* scratch) {
-  constexpr std::uint8_t kDarkUnassigned = 3;  // a dark pixel not yet given to the blob or the others
-  Window& win = scratch->win;
-  const int width = static_cast<int>(image.getWidth());
-  const int height = static_cast<int>(image.getHeight());
-  win.u0 = std::max(0, bbox.u_min - margin);
-  win.v0 = std::max(0, bbox.v_min - margin);
-  win.w = std::min(width - 1, bbox.u_max + margin) - win.u0 + 1;
-  win.h = std::min(height - 1, bbox.v_max + margin) - win.v0 + 1;
-  win.cells.resize(static_cast<size_t>(win.w * win.h));
-  for (int y = 0; y < win.h; ++y) {
-    const unsigned char* row = image[win.v0 + y] + win.u0;
-    std::uint8_t* cells = &win.cells[static_cast<size_t>(y * win.w)];
-    for (int x = 0; x < win.w; ++x) cells[x] = static_cast<int>(row[x]) <= threshold ? kDarkUnassigned : std::uint8_t{kFree};
-  }
-  // The fill stays inside the bbox; window coordinates from here on.
-  const int x0 = bbox.u_min - win.u0, y0 = bbox.v_min - win.v0, x1 = bbox.u_max - win.u0, y1 = bbox.v_max - win.v0;
-  const PixelBox local_bbox{x0, y0, x1, y1};
-  std::uint8_t* cells = win.cells.data();
-  const int w = win.w;
-  bool found = false;
-  std::vector<std::pair<int, int>>& stack = scratch->stack;
-  std::vector<std::pair<int, int>>& filled = scratch->filled;
-  stack.clear();
-  for (const auto& [seed_u, seed_v] : scratch->seeds) {
-    const int sx = seed_u - win.u0, sy = seed_v - win.v0;
-    if (sx < x0 || sx > x1 || sy < y0 || sy > y1) continue;
-    if (cells[sy * w + sx] != kDarkUnassigned) continue;
-    PixelBox span{sx, sy, sx, sy};
-    filled.clear();
-    cells[sy * w + sx] = kBlob;
-    stack.emplace_back(sx, sy);
-    while (!stack.empty()) {
-      const auto [x, y] = stack.back();
-      stack.pop_back();
-      filled.emplace_back(x, y);
-      span.u_min = std::min(span.u_min, x);
-      span.v_min = std::min(span.v_min, y);
-      span.u_max = std::max(span.u_max, x);
-      span.v_max = std::max(span.v_max, y);
-      for (int ny = std::max(y0, y - 1); ny <= std::min(y1, y + 1); ++ny) {
-        for (int nx = std::max(x0, x - 1); nx <= std::min(x1, x + 1); ++nx) {
-          if (cells[ny * w + nx] != kDarkUnassigned) continue;
-          cells[ny * w + nx] = kBlob;
-          stack.emplace_back(nx, ny);
-        }
-      }
-    }
-    if (span == local_bbox) {
-      found = true;
-      break;
-    }
-    for (const auto& [x, y] : filled) cells[y * w + x] = kDarkUnassigned;  // another blob reaching into the box
-  }
-  if (!found) return false;
-  // Every other dark pixel and its free neighbours are "other" (a neighbour made other here is not dark, so
-  // it does not spread further).
-  for (int y = 0; y < win.h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      if (cells[y * w + x] != kDarkUnassigned) continue;
-      for (int ny = std::max(0, y - 1); ny <= std::min(win.h - 1, y + 1); ++ny) {
-        for (int nx = std::max(0, x - 1); nx <= std::min(w - 1, x + 1); ++nx) {
-          if (cells[ny * w + nx] == kFree) cells[ny * w + nx] = kOther;
-        }
-      }
-      cells[y * w + x] = kOther;
-    }
-  }
-  return true;
-}
 
 BlobVerdict Reject(RejectReason reason, const std::string& detail) {
   BlobVerdict verdict;
@@ -155,23 +42,6 @@ std::string Describe(const char* what, double value, const char* limit_name, dou
   return s.str();
 }
 
-// Seeds for the blob's pixels: the required one alone if given; else every pixel of the box's top row,
-// which the blob touches. That is enough, and the first border pixel of vpDot2's trace (a copy of its
-// border list) is not needed: at most one 8-connected dark component can span the box. Two would hold a
-// left-right 8-path (A) and a top-bottom 8-path (B) that share no pixel and are nowhere 8-adjacent; B's
-// diagonal steps then each have a corner pixel outside A, so B widens to a top-bottom 4-path outside A,
-// which the left-right 8-path A rules out (the Hex theorem). Whichever seed reaches it, the blob is the same.
-void BlobSeeds(const PixelBox& bbox, const std::pair<int, int>* required_seed,
-               std::vector<std::pair<int, int>>* seeds_out) {
-  std::vector<std::pair<int, int>>& seeds = *seeds_out;
-  seeds.clear();
-  if (required_seed != nullptr) {
-    seeds.push_back(*required_seed);
-    return;
-  }
-  for (int u = bbox.u_min; u <= bbox.u_max; ++u) seeds.emplace_back(u, bbox.v_min);
-}
-
 // The blob's grey levels and the raw sums of its pixel centres, relative to the bbox corner (px).
 struct BlobSums {
   GreyHistogram& values;
@@ -181,38 +51,53 @@ struct BlobSums {
 // Area, dot level and second moments from the blob's own pixels (pixel centres, in double: vpDot2's
 // moments are accumulated from float increments such as u^3 / 3 and lose most of their digits for
 // small blobs far from the image origin; a 3 px disc at u = 512 came out with an axis ratio of 0.7).
-BlobSums SumBlob(const vpImage<unsigned char>& image, const Window& win, const PixelBox& bbox,
+// The sums are of integers, added run by run in 64-bit integers: the same values a pixel-by-pixel double
+// sum gives (every partial sum is an integer below 2^53).
+BlobSums SumBlob(const vpImage<unsigned char>& image, const std::vector<PixelRun>& runs, const PixelBox& bbox,
                  GreyHistogram* values) {
   values->Clear();
   BlobSums b{*values};
-  for (int v = bbox.v_min; v <= bbox.v_max; ++v) {
-    for (int u = bbox.u_min; u <= bbox.u_max; ++u) {
-      if (win.At(u, v) != kBlob) continue;
-      b.values.Add(image[v][u]);
-      const double x = u - bbox.u_min, y = v - bbox.v_min;  // local, to keep the sums small
-      b.su += x;
-      b.sv += y;
-      b.suu += x * x;
-      b.suv += x * y;
-      b.svv += y * y;
-    }
+  auto squares = [](std::int64_t k) { return k * (k + 1) * (2 * k + 1) / 6; };  // 0^2 + ... + k^2
+  std::int64_t su = 0, sv = 0, suu = 0, suv = 0, svv = 0;
+  for (const PixelRun& run : runs) {
+    const unsigned char* row = image[run.v];
+    for (int u = run.u_begin; u <= run.u_end; ++u) b.values.Add(row[u]);
+    const std::int64_t x0 = run.u_begin - bbox.u_min, x1 = run.u_end - bbox.u_min, y = run.v - bbox.v_min;
+    const std::int64_t count = x1 - x0 + 1, sum_x = (x0 + x1) * count / 2;
+    su += sum_x;
+    sv += y * count;
+    suu += squares(x1) - (x0 > 0 ? squares(x0 - 1) : 0);
+    suv += y * sum_x;
+    svv += y * y * count;
   }
+  b.su = static_cast<double>(su);
+  b.sv = static_cast<double>(sv);
+  b.suu = static_cast<double>(suu);
+  b.suv = static_cast<double>(suv);
+  b.svv = static_cast<double>(svv);
   return b;
 }
 
 // Background: the free pixels of the ring between the bbox dilated by gap and by gap + width.
-void BackgroundRing(const vpImage<unsigned char>& image, const Window& win, const PixelBox& bbox,
+void BackgroundRing(const vpImage<unsigned char>& image, const BlobWindow& win, const PixelBox& bbox,
                     const DotAcceptanceOptions& options, GreyHistogram* ring_out) {
   GreyHistogram& ring = *ring_out;
   ring.Clear();
   const int g = options.ring_gap_px, r = options.ring_gap_px + options.ring_width_px;
-  for (int v = bbox.v_min - r; v <= bbox.v_max + r; ++v) {
-    const bool inner_row = v >= bbox.v_min - g && v <= bbox.v_max + g;  // skips the gap and the bbox
-    for (int u = bbox.u_min - r; u <= bbox.u_max + r; ++u) {
-      if (inner_row && u == bbox.u_min - g) u = bbox.u_max + g + 1;
-      if (u > bbox.u_max + r) break;
-      if (!win.Contains(u, v) || win.At(u, v) != kFree) continue;
-      ring.Add(image[v][u]);
+  const int u_begin = std::max(win.u0, bbox.u_min - r), u_end = std::min(win.u0 + win.w - 1, bbox.u_max + r);
+  auto add = [&](const unsigned char* pixels, const std::uint8_t* cells, int from, int to) {
+    for (int u = from; u <= to; ++u) {
+      if (cells[u - win.u0] == kFree) ring.Add(pixels[u]);
+    }
+  };
+  for (int v = std::max(win.v0, bbox.v_min - r); v <= std::min(win.v0 + win.h - 1, bbox.v_max + r); ++v) {
+    const unsigned char* pixels = image[v];
+    const std::uint8_t* cells = win.Row(v);
+    if (v >= bbox.v_min - g && v <= bbox.v_max + g) {  // skips the gap and the bbox
+      add(pixels, cells, u_begin, std::min(u_end, bbox.u_min - g - 1));
+      add(pixels, cells, std::max(u_begin, bbox.u_max + g + 1), u_end);
+    } else {
+      add(pixels, cells, u_begin, u_end);
     }
   }
 }
@@ -220,7 +105,7 @@ void BackgroundRing(const vpImage<unsigned char>& image, const Window& win, cons
 // D2: the largest coverage by the dot of a blob pixel within `margin` px of the image border; nullopt
 // when the bbox keeps clear of the margin. A (nearly) fully dark one there means the dot goes on past
 // the edge and its centroid is biased.
-std::optional<double> WorstBorderCoverage(const vpImage<unsigned char>& image, const Window& win,
+std::optional<double> WorstBorderCoverage(const vpImage<unsigned char>& image, const BlobWindow& win,
                                           const DotDetection& d, int margin) {
   const int width = static_cast<int>(image.getWidth());
   const int height = static_cast<int>(image.getHeight());
@@ -274,13 +159,13 @@ std::string EllipseTestFailure(const vpImage<unsigned char>& image, int threshol
     const auto [cos_t, sin_t] = kCosSin[static_cast<size_t>(k)];
     const double ai = p * std::max(0.0, d.semi_major_px - 1.0) * cos_t;
     const double bi = p * std::max(0.0, d.semi_minor_px - 1.0) * sin_t;
-    const int ui = static_cast<int>(std::lround(d.cog_binary_px.x() + c * ai - s * bi));
-    const int vi = static_cast<int>(std::lround(d.cog_binary_px.y() + s * ai + c * bi));
+    const int ui = static_cast<int>(RoundHalfAway(d.cog_binary_px.x() + c * ai - s * bi));
+    const int vi = static_cast<int>(RoundHalfAway(d.cog_binary_px.y() + s * ai + c * bi));
     if (ui < 0 || vi < 0 || ui >= width || vi >= height || static_cast<int>(image[vi][ui]) > threshold) ++inner_bad;
     const double ao = (2.0 - p) * (d.semi_major_px + 1.0) * cos_t;
     const double bo = (2.0 - p) * (d.semi_minor_px + 1.0) * sin_t;
-    const int uo = static_cast<int>(std::lround(d.cog_binary_px.x() + c * ao - s * bo));
-    const int vo = static_cast<int>(std::lround(d.cog_binary_px.y() + s * ao + c * bo));
+    const int uo = static_cast<int>(RoundHalfAway(d.cog_binary_px.x() + c * ao - s * bo));
+    const int vo = static_cast<int>(RoundHalfAway(d.cog_binary_px.y() + s * ao + c * bo));
     if (uo < 0 || vo < 0 || uo >= width || vo >= height) continue;
     if (static_cast<int>(image[vo][uo]) <= threshold) ++outer_bad;
   }
@@ -292,23 +177,32 @@ std::string EllipseTestFailure(const vpImage<unsigned char>& image, int threshol
 }
 
 // Intensity-weighted centroid: weights (background - I)+ over the bbox dilated by refine_margin_px,
-// other blobs (and their rims) excluded. Replaces d->centroid_px when it lies inside the bbox.
-void RefineCentroid(const vpImage<unsigned char>& image, const Window& win, int refine_margin_px, DotDetection* d) {
+// other blobs (and their rims) excluded. Replaces d->centroid_px when it lies inside the bbox. The
+// background is a median of grey levels, so twice every weight is an integer: the sums are kept doubled
+// in 64-bit integers, the exact values a double sum gives (every partial sum a multiple of 0.5 below 2^52).
+void RefineCentroid(const vpImage<unsigned char>& image, const BlobWindow& win, int refine_margin_px, DotDetection* d) {
   const int width = static_cast<int>(image.getWidth());
   const int height = static_cast<int>(image.getHeight());
   const int rm = refine_margin_px;
-  double sw = 0, su = 0, sv = 0;
+  const int twice_background = static_cast<int>(2.0 * d->background_level);
+  std::int64_t sw2 = 0, su2 = 0, sv2 = 0;
+  const int u_begin = std::max(0, d->bbox.u_min - rm), u_end = std::min(width - 1, d->bbox.u_max + rm);
   for (int v = std::max(0, d->bbox.v_min - rm); v <= std::min(height - 1, d->bbox.v_max + rm); ++v) {
-    for (int u = std::max(0, d->bbox.u_min - rm); u <= std::min(width - 1, d->bbox.u_max + rm); ++u) {
-      if (win.At(u, v) == kOther) continue;
-      const double w = d->background_level - static_cast<double>(image[v][u]);
-      if (w <= 0) continue;
-      sw += w;
-      su += w * u;
-      sv += w * v;
+    const unsigned char* pixels = image[v];
+    const std::uint8_t* cells = win.Row(v);
+    std::int64_t row_w2 = 0, row_u2 = 0;
+    for (int u = u_begin; u <= u_end; ++u) {
+      const int w2 = twice_background - 2 * static_cast<int>(pixels[u]);
+      if (cells[u - win.u0] == kOther || w2 <= 0) continue;
+      row_w2 += w2;
+      row_u2 += static_cast<std::int64_t>(w2) * u;
     }
+    sw2 += row_w2;
+    su2 += row_u2;
+    sv2 += row_w2 * v;
   }
-  if (sw > 0) {
+  if (sw2 > 0) {
+    const double sw = 0.5 * static_cast<double>(sw2), su = 0.5 * static_cast<double>(su2), sv = 0.5 * static_cast<double>(sv2);
     const Eigen::Vector2d c_w(su / sw, sv / sw);
     if (c_w.allFinite() && c_w.x() >= d->bbox.u_min && c_w.x() <= d->bbox.u_max && c_w.y() >= d->bbox.v_min &&
         c_w.y() <= d->bbox.v_max) {
@@ -327,61 +221,47 @@ Levels DarkestAndMedian(const vpImage<unsigned char>& image, const PixelBox& box
 Levels DarkestAndMedian(const vpImage<unsigned char>& image, const PixelBox& darkest_box, const PixelBox& median_box) {
   const int w = static_cast<int>(image.getWidth()), h = static_cast<int>(image.getHeight());
   Levels levels;
-  // Four histograms filled in turn, then added: runs of one grey level do not wait on one counter.
-  std::array<std::array<int, 256>, 4> parts{};
+  LevelCounts counts;
   const int mu0 = std::max(0, median_box.u_min), mu1 = std::min(w - 1, median_box.u_max);
   int n = 0;
   for (int v = std::max(0, median_box.v_min); v <= std::min(h - 1, median_box.v_max); ++v) {
-    const unsigned char* row = image[v];
-    int u = mu0;
-    for (; u + 3 <= mu1; u += 4) {
-      ++parts[0][row[u]];
-      ++parts[1][row[u + 1]];
-      ++parts[2][row[u + 2]];
-      ++parts[3][row[u + 3]];
-    }
-    for (; u <= mu1; ++u) ++parts[0][row[u]];
+    counts.Add(image[v] + mu0, mu1 - mu0 + 1);
     n += std::max(0, mu1 - mu0 + 1);
   }
-  std::array<int, 256> hist;
-  for (size_t i = 0; i < 256; ++i) hist[i] = parts[0][i] + parts[1][i] + parts[2][i] + parts[3][i];
-  for (int seen = 0; levels.median < 255; ++levels.median) {
-    seen += hist[static_cast<size_t>(levels.median)];
-    if (2 * seen >= n) break;
-  }
+  levels.median = counts.HalfLevel(n);
   const int u0 = std::max(0, darkest_box.u_min), u1 = std::min(w - 1, darkest_box.u_max);
   unsigned char darkest = 255;
+#if defined(__SSE2__)
+  __m128i darkest16 = _mm_set1_epi8(-1);  // sixteen columns at a time
+#endif
   for (int v = std::max(0, darkest_box.v_min); v <= std::min(h - 1, darkest_box.v_max); ++v) {
     const unsigned char* row = image[v];
-    for (int u = u0; u <= u1; ++u) darkest = std::min(darkest, row[u]);
+    int u = u0;
+#if defined(__SSE2__)
+    if (u1 - u0 + 1 >= 16) {
+      for (; u + 15 <= u1; u += 16) {
+        darkest16 = _mm_min_epu8(darkest16, _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + u)));
+      }
+      if (u <= u1) {  // the last sixteen columns, overlapping the ones done
+        darkest16 = _mm_min_epu8(darkest16, _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + u1 - 15)));
+      }
+      continue;
+    }
+#endif
+    for (; u <= u1; ++u) darkest = std::min(darkest, row[u]);
   }
+#if defined(__SSE2__)
+  darkest16 = _mm_min_epu8(darkest16, _mm_srli_si128(darkest16, 8));
+  darkest16 = _mm_min_epu8(darkest16, _mm_srli_si128(darkest16, 4));
+  darkest16 = _mm_min_epu8(darkest16, _mm_srli_si128(darkest16, 2));
+  darkest16 = _mm_min_epu8(darkest16, _mm_srli_si128(darkest16, 1));
+  darkest = std::min(darkest, static_cast<unsigned char>(_mm_cvtsi128_si32(darkest16) & 0xff));
+#endif
   levels.darkest = darkest;
   return levels;
 }
 
-PixelBox BoxOf(const vpDot2& dot) {
-  const vpRect rect = dot.getBBox();
-  PixelBox box;
-  box.u_min = static_cast<int>(std::lround(rect.getLeft()));
-  box.v_min = static_cast<int>(std::lround(rect.getTop()));
-  box.u_max = static_cast<int>(std::lround(rect.getRight()));
-  box.v_max = static_cast<int>(std::lround(rect.getBottom()));
-  return box;
-}
-
-vpDot2 MakeDarkDot(int threshold) {
-  vpDot2 dot;
-  dot.setGraphics(false);
-  dot.setComputeMoments(true);
-  dot.setGrayLevelMin(0);
-  dot.setGrayLevelMax(static_cast<unsigned int>(std::clamp(threshold, 0, 255)));
-  dot.setSizePrecision(0.0);
-  dot.setEllipsoidShapePrecision(0.0);
-  dot.setEllipsoidBadPointsPercentage(1.0);
-  return dot;
-}
-
-BlobVerdict MeasureBlob(const vpImage<unsigned char>& image, int threshold, const vpDot2& dot,
+BlobVerdict MeasureBlob(const vpImage<unsigned char>& image, int threshold, const TracedBlob& dot,
                         const DotAcceptanceOptions& options, DotDetection* out,
                         const std::pair<int, int>* required_seed) {
   DotDetection& d = *out;
@@ -389,26 +269,25 @@ BlobVerdict MeasureBlob(const vpImage<unsigned char>& image, int threshold, cons
   const int width = static_cast<int>(image.getWidth());
   const int height = static_cast<int>(image.getHeight());
 
-  d.bbox = BoxOf(dot);
+  d.bbox = dot.bbox;
   d.threshold = threshold;
-  d.cog_binary_px = Eigen::Vector2d(dot.getCog().get_u(), dot.getCog().get_v());
+  d.cog_binary_px = dot.cog_px;
   d.centroid_px = d.cog_binary_px;
-  d.polygon_area_px2 = dot.getArea();
+  d.polygon_area_px2 = dot.polygon_area_px2;
   if (d.bbox.u_min < 0 || d.bbox.v_min < 0 || d.bbox.u_max >= width || d.bbox.v_max >= height ||
       d.bbox.width() <= 0 || d.bbox.height() <= 0) {
     return Reject(RejectReason::kTrackerFailed, "vpDot2 returned a bounding box outside the image");
   }
   thread_local Scratch scratch;
-  BlobSeeds(d.bbox, required_seed, &scratch.seeds);
   const int margin = std::max(options.refine_margin_px, options.ring_gap_px + options.ring_width_px);
-  if (!ClassifyWindow(image, threshold, d.bbox, margin, &scratch)) {
+  if (!ClassifyBlobWindow(image, threshold, d.bbox, margin, required_seed, &scratch.win, &scratch.runs)) {
     return Reject(RejectReason::kTrackerFailed, required_seed != nullptr
                                                     ? "vpDot2 traced a blob without the seed pixel"
                                                     : "no 8-connected dark blob spans vpDot2's bounding box");
   }
-  const Window& win = scratch.win;
+  const BlobWindow& win = scratch.win;
 
-  BlobSums blob = SumBlob(image, win, d.bbox, &scratch.values);
+  BlobSums blob = SumBlob(image, scratch.runs, d.bbox, &scratch.values);
   d.area_px2 = static_cast<double>(blob.values.n);
   if (d.area_px2 < options.min_area_px2) {
     return Reject(RejectReason::kTooSmall, Describe("area", d.area_px2, "min", options.min_area_px2));

@@ -116,7 +116,9 @@ TEST(DarkComponents, RunLabellingMatchesPixelByPixelDefinition) {
 
 TEST(DarkComponents, NarrowSumsEqualWideSumsOnAFullFrame) {
   const vpImage<unsigned char> image = TestImage(640, 480, 7);
-  for (int window : {3, 41, 301, 481, 1001}) {  // 16-bit columns up to 257 rows, then 32-bit
+  // 16-bit columns up to 257 rows, then 32-bit; sixteen pixels at a time while the box holds < 2^15 pixels
+  // (181 x 181), one by one from 183 on.
+  for (int window : {3, 41, 181, 183, 301, 481, 1001}) {
     SCOPED_TRACE(window);
     ExpectSame(AdaptiveDarkComponentsWide(image, window, 10), AdaptiveDarkComponents(image, window, 10));
   }

@@ -6,12 +6,11 @@
 #include <set>
 #include <sstream>
 
-#include <visp3/blob/vpDot2.h>
 #include <visp3/core/vpException.h>
-#include <visp3/core/vpImagePoint.h>
 #include <visp3/core/vpTrackingException.h>
 
 #include "tracking/blob_analysis.h"
+#include "tracking/blob_trace.h"
 
 namespace selfcal::tracking {
 namespace {
@@ -62,14 +61,9 @@ void TrackOne(const vpImage<unsigned char>& image, const PreviousDot& p, int glo
     if (!local) return;
     threshold = *local;
   }
-  vpDot2 dot = internal::MakeDarkDot(threshold);
-  vpImagePoint cog;
-  cog.set_uv(p.centroid_px.x(), p.centroid_px.y());
-  dot.setCog(cog);
-  dot.setWidth(p.width_px);
-  dot.setHeight(p.height_px);
+  internal::TracedBlob dot;
   try {
-    dot.track(image);
+    dot = internal::TrackDarkBlob(image, threshold, p.centroid_px, p.width_px, p.height_px);
   } catch (const vpTrackingException& e) {
     SetStatus(t, TrackStatus::kLost, std::string("vpDot2: ") + e.getMessage());
     return;

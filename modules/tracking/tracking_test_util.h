@@ -106,4 +106,25 @@ inline vpImage<unsigned char> Render(int width, int height, double background, c
   return out;
 }
 
+// `count` dark shapes of every kind a blob tracer meets, at random (seeded) places, levels and sizes on a
+// `width` x `height` grey-200 image: filled discs and ellipses, rings (a hole), one-pixel-thin lines both
+// ways and lone pixels, shapes cut by the image edge and touching or nested ones, with grey noise.
+inline vpImage<unsigned char> RandomDarkShapes(std::uint64_t seed, int width, int height, int count, double noise_sigma) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0, 1);
+  std::vector<Shape> shapes;
+  for (int k = 0; k < count; ++k) {
+    const Eigen::Vector2d c(unit(rng) * (width + 10) - 5, unit(rng) * (height + 10) - 5);
+    const double level = 10 + 140 * unit(rng);
+    switch (static_cast<int>(unit(rng) * 5)) {
+      case 0: shapes.push_back(Disc(c, 0.6 + 8 * unit(rng), level)); break;
+      case 1: shapes.push_back(Ring(c, 1.5 + 3 * unit(rng), 5 + 4 * unit(rng), level)); break;
+      case 2: shapes.push_back(Rect(c.x(), c.y(), c.x() + 1 + 25 * unit(rng), c.y() + 0.4 + 2 * unit(rng), level)); break;
+      case 3: shapes.push_back(Ellipse(c, 2 + 9 * unit(rng), 0.7 + 3 * unit(rng), 3 * unit(rng), level)); break;
+      default: shapes.push_back(Rect(c.x(), c.y(), c.x() + 0.5 + 2 * unit(rng), c.y() + 1 + 30 * unit(rng), level)); break;
+    }
+  }
+  return Render(width, height, 200, shapes, 4, noise_sigma, seed);
+}
+
 }  // namespace selfcal::tracking::testing
