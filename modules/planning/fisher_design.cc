@@ -1,10 +1,13 @@
 #include "planning/fisher_design.h"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <Eigen/Cholesky>
 
 #include "base/status.h"
+#include "planning/gram_lower.h"
 #include "planning/pose_twists.h"
 
 namespace selfcal::planning {
@@ -20,6 +23,47 @@ void AddOuterLower(double sign, const Matrix& w, Eigen::MatrixXd* s) {
     const int len = n - c;
     for (int k = 0; k < w.cols(); ++k) s->col(c).tail(len).noalias() += (sign * w(c, k)) * w.col(k).tail(len);
   }
+}
+
+// Cholesky factor of the lower triangle of s, in place (the strict upper triangle is not read); false when s is
+// not positive definite.
+bool CholeskyLower(Eigen::MatrixXd* s) {
+  const int n = static_cast<int>(s->rows());
+  for (int c = 0; c < n; ++c) {
+    double* col = s->col(c).data();
+    for (int k = 0; k < c; ++k) {
+      const double* lk = s->col(k).data();
+      const double f = lk[c];
+      for (int r = c; r < n; ++r) col[r] -= f * lk[r];
+    }
+    if (!(col[c] > 0)) return false;
+    const double d = std::sqrt(col[c]);
+    col[c] = d;
+    const double inv = 1.0 / d;
+    for (int r = c + 1; r < n; ++r) col[r] *= inv;
+  }
+  return true;
+}
+
+// The inverse of the Cholesky factor of a 3 x 3 information block (as Eigen's LLT, then its inverse by
+// forward substitution); false when the block is not positive definite or a pivot falls below 1e-12 of its
+// trace (a dot seen from fewer than two poses).
+bool InverseCholesky3(const Eigen::Matrix3d& h, Eigen::Matrix3d* li) {
+  if (!(h(0, 0) > 0)) return false;
+  const double l00 = std::sqrt(h(0, 0));
+  const double l10 = h(1, 0) / l00, l20 = h(2, 0) / l00;
+  const double d1 = h(1, 1) - l10 * l10;
+  if (!(d1 > 0)) return false;
+  const double l11 = std::sqrt(d1);
+  const double l21 = (h(2, 1) - l20 * l10) / l11;
+  const double d2 = h(2, 2) - (l20 * l20 + l21 * l21);
+  if (!(d2 > 0)) return false;
+  const double l22 = std::sqrt(d2);
+  if (!(std::min(std::min(h(0, 0), d1), d2) > 1e-12 * h.trace())) return false;
+  const double i00 = 1.0 / l00, i11 = 1.0 / l11, i22 = 1.0 / l22;
+  const double i10 = -l10 * i00 / l11;
+  *li << i00, 0, 0, i10, i11, 0, (-l20 * i00 - l21 * i10) / l22, -l21 * i11 / l22, i22;
+  return true;
 }
 
 }  // namespace
@@ -42,16 +86,27 @@ FisherDesign::Sums FisherDesign::ZeroSums() const {
   return zero;
 }
 
+// A dot's pixel derivative with respect to the free parameters is -dpi R^T (omega_k x x + v_k) =
+// dpi ([y]x omega'_k - v'_k) with y = R^T x, omega' = R^T omega, v' = R^T v: a 2 x 6 matrix of the dot, f below,
+// times the 6 x free matrix z of the pose. The (free, f_x) block of the information is then z~^T (sum f^T f) z~
+// with z~ = diag(z, 1): one 7 x 7 sum per pose instead of a free x free update per dot.
 int FisherDesign::AddCandidate(const Eigen::VectorXd& q) {
   SELFCAL_CHECK(q.size() == problem_.robot.num_joints(), "candidate has " << q.size() << " joints");
   const internal::CameraTwists<double> tw = internal::ComputeCameraTwists<double>(problem_.robot, q.data());
   const Eigen::Matrix3d rt = tw.base_from_cam.rotation.transpose();
   const Eigen::Vector3d c = tw.base_from_cam.translation;
   const CameraIntrinsics& cam = problem_.camera;
-  const int nf = static_cast<int>(free_columns_.size());
+  const int nf = static_cast<int>(free_columns_.size()), g = nf + 1;
   const int dots = static_cast<int>(problem_.scene.dots_in_base.size());
+  Eigen::Matrix<double, 7, Eigen::Dynamic> z = Eigen::Matrix<double, 7, Eigen::Dynamic>::Zero(7, g);
+  for (int k = 0; k < nf; ++k) {
+    z.col(k).head<3>() = rt * tw.omega[free_columns_[k]];
+    z.col(k).segment<3>(3) = rt * tw.v[free_columns_[k]];
+  }
+  z(6, nf) = 1.0;
   Candidate out = ZeroSums();
-  Eigen::Matrix<double, 2, Eigen::Dynamic> a(2, num_global_);
+  Eigen::Matrix<double, 7, 7> ff = Eigen::Matrix<double, 7, 7>::Zero();
+  Eigen::Matrix<double, 2, Eigen::Dynamic> a(2, g);
   for (int j = 0; j < dots; ++j) {
     const Eigen::Vector3d x = problem_.scene.dots_in_base[j];
     const Eigen::Vector3d p = rt * (x - c);
@@ -61,21 +116,25 @@ int FisherDesign::AddCandidate(const Eigen::VectorXd& q) {
     if (u < 0 || v < 0 || u > cam.width_px - 1 || v > cam.height_px - 1) continue;  // not seen
     Eigen::Matrix<double, 2, 3> dpi;
     dpi << cam.fx_px / p.z(), 0, -cam.fx_px * xn / p.z(), 0, cam.fx_px * cam.mu / p.z(), -cam.fx_px * cam.mu * yn / p.z();
-    a.setZero();
-    for (int k = 0; k < nf; ++k) {
-      const int col = free_columns_[k];
-      a.col(k) = dpi * (-(rt * (tw.omega[col].cross(x) + tw.v[col])));
-    }
-    a(0, nf) = xn;
-    a(1, nf) = cam.mu * yn;
+    const Eigen::Vector3d y = rt * x;
+    Eigen::Matrix3d y_cross;
+    y_cross << 0, -y.z(), y.y(), y.z(), 0, -y.x(), -y.y(), y.x(), 0;
+    Eigen::Matrix<double, 2, 7> f;
+    f.leftCols<3>() = dpi * y_cross;
+    f.middleCols<3>(3) = -dpi;
+    f.col(6) << xn, cam.mu * yn;
+    ff.noalias() += f.transpose() * f;
+    a.noalias() = f * z;  // the pixel derivative with respect to (free rho, f_x)
     const Eigen::Matrix<double, 2, 3> b = dpi * rt;
-    if (j < 2) a.block<2, 3>(0, nf + 1 + 3 * j) = b;
-    AddOuterLower(1.0, a.transpose(), &out.h_gg);  // lower triangle += a^T a
-    if (j >= 2) {
+    if (j < 2) {  // a yardstick dot: one of the globals
+      out.h_gg.block(nf + 1 + 3 * j, 0, 3, g).noalias() += b.transpose() * a;
+      out.h_gg.block<3, 3>(nf + 1 + 3 * j, nf + 1 + 3 * j).noalias() += b.transpose() * b;
+    } else {
       out.h_jj[j - 2].noalias() += b.transpose() * b;
-      out.h_gj.middleCols<3>(3 * (j - 2)).noalias() += a.leftCols(nf + 1).transpose() * b;
+      out.h_gj.middleCols<3>(3 * (j - 2)).noalias() += a.transpose() * b;
     }
   }
+  out.h_gg.topLeftCorner(g, g).noalias() = z.transpose() * (ff * z);
   out.h_gg.triangularView<Eigen::StrictlyUpper>() = out.h_gg.transpose();
   candidates_.push_back(std::move(out));
   return static_cast<int>(candidates_.size()) - 1;
@@ -98,56 +157,87 @@ FisherValue FisherDesign::Evaluate(const std::vector<int>& design) const {
   return EvaluateSums(Sum(design), -1, true);
 }
 
+void FisherDesign::SubtractDots(const Sums& sums, const Candidate* add, Eigen::MatrixXd* s) const {
+  const int g = static_cast<int>(free_columns_.size()) + 1;
+  const int eliminated = static_cast<int>(problem_.scene.dots_in_base.size()) - 2;
+  // sum_j h_gj h_jj^-1 h_gj^T = W W^T, W's 3 columns per dot h_gj L_j^-T (h_jj = L_j L_j^T), a chunk of
+  // dots at a time (W of every dot is larger than the caches the loop below wants).
+  constexpr int kChunkDots = 16;
+  const int ld = (g + 3) / 4 * 4;
+  std::vector<double> w(static_cast<size_t>(ld) * 3 * kChunkDots, 0.0);  // rows g.. ld stay zero
+  int columns = 0;
+  for (int j = 0; j < eliminated; ++j) {
+    const Eigen::Matrix3d h = add != nullptr ? Eigen::Matrix3d(sums.h_jj[j] + add->h_jj[j]) : sums.h_jj[j];
+    Eigen::Matrix3d li;  // L_j^-1
+    if (!InverseCholesky3(h, &li)) continue;  // a dot seen from fewer than two poses: no information on the globals
+    double* w0 = w.data() + static_cast<size_t>(columns) * ld;
+    double* w1 = w0 + ld;
+    double* w2 = w1 + ld;
+    // The dot's (free rho, f_x) x 3 block of sums plus add, then times L_j^-T.
+    for (int k = 0; k < 3; ++k) {
+      double* wk = w0 + static_cast<size_t>(k) * ld;
+      const double* from = sums.h_gj.col(3 * j + k).data();
+      if (add != nullptr) {
+        const double* more = add->h_gj.col(3 * j + k).data();
+        for (int r = 0; r < g; ++r) wk[r] = from[r] + more[r];
+      } else {
+        for (int r = 0; r < g; ++r) wk[r] = from[r];
+      }
+    }
+    const double i00 = li(0, 0), i10 = li(1, 0), i11 = li(1, 1), i20 = li(2, 0), i21 = li(2, 1), i22 = li(2, 2);
+    for (int r = 0; r < g; ++r) {
+      const double x0 = w0[r], x1 = w1[r], x2 = w2[r];
+      w0[r] = x0 * i00;
+      w1[r] = x0 * i10 + x1 * i11;
+      w2[r] = x0 * i20 + x1 * i21 + x2 * i22;
+    }
+    columns += 3;
+    if (columns == 3 * kChunkDots) {
+      internal::SubtractGramLower(w.data(), ld, g, columns, s->data(), g);
+      columns = 0;
+    }
+  }
+  if (columns > 0) internal::SubtractGramLower(w.data(), ld, g, columns, s->data(), g);
+}
+
 FisherValue FisherDesign::EvaluateSums(const Sums& sums, int extra, bool with_variances) const {
   FisherValue value;
-  const int nf = static_cast<int>(free_columns_.size());
-  const int dots = static_cast<int>(problem_.scene.dots_in_base.size());
+  const int nf = static_cast<int>(free_columns_.size()), g = nf + 1;
   const Candidate* add = extra >= 0 ? &candidates_.at(extra) : nullptr;
   Eigen::MatrixXd h = sums.h_gg;
   if (add != nullptr) h += add->h_gg;
   // The yardstick: (|X0 - X1| - L) / sigma_y, in units where the pixel residuals have unit variance.
-  const Eigen::Vector3d d = problem_.scene.dots_in_base[0] - problem_.scene.dots_in_base[1];
-  Eigen::VectorXd g = Eigen::VectorXd::Zero(num_global_);
-  g.segment<3>(nf + 1) = d.normalized();
-  g.segment<3>(nf + 4) = -d.normalized();
+  const Eigen::Vector3d d = (problem_.scene.dots_in_base[0] - problem_.scene.dots_in_base[1]).normalized();
+  Eigen::Matrix<double, 6, 1> y;
+  y << d, -d;
   const double w = options_.pixel_noise_px / options_.yardstick_sigma_m;
-  h.noalias() += (w * w) * g * g.transpose();
+  h.bottomRightCorner<6, 6>().noalias() += (w * w) * y * y.transpose();
   // s: the information of (free rho, f_x) with every dot eliminated (lower triangle), the yardstick dots last.
-  Eigen::MatrixXd s = h.topLeftCorner(nf + 1, nf + 1);
-  // sum_j h_gj h_jj^-1 h_gj^T = W W^T, W's 3 columns per dot h_gj L_j^-T (h_jj = L_j L_j^T).
-  Eigen::MatrixXd w_dots(nf + 1, 3 * (dots - 2));
-  Eigen::Matrix<double, Eigen::Dynamic, 3> h_gj(nf + 1, 3);
-  for (int j = 0; j < dots - 2; ++j) {
-    const Eigen::Matrix3d h_jj = add != nullptr ? Eigen::Matrix3d(sums.h_jj[j] + add->h_jj[j]) : sums.h_jj[j];
-    const Eigen::LLT<Eigen::Matrix3d> llt(h_jj);
-    const Eigen::Matrix3d l = llt.matrixL();
-    if (llt.info() != Eigen::Success || !(l.diagonal().array().square().minCoeff() > 1e-12 * h_jj.trace())) {
-      w_dots.middleCols<3>(3 * j).setZero();  // a dot seen from fewer than two poses: no information on the globals
-      continue;
-    }
-    const Eigen::Matrix3d l_inv_t = l.triangularView<Eigen::Lower>().solve(Eigen::Matrix3d::Identity()).transpose();
-    h_gj = sums.h_gj.middleCols<3>(3 * j);
-    if (add != nullptr) h_gj += add->h_gj.middleCols<3>(3 * j);
-    w_dots.middleCols<3>(3 * j).noalias() = h_gj.lazyProduct(l_inv_t);
-  }
-  s.selfadjointView<Eigen::Lower>().rankUpdate(w_dots, -1.0);
+  Eigen::MatrixXd s = h.topLeftCorner(g, g);
+  SubtractDots(sums, add, &s);
   // The yardstick dots: the Schur complement of their 6 x 6 block.
-  const Eigen::LLT<Eigen::MatrixXd> yard(h.bottomRightCorner(6, 6));
+  const Eigen::LLT<Eigen::Matrix<double, 6, 6>> yard(h.bottomRightCorner<6, 6>());
   if (yard.info() != Eigen::Success) return value;
-  const Eigen::MatrixXd w_y = yard.matrixU().solve<Eigen::OnTheRight>(h.topRightCorner(nf + 1, 6));
+  const Eigen::Matrix<double, 6, 6> yard_l_inv = yard.matrixL().solve(Eigen::Matrix<double, 6, 6>::Identity());
+  const Eigen::Matrix<double, Eigen::Dynamic, 6> w_y = h.topRightCorner(g, 6) * yard_l_inv.transpose();
   AddOuterLower(-1.0, w_y, &s);
-  const Eigen::LLT<Eigen::MatrixXd> llt(s.selfadjointView<Eigen::Lower>());
-  if (llt.info() != Eigen::Success) return value;
-  const Eigen::MatrixXd l = llt.matrixL();
-  if (!(l.diagonal().minCoeff() > 0)) return value;
+  if (!CholeskyLower(&s)) return value;  // s's lower triangle is now L, s = L L^T
   const double sigma2 = options_.pixel_noise_px * options_.pixel_noise_px;
   // cov = sigma^2 s^-1: log det(cov^-1) = log det s - (nf + 1) log sigma^2.
   value.ok = true;
-  value.log_det = 2.0 * l.diagonal().array().log().sum() - (nf + 1) * std::log(sigma2);
+  value.log_det = 2.0 * s.diagonal().array().log().sum() - g * std::log(sigma2);
   if (!with_variances) return value;
-  // diag(s^-1)_k = |L^-1 e_k|^2.
-  const Eigen::MatrixXd l_inv = llt.matrixL().solve(Eigen::MatrixXd::Identity(nf + 1, nf + 1));
-  const Eigen::VectorXd variance = sigma2 * l_inv.colwise().squaredNorm().transpose();
+  // diag(s^-1)_k = |L^-1 e_k|^2: column k of L^-1 by forward substitution.
+  Eigen::VectorXd variance(g), x(g);
+  for (int k = 0; k < g; ++k) {
+    x.setZero();
+    x[k] = 1.0;
+    for (int m = k; m < g; ++m) {
+      x[m] /= s(m, m);
+      x.segment(m + 1, g - m - 1).noalias() -= x[m] * s.col(m).segment(m + 1, g - m - 1);
+    }
+    variance[k] = sigma2 * x.segment(k, g - k).squaredNorm();
+  }
   value.stddev = variance.cwiseSqrt();
   const KinematicParameters params(problem_.robot.num_joints());
   value.a_value = 0;
