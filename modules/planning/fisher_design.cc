@@ -25,17 +25,18 @@ void AddOuterLower(double sign, const Matrix& w, Eigen::MatrixXd* s) {
   }
 }
 
+// s[r] -= f l[r] for r in [from, n): one column of a factor against another (they never overlap).
+void SubtractScaled(double f, const double* __restrict l, int from, int n, double* __restrict s) {
+  for (int r = from; r < n; ++r) s[r] -= f * l[r];
+}
+
 // Cholesky factor of the lower triangle of s, in place (the strict upper triangle is not read); false when s is
 // not positive definite.
 bool CholeskyLower(Eigen::MatrixXd* s) {
   const int n = static_cast<int>(s->rows());
   for (int c = 0; c < n; ++c) {
     double* col = s->col(c).data();
-    for (int k = 0; k < c; ++k) {
-      const double* lk = s->col(k).data();
-      const double f = lk[c];
-      for (int r = c; r < n; ++r) col[r] -= f * lk[r];
-    }
+    for (int k = 0; k < c; ++k) SubtractScaled(s->col(k)[c], s->col(k).data(), c, n, col);
     if (!(col[c] > 0)) return false;
     const double d = std::sqrt(col[c]);
     col[c] = d;
@@ -65,6 +66,66 @@ bool InverseCholesky3(const Eigen::Matrix3d& h, Eigen::Matrix3d* li) {
   *li << i00, 0, 0, i10, i11, 0, (-l20 * i00 - l21 * i10) / l22, -l21 * i11 / l22, i22;
   return true;
 }
+
+// to[r] += a0[r] b0 + a1[r] b1 (a dot's two pixel rows times one column of its b: a block of a^T b).
+void AddTimes(const double* __restrict a0, const double* __restrict a1, double b0, double b1, double* __restrict to,
+              int n) {
+  for (int r = 0; r < n; ++r) to[r] += a0[r] * b0 + a1[r] * b1;
+}
+
+// The columns (w0 w1 w2) times L^-T for the inverse li of a lower triangular L, in place.
+void TimesLowerTransposed(const Eigen::Matrix3d& li, double* __restrict w0, double* __restrict w1,
+                          double* __restrict w2, int n) {
+  const double i00 = li(0, 0), i10 = li(1, 0), i11 = li(1, 1), i20 = li(2, 0), i21 = li(2, 1), i22 = li(2, 2);
+  for (int r = 0; r < n; ++r) {
+    const double x0 = w0[r], x1 = w1[r], x2 = w2[r];
+    w0[r] = x0 * i00;
+    w1[r] = x0 * i10 + x1 * i11;
+    w2[r] = x0 * i20 + x1 * i21 + x2 * i22;
+  }
+}
+
+// w = L^-1 (a - b p) as two columns w0, w1: a's two columns a[0, n) and a[n, 2n), p's three p[0, 3n), L the
+// Cholesky factor (l00, l10, l11) of I + b k b^T.
+void MarginalRows(const double* __restrict a, const Eigen::Matrix<double, 2, 3>& b, const double* __restrict p,
+                  double l00, double l10, double l11, int n, double* __restrict w0, double* __restrict w1) {
+  const double b00 = b(0, 0), b01 = b(0, 1), b02 = b(0, 2), b10 = b(1, 0), b11 = b(1, 1), b12 = b(1, 2);
+  const double i00 = 1.0 / l00, i11 = 1.0 / l11;
+  for (int r = 0; r < n; ++r) {
+    const double at0 = a[r] - (b00 * p[r] + b01 * p[n + r] + b02 * p[2 * n + r]);
+    const double at1 = a[n + r] - (b10 * p[r] + b11 * p[n + r] + b12 * p[2 * n + r]);
+    w0[r] = at0 * i00;
+    w1[r] = (at1 - l10 * w0[r]) * i11;
+  }
+}
+
+// Columns of a rank update of the lower triangle of s (s += sign W W^T), gathered a few dots at a time and
+// added by internal::AddGramLower (rows beyond `rows` of each column stay zero).
+class DotColumns {
+ public:
+  DotColumns(int rows, int columns_per_dot, double sign, Eigen::MatrixXd* s)
+      : rows_(rows), ld_((rows + 3) / 4 * 4), capacity_(16 * columns_per_dot), sign_(sign), s_(s),
+        w_(static_cast<size_t>(ld_) * capacity_, 0.0) {}
+  int ld() const { return ld_; }
+  // Room for n more columns (the ones gathered added to s first when full): the first one's rows.
+  double* Take(int n) {
+    if (count_ + n > capacity_) Flush();
+    double* first = w_.data() + static_cast<size_t>(count_) * ld_;
+    count_ += n;
+    return first;
+  }
+  void Flush() {
+    if (count_ > 0) internal::AddGramLower(sign_, w_.data(), ld_, rows_, count_, s_->data(), rows_);
+    count_ = 0;
+  }
+
+ private:
+  int rows_, ld_, capacity_;
+  double sign_;
+  Eigen::MatrixXd* s_;
+  std::vector<double> w_;
+  int count_ = 0;
+};
 
 }  // namespace
 
@@ -104,9 +165,12 @@ int FisherDesign::AddCandidate(const Eigen::VectorXd& q) {
     z.col(k).segment<3>(3) = rt * tw.v[free_columns_[k]];
   }
   z(6, nf) = 1.0;
-  Candidate out = ZeroSums();
+  Candidate out;
+  out.h_gg = Eigen::MatrixXd::Zero(num_global_, num_global_);
+  out.a = Eigen::MatrixXd::Zero(g, 2 * dots);
+  out.b.assign(dots, Eigen::Matrix<double, 2, 3>::Zero());
+  out.seen.assign(dots, 0);
   Eigen::Matrix<double, 7, 7> ff = Eigen::Matrix<double, 7, 7>::Zero();
-  Eigen::Matrix<double, 2, Eigen::Dynamic> a(2, g);
   for (int j = 0; j < dots; ++j) {
     const Eigen::Vector3d x = problem_.scene.dots_in_base[j];
     const Eigen::Vector3d p = rt * (x - c);
@@ -124,14 +188,13 @@ int FisherDesign::AddCandidate(const Eigen::VectorXd& q) {
     f.middleCols<3>(3) = -dpi;
     f.col(6) << xn, cam.mu * yn;
     ff.noalias() += f.transpose() * f;
-    a.noalias() = f * z;  // the pixel derivative with respect to (free rho, f_x)
+    out.a.middleCols<2>(2 * j).transpose().noalias() = f * z;  // the pixel derivative with respect to (free rho, f_x)
     const Eigen::Matrix<double, 2, 3> b = dpi * rt;
+    out.b[j] = b;
+    out.seen[j] = 1;
     if (j < 2) {  // a yardstick dot: one of the globals
-      out.h_gg.block(nf + 1 + 3 * j, 0, 3, g).noalias() += b.transpose() * a;
+      out.h_gg.block(nf + 1 + 3 * j, 0, 3, g).noalias() += b.transpose() * out.a.middleCols<2>(2 * j).transpose();
       out.h_gg.block<3, 3>(nf + 1 + 3 * j, nf + 1 + 3 * j).noalias() += b.transpose() * b;
-    } else {
-      out.h_jj[j - 2].noalias() += b.transpose() * b;
-      out.h_gj.middleCols<3>(3 * (j - 2)).noalias() += a.transpose() * b;
     }
   }
   out.h_gg.topLeftCorner(g, g).noalias() = z.transpose() * (ff * z);
@@ -142,13 +205,21 @@ int FisherDesign::AddCandidate(const Eigen::VectorXd& q) {
 
 FisherDesign::Sums FisherDesign::Sum(const std::vector<int>& design, int skip_position) const {
   const int dots = static_cast<int>(problem_.scene.dots_in_base.size());
+  const int g = static_cast<int>(free_columns_.size()) + 1;
   Sums sums = ZeroSums();
   for (size_t k = 0; k < design.size(); ++k) {
     if (static_cast<int>(k) == skip_position) continue;
     const Candidate& c = candidates_.at(design[k]);
     sums.h_gg += c.h_gg;
-    for (int j = 0; j < dots - 2; ++j) sums.h_jj[j] += c.h_jj[j];
-    sums.h_gj += c.h_gj;
+    for (int j = 2; j < dots; ++j) {
+      if (!c.seen[j]) continue;
+      const Eigen::Matrix<double, 2, 3>& b = c.b[j];
+      sums.h_jj[j - 2].noalias() += b.transpose() * b;
+      for (int k = 0; k < 3; ++k) {
+        AddTimes(c.a.col(2 * j).data(), c.a.col(2 * j + 1).data(), b(0, k), b(1, k),
+                 sums.h_gj.col(3 * (j - 2) + k).data(), g);
+      }
+    }
   }
   return sums;
 }
@@ -157,75 +228,133 @@ FisherValue FisherDesign::Evaluate(const std::vector<int>& design) const {
   return EvaluateSums(Sum(design), -1, true);
 }
 
-void FisherDesign::SubtractDots(const Sums& sums, const Candidate* add, Eigen::MatrixXd* s) const {
-  const int g = static_cast<int>(free_columns_.size()) + 1;
-  const int eliminated = static_cast<int>(problem_.scene.dots_in_base.size()) - 2;
-  // sum_j h_gj h_jj^-1 h_gj^T = W W^T, W's 3 columns per dot h_gj L_j^-T (h_jj = L_j L_j^T), a chunk of
-  // dots at a time (W of every dot is larger than the caches the loop below wants).
-  constexpr int kChunkDots = 16;
-  const int ld = (g + 3) / 4 * 4;
-  std::vector<double> w(static_cast<size_t>(ld) * 3 * kChunkDots, 0.0);  // rows g.. ld stay zero
-  int columns = 0;
-  for (int j = 0; j < eliminated; ++j) {
-    const Eigen::Matrix3d h = add != nullptr ? Eigen::Matrix3d(sums.h_jj[j] + add->h_jj[j]) : sums.h_jj[j];
-    Eigen::Matrix3d li;  // L_j^-1
-    if (!InverseCholesky3(h, &li)) continue;  // a dot seen from fewer than two poses: no information on the globals
-    double* w0 = w.data() + static_cast<size_t>(columns) * ld;
-    double* w1 = w0 + ld;
-    double* w2 = w1 + ld;
-    // The dot's (free rho, f_x) x 3 block of sums plus add, then times L_j^-T.
-    for (int k = 0; k < 3; ++k) {
-      double* wk = w0 + static_cast<size_t>(k) * ld;
-      const double* from = sums.h_gj.col(3 * j + k).data();
-      if (add != nullptr) {
-        const double* more = add->h_gj.col(3 * j + k).data();
-        for (int r = 0; r < g; ++r) wk[r] = from[r] + more[r];
-      } else {
-        for (int r = 0; r < g; ++r) wk[r] = from[r];
-      }
-    }
-    const double i00 = li(0, 0), i10 = li(1, 0), i11 = li(1, 1), i20 = li(2, 0), i21 = li(2, 1), i22 = li(2, 2);
-    for (int r = 0; r < g; ++r) {
-      const double x0 = w0[r], x1 = w1[r], x2 = w2[r];
-      w0[r] = x0 * i00;
-      w1[r] = x0 * i10 + x1 * i11;
-      w2[r] = x0 * i20 + x1 * i21 + x2 * i22;
-    }
-    columns += 3;
-    if (columns == 3 * kChunkDots) {
-      internal::SubtractGramLower(w.data(), ld, g, columns, s->data(), g);
-      columns = 0;
-    }
-  }
-  if (columns > 0) internal::SubtractGramLower(w.data(), ld, g, columns, s->data(), g);
-}
-
-FisherValue FisherDesign::EvaluateSums(const Sums& sums, int extra, bool with_variances) const {
-  FisherValue value;
-  const int nf = static_cast<int>(free_columns_.size()), g = nf + 1;
-  const Candidate* add = extra >= 0 ? &candidates_.at(extra) : nullptr;
-  Eigen::MatrixXd h = sums.h_gg;
-  if (add != nullptr) h += add->h_gg;
-  // The yardstick: (|X0 - X1| - L) / sigma_y, in units where the pixel residuals have unit variance.
+Eigen::Matrix<double, 6, 6> FisherDesign::YardstickInformation() const {
+  // (|X0 - X1| - L) / sigma_y, in units where the pixel residuals have unit variance.
   const Eigen::Vector3d d = (problem_.scene.dots_in_base[0] - problem_.scene.dots_in_base[1]).normalized();
   Eigen::Matrix<double, 6, 1> y;
   y << d, -d;
   const double w = options_.pixel_noise_px / options_.yardstick_sigma_m;
-  h.bottomRightCorner<6, 6>().noalias() += (w * w) * y * y.transpose();
+  return (w * w) * y * y.transpose();
+}
+
+void FisherDesign::SubtractDots(const Sums& sums, const Candidate* add, Eigen::MatrixXd* s) const {
+  const int g = static_cast<int>(free_columns_.size()) + 1;
+  const int eliminated = static_cast<int>(problem_.scene.dots_in_base.size()) - 2;
+  // sum_j h_gj h_jj^-1 h_gj^T = W W^T, W's 3 columns per dot h_gj L_j^-T (h_jj = L_j L_j^T), a chunk of
+  // dots at a time.
+  DotColumns w(g, 3, -1.0, s);
+  for (int j = 0; j < eliminated; ++j) {
+    const bool seen = add != nullptr && add->seen[j + 2];
+    Eigen::Matrix3d h = sums.h_jj[j];
+    if (seen) h.noalias() += add->b[j + 2].transpose() * add->b[j + 2];
+    Eigen::Matrix3d li;  // L_j^-1
+    if (!InverseCholesky3(h, &li)) continue;  // a dot seen from fewer than two poses: no information on the globals
+    double* w0 = w.Take(3);
+    double* w1 = w0 + w.ld();
+    double* w2 = w1 + w.ld();
+    // The dot's (free rho, f_x) x 3 block of sums plus add's a^T b, then times L_j^-T.
+    for (int k = 0; k < 3; ++k) {
+      double* wk = w0 + static_cast<size_t>(k) * w.ld();
+      std::copy_n(sums.h_gj.col(3 * j + k).data(), g, wk);
+      if (seen) {
+        const Eigen::Matrix<double, 2, 3>& b = add->b[j + 2];
+        AddTimes(add->a.col(2 * (j + 2)).data(), add->a.col(2 * (j + 2) + 1).data(), b(0, k), b(1, k), wk, g);
+      }
+    }
+    TimesLowerTransposed(li, w0, w1, w2, g);
+  }
+  w.Flush();
+}
+
+FisherValue FisherDesign::EvaluateSums(const Sums& sums, int extra, bool with_variances) const {
+  const int g = static_cast<int>(free_columns_.size()) + 1;
+  const Candidate* add = extra >= 0 ? &candidates_.at(extra) : nullptr;
   // s: the information of (free rho, f_x) with every dot eliminated (lower triangle), the yardstick dots last.
-  Eigen::MatrixXd s = h.topLeftCorner(g, g);
+  Eigen::MatrixXd s = sums.h_gg.topLeftCorner(g, g);
+  Eigen::MatrixXd h_gy = sums.h_gg.block(0, g, g, 6);
+  Eigen::Matrix<double, 6, 6> h_yy = sums.h_gg.bottomRightCorner<6, 6>();
+  if (add != nullptr) {
+    s += add->h_gg.topLeftCorner(g, g);
+    h_gy += add->h_gg.block(0, g, g, 6);
+    h_yy += add->h_gg.bottomRightCorner<6, 6>();
+  }
+  h_yy += YardstickInformation();
   SubtractDots(sums, add, &s);
+  return Finish(h_gy, h_yy, with_variances, &s);
+}
+
+FisherDesign::Rest FisherDesign::PrepareRest(Sums sums) const {
+  const int g = static_cast<int>(free_columns_.size()) + 1;
+  const int eliminated = static_cast<int>(problem_.scene.dots_in_base.size()) - 2;
+  Rest rest;
+  rest.sums = std::move(sums);
+  rest.k.resize(eliminated);
+  rest.p.resize(g, 3 * eliminated);
+  for (int j = 0; j < eliminated; ++j) {
+    Eigen::Matrix3d li;
+    if (!InverseCholesky3(rest.sums.h_jj[j], &li)) return rest;  // a dot the rest does not determine
+    rest.k[j].noalias() = li.transpose() * li;
+    rest.p.middleCols<3>(3 * j).noalias() = rest.sums.h_gj.middleCols<3>(3 * j) * rest.k[j];
+  }
+  rest.every_dot_determined = true;
+  rest.s = rest.sums.h_gg.topLeftCorner(g, g);
+  SubtractDots(rest.sums, nullptr, &rest.s);
+  return rest;
+}
+
+// A new pose's rows (a, b) for dot j, under the rest's information on the dot (its inverse k, and p = k h_gj^T),
+// add the marginal information atilde^T (I + b k b^T)^-1 atilde with atilde = a - b p: two columns
+// w = L^-1 atilde of the rank update (I + b k b^T = L L^T).
+FisherValue FisherDesign::EvaluateWithRest(const Rest& rest, int extra, bool with_variances) const {
+  if (!rest.every_dot_determined || extra < 0) return EvaluateSums(rest.sums, extra, with_variances);
+  const int g = static_cast<int>(free_columns_.size()) + 1;
+  const int dots = static_cast<int>(problem_.scene.dots_in_base.size());
+  const Candidate& c = candidates_.at(extra);
+  Eigen::MatrixXd s = rest.s;
+  DotColumns w(g, 2, 1.0, &s);
+  for (int j = 0; j < 2; ++j) {  // the yardstick dots are globals: their rows as they are
+    Eigen::Map<Eigen::VectorXd>(w.Take(1), g) = c.a.col(2 * j);
+    Eigen::Map<Eigen::VectorXd>(w.Take(1), g) = c.a.col(2 * j + 1);
+  }
+  for (int j = 2; j < dots; ++j) {
+    if (!c.seen[j]) continue;
+    const Eigen::Matrix<double, 2, 3>& b = c.b[j];
+    const Eigen::Matrix<double, 2, 3> t = b * rest.k[j - 2];
+    const double l00 = std::sqrt(1.0 + t.row(0).dot(b.row(0)));
+    const double l10 = t.row(1).dot(b.row(0)) / l00;
+    const double l11 = std::sqrt(1.0 + t.row(1).dot(b.row(1)) - l10 * l10);
+    double* w0 = w.Take(2);
+    MarginalRows(c.a.col(2 * j).data(), b, rest.p.col(3 * (j - 2)).data(), l00, l10, l11, g, w0, w0 + w.ld());
+  }
+  w.Flush();
+  const Eigen::MatrixXd h_gy = rest.sums.h_gg.block(0, g, g, 6) + c.h_gg.block(0, g, g, 6);
+  const Eigen::Matrix<double, 6, 6> h_yy = rest.sums.h_gg.bottomRightCorner<6, 6>() + c.h_gg.bottomRightCorner<6, 6>() +
+                                           YardstickInformation();
+  return Finish(h_gy, h_yy, with_variances, &s);
+}
+
+FisherValue FisherDesign::Finish(const Eigen::Ref<const Eigen::MatrixXd>& h_gy, const Eigen::Matrix<double, 6, 6>& h_yy,
+                                 bool with_variances, Eigen::MatrixXd* s) const {
+  FisherValue value;
+  const int nf = static_cast<int>(free_columns_.size()), g = nf + 1;
   // The yardstick dots: the Schur complement of their 6 x 6 block.
-  const Eigen::LLT<Eigen::Matrix<double, 6, 6>> yard(h.bottomRightCorner<6, 6>());
+  const Eigen::LLT<Eigen::Matrix<double, 6, 6>> yard(h_yy);
   if (yard.info() != Eigen::Success) return value;
-  const Eigen::Matrix<double, 6, 6> yard_l_inv = yard.matrixL().solve(Eigen::Matrix<double, 6, 6>::Identity());
-  const Eigen::Matrix<double, Eigen::Dynamic, 6> w_y = h.topRightCorner(g, 6) * yard_l_inv.transpose();
-  AddOuterLower(-1.0, w_y, &s);
-  if (!CholeskyLower(&s)) return value;  // s's lower triangle is now L, s = L L^T
+  const Eigen::Matrix<double, 6, 6> l = yard.matrixL();
+  Eigen::Matrix<double, Eigen::Dynamic, 6> w_y(g, 6);  // h_gy L^-T, row by row by forward substitution
+  for (int r = 0; r < g; ++r) {
+    for (int m = 0; m < 6; ++m) {
+      double x = h_gy(r, m);
+      for (int k = 0; k < m; ++k) x -= l(m, k) * w_y(r, k);
+      w_y(r, m) = x / l(m, m);
+    }
+  }
+  AddOuterLower(-1.0, w_y, s);
+  if (!CholeskyLower(s)) return value;  // s's lower triangle is now L, s = L L^T
   const double sigma2 = options_.pixel_noise_px * options_.pixel_noise_px;
   // cov = sigma^2 s^-1: log det(cov^-1) = log det s - (nf + 1) log sigma^2.
   value.ok = true;
-  value.log_det = 2.0 * s.diagonal().array().log().sum() - g * std::log(sigma2);
+  value.log_det = 2.0 * s->diagonal().array().log().sum() - g * std::log(sigma2);
   if (!with_variances) return value;
   // diag(s^-1)_k = |L^-1 e_k|^2: column k of L^-1 by forward substitution.
   Eigen::VectorXd variance(g), x(g);
@@ -233,8 +362,8 @@ FisherValue FisherDesign::EvaluateSums(const Sums& sums, int extra, bool with_va
     x.setZero();
     x[k] = 1.0;
     for (int m = k; m < g; ++m) {
-      x[m] /= s(m, m);
-      x.segment(m + 1, g - m - 1).noalias() -= x[m] * s.col(m).segment(m + 1, g - m - 1);
+      x[m] /= (*s)(m, m);
+      x.segment(m + 1, g - m - 1).noalias() -= x[m] * s->col(m).segment(m + 1, g - m - 1);
     }
     variance[k] = sigma2 * x.segment(k, g - k).squaredNorm();
   }

@@ -52,7 +52,7 @@ class FisherDesign {
 
   FisherValue Evaluate(const std::vector<int>& design) const;
 
-  // The contributions of a set of poses, summed (the unit of the exchange: every pose but one).
+  // The contributions of a set of poses, summed.
   struct Sums {
     Eigen::MatrixXd h_gg;               // global x global, summed over dots
     std::vector<Eigen::Matrix3d> h_jj;  // per eliminated dot
@@ -63,10 +63,39 @@ class FisherDesign {
   // The design of `sums` plus candidate `extra` (-1: none). with_variances false: only ok and log_det.
   FisherValue EvaluateSums(const Sums& sums, int extra, bool with_variances) const;
 
+  // The unit of the exchange: every pose of a design but one (Sum with a skip), with its dots eliminated once.
+  // A candidate's pixel rows then update the rest's (free rho, f_x) information by a rank-two term per dot
+  // (the information of new measurements with the dots marginalised under the rest's information on them),
+  // instead of every dot's 3 x 3 block being factored and eliminated again. Used when the rest determines
+  // every dot (each block passes the test of a dot seen from two poses); otherwise EvaluateWithRest
+  // evaluates sums plus the candidate as EvaluateSums does.
+  struct Rest {
+    Sums sums;
+    bool every_dot_determined = false;
+    Eigen::MatrixXd s;                 // (free, f_x) information, dots eliminated, yardstick not yet (lower)
+    std::vector<Eigen::Matrix3d> k;    // per eliminated dot: the inverse of its 3 x 3 block
+    Eigen::MatrixXd p;                 // (free + f_x) x 3 per eliminated dot: k times the block's transpose
+  };
+  Rest PrepareRest(Sums sums) const;
+  // The same value as EvaluateSums(rest.sums, extra, with_variances), to round-off.
+  FisherValue EvaluateWithRest(const Rest& rest, int extra, bool with_variances) const;
+
  private:
-  using Candidate = Sums;
+  // A pose's rows: per scene dot, the 2 pixel rows' derivatives with respect to (free rho, f_x) (a, columns
+  // 2j and 2j + 1) and to the dot (b); zero for a dot the pose does not see. h_gg as in Sums.
+  struct Candidate {
+    Eigen::MatrixXd h_gg;
+    Eigen::MatrixXd a;                                 // (free + f_x) x 2 * dots
+    std::vector<Eigen::Matrix<double, 2, 3>> b;        // per dot
+    std::vector<char> seen;                            // per dot
+  };
   // Lower triangle of *s -= sum over the eliminated dots of h_gj h_jj^-1 h_gj^T, for sums plus add (may be null).
   void SubtractDots(const Sums& sums, const Candidate* add, Eigen::MatrixXd* s) const;
+  // The value from s (lower, dots eliminated) and the yardstick dots' blocks: h_gy (free + f_x) x 6 and h_yy.
+  FisherValue Finish(const Eigen::Ref<const Eigen::MatrixXd>& h_gy, const Eigen::Matrix<double, 6, 6>& h_yy,
+                     bool with_variances, Eigen::MatrixXd* s) const;
+  // The yardstick's term in the information of its two dots' coordinates.
+  Eigen::Matrix<double, 6, 6> YardstickInformation() const;
   PlanningProblem problem_;
   std::vector<int> free_columns_;
   FisherDesignOptions options_;

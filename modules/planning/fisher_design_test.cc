@@ -1,6 +1,7 @@
 // The Fisher design's information (planning/fisher_design.h) against its definition computed the slow way:
 // every pixel's derivatives by central differences of the pinhole projection through the whole model, the
 // dense information of (free rho, f_x, every dot) with the yardstick term, inverted.
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <vector>
@@ -105,6 +106,41 @@ TEST(FisherDesign, InformationEqualsTheDenseDefinitionByCentralDifferences) {
     const FisherValue log_det_only = design.EvaluateSums(design.Sum(all, skip), all[skip], false);
     EXPECT_EQ(log_det_only.log_det, again.log_det) << skip;
   }
+}
+
+TEST(FisherDesign, TheExchangesRankTwoUpdateEqualsEliminatingEveryDotAgain) {
+  const World w = MakeWorld();
+  const std::vector<int> free = FreeColumns(w);
+  FisherDesign design(w.problem, free, FisherDesignOptions());
+  std::vector<int> all;
+  for (int i = 0; i < 15; ++i) all.push_back(design.AddCandidate(w.start[i]));
+  std::vector<int> others;  // the verification poses as candidates from outside the design
+  for (int i = 15; i < 25; ++i) others.push_back(design.AddCandidate(w.start[i]));
+  double largest = 0;
+  for (int skip : {1, 7, 14}) {
+    const FisherDesign::Rest rest = design.PrepareRest(design.Sum(all, skip));
+    ASSERT_TRUE(rest.every_dot_determined) << skip;  // every dot is seen from the other 14 poses
+    for (int extra : {all[skip], others[0], others[4], others[9]}) {
+      const FisherValue direct = design.EvaluateSums(rest.sums, extra, true);
+      const FisherValue fast = design.EvaluateWithRest(rest, extra, true);
+      ASSERT_TRUE(direct.ok && fast.ok) << skip << " " << extra;
+      EXPECT_NEAR(fast.log_det, direct.log_det, 1e-11 * std::abs(direct.log_det)) << skip << " " << extra;
+      EXPECT_NEAR(fast.a_value, direct.a_value, 1e-9 * direct.a_value) << skip << " " << extra;
+      for (int k = 0; k < direct.stddev.size(); ++k) {
+        EXPECT_NEAR(fast.stddev[k], direct.stddev[k], 1e-9 * direct.stddev[k]) << skip << " " << extra << " " << k;
+      }
+      largest = std::max(largest, std::abs(fast.a_value / direct.a_value - 1));
+      EXPECT_EQ(design.EvaluateWithRest(rest, extra, false).log_det, fast.log_det);
+    }
+  }
+  std::cout << "[ figures  ] largest relative difference of A between the two evaluations " << largest << "\n";
+  // A rest of one pose determines no dot: the candidate is evaluated with every dot eliminated again.
+  const FisherDesign::Rest one = design.PrepareRest(design.Sum({all[0], all[1]}, 1));
+  EXPECT_FALSE(one.every_dot_determined);
+  const FisherValue two = design.EvaluateWithRest(one, all[1], true);
+  const FisherValue expected = design.Evaluate({all[0], all[1]});
+  ASSERT_EQ(two.ok, expected.ok);
+  EXPECT_EQ(two.log_det, expected.log_det);  // the same evaluation
 }
 
 }  // namespace

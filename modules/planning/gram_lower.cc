@@ -6,12 +6,12 @@ namespace selfcal::planning::internal {
 
 namespace {
 
-// One tile of s -= w w^T: rows r0 .. r0 + kRows - 1 (kRows a multiple of the vector's lanes) by columns
+// One tile of s += sign w w^T: rows r0 .. r0 + kRows - 1 (kRows a multiple of the vector's lanes) by columns
 // c0 .. c0 + 3, summed over every column of w in registers; only its entries on or below the diagonal are
 // written.
 template <typename Vector, int kRows>
-__attribute__((always_inline)) inline void Tile(const double* w, int ld, int rows, int cols, int r0, int c0, double* s,
-                                                int lds) {
+__attribute__((always_inline)) inline void Tile(double sign, const double* w, int ld, int rows, int cols, int r0, int c0,
+                                                double* s, int lds) {
   constexpr int kLanes = sizeof(Vector) / sizeof(double), kVectors = kRows / kLanes;
   Vector acc[4][kVectors] = {};
   const double* wk = w;
@@ -25,14 +25,15 @@ __attribute__((always_inline)) inline void Tile(const double* w, int ld, int row
   }
   for (int j = 0; j < 4 && c0 + j < rows; ++j) {
     for (int i = 0; i < kRows && r0 + i < rows; ++i) {
-      if (r0 + i >= c0 + j) s[(c0 + j) * lds + r0 + i] -= acc[j][i / kLanes][i % kLanes];
+      if (r0 + i >= c0 + j) s[(c0 + j) * lds + r0 + i] += sign * acc[j][i / kLanes][i % kLanes];
     }
   }
 }
 
-// One row r of the same, columns c0 .. c0 + 3 as a 4-lane vector (the rows below the last full tile).
+// One row r of the same, columns c0 .. c0 + 3 as vectors (the rows below the last full tile).
 template <typename Vector>
-__attribute__((always_inline)) inline void RowTile(const double* w, int ld, int cols, int r, int c0, double* s, int lds) {
+__attribute__((always_inline)) inline void RowTile(double sign, const double* w, int ld, int cols, int r, int c0,
+                                                   double* s, int lds) {
   constexpr int kLanes = sizeof(Vector) / sizeof(double), kVectors = 4 / kLanes;
   Vector acc[kVectors] = {};
   const double* wk = w;
@@ -44,26 +45,28 @@ __attribute__((always_inline)) inline void RowTile(const double* w, int ld, int 
       acc[v] += b * x;
     }
   }
-  for (int j = 0; j < 4 && c0 + j <= r; ++j) s[(c0 + j) * lds + r] -= acc[j / kLanes][j % kLanes];
+  for (int j = 0; j < 4 && c0 + j <= r; ++j) s[(c0 + j) * lds + r] += sign * acc[j / kLanes][j % kLanes];
 }
 
 // Every product w_r . w_c is summed over k in order with one multiply and one add per term, whatever the tile
 // shape: the tiles only decide which sums share registers.
 template <typename Vector, int kTallRows>
-__attribute__((always_inline)) inline void GramKernel(const double* w, int ld, int rows, int cols, double* s, int lds) {
+__attribute__((always_inline)) inline void GramKernel(double sign, const double* w, int ld, int rows, int cols,
+                                                      double* s, int lds) {
   for (int c0 = 0; c0 < rows; c0 += 4) {
     int r0 = c0;
-    for (; r0 + kTallRows <= rows; r0 += kTallRows) Tile<Vector, kTallRows>(w, ld, rows, cols, r0, c0, s, lds);
-    for (; r0 + 4 <= rows; r0 += 4) Tile<Vector, 4>(w, ld, rows, cols, r0, c0, s, lds);
-    for (; r0 < rows; ++r0) RowTile<Vector>(w, ld, cols, r0, c0, s, lds);
+    for (; r0 + kTallRows <= rows; r0 += kTallRows) Tile<Vector, kTallRows>(sign, w, ld, rows, cols, r0, c0, s, lds);
+    for (; r0 + 4 <= rows; r0 += 4) Tile<Vector, 4>(sign, w, ld, rows, cols, r0, c0, s, lds);
+    for (; r0 < rows; ++r0) RowTile<Vector>(sign, w, ld, cols, r0, c0, s, lds);
   }
 }
 
 using Lanes2 = double __attribute__((vector_size(16)));
 #if defined(__x86_64__) && defined(__GNUC__)
 using Lanes4 = double __attribute__((vector_size(32)));
-__attribute__((target("avx"))) void GramAvx(const double* w, int ld, int rows, int cols, double* s, int lds) {
-  GramKernel<Lanes4, 8>(w, ld, rows, cols, s, lds);
+__attribute__((target("avx"))) void GramAvx(double sign, const double* w, int ld, int rows, int cols, double* s,
+                                            int lds) {
+  GramKernel<Lanes4, 8>(sign, w, ld, rows, cols, s, lds);
 }
 bool HasAvx() {
   static const bool has = __builtin_cpu_supports("avx");
@@ -73,23 +76,23 @@ bool HasAvx() {
 
 }  // namespace
 
-void SubtractGramLowerPortable(const double* w, int ld, int rows, int cols, double* s, int lds) {
-  GramKernel<Lanes2, 4>(w, ld, rows, cols, s, lds);
+void AddGramLowerPortable(double sign, const double* w, int ld, int rows, int cols, double* s, int lds) {
+  GramKernel<Lanes2, 4>(sign, w, ld, rows, cols, s, lds);
 }
 
-bool SubtractGramLowerAvx(const double* w, int ld, int rows, int cols, double* s, int lds) {
+bool AddGramLowerAvx(double sign, const double* w, int ld, int rows, int cols, double* s, int lds) {
 #if defined(__x86_64__) && defined(__GNUC__)
   if (!HasAvx()) return false;
-  GramAvx(w, ld, rows, cols, s, lds);
+  GramAvx(sign, w, ld, rows, cols, s, lds);
   return true;
 #else
-  (void)w, (void)ld, (void)rows, (void)cols, (void)s, (void)lds;
+  (void)sign, (void)w, (void)ld, (void)rows, (void)cols, (void)s, (void)lds;
   return false;
 #endif
 }
 
-void SubtractGramLower(const double* w, int ld, int rows, int cols, double* s, int lds) {
-  if (!SubtractGramLowerAvx(w, ld, rows, cols, s, lds)) SubtractGramLowerPortable(w, ld, rows, cols, s, lds);
+void AddGramLower(double sign, const double* w, int ld, int rows, int cols, double* s, int lds) {
+  if (!AddGramLowerAvx(sign, w, ld, rows, cols, s, lds)) AddGramLowerPortable(sign, w, ld, rows, cols, s, lds);
 }
 
 }  // namespace selfcal::planning::internal

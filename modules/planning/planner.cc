@@ -250,13 +250,14 @@ void PlanExchange(const PlanningProblem& problem, const PlannerOptions& options,
       if (changes_when_exchanged[slot] == changes && (progress.Advance(), true)) continue;
       const int current = chosen[slot];
       int best_candidate = current;
-      // Every pose but the slot's summed once; each candidate then costs one EvaluateSums.
-      const FisherDesign::Sums rest = design.Sum(fisher_design(chosen), slot);
+      // Every pose but the slot's summed and its dots eliminated once; each candidate then costs one
+      // EvaluateWithRest.
+      const FisherDesign::Rest rest = design.PrepareRest(design.Sum(fisher_design(chosen), slot));
       for (int cand = 0; cand < num_candidates; ++cand) {
         if (cand == current || !compatible(cand, slot)) continue;
         chosen[slot] = cand;
         const double score = DesignScore(
-            options.criterion, design.EvaluateSums(rest, fisher(cand), options.criterion == Criterion::kAOptimal));
+            options.criterion, design.EvaluateWithRest(rest, fisher(cand), options.criterion == Criterion::kAOptimal));
         ++result->evaluations;
         if (score < best - 1e-9 * std::abs(best)) {
           best = score;
