@@ -7,7 +7,7 @@
 #include <Eigen/Cholesky>
 
 #include "base/status.h"
-#include "planning/gram_lower.h"
+#include "planning/exchange_kernels.h"
 #include "planning/pose_twists.h"
 
 namespace selfcal::planning {
@@ -85,17 +85,18 @@ void TimesLowerTransposed(const Eigen::Matrix3d& li, double* __restrict w0, doub
   }
 }
 
-// w = L^-1 (a - b p) as two columns w0, w1: a's two columns a[0, n) and a[n, 2n), p's three p[0, 3n), L the
-// Cholesky factor (l00, l10, l11) of I + b k b^T.
-void MarginalRows(const double* __restrict a, const Eigen::Matrix<double, 2, 3>& b, const double* __restrict p,
-                  double l00, double l10, double l11, int n, double* __restrict w0, double* __restrict w1) {
-  const double b00 = b(0, 0), b01 = b(0, 1), b02 = b(0, 2), b10 = b(1, 0), b11 = b(1, 1), b12 = b(1, 2);
-  const double i00 = 1.0 / l00, i11 = 1.0 / l11;
+// A dot's two pixel rows' derivatives with respect to (free rho, f_x), a = f zt^T, into a0 and a1.
+void PixelRows(const Eigen::Matrix<double, 2, 7>& f, const Eigen::MatrixXd& zt, double* __restrict a0,
+               double* __restrict a1) {
+  const int n = static_cast<int>(zt.rows());
+  const double* __restrict z = zt.data();
+  const double f00 = f(0, 0), f01 = f(0, 1), f02 = f(0, 2), f03 = f(0, 3), f04 = f(0, 4), f05 = f(0, 5), f06 = f(0, 6);
+  const double f10 = f(1, 0), f11 = f(1, 1), f12 = f(1, 2), f13 = f(1, 3), f14 = f(1, 4), f15 = f(1, 5), f16 = f(1, 6);
   for (int r = 0; r < n; ++r) {
-    const double at0 = a[r] - (b00 * p[r] + b01 * p[n + r] + b02 * p[2 * n + r]);
-    const double at1 = a[n + r] - (b10 * p[r] + b11 * p[n + r] + b12 * p[2 * n + r]);
-    w0[r] = at0 * i00;
-    w1[r] = (at1 - l10 * w0[r]) * i11;
+    const double z0 = z[r], z1 = z[n + r], z2 = z[2 * n + r], z3 = z[3 * n + r], z4 = z[4 * n + r], z5 = z[5 * n + r],
+                 z6 = z[6 * n + r];
+    a0[r] = f00 * z0 + f01 * z1 + f02 * z2 + f03 * z3 + f04 * z4 + f05 * z5 + f06 * z6;
+    a1[r] = f10 * z0 + f11 * z1 + f12 * z2 + f13 * z3 + f14 * z4 + f15 * z5 + f16 * z6;
   }
 }
 
@@ -107,6 +108,7 @@ class DotColumns {
       : rows_(rows), ld_((rows + 3) / 4 * 4), capacity_(16 * columns_per_dot), sign_(sign), s_(s),
         w_(static_cast<size_t>(ld_) * capacity_, 0.0) {}
   int ld() const { return ld_; }
+  bool Full(int n) const { return count_ + n > capacity_; }
   // Room for n more columns (the ones gathered added to s first when full): the first one's rows.
   double* Take(int n) {
     if (count_ + n > capacity_) Flush();
@@ -149,75 +151,90 @@ FisherDesign::Sums FisherDesign::ZeroSums() const {
 
 // A dot's pixel derivative with respect to the free parameters is -dpi R^T (omega_k x x + v_k) =
 // dpi ([y]x omega'_k - v'_k) with y = R^T x, omega' = R^T omega, v' = R^T v: a 2 x 6 matrix of the dot, f below,
-// times the 6 x free matrix z of the pose. The (free, f_x) block of the information is then z~^T (sum f^T f) z~
-// with z~ = diag(z, 1): one 7 x 7 sum per pose instead of a free x free update per dot.
+// times the 6 x free matrix of the pose's twists in its camera frame. The (free, f_x) block of the information
+// is then zt (sum f^T f) zt^T: one 7 x 7 sum per pose instead of a free x free update per dot.
+void FisherDesign::DotRows(const Candidate& c, int j, Eigen::Matrix<double, 2, 7>* f,
+                           Eigen::Matrix<double, 2, 3>* b) const {
+  const CameraIntrinsics& cam = problem_.camera;
+  const Eigen::Vector3d& p = c.p[j];
+  const double xn = p.x() / p.z(), yn = p.y() / p.z();
+  Eigen::Matrix<double, 2, 3> dpi;
+  dpi << cam.fx_px / p.z(), 0, -cam.fx_px * xn / p.z(), 0, cam.fx_px * cam.mu / p.z(), -cam.fx_px * cam.mu * yn / p.z();
+  const Eigen::Vector3d y = c.rt * problem_.scene.dots_in_base[j];
+  Eigen::Matrix3d y_cross;
+  y_cross << 0, -y.z(), y.y(), y.z(), 0, -y.x(), -y.y(), y.x(), 0;
+  f->leftCols<3>().noalias() = dpi * y_cross;
+  f->middleCols<3>(3) = -dpi;
+  f->col(6) << xn, cam.mu * yn;
+  b->noalias() = dpi * c.rt;
+}
+
 int FisherDesign::AddCandidate(const Eigen::VectorXd& q) {
   SELFCAL_CHECK(q.size() == problem_.robot.num_joints(), "candidate has " << q.size() << " joints");
   const internal::CameraTwists<double> tw = internal::ComputeCameraTwists<double>(problem_.robot, q.data());
-  const Eigen::Matrix3d rt = tw.base_from_cam.rotation.transpose();
-  const Eigen::Vector3d c = tw.base_from_cam.translation;
   const CameraIntrinsics& cam = problem_.camera;
   const int nf = static_cast<int>(free_columns_.size()), g = nf + 1;
   const int dots = static_cast<int>(problem_.scene.dots_in_base.size());
-  Eigen::Matrix<double, 7, Eigen::Dynamic> z = Eigen::Matrix<double, 7, Eigen::Dynamic>::Zero(7, g);
-  for (int k = 0; k < nf; ++k) {
-    z.col(k).head<3>() = rt * tw.omega[free_columns_[k]];
-    z.col(k).segment<3>(3) = rt * tw.v[free_columns_[k]];
-  }
-  z(6, nf) = 1.0;
   Candidate out;
-  out.h_gg = Eigen::MatrixXd::Zero(num_global_, num_global_);
-  out.a = Eigen::MatrixXd::Zero(g, 2 * dots);
-  out.b.assign(dots, Eigen::Matrix<double, 2, 3>::Zero());
+  out.rt = tw.base_from_cam.rotation.transpose();
+  out.zt = Eigen::MatrixXd::Zero(g, 7);
+  for (int k = 0; k < nf; ++k) {
+    out.zt.row(k).head<3>() = (out.rt * tw.omega[free_columns_[k]]).transpose();
+    out.zt.row(k).segment<3>(3) = (out.rt * tw.v[free_columns_[k]]).transpose();
+  }
+  out.zt(nf, 6) = 1.0;
+  out.p.resize(dots);
   out.seen.assign(dots, 0);
-  Eigen::Matrix<double, 7, 7> ff = Eigen::Matrix<double, 7, 7>::Zero();
+  out.ff.setZero();
+  out.yard = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, num_global_);
+  Eigen::Matrix<double, 2, 7> f;
+  Eigen::Matrix<double, 2, 3> b;
+  Eigen::Matrix<double, Eigen::Dynamic, 2> a(g, 2);
   for (int j = 0; j < dots; ++j) {
-    const Eigen::Vector3d x = problem_.scene.dots_in_base[j];
-    const Eigen::Vector3d p = rt * (x - c);
+    const Eigen::Vector3d p = out.rt * (problem_.scene.dots_in_base[j] - tw.base_from_cam.translation);
+    out.p[j] = p;
     if (!(p.z() > 0)) continue;
-    const double xn = p.x() / p.z(), yn = p.y() / p.z();
-    const double u = cam.cx_px + cam.fx_px * xn, v = cam.cy_px + cam.fx_px * cam.mu * yn;
+    const double u = cam.cx_px + cam.fx_px * p.x() / p.z(), v = cam.cy_px + cam.fx_px * cam.mu * p.y() / p.z();
     if (u < 0 || v < 0 || u > cam.width_px - 1 || v > cam.height_px - 1) continue;  // not seen
-    Eigen::Matrix<double, 2, 3> dpi;
-    dpi << cam.fx_px / p.z(), 0, -cam.fx_px * xn / p.z(), 0, cam.fx_px * cam.mu / p.z(), -cam.fx_px * cam.mu * yn / p.z();
-    const Eigen::Vector3d y = rt * x;
-    Eigen::Matrix3d y_cross;
-    y_cross << 0, -y.z(), y.y(), y.z(), 0, -y.x(), -y.y(), y.x(), 0;
-    Eigen::Matrix<double, 2, 7> f;
-    f.leftCols<3>() = dpi * y_cross;
-    f.middleCols<3>(3) = -dpi;
-    f.col(6) << xn, cam.mu * yn;
-    ff.noalias() += f.transpose() * f;
-    out.a.middleCols<2>(2 * j).transpose().noalias() = f * z;  // the pixel derivative with respect to (free rho, f_x)
-    const Eigen::Matrix<double, 2, 3> b = dpi * rt;
-    out.b[j] = b;
     out.seen[j] = 1;
+    DotRows(out, j, &f, &b);
+    out.ff.noalias() += f.transpose() * f;
     if (j < 2) {  // a yardstick dot: one of the globals
-      out.h_gg.block(nf + 1 + 3 * j, 0, 3, g).noalias() += b.transpose() * out.a.middleCols<2>(2 * j).transpose();
-      out.h_gg.block<3, 3>(nf + 1 + 3 * j, nf + 1 + 3 * j).noalias() += b.transpose() * b;
+      PixelRows(f, out.zt, a.col(0).data(), a.col(1).data());
+      out.yard.block(3 * j, 0, 3, g).noalias() = b.transpose() * a.transpose();
+      out.yard.block<3, 3>(3 * j, g + 3 * j).noalias() = b.transpose() * b;
     }
   }
-  out.h_gg.topLeftCorner(g, g).noalias() = z.transpose() * (ff * z);
-  out.h_gg.triangularView<Eigen::StrictlyUpper>() = out.h_gg.transpose();
   candidates_.push_back(std::move(out));
   return static_cast<int>(candidates_.size()) - 1;
+}
+
+void FisherDesign::AddInformation(const Candidate& c, Eigen::MatrixXd* h) const {
+  const int g = static_cast<int>(free_columns_.size()) + 1;
+  const Eigen::MatrixXd zf = c.zt * c.ff;
+  h->topLeftCorner(g, g).noalias() += zf * c.zt.transpose();
+  h->bottomRows<6>() += c.yard;
+  h->topRightCorner(g, 6) += c.yard.leftCols(g).transpose();
 }
 
 FisherDesign::Sums FisherDesign::Sum(const std::vector<int>& design, int skip_position) const {
   const int dots = static_cast<int>(problem_.scene.dots_in_base.size());
   const int g = static_cast<int>(free_columns_.size()) + 1;
   Sums sums = ZeroSums();
+  Eigen::Matrix<double, 2, 7> f;
+  Eigen::Matrix<double, 2, 3> b;
+  Eigen::Matrix<double, Eigen::Dynamic, 2> a(g, 2);
   for (size_t k = 0; k < design.size(); ++k) {
     if (static_cast<int>(k) == skip_position) continue;
     const Candidate& c = candidates_.at(design[k]);
-    sums.h_gg += c.h_gg;
+    AddInformation(c, &sums.h_gg);
     for (int j = 2; j < dots; ++j) {
       if (!c.seen[j]) continue;
-      const Eigen::Matrix<double, 2, 3>& b = c.b[j];
+      DotRows(c, j, &f, &b);
+      PixelRows(f, c.zt, a.col(0).data(), a.col(1).data());
       sums.h_jj[j - 2].noalias() += b.transpose() * b;
-      for (int k = 0; k < 3; ++k) {
-        AddTimes(c.a.col(2 * j).data(), c.a.col(2 * j + 1).data(), b(0, k), b(1, k),
-                 sums.h_gj.col(3 * (j - 2) + k).data(), g);
+      for (int m = 0; m < 3; ++m) {
+        AddTimes(a.col(0).data(), a.col(1).data(), b(0, m), b(1, m), sums.h_gj.col(3 * (j - 2) + m).data(), g);
       }
     }
   }
@@ -243,10 +260,17 @@ void FisherDesign::SubtractDots(const Sums& sums, const Candidate* add, Eigen::M
   // sum_j h_gj h_jj^-1 h_gj^T = W W^T, W's 3 columns per dot h_gj L_j^-T (h_jj = L_j L_j^T), a chunk of
   // dots at a time.
   DotColumns w(g, 3, -1.0, s);
+  Eigen::Matrix<double, 2, 7> f;
+  Eigen::Matrix<double, 2, 3> b;
+  Eigen::Matrix<double, Eigen::Dynamic, 2> a(g, 2);
   for (int j = 0; j < eliminated; ++j) {
     const bool seen = add != nullptr && add->seen[j + 2];
     Eigen::Matrix3d h = sums.h_jj[j];
-    if (seen) h.noalias() += add->b[j + 2].transpose() * add->b[j + 2];
+    if (seen) {
+      DotRows(*add, j + 2, &f, &b);
+      PixelRows(f, add->zt, a.col(0).data(), a.col(1).data());
+      h.noalias() += b.transpose() * b;
+    }
     Eigen::Matrix3d li;  // L_j^-1
     if (!InverseCholesky3(h, &li)) continue;  // a dot seen from fewer than two poses: no information on the globals
     double* w0 = w.Take(3);
@@ -256,10 +280,7 @@ void FisherDesign::SubtractDots(const Sums& sums, const Candidate* add, Eigen::M
     for (int k = 0; k < 3; ++k) {
       double* wk = w0 + static_cast<size_t>(k) * w.ld();
       std::copy_n(sums.h_gj.col(3 * j + k).data(), g, wk);
-      if (seen) {
-        const Eigen::Matrix<double, 2, 3>& b = add->b[j + 2];
-        AddTimes(add->a.col(2 * (j + 2)).data(), add->a.col(2 * (j + 2) + 1).data(), b(0, k), b(1, k), wk, g);
-      }
+      if (seen) AddTimes(a.col(0).data(), a.col(1).data(), b(0, k), b(1, k), wk, g);
     }
     TimesLowerTransposed(li, w0, w1, w2, g);
   }
@@ -270,17 +291,11 @@ FisherValue FisherDesign::EvaluateSums(const Sums& sums, int extra, bool with_va
   const int g = static_cast<int>(free_columns_.size()) + 1;
   const Candidate* add = extra >= 0 ? &candidates_.at(extra) : nullptr;
   // s: the information of (free rho, f_x) with every dot eliminated (lower triangle), the yardstick dots last.
-  Eigen::MatrixXd s = sums.h_gg.topLeftCorner(g, g);
-  Eigen::MatrixXd h_gy = sums.h_gg.block(0, g, g, 6);
-  Eigen::Matrix<double, 6, 6> h_yy = sums.h_gg.bottomRightCorner<6, 6>();
-  if (add != nullptr) {
-    s += add->h_gg.topLeftCorner(g, g);
-    h_gy += add->h_gg.block(0, g, g, 6);
-    h_yy += add->h_gg.bottomRightCorner<6, 6>();
-  }
-  h_yy += YardstickInformation();
+  Eigen::MatrixXd h = sums.h_gg;
+  if (add != nullptr) AddInformation(*add, &h);
+  Eigen::MatrixXd s = h.topLeftCorner(g, g);
   SubtractDots(sums, add, &s);
-  return Finish(h_gy, h_yy, with_variances, &s);
+  return Finish(h.block(0, g, g, 6), h.bottomRightCorner<6, 6>() + YardstickInformation(), with_variances, &s);
 }
 
 FisherDesign::Rest FisherDesign::PrepareRest(Sums sums) const {
@@ -312,24 +327,41 @@ FisherValue FisherDesign::EvaluateWithRest(const Rest& rest, int extra, bool wit
   const Candidate& c = candidates_.at(extra);
   Eigen::MatrixXd s = rest.s;
   DotColumns w(g, 2, 1.0, &s);
+  Eigen::Matrix<double, 2, 7> f;
+  Eigen::Matrix<double, 2, 3> b;
   for (int j = 0; j < 2; ++j) {  // the yardstick dots are globals: their rows as they are
-    Eigen::Map<Eigen::VectorXd>(w.Take(1), g) = c.a.col(2 * j);
-    Eigen::Map<Eigen::VectorXd>(w.Take(1), g) = c.a.col(2 * j + 1);
+    if (!c.seen[j]) continue;
+    DotRows(c, j, &f, &b);
+    double* w0 = w.Take(2);
+    PixelRows(f, c.zt, w0, w0 + w.ld());
   }
+  // The other dots' columns, computed a chunk at a time by internal::MarginalColumns before they are added.
+  std::vector<internal::MarginalDot> pending;
+  auto add_pending = [&]() {
+    internal::MarginalColumns(pending.data(), static_cast<int>(pending.size()), c.zt.data(), g);
+    pending.clear();
+    w.Flush();
+  };
   for (int j = 2; j < dots; ++j) {
     if (!c.seen[j]) continue;
-    const Eigen::Matrix<double, 2, 3>& b = c.b[j];
+    DotRows(c, j, &f, &b);
     const Eigen::Matrix<double, 2, 3> t = b * rest.k[j - 2];
-    const double l00 = std::sqrt(1.0 + t.row(0).dot(b.row(0)));
-    const double l10 = t.row(1).dot(b.row(0)) / l00;
-    const double l11 = std::sqrt(1.0 + t.row(1).dot(b.row(1)) - l10 * l10);
-    double* w0 = w.Take(2);
-    MarginalRows(c.a.col(2 * j).data(), b, rest.p.col(3 * (j - 2)).data(), l00, l10, l11, g, w0, w0 + w.ld());
+    internal::MarginalDot d;
+    d.l00 = std::sqrt(1.0 + t.row(0).dot(b.row(0)));
+    d.l10 = t.row(1).dot(b.row(0)) / d.l00;
+    d.l11 = std::sqrt(1.0 + t.row(1).dot(b.row(1)) - d.l10 * d.l10);
+    Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>>(&d.f[0][0]) = f;
+    Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>>(&d.b[0][0]) = b;
+    d.p = rest.p.col(3 * (j - 2)).data();
+    if (w.Full(2)) add_pending();
+    d.w0 = w.Take(2);
+    d.w1 = d.w0 + w.ld();
+    pending.push_back(d);
   }
-  w.Flush();
-  const Eigen::MatrixXd h_gy = rest.sums.h_gg.block(0, g, g, 6) + c.h_gg.block(0, g, g, 6);
-  const Eigen::Matrix<double, 6, 6> h_yy = rest.sums.h_gg.bottomRightCorner<6, 6>() + c.h_gg.bottomRightCorner<6, 6>() +
-                                           YardstickInformation();
+  add_pending();
+  const Eigen::MatrixXd h_gy = rest.sums.h_gg.block(0, g, g, 6) + c.yard.leftCols(g).transpose();
+  const Eigen::Matrix<double, 6, 6> h_yy =
+      rest.sums.h_gg.bottomRightCorner<6, 6>() + c.yard.rightCols<6>() + YardstickInformation();
   return Finish(h_gy, h_yy, with_variances, &s);
 }
 

@@ -10,7 +10,7 @@
 // in units of 1 / sigma_px^2; the covariance of (free rho, f_x) is sigma_px^2 times the top-left block of
 // H^-1, the inverse of the Schur complement of the yardstick block. Contributions are cached per candidate
 // pose and summed per design (Sums); a design that differs from summed ones by one pose (the exchange)
-// costs O(dots * (free + 1)^2), the dots' rank update done by planning/gram_lower.h: ~13 us CPU for 80 dots,
+// costs O(dots * (free + 1)^2), the dots' rank update done by planning/exchange_kernels.h: ~13 us CPU for 80 dots,
 // 25 unknowns (bench/core_bench.cc BM_FisherExchange...).
 //
 // Criteria: D = log det of the (free rho, f_x) information (maximised; unit-free up to a constant),
@@ -81,14 +81,22 @@ class FisherDesign {
   FisherValue EvaluateWithRest(const Rest& rest, int extra, bool with_variances) const;
 
  private:
-  // A pose's rows: per scene dot, the 2 pixel rows' derivatives with respect to (free rho, f_x) (a, columns
-  // 2j and 2j + 1) and to the dot (b); zero for a dot the pose does not see. h_gg as in Sums.
+  // A pose, compactly (the exchange keeps a few hundred): its camera's rotation (transposed), the twists of
+  // the free parameters in the camera frame and f_x (zt: (free + f_x) x 7), every dot in the camera frame and
+  // whether it is seen; the 7 x 7 sum of its dots' f^T f (DotRows) and the yardstick dots' rows of its
+  // information (6 x global). A dot's pixel rows are made again from these where needed.
   struct Candidate {
-    Eigen::MatrixXd h_gg;
-    Eigen::MatrixXd a;                                 // (free + f_x) x 2 * dots
-    std::vector<Eigen::Matrix<double, 2, 3>> b;        // per dot
-    std::vector<char> seen;                            // per dot
+    Eigen::Matrix3d rt;
+    Eigen::MatrixXd zt;
+    std::vector<Eigen::Vector3d> p;
+    std::vector<char> seen;
+    Eigen::Matrix<double, 7, 7> ff;
+    Eigen::Matrix<double, 6, Eigen::Dynamic> yard;
   };
+  // Dot j's pixel rows: f with respect to (camera twist in the camera frame, f_x), b with respect to the dot.
+  void DotRows(const Candidate& c, int j, Eigen::Matrix<double, 2, 7>* f, Eigen::Matrix<double, 2, 3>* b) const;
+  // h += the candidate's information on the globals (global x global, both triangles).
+  void AddInformation(const Candidate& c, Eigen::MatrixXd* h) const;
   // Lower triangle of *s -= sum over the eliminated dots of h_gj h_jj^-1 h_gj^T, for sums plus add (may be null).
   void SubtractDots(const Sums& sums, const Candidate* add, Eigen::MatrixXd* s) const;
   // The value from s (lower, dots eliminated) and the yardstick dots' blocks: h_gy (free + f_x) x 6 and h_yy.
