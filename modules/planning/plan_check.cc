@@ -363,7 +363,8 @@ std::vector<Eigen::Vector2d> DotImages(const PlanningProblem& problem, const Eig
 }
 
 MoveImageMotion ImageMotionBetween(const std::vector<Eigen::Vector2d>& from, const std::vector<Eigen::Vector2d>& to) {
-  std::vector<double> shifts;
+  thread_local std::vector<double> shifts;  // the planner asks this tens of thousands of times: no allocation each
+  shifts.clear();
   for (size_t k = 0; k < from.size() && k < to.size(); ++k) {
     if (from[k].allFinite() && to[k].allFinite()) shifts.push_back((to[k] - from[k]).norm());
   }
