@@ -208,7 +208,12 @@ int CheckOnly(const PlanArgs& args, const RobotModel& robot, const io::Trajector
     problem.constraints = file.planned_for->constraints;
     problem.num_identification_poses = file.num_identification_poses > 0 ? file.num_identification_poses
                                                                          : std::min<int>(15, file.poses.size());
-    const planning::ObservabilityReport observability = planning::AnalyzeObservability(problem, file.poses, args.noise_px);
+    // The check's report is of the same poses, scene and identification poses, at the plan's recorded pixel
+    // noise: used when that is --noise-px.
+    const planning::ObservabilityReport observability =
+        check.observability.ok && check.observability.pixel_noise_px == args.noise_px
+            ? check.observability
+            : planning::AnalyzeObservability(problem, file.poses, args.noise_px);
     PrintObservability(observability, robot, std::cout);
     OutputDocument()["observability"] = report::ObservabilityJson(observability, robot);
   }
@@ -278,7 +283,11 @@ int PlanAndWrite(const PlanArgs& args, planning::Criterion criterion, const plan
   if (r.repaired_poses > 0) std::cout << "  repaired: " << r.repaired_poses << " poses replaced from the pool\n";
   if (!r.ok) return Fail(Status::Error(ErrorCode::kDegenerateData, r.message));
   PrintPlanned(args, criterion, r);
-  const planning::ObservabilityReport observability = planning::AnalyzeObservability(problem, r.poses, args.noise_px);
+  // The final check's report is of these poses at the check's pixel noise, --noise-px (MakeProblem).
+  const planning::ObservabilityReport observability =
+      r.check_final.observability.ok && r.check_final.observability.pixel_noise_px == args.noise_px
+          ? r.check_final.observability
+          : planning::AnalyzeObservability(problem, r.poses, args.noise_px);
   PrintObservability(observability, problem.robot, std::cout);
   OutputDocument()["observability"] = report::ObservabilityJson(observability, problem.robot);
   return WritePlan(args, criterion, problem, plan_path, r);

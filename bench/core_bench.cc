@@ -109,8 +109,8 @@ void BM_Plan25Poses(benchmark::State& state) {
 BENCHMARK(BM_Plan25Poses)->Arg(0)->Arg(1)->Arg(2)->ArgName("criterion")->Unit(benchmark::kMillisecond);
 
 // One evaluation of an exchange candidate (planning/fisher_design.h): the Fisher information of 15
-// identification poses over 80 dots, every dot marginalised, with 14 poses summed once (Sums) and the
-// 15th the candidate.
+// identification poses over 80 dots, every dot marginalised, with 14 poses summed and their dots eliminated
+// once (Rest) and the 15th the candidate.
 void BM_FisherExchangeEvaluation(benchmark::State& state) {
   planning::PlanningProblem problem;
   problem.robot = World().truth.nominal;
@@ -122,9 +122,9 @@ void BM_FisherExchangeEvaluation(benchmark::State& state) {
   std::vector<int> chosen;
   for (int i = 0; i < 15; ++i) chosen.push_back(design.AddCandidate(World().observations.poses[i].joints_rad));
   const int extra = design.AddCandidate(World().observations.poses[20].joints_rad);
-  const planning::FisherDesign::Sums rest = design.Sum(chosen, 7);
+  const planning::FisherDesign::Rest rest = design.PrepareRest(design.Sum(chosen, 7));
   const bool with_variances = state.range(0) != 0;
-  for (auto _ : state) benchmark::DoNotOptimize(design.EvaluateSums(rest, extra, with_variances));
+  for (auto _ : state) benchmark::DoNotOptimize(design.EvaluateWithRest(rest, extra, with_variances));
 }
 BENCHMARK(BM_FisherExchangeEvaluation)->Arg(0)->Arg(1)->ArgName("with_variances")->Unit(benchmark::kMicrosecond);
 

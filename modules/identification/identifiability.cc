@@ -64,10 +64,21 @@ Eigen::MatrixXd RelativePoseJacobian(const RobotModel& model, const Eigen::Vecto
 IdentifiabilityReport AnalyzeIdentifiability(const RobotModel& model, const Eigen::VectorXd& rho,
                                              const std::vector<Eigen::VectorXd>& joint_poses, int reference_index,
                                              const IdentifiabilityOptions& options) {
-  SELFCAL_CHECK(std::isfinite(options.rank_tolerance) && options.rank_tolerance > 0 && options.rank_tolerance < 1,
-                "rank_tolerance = " << options.rank_tolerance << " must lie in (0, 1)");
   const Eigen::MatrixXd jacobian = RelativePoseJacobian(model, rho, joint_poses, reference_index,
                                                         options.sigma_position_m, options.sigma_rotation_rad);
+  return AnalyzeIdentifiabilityOfJacobian(model, rho, jacobian, joint_poses, reference_index, options);
+}
+
+IdentifiabilityReport AnalyzeIdentifiabilityOfJacobian(const RobotModel& model, const Eigen::VectorXd& rho,
+                                                       const Eigen::MatrixXd& jacobian,
+                                                       const std::vector<Eigen::VectorXd>& joint_poses,
+                                                       int reference_index, const IdentifiabilityOptions& options) {
+  SELFCAL_CHECK(std::isfinite(options.rank_tolerance) && options.rank_tolerance > 0 && options.rank_tolerance < 1,
+                "rank_tolerance = " << options.rank_tolerance << " must lie in (0, 1)");
+  SELFCAL_CHECK(jacobian.cols() == model.num_parameters() &&
+                    jacobian.rows() == 6 * (static_cast<Eigen::Index>(joint_poses.size()) - 1),
+                "the Jacobian is " << jacobian.rows() << " x " << jacobian.cols() << " for " << joint_poses.size()
+                                   << " poses and " << model.num_parameters() << " parameters");
   const int n = model.num_parameters();
   const int rows = static_cast<int>(jacobian.rows());
   const KinematicParameters params(model.num_joints());

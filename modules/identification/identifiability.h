@@ -50,6 +50,12 @@ struct IdentifiabilityReport {
 IdentifiabilityReport AnalyzeIdentifiability(const RobotModel& model, const Eigen::VectorXd& rho,
                                              const std::vector<Eigen::VectorXd>& joint_poses, int reference_index,
                                              const IdentifiabilityOptions& options);
+// The same report from the Jacobian RelativePoseJacobian gave for these poses with options' sigmas (for a
+// caller that needs the Jacobian too: it is computed once).
+IdentifiabilityReport AnalyzeIdentifiabilityOfJacobian(const RobotModel& model, const Eigen::VectorXd& rho,
+                                                       const Eigen::MatrixXd& jacobian,
+                                                       const std::vector<Eigen::VectorXd>& joint_poses,
+                                                       int reference_index, const IdentifiabilityOptions& options);
 
 // Number of identifiable parameters (metric relative poses, scale known) at 5n + 12 / 2 (at least 12)
 // random joint configurations within the limits (fixed seed): what generic poses of this robot identify.

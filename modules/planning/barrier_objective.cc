@@ -34,13 +34,10 @@ View ViewOf(const RobotModel& robot, const Eigen::VectorXd& q, bool with_derivat
   if (!with_derivatives) {
     view.base_from_cam = BaseFromCam(robot, KinematicParameters::Nominal(robot), q);
   } else {
-    const CameraTwists<double> tw = ComputeCameraTwists<double>(robot, q.data());
-    view.base_from_cam = tw.base_from_cam;
-    for (int j = 0; j < robot.num_joints(); ++j) {
-      const int k = KinematicParameters::JointOffset(j) + 3;
-      view.omega.col(j) = tw.omega[k];
-      view.v.col(j) = tw.v[k];
-    }
+    Eigen::Matrix<double, 3, Eigen::Dynamic> omega, v;
+    view.base_from_cam = ComputeJointTwists<double>(robot, q.data(), &omega, &v);
+    view.omega.leftCols(robot.num_joints()) = omega;
+    view.v.leftCols(robot.num_joints()) = v;
   }
   const Eigen::Vector3d c = view.base_from_cam.translation, z = view.base_from_cam.rotation.col(2);
   for (int r = 0; r < 3; ++r) {

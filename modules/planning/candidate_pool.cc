@@ -41,10 +41,11 @@ bool SolveCameraIkNominal(const RobotModel& model, const Rigid3& target, const E
                           Eigen::VectorXd* q) {
   const int n = model.num_joints();
   const Eigen::Matrix3d rt = target.rotation.transpose();
+  Eigen::Matrix<double, 3, Eigen::Dynamic> omega, v;
   auto evaluate = [&](const Eigen::VectorXd& x, Eigen::VectorXd* r, Eigen::MatrixXd* jac) {
-    const internal::CameraTwists<double> tw = internal::ComputeCameraTwists<double>(model, x.data());
-    const Eigen::Matrix3d e = rt * tw.base_from_cam.rotation;
-    const Eigen::Vector3d c = tw.base_from_cam.translation;
+    const Rigid3 base_from_cam = internal::ComputeJointTwists<double>(model, x.data(), &omega, &v);
+    const Eigen::Matrix3d e = rt * base_from_cam.rotation;
+    const Eigen::Vector3d c = base_from_cam.translation;
     r->resize(6);
     r->head<3>() = rt * (c - target.translation);
     (*r)[3] = 0.5 * (e(2, 1) - e(1, 2));
@@ -52,12 +53,11 @@ bool SolveCameraIkNominal(const RobotModel& model, const Rigid3& target, const E
     (*r)[5] = 0.5 * (e(1, 0) - e(0, 1));
     jac->resize(6, n);
     for (int j = 0; j < n; ++j) {
-      const int k = KinematicParameters::JointOffset(j) + 3;  // theta_j moves the camera like q_j
-      const Eigen::Vector3d& w = tw.omega[k];
-      jac->col(j).head<3>() = rt * (w.cross(c) + tw.v[k]);
+      const Eigen::Vector3d w = omega.col(j);
+      jac->col(j).head<3>() = rt * (w.cross(c) + v.col(j));
       Eigen::Matrix3d wx;
       wx << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
-      const Eigen::Matrix3d de = rt * wx * tw.base_from_cam.rotation;
+      const Eigen::Matrix3d de = rt * wx * base_from_cam.rotation;
       jac->col(j).tail<3>() << 0.5 * (de(2, 1) - de(1, 2)), 0.5 * (de(0, 2) - de(2, 0)), 0.5 * (de(1, 0) - de(0, 1));
     }
   };
@@ -101,11 +101,14 @@ std::vector<Eigen::VectorXd> MakeCandidatePool(const PlanningProblem& problem,
   std::mt19937_64 rng(options.seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0), fraction(0.0, 1.0);
   std::uniform_int_distribution<size_t> pick(0, templates.size() - 1);
+  std::vector<Rigid3> template_views;  // each template's camera, once
+  for (const Eigen::VectorXd& q : templates) template_views.push_back(BaseFromCam(robot, rho, q));
   std::vector<Eigen::VectorXd> pool;
   const int attempts = options.count * options.max_attempts_per_candidate;
   for (int attempt = 0; attempt < attempts && static_cast<int>(pool.size()) < options.count; ++attempt) {
-    const Eigen::VectorXd& seed = templates[pick(rng)];
-    const Rigid3 tmpl = BaseFromCam(robot, rho, seed);
+    const size_t chosen = pick(rng);
+    const Eigen::VectorXd& seed = templates[chosen];
+    const Rigid3& tmpl = template_views[chosen];
     const Eigen::Vector3d w = tmpl.translation - centre;
     const double azimuth = options.azimuth_rad * unit(rng), elevation = options.elevation_rad * unit(rng);
     const double scale = options.distance_min + (options.distance_max - options.distance_min) * fraction(rng);

@@ -11,7 +11,7 @@
 namespace selfcal::planning {
 
 ObservabilityReport AnalyzeObservability(const PlanningProblem& problem, const std::vector<Eigen::VectorXd>& poses,
-                                         double pixel_noise_px) {
+                                         double pixel_noise_px, identification::IdentifiabilityReport* identifiability) {
   const std::string invalid = problem.Validate();
   SELFCAL_CHECK(invalid.empty(), "planning problem: " << invalid);
   SELFCAL_CHECK(pixel_noise_px > 0, "pixel noise " << pixel_noise_px << " must be > 0");
@@ -31,13 +31,14 @@ ObservabilityReport AnalyzeObservability(const PlanningProblem& problem, const s
   const std::vector<Eigen::VectorXd> id_poses(poses.begin(), poses.begin() + m_id);
   const Eigen::VectorXd rho = KinematicParameters::Nominal(problem.robot);
   const identification::IdentifiabilityOptions id_options;
+  const Eigen::MatrixXd full = identification::RelativePoseJacobian(problem.robot, rho, id_poses, 0,
+                                                                    id_options.sigma_position_m, id_options.sigma_rotation_rad);
   const identification::IdentifiabilityReport id =
-      identification::AnalyzeIdentifiability(problem.robot, rho, id_poses, 0, id_options);
+      identification::AnalyzeIdentifiabilityOfJacobian(problem.robot, rho, full, id_poses, 0, id_options);
+  if (identifiability != nullptr) *identifiability = id;
   report.free_names = id.free_names;
   report.fixed_names = id.fixed_names;
   report.free_indices = id.free_indices;
-  const Eigen::MatrixXd full = identification::RelativePoseJacobian(problem.robot, rho, id_poses, 0,
-                                                                    id_options.sigma_position_m, id_options.sigma_rotation_rad);
   Eigen::MatrixXd j(full.rows(), id.free_indices.size());
   for (size_t c = 0; c < id.free_indices.size(); ++c) {
     j.col(c) = full.col(id.free_indices[c]);

@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 
+#include "identification/identifiability.h"
 #include "planning/plan_problem.h"
 
 namespace selfcal::planning {
@@ -38,7 +39,10 @@ struct ObservabilityReport {
   double predicted_fx_stddev_px = 0;
 };
 
+// `identifiability` (optional): the identifiability analysis of the identification poses the report was made
+// from (default IdentifiabilityOptions, nominal rho; left as is when the poses are refused before it).
 ObservabilityReport AnalyzeObservability(const PlanningProblem& problem, const std::vector<Eigen::VectorXd>& poses,
-                                         double pixel_noise_px);
+                                         double pixel_noise_px,
+                                         identification::IdentifiabilityReport* identifiability = nullptr);
 
 }  // namespace selfcal::planning

@@ -215,11 +215,10 @@ void CheckAxisSines(const PlanConstraints& c, const std::vector<Rigid3>& base_fr
   }
 }
 
-// f_x from the identification poses as a set: the bundle's Cramer-Rao bound (dots unknown).
-void CheckFocalObservability(const PlanningProblem& problem, const std::vector<Eigen::VectorXd>& poses,
-                             PlanCheck* check) {
+// f_x from the identification poses as a set: the bundle's Cramer-Rao bound (dots unknown), from the
+// observability report of the identification poses.
+void CheckFocalObservability(const PlanningProblem& problem, const ObservabilityReport& r, PlanCheck* check) {
   const PlanConstraints& c = problem.constraints;
-  const ObservabilityReport r = AnalyzeObservability(problem, poses, c.pixel_noise_px);
   const double bound_px = c.max_fx_stddev_rel * problem.camera.fx_px;
   check->predicted_fx_stddev_px = r.prediction_ok ? r.predicted_fx_stddev_px : std::numeric_limits<double>::infinity();
   if (!(check->predicted_fx_stddev_px <= bound_px)) {
@@ -267,16 +266,15 @@ void CheckImageMotion(const PlanningProblem& problem, const std::vector<Eigen::V
   }
 }
 
-// Observability of the identification poses (C7, K3), at the nominal model rho.
-void CheckObservability(const PlanningProblem& problem, const std::vector<Eigen::VectorXd>& poses,
-                        const Eigen::VectorXd& rho, PlanCheck* check) {
+// Observability of the identification poses (C7, K3), at the nominal model rho: `id` is their
+// identifiability analysis, `generic_identifiable` the rank generic poses of the robot reach (-1: computed here).
+void CheckObservability(const PlanningProblem& problem, const identification::IdentifiabilityReport& id,
+                        int generic_identifiable, PlanCheck* check) {
   const RobotModel& robot = problem.robot;
   const PlanConstraints& c = problem.constraints;
-  const std::vector<Eigen::VectorXd> id_poses(poses.begin(), poses.begin() + problem.num_identification_poses);
-  identification::IdentifiabilityOptions id_options;
-  const identification::IdentifiabilityReport id = identification::AnalyzeIdentifiability(robot, rho, id_poses, 0, id_options);
   check->identifiable = id.rank;
-  check->generic_identifiable = identification::GenericRank(robot, rho, id_options.rank_tolerance);
+  check->generic_identifiable =
+      generic_identifiable >= 0 ? generic_identifiable : GenericIdentifiable(robot);
   check->condition_number = id.condition_number;
   if (id.rank < check->generic_identifiable) {
     Add(check, PlanIssue::kInsufficientExcitation, -1, -1,
@@ -323,7 +321,8 @@ std::string PlanCheck::Summary() const {
 namespace {
 
 // Every constraint of CheckPlan that needs the scene and camera, on poses with usable joint values.
-void CheckGeometry(const PlanningProblem& problem, const std::vector<Eigen::VectorXd>& poses, PlanCheck* check) {
+void CheckGeometry(const PlanningProblem& problem, const std::vector<Eigen::VectorXd>& poses, int generic_identifiable,
+                   PlanCheck* check) {
   const RobotModel& robot = problem.robot;
   const PlanConstraints& c = problem.constraints;
   const int m = static_cast<int>(poses.size());
@@ -340,8 +339,11 @@ void CheckGeometry(const PlanningProblem& problem, const std::vector<Eigen::Vect
   CheckSpread(c, base_from_cam, check);
   CheckAxisSines(c, base_from_cam, problem.num_identification_poses, check);
   CheckImageMotion(problem, poses, check);
-  CheckObservability(problem, poses, rho, check);
-  CheckFocalObservability(problem, poses, check);
+  // One identifiability analysis of the identification poses for the excitation and f_x checks.
+  identification::IdentifiabilityReport id;
+  check->observability = AnalyzeObservability(problem, poses, c.pixel_noise_px, &id);
+  CheckObservability(problem, id, generic_identifiable, check);
+  CheckFocalObservability(problem, check->observability, check);
 }
 
 }  // namespace
@@ -361,7 +363,8 @@ std::vector<Eigen::Vector2d> DotImages(const PlanningProblem& problem, const Eig
 }
 
 MoveImageMotion ImageMotionBetween(const std::vector<Eigen::Vector2d>& from, const std::vector<Eigen::Vector2d>& to) {
-  std::vector<double> shifts;
+  thread_local std::vector<double> shifts;  // the planner asks this tens of thousands of times: no allocation each
+  shifts.clear();
   for (size_t k = 0; k < from.size() && k < to.size(); ++k) {
     if (from[k].allFinite() && to[k].allFinite()) shifts.push_back((to[k] - from[k]).norm());
   }
@@ -383,7 +386,12 @@ MoveImageMotion ImageMotionOfMove(const PlanningProblem& problem, const Eigen::V
   return ImageMotionBetween(DotImages(problem, q_from), DotImages(problem, q_to));
 }
 
-PlanCheck CheckPlan(const PlanningProblem& problem, const std::vector<Eigen::VectorXd>& poses) {
+int GenericIdentifiable(const RobotModel& robot) {
+  return identification::GenericRank(robot, KinematicParameters::Nominal(robot),
+                                     identification::IdentifiabilityOptions().rank_tolerance);
+}
+
+PlanCheck CheckPlan(const PlanningProblem& problem, const std::vector<Eigen::VectorXd>& poses, int generic_identifiable) {
   const std::string invalid = problem.Validate();
   SELFCAL_CHECK(invalid.empty(), "planning problem: " << invalid);
   PlanCheck check;
@@ -394,7 +402,7 @@ PlanCheck CheckPlan(const PlanningProblem& problem, const std::vector<Eigen::Vec
   if (!check.problems.empty()) return check;
   CheckJointLimits(EffectiveLimits(&robot, nullptr, robot.num_joints()), c.joint_margin_rad, poses, &check);
   CheckJointTravel(c.max_joint_travel_rad, poses, robot.num_joints(), &check);
-  CheckGeometry(problem, poses, &check);
+  CheckGeometry(problem, poses, generic_identifiable, &check);
   check.ok = check.problems.empty();
   return check;
 }
@@ -442,7 +450,7 @@ PlanCheck CheckPlanFor(const RobotModel* robot, const PlanSubject& plan, const C
                             std::to_string(problem.camera.height_px) + " px camera, f_x " +
                             Fmt("%.1f", problem.camera.fx_px) + " px: scene in image, depth, spread, f_x, "
                             "excitation, image motion up to " + Fmt("%.1f", c.max_image_motion_px) + " px per move");
-      CheckGeometry(problem, plan.poses, &check);
+      CheckGeometry(problem, plan.poses, -1, &check);
     }
   }
   check.ok = check.problems.empty();

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "planning/observability.h"
 #include "planning/plan_problem.h"
 
 namespace selfcal::planning {
@@ -65,13 +66,23 @@ struct PlanCheck {
   double max_joint_travel_rad = 0;  // largest joint change between consecutive poses
   int identifiable = 0, generic_identifiable = 0;
   double condition_number = 0;      // column-normalised identification Jacobian (identification poses)
+  // The observability report of the identification poses at constraints.pixel_noise_px (planning/observability.h),
+  // made by the scene checks (ok false when they did not run).
+  ObservabilityReport observability;
   std::string Summary() const;      // one line per problem, or "plan ok"
 };
 
 // Checks `poses` (rad; the first problem.num_identification_poses identify, the rest verify; the first
 // is the reference of the relative measurements) against every constraint of the problem. Never throws on
 // bad pose data: that is what it reports. The planner's own feasibility test.
-PlanCheck CheckPlan(const PlanningProblem& problem, const std::vector<Eigen::VectorXd>& poses);
+// generic_identifiable: GenericIdentifiable(problem.robot) when the caller has it (a planner checks several
+// plans of one robot); -1: computed here.
+PlanCheck CheckPlan(const PlanningProblem& problem, const std::vector<Eigen::VectorXd>& poses,
+                    int generic_identifiable = -1);
+
+// How many parameters generic poses of the robot identify at its nominal model (identification::GenericRank
+// at the default rank tolerance): the excitation check's reference.
+int GenericIdentifiable(const RobotModel& robot);
 
 // The scene dots' pixels at joints q (nominal model); NaN for a dot behind the camera or outside the image.
 std::vector<Eigen::Vector2d> DotImages(const PlanningProblem& problem, const Eigen::VectorXd& q);

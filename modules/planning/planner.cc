@@ -11,7 +11,6 @@
 #include <ceres/iteration_callback.h>
 
 #include "base/status.h"
-#include "identification/identifiability.h"
 #include "planning/barrier_objective.h"
 #include "planning/candidate_pool.h"
 #include "planning/view_geometry.h"
@@ -251,13 +250,14 @@ void PlanExchange(const PlanningProblem& problem, const PlannerOptions& options,
       if (changes_when_exchanged[slot] == changes && (progress.Advance(), true)) continue;
       const int current = chosen[slot];
       int best_candidate = current;
-      // Every pose but the slot's summed once; each candidate then costs one EvaluateSums.
-      const FisherDesign::Sums rest = design.Sum(fisher_design(chosen), slot);
+      // Every pose but the slot's summed and its dots eliminated once; each candidate then costs one
+      // EvaluateWithRest.
+      const FisherDesign::Rest rest = design.PrepareRest(design.Sum(fisher_design(chosen), slot));
       for (int cand = 0; cand < num_candidates; ++cand) {
         if (cand == current || !compatible(cand, slot)) continue;
         chosen[slot] = cand;
         const double score = DesignScore(
-            options.criterion, design.EvaluateSums(rest, fisher(cand), options.criterion == Criterion::kAOptimal));
+            options.criterion, design.EvaluateWithRest(rest, fisher(cand), options.criterion == Criterion::kAOptimal));
         ++result->evaluations;
         if (score < best - 1e-9 * std::abs(best)) {
           best = score;
@@ -284,14 +284,14 @@ void PlanExchange(const PlanningProblem& problem, const PlannerOptions& options,
 
 // The visit order that lets the session track the dots through every move (visit_order.h): kept when
 // the check accepts it or the given order fails too. Returns the check of the order kept.
-PlanCheck OrderAsTour(const PlanningProblem& problem, std::vector<Eigen::VectorXd>* poses) {
+PlanCheck OrderAsTour(const PlanningProblem& problem, int generic_identifiable, std::vector<Eigen::VectorXd>* poses) {
   const VisitOrder visit = OrderForTracking(problem, *poses);
   std::vector<Eigen::VectorXd> reordered;
   reordered.reserve(poses->size());
   for (int i : visit.order) reordered.push_back((*poses)[i]);
-  PlanCheck check = CheckPlan(problem, reordered);
+  PlanCheck check = CheckPlan(problem, reordered, generic_identifiable);
   if (!check.ok) {
-    PlanCheck as_given = CheckPlan(problem, *poses);
+    PlanCheck as_given = CheckPlan(problem, *poses, generic_identifiable);
     if (as_given.ok) return as_given;
   }
   *poses = std::move(reordered);
@@ -348,7 +348,8 @@ PlanResult PlanMeasurements(const PlanningProblem& problem, const std::vector<Ei
   result.criterion = options.criterion;
   result.num_identification_poses = problem.num_identification_poses;
   result.poses = start;
-  result.check_start = CheckPlan(problem, start);
+  const int generic_identifiable = GenericIdentifiable(problem.robot);  // the same for every check below
+  result.check_start = CheckPlan(problem, start, generic_identifiable);
   const int m_id = problem.num_identification_poses;
   const bool usable = std::none_of(result.check_start.problems.begin(), result.check_start.problems.end(),
                                    [](const PlanProblemItem& p) {
@@ -361,6 +362,7 @@ PlanResult PlanMeasurements(const PlanningProblem& problem, const std::vector<Ei
     result.seconds = Seconds(t0);
     return result;
   }
+  PlanCheck repaired;
   if (!result.check_start.ok) {
     // Repair: poses that break a constraint are replaced by the nearest feasible candidate of a seeded pool.
     PoolOptions pool_options;
@@ -368,7 +370,7 @@ PlanResult PlanMeasurements(const PlanningProblem& problem, const std::vector<Ei
     pool_options.seed = options.seed;
     const std::vector<Eigen::VectorXd> pool = MakeCandidatePool(problem, start, pool_options);
     result.repaired_poses = RepairStart(problem, pool, &result.poses);
-    const PlanCheck repaired = CheckPlan(problem, result.poses);
+    repaired = CheckPlan(problem, result.poses, generic_identifiable);
     if (!repaired.ok) {
       result.message = "the start plan is not feasible and could not be repaired from " + std::to_string(pool.size()) +
                        " candidates:\n" + repaired.Summary();
@@ -376,12 +378,12 @@ PlanResult PlanMeasurements(const PlanningProblem& problem, const std::vector<Ei
       return result;
     }
   }
-  const Eigen::VectorXd rho = KinematicParameters::Nominal(problem.robot);
+  // The identifiable parameters of the (repaired) start: its check's identifiability analysis.
+  const ObservabilityReport& start_observability =
+      result.check_start.ok ? result.check_start.observability : repaired.observability;
   const std::vector<Eigen::VectorXd> id_start(result.poses.begin(), result.poses.begin() + m_id);
-  const identification::IdentifiabilityReport id =
-      identification::AnalyzeIdentifiability(problem.robot, rho, id_start, 0, identification::IdentifiabilityOptions());
-  result.free_columns = id.free_indices;
-  result.free_names = id.free_names;
+  result.free_columns = start_observability.free_indices;
+  result.free_names = start_observability.free_names;
   result.eq39_start = EvaluateEq39(problem.robot, id_start, result.free_columns, options.lambda, false);
   result.fisher_start = FisherOf(problem, result.free_columns, options.fisher, result.poses);
 
@@ -390,7 +392,7 @@ PlanResult PlanMeasurements(const PlanningProblem& problem, const std::vector<Ei
   } else {
     PlanExchange(problem, options, &result);
   }
-  result.check_final = OrderAsTour(problem, &result.poses);
+  result.check_final = OrderAsTour(problem, generic_identifiable, &result.poses);
 
   const std::vector<Eigen::VectorXd> id_final(result.poses.begin(), result.poses.begin() + m_id);
   result.eq39_final = EvaluateEq39(problem.robot, id_final, result.free_columns, options.lambda, false);

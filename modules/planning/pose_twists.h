@@ -78,4 +78,30 @@ CameraTwists<T> ComputeCameraTwists(const RobotModel& model, const T* q) {
   return out;
 }
 
+// The camera pose and the spatial twists of the joint angles alone (theta_j moves the camera as q_j does):
+// omega.col(j), v.col(j), resized to the joint count. The same frames and products as ComputeCameraTwists, so
+// the same values to the bit, without the other parameters' twists (the candidate pool's inverse kinematics
+// and eq. (39)'s barrier need only these).
+template <typename T>
+Rigid3T<T> ComputeJointTwists(const RobotModel& model, const T* q, Eigen::Matrix<T, 3, Eigen::Dynamic>* omega,
+                              Eigen::Matrix<T, 3, Eigen::Dynamic>* v) {
+  const int n = model.num_joints();
+  omega->resize(3, n);
+  v->resize(3, n);
+  const Vec3T<T> ez(T(0), T(0), T(1));
+  Rigid3T<T> f = model.base_from_link0.Cast<T>();
+  for (int i = 0; i < n; ++i) {
+    const LinkParameters& p = model.links[i];
+    f = f * Rigid3T<T>::FromRotation(RotX(T(p.alpha)));
+    f = f * Rigid3T<T>::FromTranslation(Vec3T<T>(T(p.a), T(0), T(0)));
+    f = f * Rigid3T<T>::FromRotation(RotY(T(p.beta)));
+    const Vec3T<T> w = f.rotation * ez;
+    omega->col(i) = w;
+    v->col(i) = f.translation.cross(w);
+    f = f * Rigid3T<T>::FromRotation(RotZ(q[i] + T(p.theta)));
+    f = f * Rigid3T<T>::FromTranslation(Vec3T<T>(T(0), T(0), T(p.d)));
+  }
+  return f * model.link_n_from_flange.Cast<T>() * model.flange_from_cam.Cast<T>();
+}
+
 }  // namespace selfcal::planning::internal
