@@ -214,6 +214,40 @@ int FindRoot(std::vector<int>* parent, int i) {
   return i;
 }
 
+// Rows added block by block; Finish() gives a matrix with the same Gram matrix as all of them stacked: the
+// stack itself while it has at most `width` rows, otherwise the upper triangle of its Householder QR. The
+// rows are folded into that triangle whenever the buffer (the triangle and eight times `width` rows) is
+// full, so the memory is O(width^2) whatever the number of rows.
+class RowFolder {
+ public:
+  explicit RowFolder(int width) : width_(width), buffer_(9 * std::max(width, 1), width) {}
+
+  void Add(const Eigen::Ref<const Eigen::MatrixXd>& rows) {
+    if (used_ + rows.rows() > buffer_.rows()) Fold();
+    if (used_ + rows.rows() > buffer_.rows()) buffer_.conservativeResize(used_ + rows.rows(), Eigen::NoChange);
+    buffer_.middleRows(used_, rows.rows()) = rows;
+    used_ += static_cast<int>(rows.rows());
+  }
+
+  Eigen::MatrixXd Finish() {
+    if (used_ > width_) Fold();
+    return buffer_.topRows(used_);
+  }
+
+ private:
+  void Fold() {
+    if (used_ <= width_) return;
+    Eigen::Ref<Eigen::MatrixXd> rows = buffer_.topRows(used_);
+    Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(rows);  // in place
+    buffer_.topRows(width_).triangularView<Eigen::StrictlyLower>().setZero();
+    used_ = width_;
+  }
+
+  int width_;
+  Eigen::MatrixXd buffer_;
+  int used_ = 0;
+};
+
 }  // namespace
 
 bool ReducedJacobian(const BundleData& data, const BundleState& state, const GlobalColumns& columns,
@@ -250,8 +284,9 @@ bool ReducedJacobian(const BundleData& data, const BundleState& state, const Glo
     group_yardsticks[group_of[data.yardsticks[k].dot_a]].push_back(static_cast<int>(k));
   }
 
-  std::vector<Eigen::MatrixXd> blocks;
-  int total_rows = 0;
+  // The groups' rows are folded into one triangular factor as they come (RowFolder): the stacked matrix of
+  // every group's rows, 3 x dots + yardsticks by the globals, was tens of megabytes at 2000 dots.
+  RowFolder folder(num_global);
   std::vector<double> d_columns(2 * std::max(num_kinematic, 1));
   for (int g = 0; g < num_groups; ++g) {
     const int rows = 2 * static_cast<int>(group_observations[g].size()) + static_cast<int>(group_yardsticks[g].size());
@@ -287,23 +322,10 @@ bool ReducedJacobian(const BundleData& data, const BundleState& state, const Glo
     Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(a);
     const int rank = static_cast<int>(qr.rank());
     if (rows <= rank) continue;
-    const Eigen::MatrixXd qtb = qr.householderQ().adjoint() * b;
-    blocks.push_back(qtb.bottomRows(rows - rank));
-    total_rows += rows - rank;
+    b.applyOnTheLeft(qr.householderQ().adjoint());
+    folder.Add(b.bottomRows(rows - rank));
   }
-  Eigen::MatrixXd stacked(total_rows, num_global);
-  int row = 0;
-  for (const Eigen::MatrixXd& block : blocks) {
-    stacked.middleRows(row, block.rows()) = block;
-    row += static_cast<int>(block.rows());
-  }
-  if (total_rows <= num_global) {
-    *reduced = stacked;
-    return true;
-  }
-  // Same Gram matrix, num_global rows: the rank analysis and the covariance work on a small matrix.
-  Eigen::HouseholderQR<Eigen::MatrixXd> qr(stacked);
-  *reduced = qr.matrixQR().topRows(num_global).triangularView<Eigen::Upper>();
+  *reduced = folder.Finish();
   return true;
 }
 
