@@ -6,9 +6,9 @@
 
 #include <cerrno>
 #include <cstring>
-#include <memory>
+#include <cstdint>
 
-#include <openssl/evp.h>
+#include <nettle/sha2.h>
 
 #include "base/atomic_file.h"
 
@@ -39,11 +39,12 @@ Status FileError(const std::string& what, const std::string& path, int error) {
 }  // namespace
 
 std::string Sha256Hex(std::string_view bytes) {
-  unsigned char digest[EVP_MAX_MD_SIZE];
-  unsigned int length = 0;
-  SELFCAL_CHECK(EVP_Digest(bytes.data(), bytes.size(), digest, &length, EVP_sha256(), nullptr) == 1,
-                "OpenSSL SHA-256 failed");
-  return Hex(digest, length);
+  sha256_ctx context;
+  sha256_init(&context);
+  sha256_update(&context, bytes.size(), reinterpret_cast<const uint8_t*>(bytes.data()));
+  uint8_t digest[SHA256_DIGEST_SIZE];
+  sha256_digest(&context, SHA256_DIGEST_SIZE, digest);
+  return Hex(digest, SHA256_DIGEST_SIZE);
 }
 
 Result<std::string> Sha256OfFile(const std::string& path) {
@@ -56,21 +57,19 @@ Result<std::string> Sha256OfFile(const std::string& path) {
   if (!S_ISREG(info.st_mode)) {
     return Status::Error(ErrorCode::kInvalidInput, path + " is not a regular file: cannot compute its SHA-256");
   }
-  const std::unique_ptr<EVP_MD_CTX, void (*)(EVP_MD_CTX*)> context(EVP_MD_CTX_new(), EVP_MD_CTX_free);
-  SELFCAL_CHECK(context != nullptr && EVP_DigestInit_ex(context.get(), EVP_sha256(), nullptr) == 1,
-                "OpenSSL SHA-256 failed");
+  sha256_ctx context;
+  sha256_init(&context);
   char buffer[1 << 16];
   for (;;) {
     const ssize_t n = ::read(fd, buffer, sizeof(buffer));
     if (n < 0 && errno == EINTR) continue;
     if (n < 0) return FileError("cannot read", path, errno);
     if (n == 0) break;
-    SELFCAL_CHECK(EVP_DigestUpdate(context.get(), buffer, static_cast<std::size_t>(n)) == 1, "OpenSSL SHA-256 failed");
+    sha256_update(&context, static_cast<std::size_t>(n), reinterpret_cast<const uint8_t*>(buffer));
   }
-  unsigned char digest[EVP_MAX_MD_SIZE];
-  unsigned int length = 0;
-  SELFCAL_CHECK(EVP_DigestFinal_ex(context.get(), digest, &length) == 1, "OpenSSL SHA-256 failed");
-  return Hex(digest, length);
+  uint8_t digest[SHA256_DIGEST_SIZE];
+  sha256_digest(&context, SHA256_DIGEST_SIZE, digest);
+  return Hex(digest, SHA256_DIGEST_SIZE);
 }
 
 }  // namespace selfcal
