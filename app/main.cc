@@ -15,9 +15,10 @@ int main(int argc, char** argv) {
                                           {"plan", AddPlanCommand},
                                           {"report", AddReportCommand},
                                           {"compensate", AddCompensateCommand}};
-  bool here = argc >= 2 && std::strcmp(argv[1], "--version") == 0;
+  const bool version = argc >= 2 && std::strcmp(argv[1], "--version") == 0;
+  bool here = version;
   for (const CommandEntry& entry : fast) here = here || (argc >= 2 && std::strcmp(argv[1], entry.name) == 0);
   if (!here) return RunFullExecutable(argv);
-  selfcal::PrepareProcessHeap();  // page faults were a fifth of a calibration's CPU time (base/process_heap.h)
+  if (!version) selfcal::PrepareProcessHeap();  // page faults were a fifth of a calibration's CPU (base/process_heap.h)
   return RunCommandLine(argc, argv, fast);
 }
