@@ -37,8 +37,9 @@ bool MinimalNullVector(const Eigen::Matrix<double, 8, 9>& design, Eigen::Matrix<
   const auto& r = qr.matrixQR();
   // Pivoting sorts |R_ii| downwards; the last one plays the role of the 8th singular value.
   if (!(std::abs(r(7, 7)) > kRankTolerance * std::abs(r(0, 0)))) return false;
-  const Eigen::Matrix<double, 9, 9> q = qr.householderQ();
-  *null = q.col(8);
+  // Q e_9: the eight reflectors applied to one vector rather than to the identity.
+  *null = Eigen::Matrix<double, 9, 1>::Unit(8);
+  null->applyOnTheLeft(qr.householderQ());
   return true;
 }
 
