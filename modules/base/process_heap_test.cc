@@ -30,17 +30,17 @@ TEST(ProcessHeap, MallocKeepsWorkingAfterThePreparation) {
 }
 
 // Where the kernel offers transparent huge pages on request ("always" or "madvise"), part of the heap is
-// advised; where it does not ("never", or no THP at all), nothing is.
-TEST(ProcessHeap, AdvisesHugePagesExactlyWhereTheKernelOffersThem) {
+// advised. (Where it does not, madvise may still succeed as a no-op, or fail without THP support: the
+// heap works either way, which the test above checks.)
+TEST(ProcessHeap, AdvisesHugePagesWhereTheKernelOffersThem) {
   std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
   std::string mode;
   std::getline(in, mode);
   const HeapPreparation prepared = PrepareProcessHeap(std::size_t{8} << 20);
-  if (mode.find("[always]") != std::string::npos || mode.find("[madvise]") != std::string::npos) {
-    EXPECT_GE(prepared.huge_page_bytes, std::size_t{2} << 20) << mode;
-  } else {
-    EXPECT_EQ(prepared.huge_page_bytes, 0u) << (mode.empty() ? "no THP" : mode);
+  if (mode.find("[always]") == std::string::npos && mode.find("[madvise]") == std::string::npos) {
+    GTEST_SKIP() << "transparent huge pages not offered on request here: " << (mode.empty() ? "no THP" : mode);
   }
+  EXPECT_GE(prepared.huge_page_bytes, std::size_t{2} << 20) << mode;
 }
 
 }  // namespace
