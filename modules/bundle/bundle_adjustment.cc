@@ -191,6 +191,44 @@ bool AnalyzeStartGauge(const BundleData& data, const BundleState& state, const B
   return true;
 }
 
+// Weak directions: the joint parameters these poses determine worse than their manufacturing tolerance are
+// held at the robot description's value (the start moved back there) and named, with the joints that barely
+// move. False when the nominal model cannot be evaluated (a dot behind a camera).
+bool HoldWeakParameters(const BundleData& data, const BundleOptions& options, internal::Gauge* gauge,
+                        BundleState* state, BundleReport* report) {
+  for (int j = 0; j < data.robot.num_joints() && data.base_from_flange.empty(); ++j) {
+    double lo = 0, hi = 0;
+    for (size_t p = 0; p < data.joints.size(); ++p) {
+      lo = p == 0 ? data.joints[p][j] : std::min(lo, data.joints[p][j]);
+      hi = p == 0 ? data.joints[p][j] : std::max(hi, data.joints[p][j]);
+    }
+    if (!data.joints.empty() && hi - lo < kBarelyMovingRad) report->barely_moving.push_back({j + 1, hi - lo});
+  }
+  if (options.weak_length_tolerance_m <= 0 && options.weak_angle_tolerance_rad <= 0) return true;
+  BundleState nominal = *state;
+  const Eigen::VectorXd nominal_rho = KinematicParameters::Nominal(data.robot);
+  nominal.rho = nominal_rho;
+  std::vector<identification::WeakColumn> weak;
+  if (!internal::FindWeakParameters(data, nominal, *gauge, options.intrinsics, options.weak_length_tolerance_m,
+                                    options.weak_angle_tolerance_rad, &weak)) {
+    return false;
+  }
+  const KinematicParameters params(data.robot.num_joints());
+  for (const identification::WeakColumn& w : weak) {
+    report->weak.push_back({params.name(w.column), params.kind(w.column) == ParameterKind::kLength,
+                            w.conditional_std, w.tolerance, w.combination});
+    report->fixed_names.push_back(params.name(w.column));
+    state->rho[w.column] = nominal_rho[w.column];
+    auto it = std::find(gauge->free_kinematic.begin(), gauge->free_kinematic.end(), w.column);
+    if (it != gauge->free_kinematic.end()) gauge->free_kinematic.erase(it);
+    auto name = std::find(gauge->free_names.begin(), gauge->free_names.end(), params.name(w.column));
+    if (name != gauge->free_names.end()) gauge->free_names.erase(name);
+  }
+  report->free_indices = gauge->free_kinematic;
+  report->free_names = gauge->free_names;
+  return true;
+}
+
 // Why the free set cannot be estimated from these poses (K3), or empty when it can.
 std::string WhyNotIdentifiable(const internal::Gauge& gauge, const BundleOptions& options, int num_poses,
                                int generic_rank) {
@@ -255,6 +293,10 @@ ScreenedFit SolveScreened(const std::vector<int>& free, const BundleOptions& opt
     Subset(full, full_state, keep, data, state, &dot_map);
     if (data->yardsticks.empty() && data->base_from_flange.empty()) {
       fit.scale_lost = true;
+      const std::vector<double> errors = ReprojectionErrors(full, full_state);
+      for (size_t k = 0; k < keep.size(); ++k) {
+        if (!keep[k]) report->removed.push_back({full.pose_ids[full.observations[k].pose], full.dot_ids[full.observations[k].dot], errors[k]});
+      }
       return fit;
     }
     summary = Solve(*data, free, options, true, state);
@@ -381,10 +423,15 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
   }
   const std::string not_identifiable = WhyNotIdentifiable(gauge, options, num_poses, report.generic_rank);
   if (!not_identifiable.empty()) return finish(Outcome::kDegenerate, not_identifiable);
+  if (!HoldWeakParameters(data, options, &gauge, &state, &report)) {
+    return finish(Outcome::kFailure, "the nominal model puts a triangulated dot behind a camera");
+  }
 
   const ScreenedFit fit = SolveScreened(gauge.free_kinematic, options, &data, &state, &report);
   if (fit.scale_lost) {
-    return finish(Outcome::kScaleUnresolved, "the residual screen removed the yardstick's views");
+    return finish(Outcome::kScaleUnresolved, "the residual screen removed " + std::to_string(report.removed.size()) +
+                                                 " observations, among them the yardstick's views (the solve before it "
+                                                 "had not found the images' geometry: a poor start)");
   }
   const internal::LmSummary& summary = fit.summary;
   const bool converged = summary.termination == internal::LmSummary::Termination::kConvergence;

@@ -94,6 +94,13 @@ struct BundleOptions {
   // With anything held, the generic-rank check (require_generic_rank) does not apply.
   std::vector<std::string> held_parameters;
   std::vector<std::string> free_parameters;
+  // Weak directions (near-unidentifiable, not only rank deficient): a joint parameter (alpha, a, theta, d,
+  // beta) whose standard deviation given the parameters kept before it (the gauge's selection order:
+  // intrinsics, camera, base, joint by joint) exceeds its manufacturing tolerance at the stated pixel noise is
+  // held at the robot description's value and named in BundleReport::weak: the description is then the
+  // better estimate. The camera, base and intrinsics are never held this way. 0 turns a kind off.
+  double weak_length_tolerance_m = 5e-3;
+  double weak_angle_tolerance_rad = 8.726646259971648e-3;  // 0.5 deg
   // Empty when valid; otherwise every problem, one per line.
   std::string Validate() const;
 };
@@ -115,6 +122,24 @@ struct RemovedObservation {
   double residual_px = 0;  // |r| at the final solution
 };
 
+// A joint parameter held at the robot description's value because the data determine it worse than its
+// tolerance (BundleOptions::weak_length_tolerance_m, weak_angle_tolerance_rad).
+struct WeakParameter {
+  std::string name;            // "j4.d"
+  bool length = true;          // m, else rad
+  double conditional_std = 0;  // given the parameters kept before it, at the stated pixel noise
+  double tolerance = 0;
+  std::string combination;     // "0.71 j2.d - 0.71 j4.d": what it trades off with
+};
+
+// A joint whose recorded angle varies by less than kBarelyMovingRad over the identification poses: its
+// neighbours' offsets are then hard to tell apart.
+constexpr double kBarelyMovingRad = 0.0349065850398866;  // 2 deg
+struct BarelyMovingJoint {
+  int joint = 0;  // 1-based
+  double range_rad = 0;
+};
+
 struct BundleReport {
   Outcome outcome = Outcome::kNotRun;
   std::string message;
@@ -129,6 +154,8 @@ struct BundleReport {
   std::vector<std::string> free_names, fixed_names;  // fixed: by the rank analysis and by request
   std::vector<std::string> held_names;        // held by request (BundleOptions::held_parameters, free_parameters)
   std::vector<std::string> null_combinations; // "1.00 base.tx", "0.71 j2.d - 0.71 j3.d", ...
+  std::vector<WeakParameter> weak;            // held at the description's value: the data determine them too poorly
+  std::vector<BarelyMovingJoint> barely_moving;
   int generic_rank = 0;                       // free kinematic count for generic poses of this robot
   double condition_number = 0;                // column-normalised reduced Jacobian of the free set
   // Marginal standard deviations, dots as nuisance: s^2 (J_g^T (I - P_dots) J_g)^-1 over the free

@@ -24,6 +24,12 @@ std::string BundleOptions::Validate() const {
   if (!(gradient_tolerance >= 0)) out << "gradient_tolerance = " << gradient_tolerance << " must be >= 0\n";
   if (!(parameter_tolerance >= 0)) out << "parameter_tolerance = " << parameter_tolerance << " must be >= 0\n";
   if (!(rank_tolerance > 0 && rank_tolerance < 1)) out << "rank_tolerance = " << rank_tolerance << " must lie in (0, 1)\n";
+  if (!(weak_length_tolerance_m >= 0) || !std::isfinite(weak_length_tolerance_m)) {
+    out << "weak_length_tolerance_m = " << weak_length_tolerance_m << " must be finite and >= 0\n";
+  }
+  if (!(weak_angle_tolerance_rad >= 0) || !std::isfinite(weak_angle_tolerance_rad)) {
+    out << "weak_angle_tolerance_rad = " << weak_angle_tolerance_rad << " must be finite and >= 0\n";
+  }
   if (min_identification_poses < 2) {
     out << "min_identification_poses = " << min_identification_poses << " must be >= 2\n";
   }

@@ -117,4 +117,12 @@ struct Gauge {
 bool AnalyzeGauge(const BundleData& data, const BundleState& state, const IntrinsicsMask& estimate,
                   double rank_tolerance, Gauge* gauge, const std::vector<int>& held = {});
 
+// Weak directions of the free set `gauge` leaves (BundleOptions::weak_length_tolerance_m): the joint
+// parameters these poses determine worse than their tolerance at data.sigma_px, given the columns kept
+// before them in SelectionOrder, evaluated at `state` (the nominal model, as the gauge). Returns false
+// when the problem cannot be evaluated there.
+bool FindWeakParameters(const BundleData& data, const BundleState& state, const Gauge& gauge,
+                        const IntrinsicsMask& estimate, double length_tolerance_m, double angle_tolerance_rad,
+                        std::vector<identification::WeakColumn>* weak);
+
 }  // namespace selfcal::bundle::internal

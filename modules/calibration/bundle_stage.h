@@ -22,6 +22,7 @@
 #include "bundle/bundle_adjustment.h"
 #include "observations/observation_set.h"
 #include "calibration/fit_geometry.h"
+#include "calibration/hand_eye_start.h"
 #include "calibration/heldout_reprojection.h"
 #include "calibration/paper_pipeline.h"
 #include "calibration/predicted_error.h"
@@ -31,6 +32,10 @@ namespace selfcal::calibration {
 struct BundleStageOptions {
   bundle::BundleOptions bundle;
   bool retry_from_nominal = true;  // when the start from the paper's result does not converge
+  // A joint-angle set started at the nominal model takes its camera correction from the images
+  // (StartCameraFromImages) instead of the robot description's camera mount.
+  bool camera_start_from_images = true;
+  HandEyeStartOptions hand_eye;
 };
 
 enum class BundleStart { kNotRun, kPaperPipeline, kNominal };

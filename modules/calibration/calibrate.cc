@@ -194,7 +194,10 @@ CalibrationReport CalibrateSteps(const ObservationSet& observations, const Calib
   report.verdict = VerdictFor(report.paper.outcome);
   report.message = report.paper.message;
   if (options.method == Method::kBundle) {
-    report.bundle = RunBundleStage(obs, report.paper, options.bundle);
+    BundleStageOptions stage_options = options.bundle;
+    stage_options.hand_eye = options.hand_eye;
+    stage_options.hand_eye.two_view.seed = options.paper.two_view.seed;
+    report.bundle = RunBundleStage(obs, report.paper, stage_options);
     if (flange_poses) {
       report.bundle->start_note = observations.flange_from_cam_known
                                       ? "the set's nominal hand-eye transform and prior f_x"

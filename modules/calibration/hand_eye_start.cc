@@ -260,3 +260,32 @@ HandEyeStartReport StartHandEye(const ObservationSet& obs, const HandEyeStartOpt
 }
 
 }  // namespace selfcal::calibration
+
+namespace selfcal::calibration {
+
+HandEyeStartReport StartCameraFromImages(const ObservationSet& observations, const HandEyeStartOptions& options,
+                                         Eigen::VectorXd* rho) {
+  const RobotModel& robot = observations.robot;
+  const Eigen::VectorXd nominal = KinematicParameters::Nominal(robot);
+  ObservationSet flange = observations;
+  flange.robot.links.clear();
+  flange.robot.limits.clear();
+  for (PoseObservation& pose : flange.poses) {
+    if (pose.joints_rad.size() != robot.num_joints()) {
+      HandEyeStartReport report;
+      report.message = "pose " + pose.id + " has no joint angle per joint";
+      return report;
+    }
+    pose.base_from_flange = BaseFromFlange(robot, nominal, pose.joints_rad);
+    pose.joints_rad.resize(0);
+  }
+  HandEyeStartReport report = StartHandEye(flange, options);
+  if (!report.ok) return report;
+  const Rigid3 correction = robot.flange_from_cam.Inverse() * report.flange_from_cam;
+  const int cam = KinematicParameters(robot.num_joints()).CamOffset();
+  rho->segment<3>(cam) = correction.translation;
+  rho->segment<3>(cam + 3) = LogSO3(correction.rotation);
+  return report;
+}
+
+}  // namespace selfcal::calibration

@@ -73,4 +73,12 @@ struct HandEyeStartOptions {
 
 HandEyeStartReport StartHandEye(const ObservationSet& observations, const HandEyeStartOptions& options);
 
+// A joint-angle set's camera start from its images: the flange poses of the nominal kinematics at the
+// recorded joints stand in for recorded flange poses (StartHandEye), and the hand-eye transform found becomes
+// the camera correction of `rho` (robot.flange_from_cam times the correction), so that a wrong or absent
+// camera mount in the robot description does not decide which minimum the bundle reaches. `rho` is left
+// as it is when the start fails (report.ok false, with the reason).
+HandEyeStartReport StartCameraFromImages(const ObservationSet& observations, const HandEyeStartOptions& options,
+                                         Eigen::VectorXd* rho);
+
 }  // namespace selfcal::calibration

@@ -13,9 +13,7 @@
 
 namespace selfcal::identification {
 
-namespace {
-
-// "0.71 j2.d - 0.71 j3.d": terms above 0.05 in magnitude, largest first, leading sign positive.
+// Terms above 0.05 in magnitude, largest first, leading sign positive.
 std::string FormatCombination(const Eigen::VectorXd& v, const std::vector<std::string>& names) {
   std::vector<int> order(v.size());
   std::iota(order.begin(), order.end(), 0);
@@ -39,8 +37,6 @@ std::string FormatCombination(const Eigen::VectorXd& v, const std::vector<std::s
   }
   return out;
 }
-
-}  // namespace
 
 Eigen::MatrixXd NormalizeColumns(const Eigen::MatrixXd& j, double tolerance, Eigen::VectorXd* norms,
                                  std::vector<bool>* zero) {
@@ -145,6 +141,48 @@ RankSelection SelectColumns(const Eigen::MatrixXd& jacobian, const std::vector<i
   }
   for (const Eigen::VectorXd& x : null_vectors) out.null_combinations.push_back(FormatCombination(x, names));
   return out;
+}
+
+std::vector<WeakColumn> FindWeakColumns(const Eigen::MatrixXd& whitened, const std::vector<int>& order,
+                                        const Eigen::VectorXd& tolerance, const std::vector<std::string>& names) {
+  const int rows = static_cast<int>(whitened.rows());
+  std::vector<WeakColumn> weak;
+  Eigen::MatrixXd basis(rows, std::min<int>(rows, static_cast<int>(order.size())));
+  std::vector<int> kept;
+  for (int c : order) {
+    Eigen::VectorXd v = whitened.col(c);
+    const double norm = v.norm();
+    const int num_basis = static_cast<int>(kept.size());
+    for (int pass = 0; pass < 2; ++pass) {  // re-orthogonalised once
+      const auto q = basis.leftCols(num_basis);
+      v -= q * (q.transpose() * v);
+    }
+    const double residual = v.norm();
+    const double conditional_std = residual > 0 ? 1.0 / residual : std::numeric_limits<double>::infinity();
+    if (tolerance[c] > 0 && conditional_std > tolerance[c]) {
+      WeakColumn w;
+      w.column = c;
+      w.conditional_std = conditional_std;
+      w.tolerance = tolerance[c];
+      // The column on the earlier kept ones, all normalised: the direction the data cannot see.
+      Eigen::VectorXd x = Eigen::VectorXd::Zero(whitened.cols());
+      x[c] = 1.0;
+      if (!kept.empty() && norm > 0) {
+        Eigen::MatrixXd sub(rows, kept.size());
+        for (size_t k = 0; k < kept.size(); ++k) sub.col(k) = whitened.col(kept[k]) / whitened.col(kept[k]).norm();
+        const Eigen::VectorXd a = sub.colPivHouseholderQr().solve(whitened.col(c) / norm);
+        for (size_t k = 0; k < kept.size(); ++k) x[kept[k]] = -a[k];
+      }
+      w.combination = FormatCombination(x.normalized(), names);
+      weak.push_back(w);
+      continue;
+    }
+    if (residual > 0 && num_basis < rows) {
+      basis.col(num_basis) = v / residual;
+      kept.push_back(c);
+    }
+  }
+  return weak;
 }
 
 }  // namespace selfcal::identification

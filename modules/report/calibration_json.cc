@@ -62,6 +62,26 @@ json VerificationJson(const ObservationSet& obs, const calibration::Verification
           {"calibrated_model", VerificationSummaryJson(calibrated)}};
 }
 
+// The parameters held because these poses determine them worse than their tolerance, and the joints that
+// barely move (mm and deg, as the rest of the report's parameters).
+json WeakJson(const bundle::BundleReport& b) {
+  json held = json::array();
+  for (const bundle::WeakParameter& w : b.weak) {
+    const double scale = w.length ? 1e3 : RadToDeg(1.0);
+    const char* unit = w.length ? "mm" : "deg";
+    held.push_back({{"name", w.name},
+                    {"unit", unit},
+                    {"conditional_std", w.conditional_std * scale},
+                    {"tolerance", w.tolerance * scale},
+                    {"combination", w.combination}});
+  }
+  json joints = json::array();
+  for (const bundle::BarelyMovingJoint& j : b.barely_moving) {
+    joints.push_back({{"joint", j.joint}, {"range_deg", RadToDeg(j.range_rad)}});
+  }
+  return {{"held", held}, {"barely_moving_joints", joints}};
+}
+
 json PredictedErrorJson(const calibration::PredictedDistanceErrors& p) {
   json distances = json::array();
   for (const calibration::PredictedDistanceError& e : p.distances) {
@@ -258,6 +278,7 @@ json BundleSectionJson(const ObservationSet& obs, const calibration::BundleStage
           {"free", b.free_names},
           {"fixed", b.fixed_names},
           {"null_combinations", b.null_combinations},
+          {"weak", WeakJson(b)},
           {"generic_rank", b.generic_rank},
           {"condition_number", Finite(b.condition_number)},
           {"covariance_available", b.covariance_available},

@@ -88,6 +88,22 @@ void PrintLensSummary(const bundle::BundleReport& b, std::ostream& out) {
   if (!line.empty()) out << "  intrinsics: " << line << "\n";
 }
 
+// The joints that barely move and the parameters held because the data determine them too poorly.
+void PrintWeakDirections(const bundle::BundleReport& b, std::ostream& out) {
+  for (const bundle::BarelyMovingJoint& j : b.barely_moving) {
+    out << "  joint " << j.joint << " barely moves (" << std::fixed << std::setprecision(1) << RadToDeg(j.range_rad)
+        << " deg over the identification poses): the parameters beside it are hard to tell apart\n";
+    out.unsetf(std::ios::floatfield);
+  }
+  for (const bundle::WeakParameter& w : b.weak) {
+    const double scale = w.length ? kMm : RadToDeg(1.0);
+    const char* unit = w.length ? " mm" : " deg";
+    out << "  held (weak): " << w.name << " at the robot description's value: these poses determine it to +- "
+        << std::setprecision(3) << w.conditional_std * scale << unit << " given the others, worse than its tolerance "
+        << w.tolerance * scale << unit << " (the direction " << w.combination << ")\n";
+  }
+}
+
 void PrintBundleSummary(const calibration::BundleStageReport& stage, bool flange_poses, std::ostream& out) {
   const bundle::BundleReport& b = stage.bundle;
   out << (flange_poses ? "hand-eye bundle adjustment (recorded flange poses): " : "kinematic bundle adjustment: ")
@@ -100,6 +116,7 @@ void PrintBundleSummary(const calibration::BundleStageReport& stage, bool flange
   if (!b.held_names.empty()) out << " (" << b.held_names.size() << " held by request)";
   out << "; " << b.num_observations << " observations, " << b.removed.size() << " removed by the screen, "
       << b.dropped_dots.size() << " dots dropped\n";
+  PrintWeakDirections(b, out);
   out << "  " << b.iterations << " iterations (" << b.termination << "), reprojection RMS " << std::setprecision(4)
       << b.rms_reprojection_px << " px; f_x = " << std::fixed << std::setprecision(3) << b.fx_px << " +- "
       << b.fx_stddev << " px\n";
