@@ -30,10 +30,10 @@ int LineAt(const std::string& text, size_t at) {
   return line;
 }
 
-// The names a message quotes: between [ ], ' ' or " ".
+// The names a message quotes: between [ ], ` `, ' ' or " ".
 std::vector<std::string> QuotedNames(const std::string& message) {
   std::vector<std::string> names;
-  for (const auto& [open, close] : {std::pair<char, char>{'[', ']'}, {'\'', '\''}, {'"', '"'}}) {
+  for (const auto& [open, close] : {std::pair<char, char>{'[', ']'}, {'`', '`'}, {'\'', '\''}, {'"', '"'}}) {
     for (size_t a = message.find(open); a != std::string::npos; a = message.find(open, a + 1)) {
       const size_t b = message.find(close, a + 1);
       if (b == std::string::npos) break;
@@ -73,6 +73,15 @@ std::mutex& ConsoleMutex() {
 }
 
 }  // namespace
+
+Status WithUrdfLine(const std::string& text, const std::string& name, const Status& status) {
+  const std::string& message = status.message();
+  const std::string prefix = name + ": ";
+  if (status.ok() || message.rfind(prefix, 0) != 0) return status;
+  std::string where = Where(text, {message.substr(prefix.size())});
+  where = where.substr(0, where.find(':'));  // the line only: the message names the element itself
+  return Status::Error(status.code(), name + ":" + where + ": " + message.substr(prefix.size()));
+}
 
 Result<std::shared_ptr<::urdf::ModelInterface>> ParseUrdfText(const std::string& text, const std::string& name) {
   XmlScanLimits limits;

@@ -25,4 +25,8 @@ inline constexpr std::size_t kMaxUrdfBytes = 16u << 20;
 // "<name>:<line>: ...".
 Result<std::shared_ptr<::urdf::ModelInterface>> ParseUrdfText(const std::string& text, const std::string& name);
 
+// `status` ("<name>: ... joint `j` ...", a refusal of the chain or its model) with the line of the element it
+// quotes by name inserted after `name` (else the line of <robot>); other statuses unchanged.
+Status WithUrdfLine(const std::string& text, const std::string& name, const Status& status);
+
 }  // namespace selfcal::urdf

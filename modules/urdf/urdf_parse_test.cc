@@ -83,5 +83,20 @@ TEST(UrdfParse, UrdfdomModelErrorsNameTheElementAndItsLine) {
       << second;
 }
 
+// selfcal's own refusals of the chain (a joint it cannot take, a missing link) name the joint's line too, or
+// the line of <robot> when the name is not an element of the file.
+TEST(UrdfParse, ChainRefusalsNameTheLineOfTheElement) {
+  std::string text = Ur5e();
+  const std::string revolute = "name=\"joint4\" type=\"revolute\"";
+  text.replace(text.find(revolute), revolute.size(), "name=\"joint4\" type=\"prismatic\"");
+  EXPECT_EQ(Refusal(text).rfind("arm.urdf:" + std::to_string(LineOf(text, "name=\"joint4\"")) + ": joint `joint4` is prismatic", 0),
+            0u) << Refusal(text);
+  Result<UrdfRobot> robot = ParseUrdfRobot(Ur5e(), "arm.urdf", {"base_link", "tool9", ""}, Rigid3());
+  ASSERT_FALSE(robot.ok());
+  EXPECT_EQ(robot.status().message().rfind("arm.urdf:" + std::to_string(LineOf(Ur5e(), "<robot")) +
+                                               ": tip_link `tool9` is not a link of robot `ur5e`", 0),
+            0u) << robot.status().message();
+}
+
 }  // namespace
 }  // namespace selfcal::urdf

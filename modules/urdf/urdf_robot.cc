@@ -135,14 +135,16 @@ Result<UrdfRobot> ParseUrdfRobot(const std::string& text, const std::string& nam
   const Result<std::shared_ptr<::urdf::ModelInterface>> parsed = ParseUrdfText(text, name);
   if (!parsed.ok()) return parsed.status();
   Result<UrdfChain> chain = ExtractChain(**parsed, name, spec);
-  if (!chain.ok()) return chain.status();
+  if (!chain.ok()) return WithUrdfLine(text, name, chain.status());
   UrdfRobot robot;
   robot.model = ModelFromAxes(*chain, flange_from_cam.value_or(Rigid3()));
   for (const AxisLine& axis : chain->axes) robot.joint_names.push_back(axis.name);
   const std::string invalid = robot.model.Validate();
-  if (!invalid.empty()) return Status::Error(ErrorCode::kInvalidInput, name + ": the converted model: " + invalid);
+  if (!invalid.empty()) {
+    return WithUrdfLine(text, name, Status::Error(ErrorCode::kInvalidInput, name + ": the converted model: " + invalid));
+  }
   Result<FkCheck> check = CompareWithKdl(text, name, spec, robot.model, options);
-  if (!check.ok()) return check.status();
+  if (!check.ok()) return WithUrdfLine(text, name, check.status());
   robot.check = *check;
   return robot;
 }
