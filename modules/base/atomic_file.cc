@@ -119,7 +119,8 @@ Result<std::string> ReadFileCapped(const std::string& path, std::size_t max_byte
     error = path + " is not a regular file";
   } else if (static_cast<unsigned long long>(info.st_size) > max_bytes) {
     error =
-        path + " is " + std::to_string(info.st_size) + " bytes, more than the limit of " + std::to_string(max_bytes);
+        path + " is " + std::to_string(info.st_size) + " bytes, more than the limit of " + std::to_string(max_bytes) +
+        " bytes";
   } else {
     // One byte past the size from fstat, so that a file growing meanwhile is noticed.
     text.resize(static_cast<size_t>(info.st_size) + 1);
@@ -137,7 +138,9 @@ Result<std::string> ReadFileCapped(const std::string& path, std::size_t max_byte
       if (used == text.size() && used <= max_bytes) text.resize(std::min(text.size() * 2, max_bytes + 1));
     }
     text.resize(used);
-    if (error.empty() && used > max_bytes) error = path + " is larger than " + std::to_string(max_bytes) + " bytes";
+    if (error.empty() && used > max_bytes) {
+      error = path + " grew while it was read, to more than the limit of " + std::to_string(max_bytes) + " bytes";
+    }
   }
   ::close(fd);
   if (error_number != 0) return Status::Error(ErrorCode::kInvalidInput, error).WithDetail(kErrnoDomain, error_number);

@@ -35,9 +35,9 @@ namespace {
   WriteAndExit(fd, bytes);
 }
 
-ChildOutput Failed(const std::string& detail) {
+ChildOutput Failed(const std::string& detail, ChildEnd end = ChildEnd::kFailed) {
   ChildOutput out;
-  out.end = ChildEnd::kFailed;
+  out.end = end;
   out.detail = detail;
   return out;
 }
@@ -48,7 +48,8 @@ ChildOutput Reap(pid_t pid, std::string bytes) {
   while (::waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) return Failed(std::string("waitpid: ") + std::strerror(errno));
   }
-  if (WIFSIGNALED(status)) return Failed("ended by signal " + std::to_string(WTERMSIG(status)));
+  if (WIFSIGNALED(status)) return Failed("ended by signal " + std::to_string(WTERMSIG(status)), ChildEnd::kCrashed);
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 3) return Failed("the work threw an exception", ChildEnd::kCrashed);
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
     return Failed("exited with status " + std::to_string(WEXITSTATUS(status)));
   }

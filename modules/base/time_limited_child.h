@@ -20,13 +20,14 @@ namespace selfcal {
 enum class ChildEnd {
   kFinished,   // the child wrote its bytes and exited 0
   kTimedOut,   // killed after `limit`
-  kFailed,     // fork or pipe failed, the child was killed by a signal or exited non-zero
+  kCrashed,    // the work crashed the child (ended by a signal other than the limit's kill) or threw
+  kFailed,     // fork, pipe or waitpid failed, or the child exited non-zero for another reason
 };
 
 struct ChildOutput {
   ChildEnd end = ChildEnd::kFailed;
   std::string bytes;   // what `work` returned (kFinished only)
-  std::string detail;  // for kFailed: why, e.g. "ended by signal 11" or "fork: Resource temporarily unavailable"
+  std::string detail;  // kCrashed, kFailed: why, e.g. "ended by signal 11" or "fork: Resource temporarily unavailable"
 };
 
 // Runs `work` in a forked child and returns its bytes, within `limit` of wall-clock time.

@@ -47,19 +47,19 @@ TEST(TimeLimitedChild, WorkThatNeverReturnsIsStoppedAtTheLimit) {
   EXPECT_LT(seconds, 10.0);  // stopped, not waited for (a loaded machine may be slow to kill)
 }
 
-TEST(TimeLimitedChild, AChildThatCrashesOrThrowsIsAFailureThatSaysHow) {
+TEST(TimeLimitedChild, AChildThatCrashesOrThrowsIsACrashThatSaysHow) {
   const ChildOutput crashed = RunInTimeLimitedChild(
       []() -> std::string {
         std::signal(SIGABRT, SIG_DFL);
         std::abort();
       },
       milliseconds(20000));
-  EXPECT_EQ(crashed.end, ChildEnd::kFailed);
+  EXPECT_EQ(crashed.end, ChildEnd::kCrashed);
   EXPECT_EQ(crashed.detail, "ended by signal " + std::to_string(SIGABRT));
   const ChildOutput threw = RunInTimeLimitedChild([]() -> std::string { throw std::runtime_error("no"); },
                                                   milliseconds(20000));
-  EXPECT_EQ(threw.end, ChildEnd::kFailed);
-  EXPECT_EQ(threw.detail, "exited with status 3");
+  EXPECT_EQ(threw.end, ChildEnd::kCrashed);
+  EXPECT_EQ(threw.detail, "the work threw an exception");
 }
 
 }  // namespace

@@ -16,10 +16,12 @@
 #include "base/atomic_file.h"
 #include "base/terminal_text.h"
 #include "base/time_limited_child.h"
+#include "base/xml_scan.h"
 #include "io/camera_formats.h"
 #include "io/camera_xml.h"
 #include "io/opencv_lines.h"
 #include "io/yaml_schema.h"
+#include "yaml/yaml_reader.h"
 
 namespace selfcal::io {
 
@@ -192,6 +194,29 @@ bool MalformedYamlDirective(const std::string& contents) {
   return !std::regex_match(line, directive);
 }
 
+// Before OpenCV's reader, which recurses once per nesting level (100,000 levels crash it) and keeps the
+// last of a repeated key: the text's nesting and keys are checked here, by line. An XML text (its first
+// non-blank character `<`) by the non-recursive scan of base/xml_scan.h (depth, repeated sibling elements
+// except OpenCV's sequence items `<_>`, UTF-8); a YAML or JSON text by selfcal's strict YAML reader (depth,
+// duplicate keys, UTF-8; OpenCV's `!!opencv-matrix` tags accepted).
+Status CheckOpenCvStructure(const std::string& path, const std::string& contents) {
+  const size_t first = contents.find_first_not_of(" \t\r\n");
+  if (first != std::string::npos && contents[first] == '<') {
+    XmlScanLimits limits;
+    limits.kind = "an OpenCV camera file";
+    limits.max_bytes = kMaxCameraFileBytes;
+    limits.require_utf8 = true;
+    limits.refuse_repeated_siblings = true;
+    limits.repeatable = {"_"};
+    return ScanXml(contents, path, limits);
+  }
+  yaml::YamlRules rules;
+  rules.max_bytes = kMaxCameraFileBytes;
+  rules.accepted_tag_prefix = "tag:yaml.org,2002:opencv-";
+  const Result<yaml::YamlDocument> doc = yaml::ParseYamlText(contents, path, rules);
+  return doc.ok() ? Status::Ok() : doc.status();
+}
+
 Result<CameraIntrinsics> LoadOpenCv(const std::string& path, const std::string& contents) {
   Problems problems(path);
   if (MalformedYamlDirective(contents)) {
@@ -206,6 +231,9 @@ Result<CameraIntrinsics> LoadOpenCv(const std::string& path, const std::string& 
     return Status::Error(ErrorCode::kInvalidInput, "cannot read " + path + " as an OpenCV FileStorage file: " + path +
                                                        ":" + std::to_string(line) +
                                                        ": a second `%YAML` directive inside the document");
+  }
+  if (Status s = CheckOpenCvStructure(path, contents); !s.ok()) {
+    return Status::Error(ErrorCode::kInvalidInput, "cannot read " + path + " as an OpenCV FileStorage file: " + s.message());
   }
   const Result<const internal::CameraFormatBackend*> backend = internal::CameraFormats();
   if (!backend.ok()) return backend.status();
@@ -294,6 +322,12 @@ Result<CameraIntrinsics> LoadOpenCvWithin(const std::string& path, const std::st
                                "did not finish the text within " + Seconds(limit) +
                                " s and was stopped (it loops forever on some malformed YAML); check the " +
                                "file's syntax, or write it again with cv::FileStorage");
+    case ChildEnd::kCrashed:
+      // The text made OpenCV's reader crash: the file's fault as far as the user can act on it.
+      return Status::Error(ErrorCode::kInvalidInput,
+                           "cannot read " + path + " as an OpenCV FileStorage file: " + path + ":1: OpenCV's reader " +
+                               "crashed on the text (" + out.detail + "); check the file's syntax, or write it " +
+                               "again with cv::FileStorage");
     case ChildEnd::kFailed:
       break;
   }

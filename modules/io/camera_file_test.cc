@@ -215,11 +215,12 @@ TEST_F(BadCameraFiles, OpenCv) {
   ASSERT_TRUE(LoadCameraFile((WriteFile(dir_.File("standard.yaml"), "%YAML 1.2" + OpenCv("").substr(9)), dir_.File("standard.yaml"))).ok())
       << "the YAML standard's directive is not refused";
   EXPECT_TRUE(Refused("fisheye.yaml", OpenCv("fisheye_model: 1\n"), "`fisheye_model` at " + dir_.File("fisheye.yaml") + ":9 is set"));
-  // A parse error: the line cv::FileStorage's parser names; a file it cannot start reading: line 1.
+  // A parse error: the line selfcal's strict YAML reader names (it reads the text before cv::FileStorage
+  // does, for the nesting and repeated keys); an empty file: line 1.
   EXPECT_TRUE(Refused("garbage.yaml", "%YAML:1.0\n---\nimage_width: 5\nimage_height: [\n",
-                      "cannot read " + dir_.File("garbage.yaml") + " as an OpenCV FileStorage file: " +
-                          dir_.File("garbage.yaml") + ":4: Missing , between the elements"));
-  EXPECT_TRUE(Refused("empty.yaml", "", dir_.File("empty.yaml") + ":1: "));
+                      "cannot read " + dir_.File("garbage.yaml") + " as an OpenCV FileStorage file: malformed YAML at " +
+                          dir_.File("garbage.yaml") + ":5: did not find expected node content"));
+  EXPECT_TRUE(Refused("empty.yaml", "", dir_.File("empty.yaml") + ":1 (the file is empty"));
   EXPECT_TRUE(Refused("utf16.yaml", std::string("\xff\xfe" "a\0:\0", 6), dir_.File("utf16.yaml") + ":1: "));
   EXPECT_TRUE(Refused("named.yaml", OpenCv(""), "a camera name (`A`) is for ViSP files", "A"));
   EXPECT_TRUE(Refused("camera.txt", OpenCv(""), "unknown format"));
@@ -279,6 +280,85 @@ TEST_F(BadCameraFiles, Visp) {
   std::string nosize = Visp(model);
   nosize.replace(nosize.find("    <image_width>640</image_width>\n"), 35, "");
   EXPECT_TRUE(Refused("nosize.xml", nosize, "missing element <image_width> in <camera>"));
+}
+
+std::string Nested(const std::string& open, const std::string& close, int depth) {
+  std::string text;
+  for (int i = 0; i < depth; ++i) text += open;
+  for (int i = 0; i < depth; ++i) text += close;
+  return text;
+}
+
+const char* const kOpenCvXml =
+    "<?xml version=\"1.0\"?>\n<opencv_storage>\n<image_width>640</image_width>\n<image_height>480</image_height>\n"
+    "<camera_matrix type_id=\"opencv-matrix\">\n  <rows>3</rows>\n  <cols>3</cols>\n  <dt>d</dt>\n"
+    "  <data>600. 0. 320. 0. 600. 240. 0. 0. 1.</data></camera_matrix>\n"
+    "<distortion_coefficients type_id=\"opencv-matrix\">\n  <rows>5</rows>\n  <cols>1</cols>\n  <dt>d</dt>\n"
+    "  <data>0.1 0. 0. 0. 0.</data></distortion_coefficients>\n</opencv_storage>\n";
+
+const char* const kOpenCvJson =
+    "{\n    \"image_width\": 640,\n    \"image_height\": 480,\n    \"camera_matrix\": {\n"
+    "        \"type_id\": \"opencv-matrix\",\n        \"rows\": 3,\n        \"cols\": 3,\n        \"dt\": \"d\",\n"
+    "        \"data\": [ 600.0, 0.0, 320.0, 0.0, 600.0, 240.0, 0.0, 0.0, 1.0 ]\n    },\n    \"distortion_coefficients\": {\n"
+    "        \"type_id\": \"opencv-matrix\",\n        \"rows\": 5,\n        \"cols\": 1,\n        \"dt\": \"d\",\n"
+    "        \"data\": [ 0.1, 0.0, 0.0, 0.0, 0.0 ]\n    }\n}\n";
+
+// 100,000 nested levels crashed OpenCV's reader (the child process ended by SIGSEGV: exit 70 "internal
+// error"); ViSP files are read into a tree whose destruction recursed as deep. Each is refused by the
+// depth limit before any parser sees the text, naming the file and the line, quickly.
+TEST_F(BadCameraFiles, DeepNestingIsRefusedByLineBeforeAnyParserSeesIt) {
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_TRUE(Refused("deep.yaml", OpenCv("") + "nested: " + Nested("[", "]", 100000) + "\n",
+                      dir_.File("deep.yaml") + ":9"));
+  EXPECT_TRUE(Refused("deep.yaml", OpenCv("") + "nested: " + Nested("[", "]", 100000) + "\n", "nested deeper than 64"));
+  EXPECT_TRUE(Refused("block.yaml", OpenCv("") + "nested:\n" + Nested("- ", "", 100000) + "x\n", "nested deeper than 64"));
+  std::string xml = kOpenCvXml;
+  xml.insert(xml.find("</opencv_storage>"), Nested("<a>", "</a>", 100000));
+  EXPECT_TRUE(Refused("deep.xml", xml, dir_.File("deep.xml") +
+                                           ":15: elements nested deeper than 64 levels, the limit for an OpenCV camera file"));
+  std::string visp = Visp("      <type>perspectiveProjWithoutDistortion</type>\n");
+  visp.insert(visp.find("</root>"), Nested("<camera>", "</camera>", 100000));
+  EXPECT_TRUE(Refused("deep_visp.xml", visp, dir_.File("deep_visp.xml") +
+                                                 ":11: elements nested deeper than 64 levels, the limit for a ViSP camera file"));
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
+}
+
+// cv::FileStorage keeps the last of a repeated key: a camera file with two image widths was read with the
+// second. Refused naming the key and its line, in YAML, JSON and XML; the same files without the repeat load.
+TEST_F(BadCameraFiles, OpenCvRepeatedKeysAreRefusedByLine) {
+  for (const auto& [name, text] : {std::pair<std::string, std::string>{"good.xml", kOpenCvXml}, {"good.json", kOpenCvJson}}) {
+    WriteFile(dir_.File(name), text);
+    const Result<CameraIntrinsics> good = LoadCameraFile(dir_.File(name));
+    ASSERT_TRUE(good.ok()) << good.status().ToString();
+    EXPECT_EQ(good->width_px, 640);
+    EXPECT_EQ(good->k1, 0.1);
+  }
+  EXPECT_TRUE(Refused("dup.yaml", OpenCv("image_width: 800\n"), "duplicate key `image_width` at " + dir_.File("dup.yaml") + ":9"));
+  EXPECT_TRUE(Refused("dup.yaml", OpenCv("", "3, rows: 3, cols: 3, dt: d, data: [600, 0, 320, 0, 600, 240, 0, 0, 1]"),
+                      "duplicate key `rows` at " + dir_.File("dup.yaml") + ":6"));
+  std::string json = kOpenCvJson;
+  json.insert(json.find("    \"camera_matrix\""), "    \"image_width\": 800,\n");
+  EXPECT_TRUE(Refused("dup.json", json, "duplicate key `image_width` at " + dir_.File("dup.json") + ":4"));
+  std::string xml = kOpenCvXml;
+  xml.insert(xml.find("</opencv_storage>"), "<image_width>800</image_width>\n");
+  EXPECT_TRUE(Refused("dup.xml", xml, dir_.File("dup.xml") + ":15: element <image_width> appears twice in <opencv_storage>"));
+}
+
+// ViSP's reader took an element inside <type> (its text around the element read as the type) and bytes
+// that are not UTF-8: both refused by line.
+TEST_F(BadCameraFiles, VispElementInsideAValueAndInvalidUtf8AreRefusedByLine) {
+  const std::string model = "      <type>perspectiveProj<x/>WithoutDistortion</type>\n      <px>600</px>\n      <py>601</py>\n"
+                            "      <u0>320</u0>\n      <v0>240</v0>\n";
+  EXPECT_TRUE(Refused("inside.xml", Visp(model), "element <x> inside <type> at " + dir_.File("inside.xml") + ":8: <type> holds a value"));
+  std::string px = model;
+  px.replace(px.find("<x/>"), 4, "");
+  px.replace(px.find("<px>600</px>"), 12, "<px>6<b>0</b>0</px>");
+  EXPECT_TRUE(Refused("inside.xml", Visp(px), "element <b> inside <px> at " + dir_.File("inside.xml") + ":9"));
+  std::string name = Visp(px);
+  name.replace(name.find("<px>6<b>0</b>0</px>"), 19, "<px>600</px>");
+  ASSERT_TRUE(LoadCameraFile((WriteFile(dir_.File("good.xml"), name), dir_.File("good.xml"))).ok());
+  name.replace(name.find("<name>A</name>"), 14, "<name>A\xff</name>");
+  EXPECT_TRUE(Refused("utf8.xml", name, dir_.File("utf8.xml") + ":4: invalid UTF-8 (a ViSP camera file must be UTF-8)", "A"));
 }
 
 TEST(CameraFile, VispRefusesWhatItCannotHoldAndWritesNothing) {

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <vector>
 
+#include "base/xml_scan.h"
 #include "io/yaml_schema.h"
 
 namespace selfcal::io {
@@ -150,6 +151,16 @@ void CheckChildren(const XmlElement& e, const std::vector<std::string>& allowed,
   }
 }
 
+// The children of `e` that hold a value (all but those in `containers`) hold text only: an element inside
+// <type> or <px> is refused (its text around the element would otherwise be read as the value).
+void CheckLeaves(const XmlElement& e, const std::vector<std::string>& containers, Problems* problems) {
+  for (const XmlElement& c : e.children) {
+    if (c.children.empty() || std::find(containers.begin(), containers.end(), c.name) != containers.end()) continue;
+    problems->Add("element <" + c.children[0].name + "> inside <" + c.name + "> at " + problems->At(c.children[0].line) +
+                  ": <" + c.name + "> holds a value, not elements");
+  }
+}
+
 const XmlElement* Child(const XmlElement& e, const std::string& name) {
   for (const XmlElement& c : e.children) {
     if (c.name == name) return &c;
@@ -207,6 +218,7 @@ const XmlElement* ChooseModel(const XmlElement& camera, Problems* problems) {
                     " and " + kWithDistortion + " (a Kannala-Brandt or other fisheye model is not selfcal's)");
     }
     CheckChildren(m, {"type", "px", "py", "u0", "v0", "kud", "kdu"}, {}, problems);
+    CheckLeaves(m, {}, problems);
   }
   if (with == nullptr && without == nullptr && problems->empty()) {
     problems->Add("camera at " + problems->At(camera.line) + " has no <model>");
@@ -219,6 +231,14 @@ const XmlElement* ChooseModel(const XmlElement& camera, Problems* problems) {
 Result<CameraIntrinsics> ParseVispCameraXml(const std::string& path, const std::string& contents,
                                             const std::string& camera_name) {
   Problems problems(path);
+  // Before the tree is built (a tree of 100,000 nested elements overflows the stack when it is destroyed):
+  // size, depth, UTF-8 and tags closed, by line.
+  XmlScanLimits limits;
+  limits.kind = "a ViSP camera file";
+  limits.require_utf8 = true;
+  if (Status s = ScanXml(contents, path, limits); !s.ok()) {
+    return Status::Error(ErrorCode::kInvalidInput, "cannot read " + path + " as a ViSP camera file: " + s.message());
+  }
   XmlElement root;
   int error_line = 1;
   if (const std::string error = ParseXml(contents, &root, &error_line); !error.empty()) {
@@ -255,6 +275,7 @@ Result<CameraIntrinsics> ParseVispCameraXml(const std::string& path, const std::
   CheckChildren(camera, {"name", "image_width", "image_height", "subsampling_width", "subsampling_height", "full_width",
                          "full_height", "model", "additional_information"},
                 {"model"}, &problems);
+  CheckLeaves(camera, {"model", "additional_information"}, &problems);
   CameraIntrinsics out;
   ReadSize(camera, "image_width", &problems, &out.width_px);
   ReadSize(camera, "image_height", &problems, &out.height_px);

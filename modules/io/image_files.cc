@@ -23,7 +23,8 @@ Status ReadOne(const std::string& path, std::size_t max_bytes, std::size_t max_p
   if (ec || bytes > max_bytes) {
     return Status::Error(ErrorCode::kInvalidInput, path + ": " +
                                                        (ec ? "cannot read its size: " + ec.message()
-                                                           : "larger than " + std::to_string(max_bytes >> 20) + " MiB"));
+                                                           : std::to_string(bytes) + " bytes, more than the limit of " +
+                                                                 std::to_string(max_bytes) + " bytes"));
   }
   try {
     vpImageIo::read(*image, path);

@@ -220,8 +220,9 @@ TEST(MalformedFiles, C8FileOverTheSizeCapIsRefusedBeforeParsing) {
   std::string text = "poses_deg:\n";
   while (text.size() < 11u * 1000u * 1000u) text += "  - [0, 0, 0, 0, 0, 0]\n";
   WriteFile(path, text);
-  EXPECT_TRUE(CleanRefusal(LoadRobotModel(path).status(), path, "more than the limit of 10485760"));
-  EXPECT_TRUE(CleanRefusal(yaml::ParseYamlText(text, "memory.yaml").status(), "memory.yaml", "larger than"));
+  const std::string size = std::to_string(text.size()) + " bytes, more than the limit of 10485760 bytes";
+  EXPECT_TRUE(CleanRefusal(LoadRobotModel(path).status(), path, path + " is " + size));
+  EXPECT_TRUE(CleanRefusal(yaml::ParseYamlText(text, "memory.yaml").status(), "memory.yaml", "memory.yaml is " + size));
 }
 
 TEST(MalformedFiles, C8DeepNestingIsRefusedWithoutRecursion) {

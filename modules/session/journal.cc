@@ -149,7 +149,7 @@ Result<std::string> ReadAll(int fd, const std::string& path, std::uint64_t max_b
   if (!S_ISREG(info.st_mode)) return Status::Error(ErrorCode::kInvalidInput, "journal " + path + " is not a regular file");
   if (static_cast<std::uint64_t>(info.st_size) > max_bytes) {
     return Status::Error(ErrorCode::kInvalidInput, "journal " + path + " is " + std::to_string(info.st_size) +
-                                               " bytes, more than the limit of " + std::to_string(max_bytes));
+                                               " bytes, more than the limit of " + std::to_string(max_bytes) + " bytes");
   }
   std::string data(static_cast<std::size_t>(info.st_size), '\0');
   std::size_t used = 0;

@@ -384,7 +384,8 @@ Result<Session> CreateSession(const std::string& path, const SessionInputs& inpu
     if (!SafeFileName(input.name)) problems.push_back("input name \"" + input.name + "\" is not a plain file name");
     if (!names.insert(input.name).second) problems.push_back("input \"" + input.name + "\" is given twice");
     if (input.contents.size() > kMaxInputBytes) {
-      problems.push_back("input \"" + input.name + "\" is larger than " + std::to_string(kMaxInputBytes) + " bytes");
+      problems.push_back("input \"" + input.name + "\" is " + std::to_string(input.contents.size()) +
+                         " bytes, more than the limit of " + std::to_string(kMaxInputBytes) + " bytes");
     }
     input_bytes += input.contents.size();
   }

@@ -5,17 +5,16 @@
 
 #include <kdl/chain.hpp>
 #include <kdl/chainfksolverpos_recursive.hpp>
-#include <urdf_parser/urdf_parser.h>
+#include <urdf_model/model.h>
 
 #include "base/atomic_file.h"
 #include "urdf/kdl_chain.h"
 #include "urdf/urdf_chain.h"
+#include "urdf/urdf_parse.h"
 #include "urdf/urdf_writer.h"
 
 namespace selfcal::urdf {
 namespace {
-
-constexpr std::size_t kMaxUrdfBytes = 16u << 20;
 
 Rigid3 RigidOf(const KDL::Frame& f) {
   Eigen::Matrix3d r;
@@ -99,9 +98,9 @@ std::vector<Eigen::VectorXd> RandomJointsWithinLimits(const RobotModel& model, i
 Result<std::vector<Rigid3>> KdlChainPoses(const std::string& text, const std::string& name,
                                           const std::string& base_link, const std::string& tip_link,
                                           const std::vector<Eigen::VectorXd>& joints) {
-  const ::urdf::ModelInterfaceSharedPtr parsed = ::urdf::parseURDF(text);
-  if (!parsed) return Status::Error(ErrorCode::kInvalidInput, name + ": urdfdom could not read the URDF");
-  Result<KDL::Chain> built = KdlChainOf(*parsed, name, base_link, tip_link);
+  const Result<std::shared_ptr<::urdf::ModelInterface>> parsed = ParseUrdfText(text, name);
+  if (!parsed.ok()) return parsed.status();
+  Result<KDL::Chain> built = KdlChainOf(**parsed, name, base_link, tip_link);
   if (!built.ok()) return built.status();
   const KDL::Chain& chain = *built;
   KDL::ChainFkSolverPos_recursive solver(chain);
@@ -133,17 +132,19 @@ Result<UrdfRobot> ParseUrdfRobot(const std::string& text, const std::string& nam
         ErrorCode::kInvalidInput,
         name + ": give camera_link (a link of the URDF at the camera's optical frame) or flange_from_cam");
   }
-  const ::urdf::ModelInterfaceSharedPtr parsed = ::urdf::parseURDF(text);
-  if (!parsed) return Status::Error(ErrorCode::kInvalidInput, name + ": urdfdom could not parse the URDF");
-  Result<UrdfChain> chain = ExtractChain(*parsed, name, spec);
-  if (!chain.ok()) return chain.status();
+  const Result<std::shared_ptr<::urdf::ModelInterface>> parsed = ParseUrdfText(text, name);
+  if (!parsed.ok()) return parsed.status();
+  Result<UrdfChain> chain = ExtractChain(**parsed, name, spec);
+  if (!chain.ok()) return WithUrdfLine(text, name, chain.status());
   UrdfRobot robot;
   robot.model = ModelFromAxes(*chain, flange_from_cam.value_or(Rigid3()));
   for (const AxisLine& axis : chain->axes) robot.joint_names.push_back(axis.name);
   const std::string invalid = robot.model.Validate();
-  if (!invalid.empty()) return Status::Error(ErrorCode::kInvalidInput, name + ": the converted model: " + invalid);
+  if (!invalid.empty()) {
+    return WithUrdfLine(text, name, Status::Error(ErrorCode::kInvalidInput, name + ": the converted model: " + invalid));
+  }
   Result<FkCheck> check = CompareWithKdl(text, name, spec, robot.model, options);
-  if (!check.ok()) return check.status();
+  if (!check.ok()) return WithUrdfLine(text, name, check.status());
   robot.check = *check;
   return robot;
 }

@@ -129,7 +129,7 @@ TEST(UrdfRobot, RefusesWhatTheModelCannotHold) {
   ExpectRefused(ur, {"base_link", "tool9", ""}, "tip_link `tool9` is not a link of robot `ur5e`");
   ExpectRefused(ur, {"tool0", "base_link", ""}, "link `base_link` is not below link `tool0`");
   ExpectRefused(ur, {"base_link", "link3", "camera_optical_frame"}, "joint `joint4` between tip_link `link3`");
-  ExpectRefused("<robot name=\"x\"><link name=", kWithCamera, "urdfdom could not parse");
+  ExpectRefused("<robot name=\"x\"><link name=", kWithCamera, "arm.urdf:1: unterminated tag `<link`");
 }
 
 TEST(UrdfRobot, KdlDisagreementIsRefusedNamingTheWorstPose) {

@@ -308,7 +308,9 @@ class TreeBuilder {
       return Fail(error, mark, terse_ ? "YAML anchors are not allowed in a sequence index"
                                       : "YAML anchors (&name) are not supported; write the values out");
     }
-    if (tag != nullptr && Text(tag) != "!") {
+    const bool accepted = tag != nullptr && !rules_.accepted_tag_prefix.empty() &&
+                          Text(tag).rfind(rules_.accepted_tag_prefix, 0) == 0;
+    if (tag != nullptr && Text(tag) != "!" && !accepted) {
       return Fail(error, mark, "explicit YAML tags (" + Text(tag) + ") are not " + (terse_ ? "allowed" : "supported"));
     }
     return true;
@@ -372,7 +374,8 @@ class TreeBuilder {
 Result<YamlDocument> ParseYamlText(const std::string& text_in, const std::string& name, const YamlRules& rules) {
   if (text_in.size() > rules.max_bytes) {
     const int line = 1 + static_cast<int>(std::count(text_in.begin(), text_in.begin() + rules.max_bytes, '\n'));
-    return UsageError("the file is larger than " + std::to_string(rules.max_bytes) + " bytes (the limit falls at " +
+    return UsageError(name + " is " + std::to_string(text_in.size()) + " bytes, more than the limit of " +
+                      std::to_string(rules.max_bytes) + " bytes (the limit falls at " +
                       At(name, line) + ")");
   }
   std::string text = text_in;

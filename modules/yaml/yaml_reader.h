@@ -38,6 +38,9 @@ struct YamlRules {
   int max_depth = kMaxYamlDepth;  // nested sequences and maps
   std::size_t max_nodes = kMaxYamlNodes;
   YamlWording wording = YamlWording::kUserFile;
+  // Explicit tags that start with this are accepted (and ignored): OpenCV's `!!opencv-matrix` is
+  // "tag:yaml.org,2002:opencv-matrix". Empty: every explicit tag but `!` is refused.
+  std::string accepted_tag_prefix;
 };
 
 struct YamlNode {

@@ -56,17 +56,17 @@ TEST(YamlReader, BomAndCrlfAreAcceptedAndLinesCountOnce) {
 TEST(YamlReader, UserFileRefusalsSayWhereAfterTheProblem) {
   EXPECT_EQ(Refusal("a: 1\nb: &x 2\n"), "YAML anchors (&name) are not supported; write the values out at f.yaml:2");
   EXPECT_EQ(Refusal("a: 1\na: 2\n"), "duplicate key `a` at f.yaml:2");
-  EXPECT_EQ(Refusal("a: [[[1]]]\n", YamlRules{kMaxYamlBytes, 2, kMaxYamlNodes, YamlWording::kUserFile}),
+  EXPECT_EQ(Refusal("a: [[[1]]]\n", YamlRules{kMaxYamlBytes, 2, kMaxYamlNodes, YamlWording::kUserFile, ""}),
             "YAML nested deeper than 2 levels at f.yaml:1");
   EXPECT_NE(Refusal("a: b\x01\n").find("control character U+0001 at f.yaml:1"), std::string::npos);
   EXPECT_NE(Refusal("a: 1\nb: \xC3\x28\n").find("invalid UTF-8 (byte 0xC3) at f.yaml:2"), std::string::npos);
   EXPECT_EQ(Refusal("\xFF\xFE" "a\0"), "a UTF-16 or UTF-32 byte order mark at f.yaml:1: the file is not UTF-8; save it as UTF-8");
   EXPECT_EQ(Refusal("a: 1\n---\nb: 2\n"), "more than one YAML document (a second `---`) at f.yaml:2");
   EXPECT_EQ(Refusal("# only a comment\n"), "no YAML document at f.yaml:1 (the file is empty or holds only comments)");
-  EXPECT_EQ(Refusal("a: 12345\n", YamlRules{4, kMaxYamlDepth, kMaxYamlNodes, YamlWording::kUserFile}),
-            "the file is larger than 4 bytes (the limit falls at f.yaml:1)");
-  EXPECT_EQ(Refusal("a: 1\nb: 2\nc: 3\n", YamlRules{9, kMaxYamlDepth, kMaxYamlNodes, YamlWording::kUserFile}),
-            "the file is larger than 9 bytes (the limit falls at f.yaml:2)");
+  EXPECT_EQ(Refusal("a: 12345\n", YamlRules{4, kMaxYamlDepth, kMaxYamlNodes, YamlWording::kUserFile, ""}),
+            "f.yaml is 9 bytes, more than the limit of 4 bytes (the limit falls at f.yaml:1)");
+  EXPECT_EQ(Refusal("a: 1\nb: 2\nc: 3\n", YamlRules{9, kMaxYamlDepth, kMaxYamlNodes, YamlWording::kUserFile, ""}),
+            "f.yaml is 15 bytes, more than the limit of 9 bytes (the limit falls at f.yaml:2)");
   EXPECT_NE(Refusal("a: {\n").find("malformed YAML at f.yaml:"), std::string::npos);
   EXPECT_EQ(Refusal("a: 1\nb: *x\n"), "YAML aliases (*name) are not supported; write the values out at f.yaml:2");
 }
@@ -123,6 +123,18 @@ TEST(YamlReader, OpenCvFirstLineIsAComment) {
   ASSERT_TRUE(doc.ok()) << doc.status().ToString();
   EXPECT_EQ(doc->root.key_lines, (std::vector<int>{3}));
   EXPECT_NE(Refusal("%FOO bar\n---\nx: 1\n").find("malformed YAML at f.yaml:1"), std::string::npos);
+}
+
+// OpenCV camera files are checked by this reader (depth, duplicate keys) before OpenCV reads them: their
+// `!!opencv-matrix` tags are accepted when the rules say so, other tags still refused.
+TEST(YamlReader, TagsWithTheAcceptedPrefixPass) {
+  const std::string text = "%YAML:1.0\n---\nk: !!opencv-matrix\n  rows: 1\n";
+  EXPECT_NE(Refusal(text).find("explicit YAML tags (tag:yaml.org,2002:opencv-matrix) are not supported"), std::string::npos);
+  YamlRules rules;
+  rules.accepted_tag_prefix = "tag:yaml.org,2002:opencv-";
+  EXPECT_TRUE(ParseYamlText(text, "f.yaml", rules).ok());
+  EXPECT_FALSE(ParseYamlText("k: !!binary x\n", "f.yaml", rules).ok());
+  EXPECT_EQ(ParseYamlText(text + "k: 2\n", "f.yaml", rules).status().message(), "duplicate key `k` at f.yaml:5");
 }
 
 TEST(YamlReader, SequenceIndexRefusalsSayWhereFirst) {

@@ -1,6 +1,7 @@
 // Camera files on the command line (docs/camera-files.md): `detect --camera-file`, `calibrate --camera-file`
 // replacing the observations' camera, `--write-camera-opencv` / `--write-camera-visp` of the calibrated
 // intrinsics, every written file read back; bad files refused naming the file, with nothing written.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -198,6 +199,36 @@ TEST(CameraFilesCli, BadCameraFilesAreRefusedNamingTheFileAndNothingIsWritten) {
   EXPECT_NE(output.find("camera file " + sized + " is for 800x480 images, the images are 640x480"), std::string::npos)
       << output;
   EXPECT_FALSE(fs::exists(dir / "franka.yaml"));
+}
+
+// An OpenCV camera file nested 100,000 deep crashed OpenCV's reader: selfcal survived (the reader runs in a
+// child process) but answered exit 70 "internal error". A repeated key was taken (the last one). Both are
+// now refusals (exit 2) naming the file and the line, with nothing written.
+TEST(CameraFilesCli, DeeplyNestedOrRepeatedKeyOpenCvFilesAreRefusedByLine) {
+  const fs::path dir = FreshDir("camera_files", "deep");
+  const sim::SimResult world = testing::PumaArcWorld(0.2);
+  const std::string obs_path = (dir / "obs.yaml").string(), good = (dir / "good.yaml").string();
+  ASSERT_TRUE(io::SaveObservations(world.observations, obs_path).ok());
+  ASSERT_TRUE(io::SaveCameraOpenCv(world.observations.camera, good).ok());
+  const std::string text = testing::ReadFile(good);
+  const int lines = static_cast<int>(std::count(text.begin(), text.end(), '\n'));
+  std::string nested = text + "nested: ";
+  for (int i = 0; i < 100000; ++i) nested += "[";
+  for (int i = 0; i < 100000; ++i) nested += "]";
+  std::ofstream(dir / "deep.yaml") << nested << "\n";
+  std::ofstream(dir / "repeated.yaml") << text << "image_width: 800\n";
+  const fs::path out = dir / "out";
+  for (const auto& [file, expected] :
+       {std::pair<std::string, std::string>{"deep.yaml", "YAML nested deeper than 64 levels at "},
+        {"repeated.yaml", "duplicate key `image_width` at "}}) {
+    const std::string path = (dir / file).string();
+    std::string output;
+    EXPECT_EQ(RunSelfcal("calibrate " + obs_path + " --camera-file " + path + " --out " + out.string(), &output), 2)
+        << file << "\n" << output;
+    EXPECT_NE(output.find(expected + path + ":" + std::to_string(lines + 1)), std::string::npos) << file << "\n" << output;
+    EXPECT_EQ(output.find("internal error"), std::string::npos) << output;
+    EXPECT_FALSE(fs::exists(out)) << file;
+  }
 }
 
 // `selfcal` loads OpenCV and ViSP only for a camera file (libselfcal_camera_formats.so beside it): a copy

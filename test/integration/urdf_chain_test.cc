@@ -1,7 +1,10 @@
 // A URDF robot end to end: simulate (points mode) with the test UR5e URDF as the nominal robot, then the
 // calibrated.urdf that calibrate wrote re-read by urdfdom + KDL: its KDL forward kinematics equals
 // the calibrated model of calibrated_model.yaml to 1e-9 m / 1e-9 rad at random joints within the limits.
+#include <algorithm>
+#include <chrono>
 #include <filesystem>
+#include <fstream>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -55,6 +58,38 @@ TEST(UrdfChain, SimulatedUrdfRobotCalibratesAndItsCalibratedUrdfEqualsTheModel) 
   const PoseDifference moved = ComparePoses(BaseFromCam(*nominal, KinematicParameters::Nominal(*nominal), joints[0]),
                                             BaseFromCam(model, rho, joints[0]));
   EXPECT_GT(moved.position_m, 1e-5);
+  if (!HasFailure()) fs::remove_all(dir);
+}
+
+// A robot config naming a URDF followed by 100,000 nested elements: `plan --check` ended by SIGSEGV (exit
+// 139) after 15-21 s in tinyxml's recursion; every command that reads a robot config was exposed. Now a
+// refusal (exit 2) naming the URDF, the line and the limit, well under a second, nothing written.
+TEST(UrdfChain, DeeplyNestedUrdfIsRefusedByLineQuicklyByEveryCommandThatReadsARobot) {
+  const fs::path dir = testing::FreshDir("UrdfChain", "deep");
+  const std::string source = SELFCAL_SOURCE_DIR;
+  std::string urdf = testing::ReadFile(source + "/test/data/urdf/ur5e.urdf");
+  const size_t end = urdf.rfind("</robot>");
+  ASSERT_NE(end, std::string::npos);
+  const int line = 1 + static_cast<int>(std::count(urdf.begin(), urdf.begin() + static_cast<long>(end), '\n'));
+  std::string deep;
+  for (int i = 0; i < 100000; ++i) deep += "<link>";
+  for (int i = 0; i < 100000; ++i) deep += "</link>";
+  urdf.insert(end, deep);
+  std::ofstream(dir / "ur5e.urdf") << urdf;
+  fs::copy_file(source + "/test/data/urdf/ur5e_robot.yaml", dir / "robot.yaml");
+  const std::string robot = (dir / "robot.yaml").string();
+  const std::string expected = (dir / "ur5e.urdf").string() + ":" + std::to_string(line) +
+                               ": elements nested deeper than 64 levels, the limit for a URDF";
+  for (const std::string& command :
+       {"plan --check " + source + "/config/trajectories/initial_ur5e.yaml --robot " + robot,
+        "simulate --points --robot " + robot + " --out " + (dir / "sim").string()}) {
+    std::string output;
+    const auto start = std::chrono::steady_clock::now();
+    EXPECT_EQ(testing::RunSelfcal(command, &output), 2) << command << "\n" << output;
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0) << command;
+    EXPECT_NE(output.find(expected), std::string::npos) << command << "\n" << output;
+  }
+  EXPECT_FALSE(fs::exists(dir / "sim"));
   if (!HasFailure()) fs::remove_all(dir);
 }
 
