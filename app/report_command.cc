@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "app/cli_util.h"
+#include "app/output_options.h"
 #include "app/commands.h"
 #include "io/atomic_file.h"
 #include "io/report_json.h"
@@ -82,7 +83,7 @@ Command AddReportCommand(CLI::App& app) {
                 "study's JSON output; reads its input only");
   cmd->add_option("input", args->input, "report.json of calibrate or simulate, or the JSON file of study --out")
       ->required();
-  cmd->add_option("--out", args->out, "HTML file to write (replaced atomically)")->required();
+  AddOutputOption(cmd, "--out", &args->out, OutputKind::kFile, "HTML file to write (an existing one only with --force)")->required();
   cmd->add_option("--plotly-js", args->plotly_js,
                   "plotly.js to inline (default: $SELFCAL_PLOTLY_JS, else the one found at configure time: " +
                       std::string(SELFCAL_PLOTLY_JS) + ")");

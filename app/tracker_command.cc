@@ -11,6 +11,7 @@
 
 #include "app/cli_output.h"
 #include "app/cli_util.h"
+#include "app/output_options.h"
 #include "app/commands.h"
 #include "external/tracker_identification.h"
 #include "io/fanuc_tracker_csv.h"
@@ -33,10 +34,14 @@ struct TrackerArgs {
 // The identified arm as calibrate writes it (calibrated_model.yaml, docs/calibrated-model-format.md) and,
 // when the model's joints are the controller's (no J3 coupling), as calibrated.urdf. The model's base is the
 // tracker frame and its "camera" the SMR nest (flange_from_cam = flange_from_nest).
+// --out, or the report's directory.
+std::filesystem::path ModelDirectory(const TrackerArgs& args) {
+  return !args.out.empty() ? std::filesystem::path(args.out) : std::filesystem::path(args.report).parent_path();
+}
+
 Status WriteTrackerModel(const TrackerArgs& args, const std::string& data_path,
                          const external::TrackerIdentificationReport& r) {
-  const std::filesystem::path dir =
-      !args.out.empty() ? std::filesystem::path(args.out) : std::filesystem::path(args.report).parent_path();
+  const std::filesystem::path dir = ModelDirectory(args);
   if (!args.out.empty()) {
     if (Status s = EnsureDirectory(args.out); !s.ok()) return s;
   }
@@ -87,10 +92,13 @@ Command AddTrackerCommand(CLI::App& app) {
   cmd->add_option("--file", args->file, "Tracker file inside --data");
   cmd->add_option("--holdout-every", args->holdout_every, "Hold out rows i % N == 1 (0: none)")->check(CLI::Range(0, 1000));
   cmd->add_option("--j3-coupling", args->j3_coupling, "Model q3 = J3 + c * J2 (Fanuc: 1)");
-  cmd->add_option("--report", args->report, "JSON report to write");
-  cmd->add_option("--out", args->out,
+  AddOutputOption(cmd, "--report", &args->report, OutputKind::kFile, "JSON report to write");
+  AddOutputOption(cmd, "--out", &args->out, OutputKind::kDirectory,
                   "Directory of the identified model (calibrated_model.yaml, and calibrated.urdf without J3 coupling); "
-                  "default: the report's directory");
+                  "default: the report's directory",
+                  {"calibrated_model.yaml", "calibrated.urdf"});
+  SetOutputPathWhenEmpty(cmd, "--out", [args]() { return ModelDirectory(*args).string(); });
+  AddInputPaths(cmd, [args]() { return std::vector<std::string>{(std::filesystem::path(args->data_dir) / args->file).string()}; });
   return [args]() {
     const std::string path = (std::filesystem::path(args->data_dir) / args->file).string();
     const Result<std::vector<io::FanucTrackerRow>> rows = io::LoadFanucTrackerCsv(path);
