@@ -42,11 +42,6 @@ Result<std::string> ReadPlotlyJs(const std::string& option) {
                            "SELFCAL_PLOTLY_JS=PATH");
 }
 
-bool SameFile(const std::string& a, const std::string& b) {
-  std::error_code error;
-  return std::filesystem::equivalent(a, b, error) && !error;
-}
-
 struct ReportArgs {
   std::string input;
   std::string out;
@@ -88,10 +83,6 @@ Command AddReportCommand(CLI::App& app) {
                   "plotly.js to inline (default: $SELFCAL_PLOTLY_JS, else the one found at configure time: " +
                       std::string(SELFCAL_PLOTLY_JS) + ")");
   return [args]() {
-    if (SameFile(args->input, args->out)) {
-      return Fail(Status::Error(ErrorCode::kInvalidInput, "--out " + args->out + " is the input " + args->input +
-                                                              ": report never writes over its input"));
-    }
     Result<nlohmann::json> document = io::ReadJsonFile(args->input);
     if (!document.ok()) return Fail(document.status());
     if (Status s = WriteHtmlReport(*document, args->out, args->plotly_js, args->input); !s.ok()) return Fail(s);
