@@ -31,14 +31,14 @@ struct TrackerArgs {
   std::string out;  // the model's directory; empty: the report's
 };
 
-// The identified arm as calibrate writes it (calibrated_model.yaml, docs/calibrated-model-format.md) and,
-// when the model's joints are the controller's (no J3 coupling), as calibrated.urdf. The model's base is the
-// tracker frame and its "camera" the SMR nest (flange_from_cam = flange_from_nest).
 // --out, or the report's directory.
 std::filesystem::path ModelDirectory(const TrackerArgs& args) {
   return !args.out.empty() ? std::filesystem::path(args.out) : std::filesystem::path(args.report).parent_path();
 }
 
+// The identified arm as calibrate writes it (calibrated_model.yaml, docs/calibrated-model-format.md) and,
+// when the model's joints are the controller's (no J3 coupling), as calibrated.urdf. The model's base is the
+// tracker frame and its "camera" the SMR nest (flange_from_cam = flange_from_nest).
 Status WriteTrackerModel(const TrackerArgs& args, const std::string& data_path,
                          const external::TrackerIdentificationReport& r) {
   const std::filesystem::path dir = ModelDirectory(args);
@@ -97,8 +97,13 @@ Command AddTrackerCommand(CLI::App& app) {
                   "Directory of the identified model (calibrated_model.yaml, and calibrated.urdf without J3 coupling); "
                   "default: the report's directory",
                   {"calibrated_model.yaml", "calibrated.urdf"});
-  SetOutputPathWhenEmpty(cmd, "--out", [args]() { return ModelDirectory(*args).string(); });
-  AddInputPaths(cmd, [args]() { return std::vector<std::string>{(std::filesystem::path(args->data_dir) / args->file).string()}; });
+  SetOutputPathWhenEmpty(cmd, "--out", [args]() {
+    const std::string dir = ModelDirectory(*args).string();
+    return dir.empty() ? std::string(".") : dir;  // a report in the working directory
+  });
+  AddInputPaths(cmd, [args]() {
+    return std::vector<std::string>{(std::filesystem::path(args->data_dir) / args->file).string()};
+  });
   return [args]() {
     const std::string path = (std::filesystem::path(args->data_dir) / args->file).string();
     const Result<std::vector<io::FanucTrackerRow>> rows = io::LoadFanucTrackerCsv(path);
