@@ -83,11 +83,8 @@ void PrintErrors(const char* title, const external::ErrorStats& e) {
   std::cout << "  " << title << " (" << e.count << " rows): mean " << e.mean_m * 1e3 << " mm, RMS " << e.rms_m * 1e3
             << " mm, max " << e.max_m * 1e3 << " mm, rotation RMS " << RadToDeg(e.rms_rotation_rad) << " deg\n";
 }
-}  // namespace
-
-Command AddTrackerCommand(CLI::App& app) {
-  auto args = std::make_shared<TrackerArgs>();
-  CLI::App* cmd = app.add_subcommand("identify-tracker", "Kinematic identification from laser-tracker nest poses");
+// The command's options; the model's directory and the tracker file for the output-path check.
+void AddTrackerOptions(CLI::App* cmd, const std::shared_ptr<TrackerArgs>& args) {
   cmd->add_option("--data", args->data_dir, "Folder holding the tracker file")->required();
   cmd->add_option("--file", args->file, "Tracker file inside --data");
   cmd->add_option("--holdout-every", args->holdout_every, "Hold out rows i % N == 1 (0: none)")->check(CLI::Range(0, 1000));
@@ -104,6 +101,14 @@ Command AddTrackerCommand(CLI::App& app) {
   AddInputPaths(cmd, [args]() {
     return std::vector<std::string>{(std::filesystem::path(args->data_dir) / args->file).string()};
   });
+}
+
+}  // namespace
+
+Command AddTrackerCommand(CLI::App& app) {
+  auto args = std::make_shared<TrackerArgs>();
+  CLI::App* cmd = app.add_subcommand("identify-tracker", "Kinematic identification from laser-tracker nest poses");
+  AddTrackerOptions(cmd, args);
   return [args]() {
     const std::string path = (std::filesystem::path(args->data_dir) / args->file).string();
     const Result<std::vector<io::FanucTrackerRow>> rows = io::LoadFanucTrackerCsv(path);
