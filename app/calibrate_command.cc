@@ -10,6 +10,7 @@
 #include "app/cli_util.h"
 #include "app/commands.h"
 #include "app/model_exports.h"
+#include "app/output_options.h"
 #include "app/report_command.h"
 #include "io/camera_file.h"
 #include "io/hand_eye_file.h"
@@ -36,31 +37,6 @@ struct LoadedInput {
   // observations (the file is parsed once).
   std::optional<io::RobotOrigin> origin;
 };
-
-// Refuses (kUsage, naming both paths) an output directory that is the session directory or inside it,
-// compared as weakly canonical absolute paths (symlinks of the existing part resolved), so that a
-// calibration never writes into the session it reads.
-Status CheckOutputOutsideSession(const std::string& out_dir, const std::string& session_path) {
-  namespace fs = std::filesystem;
-  auto resolve = [](const std::string& path) {
-    std::error_code error;
-    fs::path resolved = fs::weakly_canonical(fs::absolute(path), error);
-    if (error) resolved = fs::absolute(path).lexically_normal();
-    while (!resolved.empty() && resolved.filename().empty() && resolved != resolved.root_path()) {
-      resolved = resolved.parent_path();  // "a/b/" names b
-    }
-    return resolved;
-  };
-  const fs::path session = resolve(session_path);
-  const fs::path out = resolve(out_dir);
-  if (std::mismatch(session.begin(), session.end(), out.begin(), out.end()).first != session.end()) {
-    return Status::Ok();
-  }
-  return Status::Error(ErrorCode::kInvalidInput, "output directory " + out_dir + " is " +
-                                             (out == session ? "the session directory " : "inside the session ") +
-                                             session_path +
-                                             ": calibrate never writes into a session; choose --out outside it");
-}
 
 void PrintSummary(const session::JournalSummary& s) {
   std::cout << "session: " << s.samples_accepted << " of " << s.poses_planned << " poses accepted, " << s.resumes
@@ -110,7 +86,6 @@ Result<LoadedInput> LoadInput(const CalibrateRequest& request) {
     if (Status s = io::CheckCameraFileSupport(); !s.ok()) return s;
   }
   if (session::IsSessionDirectory(request.input)) {
-    if (Status s = CheckOutputOutsideSession(request.out_dir, request.input); !s.ok()) return s;
     Result<session::SessionObservations> session = session::LoadSessionObservations(request.input);
     if (!session.ok()) return session.status();
     for (const std::string& finding : session->findings) {
@@ -153,6 +128,12 @@ Status WriteCameraFiles(const CalibrateRequest& request, const calibration::Cali
   if (!report.model) {
     std::cout << "camera files: not written (no calibrated model)\n";
     return Status::Ok();
+  }
+  for (const std::string& path : {request.write_camera_opencv, request.write_camera_visp}) {
+    const std::string directory = std::filesystem::path(path).parent_path().string();
+    if (!directory.empty()) {  // checked before the solve (output_options.h): e.g. inside --out
+      if (Status s = EnsureDirectory(directory); !s.ok()) return s;
+    }
   }
   if (!request.write_camera_opencv.empty()) {
     if (Status s = io::SaveCameraOpenCv(report.model->camera, request.write_camera_opencv); !s.ok()) return s;
@@ -274,6 +255,12 @@ void AddParameterMaskOptions(CLI::App* cmd, std::vector<std::string>* fix, std::
       ->delimiter(',');
 }
 
+std::vector<std::string> CalibrationOutputFiles() {
+  return {"observations.yaml", "report.json",           "report.html",
+          "calibrated_model.yaml", "calibrated.urdf", "calibrated_robot.yaml", "camera_static_transform.yaml",
+          "hand_eye.yaml"};
+}
+
 int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   Result<LoadedInput> loaded = LoadInput(request);
   if (!loaded.ok()) return Fail(loaded.status());
@@ -322,7 +309,8 @@ Command AddCalibrateCommand(CLI::App& app) {
   cmd->add_option("observations", request->input,
                   "Observations file (docs/observations-format.md) or session directory (docs/session-format.md)")
       ->required();
-  cmd->add_option("--out", request->out_dir, "Output directory (created if missing)");
+  AddOutputOption(cmd, "--out", &request->out_dir, OutputKind::kDirectory,
+                  "Output directory (created if missing; outside any session)", CalibrationOutputFiles());
   cmd->add_option("--seed", request->seed, "Seed of the RANSAC sampling (results are deterministic per seed)");
   AddMethodOption(cmd, method.get());
   AddParameterMaskOptions(cmd, &request->fix, &request->free);
@@ -336,9 +324,9 @@ Command AddCalibrateCommand(CLI::App& app) {
   cmd->add_option("--camera-name", request->camera_name,
                   "The camera of a ViSP --camera-file holding several; also the name --write-camera-visp writes "
                   "(default Camera)");
-  cmd->add_option("--write-camera-opencv", request->write_camera_opencv,
+  AddOutputOption(cmd, "--write-camera-opencv", &request->write_camera_opencv, OutputKind::kFileAndParents,
                   "Also write the calibrated intrinsics as an OpenCV FileStorage YAML file (when accepted)");
-  cmd->add_option("--write-camera-visp", request->write_camera_visp,
+  AddOutputOption(cmd, "--write-camera-visp", &request->write_camera_visp, OutputKind::kFileAndParents,
                   "Also write the calibrated intrinsics as a ViSP XML file (when accepted; refused, before anything is "
                   "written, for a lens with k2, p1, p2 or k3)");
   auto no_html = std::make_shared<bool>(false);

@@ -49,6 +49,10 @@ struct CalibrationRun {
   calibration::CalibrationReport report;
 };
 
+// The names calibrate (and simulate, through it) may write into its output directory: one that holds any
+// of them is refused without --force (output_options.h).
+std::vector<std::string> CalibrationOutputFiles();
+
 // Loads request.input (a session directory when it holds session.json), calibrates, writes into
 // request.out_dir; returns the process exit code. *run (optional) receives the observations and report.
 int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run = nullptr);

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "app/cli_help.h"
 #include "app/cli_output.h"
 #include "app/cli_util.h"
+#include "app/output_options.h"
 
 namespace selfcal::app {
 
@@ -25,6 +27,10 @@ int RunCommandLine(int argc, char** argv, const std::vector<CommandEntry>& entri
   std::vector<std::pair<const char*, Command>> commands;
   for (const CommandEntry& entry : entries) commands.emplace_back(entry.name, entry.add(app));
   AddOutputFlags(app);
+  if (argc == 1 && std::getenv(kListOutputOptionsVariable) != nullptr) {  // for the output-path test; not in the help
+    ListOutputOptions(app, std::cout);
+    return static_cast<int>(ExitCode::kOk);
+  }
   // CLI11 answers --help before it looks at the other words, so `selfcal calibrat --help` would print
   // the top-level help and exit 0: a mistyped command or option beside --help is a usage error too.
   for (int i = 1; i < argc; ++i) {
@@ -58,7 +64,12 @@ int RunCommandLine(int argc, char** argv, const std::vector<CommandEntry>& entri
       if (!app.got_subcommand(name)) continue;
       std::string full_name = name;
       for (const CLI::App* sub : app.get_subcommand(name)->get_subcommands()) full_name += " " + sub->get_name();
-      return RunWithOutputMode(full_name, command);
+      // Every output path is checked before the command does any work (output_options.h).
+      const CLI::App& chosen = *app.get_subcommand(name);
+      return RunWithOutputMode(full_name, [&chosen, &command]() {
+        if (Status s = CheckOutputOptions(chosen); !s.ok()) return Fail(s);
+        return command();
+      });
     }
   } catch (const std::exception& e) {
     // Nothing the user did explains an exception escaping a command: every expected failure is a Status

@@ -8,6 +8,7 @@
 
 #include "app/cli_output.h"
 #include "app/cli_util.h"
+#include "app/output_options.h"
 #include "app/commands.h"
 #include "compensation/compensation.h"
 #include "io/robot_config.h"
@@ -114,7 +115,7 @@ Command AddCompensateCommand(CLI::App& app) {
       "for a controller that takes no model)");
   cmd->add_option("model", args->model, "Calibrated model (calibrated_model.yaml of calibrate)")->required();
   cmd->add_option("--targets", args->targets, "Target poses in the base frame (docs/compensation.md)")->required();
-  cmd->add_option("--out", args->out, "Joint file to write (docs/trajectory-format.md)")->required();
+  AddOutputOption(cmd, "--out", &args->out, OutputKind::kFile, "Joint file to write (docs/trajectory-format.md)")->required();
   cmd->add_option("--robot", args->robot,
                   "The nominal robot config: each target is first solved on it (what the controller's own model "
                   "would command), from the target's seed or the previous solution; without it the seeds are used");

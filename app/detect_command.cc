@@ -11,6 +11,7 @@
 
 #include "app/cli_output.h"
 #include "app/cli_util.h"
+#include "app/output_options.h"
 #include "app/commands.h"
 #include "base/atomic_file.h"
 #include "detection/contact_sheet.h"
@@ -248,8 +249,9 @@ Command AddDetectCommand(CLI::App& app) {
                   "Robot poses: a directory or glob of per-image files (ROS x,y,z,qx..qw or ViSP vpPoseVector), "
                   "or a selfcal-poses list")
       ->required();
-  cmd->add_option("--out", a->out, "Observations file to write (docs/observations-format.md)")->required();
-  cmd->add_option("--contact-sheet", a->contact_sheet, "Also write every image with its points and ids as one PNG");
+  AddOutputOption(cmd, "--out", &a->out, OutputKind::kFile, "Observations file to write (docs/observations-format.md)")->required();
+  AddOutputOption(cmd, "--contact-sheet", &a->contact_sheet, OutputKind::kFile,
+                  "Also write every image with its points and ids as one PNG");
   cmd->add_option("--contact-sheet-tile-px", a->sheet_tile_px, "Largest thumbnail width on the contact sheet, px")
       ->check(CLI::Range(64, 8192));
   cmd->add_option("--detector", a->detector, "dots or chessboard")->check(CLI::IsMember({"dots", "chessboard"}));

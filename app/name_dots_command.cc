@@ -14,6 +14,7 @@
 
 #include "acquisition/dot_naming.h"
 #include "app/cli_util.h"
+#include "app/output_options.h"
 #include "app/commands.h"
 #include "app/identify_options.h"
 #include "base/atomic_file.h"
@@ -176,8 +177,9 @@ Command AddNameDotsCommand(CLI::App& app) {
       "Grab one frame, detect and name its dots, save it with every id drawn, set the yardstick in the setup");
   cmd->add_option("--image", a->image, "Name the dots of this image file (PNG, JPEG, PGM)");
   cmd->add_option("--device", a->device, "...or of one frame of this V4L2 camera (e.g. /dev/video0)");
-  cmd->add_option("--setup", a->setup, "Setup file to write or update (docs/session-format.md)")->required();
-  cmd->add_option("--out", a->out_png, "Annotated PNG to write")->required();
+  AddOutputOption(cmd, "--setup", &a->setup, OutputKind::kUpdatedFile,
+                  "Setup file to write or update (docs/session-format.md; outside any session)")->required();
+  AddOutputOption(cmd, "--out", &a->out_png, OutputKind::kFile, "Annotated PNG to write")->required();
   cmd->add_flag("--show", a->show, "Also show the annotated image in an X11 window (click to close)");
   cmd->add_option("--yardstick", a->yardstick, "The yardstick's two end dots A,B (ids as drawn)")->delimiter(',');
   cmd->add_option("--length-mm", a->length_mm, "The yardstick's length, mm")->check(CLI::PositiveNumber);

@@ -8,6 +8,7 @@
 
 #include "app/cli_output.h"
 #include "app/cli_util.h"
+#include "app/output_options.h"
 #include "app/commands.h"
 #include "io/robot_config.h"
 #include "io/trajectory_file.h"
@@ -102,7 +103,7 @@ void AddPlanOptions(CLI::App* cmd, PlanArgs* args) {
   cmd->add_option("--start", args->start,
                   "Start trajectory (offending poses are repaired from a pool); default: "
                   "config/trajectories/initial_<robot name>.yaml");
-  cmd->add_option("--out", args->out, "Plan file to write");
+  AddOutputOption(cmd, "--out", &args->out, OutputKind::kFileAndParents, "Plan file to write (its directory created)");
   cmd->add_option("--check", args->check,
                   "Check this plan instead of planning (exit 3 when it has problems, 2 when it is for another robot)");
   cmd->add_option("--criterion", args->criterion,

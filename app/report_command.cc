@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "app/cli_util.h"
+#include "app/output_options.h"
 #include "app/commands.h"
 #include "io/atomic_file.h"
 #include "io/report_json.h"
@@ -39,11 +40,6 @@ Result<std::string> ReadPlotlyJs(const std::string& option) {
                            "). report.html inlines it: install Debian's python3-plotly (scripts/install-deps, or "
                            "apt-get install python3-plotly), or name the file with --plotly-js PATH or "
                            "SELFCAL_PLOTLY_JS=PATH");
-}
-
-bool SameFile(const std::string& a, const std::string& b) {
-  std::error_code error;
-  return std::filesystem::equivalent(a, b, error) && !error;
 }
 
 struct ReportArgs {
@@ -82,15 +78,11 @@ Command AddReportCommand(CLI::App& app) {
                 "study's JSON output; reads its input only");
   cmd->add_option("input", args->input, "report.json of calibrate or simulate, or the JSON file of study --out")
       ->required();
-  cmd->add_option("--out", args->out, "HTML file to write (replaced atomically)")->required();
+  AddOutputOption(cmd, "--out", &args->out, OutputKind::kFile, "HTML file to write (an existing one only with --force)")->required();
   cmd->add_option("--plotly-js", args->plotly_js,
                   "plotly.js to inline (default: $SELFCAL_PLOTLY_JS, else the one found at configure time: " +
                       std::string(SELFCAL_PLOTLY_JS) + ")");
   return [args]() {
-    if (SameFile(args->input, args->out)) {
-      return Fail(Status::Error(ErrorCode::kInvalidInput, "--out " + args->out + " is the input " + args->input +
-                                                              ": report never writes over its input"));
-    }
     Result<nlohmann::json> document = io::ReadJsonFile(args->input);
     if (!document.ok()) return Fail(document.status());
     if (Status s = WriteHtmlReport(*document, args->out, args->plotly_js, args->input); !s.ok()) return Fail(s);

@@ -18,6 +18,7 @@
 
 #include "app/cli_output.h"
 #include "app/cli_util.h"
+#include "app/output_options.h"
 #include "app/commands.h"
 #include "capture/v4l2_camera.h"
 #include "io/observations_file.h"
@@ -527,7 +528,8 @@ int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
 Command AddRunCommand(CLI::App& app) {
   auto a = std::make_shared<RunSettings>();
   CLI::App* cmd = app.add_subcommand("run", "Drive a robot through a plan and record a session directory");
-  cmd->add_option("--session", a->session, "Session directory (created; never overwritten)")->required();
+  AddOutputOption(cmd, "--session", &a->session, OutputKind::kSessionDirectory,
+                  "Session directory (created, never overwritten, never inside another session)")->required();
   cmd->add_flag("--resume", a->resume, "Continue a session after a stop or crash (checks every input's hash)");
   cmd->add_flag("--force-resume-with-changed-config", a->force_changed_config,
                 "Resume although an input differs from the recorded one");

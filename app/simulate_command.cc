@@ -13,6 +13,7 @@
 #include "app/session_command.h"
 #include "app/cli_output.h"
 #include "app/cli_util.h"
+#include "app/output_options.h"
 #include "app/commands.h"
 #include "io/report_json.h"
 #include "io/observations_file.h"
@@ -204,6 +205,14 @@ nlohmann::json CompareBundleWithTruth(const sim::SimResult& world, const Observa
 
 namespace {
 
+// What simulate writes into --out beside its sessions (which are never overwritten: FreshSessionPath).
+std::vector<std::string> SimulateOutputFiles() {
+  std::vector<std::string> files = CalibrationOutputFiles();
+  files.push_back("truth.json");
+  files.push_back("comparison_with_truth.json");
+  return files;
+}
+
 // The first free "<out>/session", "<out>/session-2", ...: sessions are never overwritten (C10).
 std::string FreshSessionPath(const std::string& out) {
   for (int k = 1;; ++k) {
@@ -293,7 +302,8 @@ Command AddSimulateCommand(CLI::App& app) {
   AddRobotOption(cmd, &args->robot);
   cmd->add_option("--trajectory", args->trajectory,
                   "Trajectory file (for the robot); default: config/trajectories/initial_<robot name>.yaml");
-  cmd->add_option("--out", args->out, "Output directory");
+  AddOutputOption(cmd, "--out", &args->out, OutputKind::kDirectory, "Output directory (created if missing; outside any session)",
+                  SimulateOutputFiles());
   cmd->add_option("--noise-px", args->noise_px, "Pixel noise std (px)")->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--seed", args->seed, "World and noise seed");
   cmd->add_flag("--perturb-gauge", args->perturb_gauge, "Also perturb the parameters the measurements cannot see");
@@ -409,7 +419,7 @@ Command AddMakeTrajectoryCommand(CLI::App& app) {
   auto home_deg = std::make_shared<std::vector<double>>();
   CLI::App* cmd = app.add_subcommand("make-trajectory", "Write the smooth initial trajectory around the simulated scene");
   cmd->add_option("--robot", *robot_path, "Robot config");
-  cmd->add_option("--out", *out_path, "Trajectory file to write")->required();
+  AddOutputOption(cmd, "--out", out_path.get(), OutputKind::kFile, "Trajectory file to write")->required();
   cmd->add_option("--poses", *poses, "Number of poses")->check(CLI::Range(3, 1000));
   cmd->add_option("--home-deg", *home_deg,
                   "Joint angles (deg, comma-separated) where the camera looks at the scene; default: the config's "

@@ -4,6 +4,7 @@
 
 #include "app/cli_output.h"
 #include "app/cli_util.h"
+#include "app/output_options.h"
 #include "app/commands.h"
 #include "report/study_report.h"
 #include "io/report_json.h"
@@ -39,7 +40,7 @@ Command AddStudyCommand(CLI::App& app) {
   cmd->add_option("--runs", args->runs, "Runs per cell")->check(CLI::Range(1, 100000));
   cmd->add_option("--noise-px", args->noise, "Pixel noise levels (std, px)")->delimiter(',');
   cmd->add_option("--seed", args->seed, "Base seed");
-  cmd->add_option("--out", args->out, "JSON output file");
+  AddOutputOption(cmd, "--out", &args->out, OutputKind::kFile, "JSON output file");
   cmd->add_flag("--no-opencv", args->no_opencv, "Skip the OpenCV comparison row");
   cmd->add_flag("--no-bound", args->no_bound, "Skip the Cramer-Rao rows");
   cmd->add_flag("--no-bundle", args->no_bundle, "Skip the kinematic bundle adjustment rows");

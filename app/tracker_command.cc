@@ -11,6 +11,7 @@
 
 #include "app/cli_output.h"
 #include "app/cli_util.h"
+#include "app/output_options.h"
 #include "app/commands.h"
 #include "external/tracker_identification.h"
 #include "io/fanuc_tracker_csv.h"
@@ -30,13 +31,17 @@ struct TrackerArgs {
   std::string out;  // the model's directory; empty: the report's
 };
 
+// --out, or the report's directory.
+std::filesystem::path ModelDirectory(const TrackerArgs& args) {
+  return !args.out.empty() ? std::filesystem::path(args.out) : std::filesystem::path(args.report).parent_path();
+}
+
 // The identified arm as calibrate writes it (calibrated_model.yaml, docs/calibrated-model-format.md) and,
 // when the model's joints are the controller's (no J3 coupling), as calibrated.urdf. The model's base is the
 // tracker frame and its "camera" the SMR nest (flange_from_cam = flange_from_nest).
 Status WriteTrackerModel(const TrackerArgs& args, const std::string& data_path,
                          const external::TrackerIdentificationReport& r) {
-  const std::filesystem::path dir =
-      !args.out.empty() ? std::filesystem::path(args.out) : std::filesystem::path(args.report).parent_path();
+  const std::filesystem::path dir = ModelDirectory(args);
   if (!args.out.empty()) {
     if (Status s = EnsureDirectory(args.out); !s.ok()) return s;
   }
@@ -78,19 +83,32 @@ void PrintErrors(const char* title, const external::ErrorStats& e) {
   std::cout << "  " << title << " (" << e.count << " rows): mean " << e.mean_m * 1e3 << " mm, RMS " << e.rms_m * 1e3
             << " mm, max " << e.max_m * 1e3 << " mm, rotation RMS " << RadToDeg(e.rms_rotation_rad) << " deg\n";
 }
+// The command's options; the model's directory and the tracker file for the output-path check.
+void AddTrackerOptions(CLI::App* cmd, const std::shared_ptr<TrackerArgs>& args) {
+  cmd->add_option("--data", args->data_dir, "Folder holding the tracker file")->required();
+  cmd->add_option("--file", args->file, "Tracker file inside --data");
+  cmd->add_option("--holdout-every", args->holdout_every, "Hold out rows i % N == 1 (0: none)")->check(CLI::Range(0, 1000));
+  cmd->add_option("--j3-coupling", args->j3_coupling, "Model q3 = J3 + c * J2 (Fanuc: 1)");
+  AddOutputOption(cmd, "--report", &args->report, OutputKind::kFile, "JSON report to write");
+  AddOutputOption(cmd, "--out", &args->out, OutputKind::kDirectory,
+                  "Directory of the identified model (calibrated_model.yaml, and calibrated.urdf without J3 coupling); "
+                  "default: the report's directory",
+                  {"calibrated_model.yaml", "calibrated.urdf"});
+  SetOutputPathWhenEmpty(cmd, "--out", [args]() {
+    const std::string dir = ModelDirectory(*args).string();
+    return dir.empty() ? std::string(".") : dir;  // a report in the working directory
+  });
+  AddInputPaths(cmd, [args]() {
+    return std::vector<std::string>{(std::filesystem::path(args->data_dir) / args->file).string()};
+  });
+}
+
 }  // namespace
 
 Command AddTrackerCommand(CLI::App& app) {
   auto args = std::make_shared<TrackerArgs>();
   CLI::App* cmd = app.add_subcommand("identify-tracker", "Kinematic identification from laser-tracker nest poses");
-  cmd->add_option("--data", args->data_dir, "Folder holding the tracker file")->required();
-  cmd->add_option("--file", args->file, "Tracker file inside --data");
-  cmd->add_option("--holdout-every", args->holdout_every, "Hold out rows i % N == 1 (0: none)")->check(CLI::Range(0, 1000));
-  cmd->add_option("--j3-coupling", args->j3_coupling, "Model q3 = J3 + c * J2 (Fanuc: 1)");
-  cmd->add_option("--report", args->report, "JSON report to write");
-  cmd->add_option("--out", args->out,
-                  "Directory of the identified model (calibrated_model.yaml, and calibrated.urdf without J3 coupling); "
-                  "default: the report's directory");
+  AddTrackerOptions(cmd, args);
   return [args]() {
     const std::string path = (std::filesystem::path(args->data_dir) / args->file).string();
     const Result<std::vector<io::FanucTrackerRow>> rows = io::LoadFanucTrackerCsv(path);

@@ -250,7 +250,9 @@ TEST(Cli, PlanCheckAcceptsTheArcAndThePlannedFile) {
   EXPECT_NE(output.find("predicted std at 0.2 px"), std::string::npos) << output;
   EXPECT_EQ(RunSelfcal("plan --criterion best --out " + a, &output), 2) << output;
   // The defaults follow the robot: start and scene from initial_ur5e.yaml.
-  EXPECT_EQ(RunSelfcal("plan --robot config/robots/ur5e.yaml --criterion a-optimal --out " + a, &output), 0) << output;
+  // --force: a.yaml is the plan written above.
+  EXPECT_EQ(RunSelfcal("plan --robot config/robots/ur5e.yaml --criterion a-optimal --force --out " + a, &output), 0)
+      << output;
   EXPECT_NE(output.find("initial_ur5e.yaml"), std::string::npos) << output;
 }
 
@@ -332,8 +334,12 @@ TEST(CliSession, SimulateRunsASessionEndToEndAndBeatsTheNominalModel) {
   const double nominal = comparison["bundle"]["error3d_rms_mm"]["nominal"].get<double>();
   const double bundle = comparison["bundle"]["error3d_rms_mm"]["bundle"].get<double>();
   EXPECT_LT(bundle, 0.25 * nominal) << output;
-  // A second simulate into the same folder makes a new session, never overwriting the first (C10).
-  ASSERT_EQ(RunSelfcal("simulate --out " + dir.string() + " --seed 2", &output), 0) << output;
+  // A second simulate into the same folder is refused (its files are there) unless --force, and then makes a
+  // new session, never overwriting the first (C10).
+  EXPECT_EQ(RunSelfcal("simulate --out " + dir.string() + " --seed 2", &output), 2) << output;
+  EXPECT_NE(output.find("--force"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(dir / "session-2"));
+  ASSERT_EQ(RunSelfcal("simulate --out " + dir.string() + " --seed 2 --force", &output), 0) << output;
   EXPECT_TRUE(fs::exists(dir / "session-2" / "session.json"));
 }
 
@@ -391,11 +397,12 @@ TEST(CliNameDots, NamesARecordedFrameWritesThePngAndASetupThatRunAccepts) {
       << output;
   EXPECT_NE(output.find("9999"), std::string::npos) << output;
   EXPECT_FALSE(fs::exists(setup));
+  // The refusal leaves the annotated PNG for the operator to look at: the next tries replace it (--force).
   EXPECT_EQ(RunSelfcal("name-dots --image " + frame + " --setup " + setup + " --out " + png +
-                           " --fx-px 1000 --pixel-noise-px 0.02 --yardstick 3,3 --length-mm 200", &output), 2)
+                           " --fx-px 1000 --pixel-noise-px 0.02 --yardstick 3,3 --length-mm 200 --force", &output), 2)
       << output;
   ASSERT_EQ(RunSelfcal("name-dots --image " + frame + " --setup " + setup + " --out " + png +
-                           " --fx-px 1000 --pixel-noise-px 0.02 --yardstick 3,10 --length-mm 200", &output), 0)
+                           " --fx-px 1000 --pixel-noise-px 0.02 --yardstick 3,10 --length-mm 200 --force", &output), 0)
       << output;
   std::ifstream png_in(png, std::ios::binary);
   std::string magic(8, '\0');
@@ -415,7 +422,8 @@ TEST(CliNameDots, NamesARecordedFrameWritesThePngAndASetupThatRunAccepts) {
     EXPECT_NE(output.find(row), std::string::npos) << row;
   }
   // An update keeps the yardstick unless a new one is given.
-  ASSERT_EQ(RunSelfcal("name-dots --image " + frame + " --setup " + setup + " --out " + png, &output), 0) << output;
+  ASSERT_EQ(RunSelfcal("name-dots --image " + frame + " --setup " + setup + " --out " + png + " --force", &output), 0)
+      << output;
   EXPECT_EQ(ReadJson(setup)["yardsticks"], written["yardsticks"]);
   // run takes it with the reference identifier; it only stops at the camera this machine does not have.
   const fs::path joints = dir / "joints.txt";
