@@ -40,7 +40,7 @@ struct Args {
   uint64_t seed = 0;
   double latency_s = 0.05;
   double encoder_noise_deg = 0;
-  std::vector<int> reject, hang, protective_stop, emergency_stop, drop_connection, jog_after, slow_settle;
+  std::vector<int> reject, hang, protective_stop, emergency_stop, drop_connection, jog_after, slow_settle, never_settle;
   std::vector<int> stale_read, nan_read, short_read;
   double jog_deg = 0;  // 0: the default jog (0.02 rad on joint 1)
 };
@@ -92,6 +92,8 @@ int main(int argc, char** argv) {
   AddFaultOption(app, "--jog-after-move", &args.jog_after, "Someone jogs the arm after move K settled");
   app.add_option("--jog-deg", args.jog_deg, "Size of that jog on joint 1 (deg; default 0.02 rad)");
   AddFaultOption(app, "--slow-settle-move", &args.slow_settle, "Move K rings down 20 times slower");
+  AddFaultOption(app, "--never-settle-move", &args.never_settle,
+                 "After move K every joint reads 0.05 rad/s: the arm never comes to rest");
   AddFaultOption(app, "--stale-read", &args.stale_read, "Joint reading N is stale");
   AddFaultOption(app, "--nan-read", &args.nan_read, "Joint reading N has NaN in joint 2");
   AddFaultOption(app, "--short-read", &args.short_read, "Joint reading N lacks a joint");
@@ -142,6 +144,7 @@ int main(int argc, char** argv) {
     faults.jog_offset_rad[0] = args.jog_deg * kRadPerDeg;
   }
   faults.slow_settle_moves = AsSet(args.slow_settle);
+  faults.never_settle_moves = AsSet(args.never_settle);
   faults.stale_reads = AsSet(args.stale_read);
   faults.nan_reads = AsSet(args.nan_read);
   faults.short_reads = AsSet(args.short_read);

@@ -36,6 +36,8 @@
 #include "session/samples.h"
 #include "session/session_cleanup.h"
 #include "session/session_dir.h"
+#include "session/session_lock.h"
+#include "session/session_snapshot.h"
 #include "session/session_observations.h"
 #include "session/setup_file.h"
 
@@ -102,6 +104,7 @@ json RunJson(const RunSettings& a) {
             {"short_reads", a.fault_short_reads}}}};
   // The jog's delay only when not the default, so that the run.json of earlier sessions is unchanged.
   if (a.fault_jog_delay_s != RunSettings().fault_jog_delay_s) run["faults"]["jog_delay_s"] = a.fault_jog_delay_s;
+  if (!a.fault_never_settle_moves.empty()) run["faults"]["never_settle_moves"] = a.fault_never_settle_moves;
   return run;
 }
 
@@ -185,6 +188,11 @@ Status CheckRunSettings(RunSettings* a) {
                          "--camera sim renders what the simulated arm sees: it needs --robot sim, and --robot sim "
                          "needs --camera sim");
   }
+  if (sim_robot && !a->setup.empty()) {
+    return Status::Error(ErrorCode::kInvalidInput,
+                         "--setup " + a->setup + " does not apply to --robot sim: the simulated cell makes its own "
+                         "setup (camera, yardstick, checks); leave --setup out, or run a real robot and camera");
+  }
   if (!sim_robot && a->setup.empty()) {
     return Status::Error(ErrorCode::kInvalidInput,
                          "--setup FILE (camera, yardstick; docs/session-format.md) is required with a real camera");
@@ -236,6 +244,19 @@ Status LoadRunPlan(const RunSettings& a, RunPlan* run) {
   return Status::Ok();
 }
 
+// A resumed simulated cell restarts where the last accepted sample of `records` left the arm
+// (sim_session.h); other backends are where they are.
+Status RestartSimulatedArm(const RunSettings& a, const std::vector<nlohmann::json>& records, RunPlan* run) {
+  if (a.robot_backend != "sim") return Status::Ok();
+  Result<session::SessionLog> log = session::ReadSessionLog(records);
+  if (!log.ok()) return log.status();
+  if (const session::AcceptedSample* last = log->LastAcceptedSample()) {
+    simulation::RestartSimCell(&run->cell.value(), SimCellOptionsFor(a), run->plan[last->pose].joints_rad,
+                               last->sim_clock_s.value_or(0));
+  }
+  return Status::Ok();
+}
+
 // Stage 2, --resume: opens the session (inputs compared, journal recovered, orphans moved: reported) and
 // restarts the simulated arm where the last accepted sample left it (sim_session.h).
 Result<session::Session> ResumeSession(const RunSettings& a, RunPlan* run) {
@@ -249,15 +270,26 @@ Result<session::Session> ResumeSession(const RunSettings& a, RunPlan* run) {
   }
   for (const std::string& o : r.orphans) std::cout << "moved an unrecorded image aside: " << o << "\n";
   if (!r.stale_lock_from.empty()) std::cout << "took over the lock of a dead process: " << r.stale_lock_from << "\n";
-  Result<session::SessionLog> log = session::ReadSessionLog(opened->journal().records());
-  if (!log.ok()) return log.status();
-  if (a.robot_backend == "sim") {
-    if (const session::AcceptedSample* last = log->LastAcceptedSample()) {
-      simulation::RestartSimCell(&run->cell.value(), SimCellOptionsFor(a), run->plan[last->pose].joints_rad,
-                               last->sim_clock_s.value_or(0));
-    }
-  }
+  if (Status s = RestartSimulatedArm(a, opened->journal().records(), run); !s.ok()) return s;
   return opened;
+}
+
+// Stage 2, --resume --dry-run: the session read without changing anything (session::ReadSession: no lock
+// taken, no tail truncated, no image moved); the inputs compared as a resume compares them, and what a
+// resume would repair reported.
+Result<session::SessionSnapshot> InspectResume(const RunSettings& a, RunPlan* run) {
+  Result<session::SessionSnapshot> snapshot = session::ReadSession(a.session);
+  if (!snapshot.ok()) return snapshot.status();
+  const std::vector<std::string> changed = session::ChangedInputs(snapshot->manifest, run->inputs);
+  if (!changed.empty() && !a.force_changed_config) return session::ChangedInputsRefusal(a.session, changed);
+  for (const std::string& finding : snapshot->Findings()) std::cout << "dry run: " << finding << "\n";
+  if (const std::string holder = session::LockHolderNamed(a.session); !holder.empty()) {
+    std::cout << "dry run: " << a.session << "/lock names " << holder
+              << ": a resume is refused while that process holds it, and takes it over only with "
+                 "--take-over-stale-lock once it has ended; left unchanged\n";
+  }
+  if (Status s = RestartSimulatedArm(a, snapshot->records, run); !s.ok()) return s;
+  return snapshot;
 }
 
 // Stage 2, a new session: created (with its parent folder) from the inputs once the run can start (the
@@ -348,6 +380,7 @@ Status MakeBackends(const RunSettings& a, RunPlan* run, Backends* b) {
 // The session directory a run writes into, as found before anything is created.
 struct SessionTarget {
   std::optional<session::Session> opened;  // --resume of a recorded session
+  std::optional<session::SessionSnapshot> inspected;  // --resume --dry-run: read only
   bool restart_creation = false;           // --resume of an interrupted creation: made again (same inputs)
 };
 
@@ -381,9 +414,16 @@ Status PrepareSession(const RunSettings& a, RunPlan* run, Backends* backends, Se
                                "`");
     }
     std::cout << "session " << a.session << ": its creation was interrupted (no session.json, nothing recorded); "
-              << "it is created again once the run can start\n";
+              << (a.dry_run ? "a resume would create it again (dry run: left as it is)\n"
+                            : "it is created again once the run can start\n");
     out->restart_creation = true;
     return Status::Ok();
+  }
+  if (a.dry_run) {
+    Result<session::SessionSnapshot> inspected = InspectResume(a, run);
+    if (!inspected.ok()) return inspected.status();
+    out->inspected.emplace(std::move(inspected).value());
+    return a.robot_backend == "sim" ? MakeBackends(a, run, backends) : Status::Ok();
   }
   Result<session::Session> opened = ResumeSession(a, run);
   if (!opened.ok()) return opened.status();
@@ -412,8 +452,8 @@ void RecordRunFigures(const RunSettings& a, const acquisition::RunReport& report
 
 // Stage 4: the session loop (acquisition::RunSession) and what it did; returns the exit code.
 // `session` is the session to continue, or null: then `create` makes it once the run can start.
-int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, session::Session* session,
-                 const std::function<Result<session::Session*>()>& create,
+int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, const SessionTarget& target,
+                 session::Session* session, const std::function<Result<session::Session*>()>& create,
                  const std::optional<session::Session>& created) {
   const bool sim_robot = a.robot_backend == "sim";
   InstallStopHandlers();
@@ -430,6 +470,7 @@ int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, se
   context.clock = b.clock;
   context.session = session;
   context.create_session = create;
+  if (target.inspected) context.dry_run_of = &*target.inspected;  // a dry run of a resume: read only
   context.identifier = b.identifier;
   context.prediction = &run.prediction;
   context.stop_requested = &g_stop_requested;
@@ -451,7 +492,13 @@ int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, se
       report.message.rfind("not confirmed", 0) == 0) {
     return 0;
   }
-  std::cout << "run: " << acquisition::RunOutcomeName(report.outcome) << ": " << TerminalSafe(report.message) << "\n";
+  if (report.outcome == acquisition::RunOutcome::kRefused) {  // nothing moved: the refusal on stderr
+    std::cerr << "selfcal: run: refused: " << TerminalSafe(report.message) << "\n";
+    RecordError(report.message);
+  } else {
+    std::cout << "run: " << acquisition::RunOutcomeName(report.outcome) << ": " << TerminalSafe(report.message)
+              << "\n";
+  }
   std::cout << "this run: " << report.accepted << " samples accepted from pose " << report.first_pose << ", "
             << report.frames_grabbed << " frames grabbed, " << report.frames_tracked << " tracked";
   for (const auto& [reason, n] : report.skips) std::cout << ", skipped " << reason << " x" << n;
@@ -467,6 +514,11 @@ int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, se
   if (b.live_view) {
     std::cout << "live view: " << b.live_view->frames_drawn() << " frames drawn, " << b.live_view->frames_throttled()
               << " frames of moves not redrawn (at most 15 a second)\n";
+  }
+  if (report.outcome == acquisition::RunOutcome::kTooFewSamples) {
+    std::cout << "NOT COMPLETE: too few samples to calibrate. Look at the skipped poses' frames in " << a.session
+              << "/images/rejected/, fix the cause, then: selfcal run --resume --session " << a.session
+              << " --revisit-skipped 1 (same options)\n";
   }
   const bool halted =
       report.outcome == acquisition::RunOutcome::kHalted || report.outcome == acquisition::RunOutcome::kInterrupted;
@@ -520,67 +572,9 @@ int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
     created.emplace(std::move(made).value());
     return &*created;
   };
-  const int code = DriveSession(a, run, backends, target.opened ? &*target.opened : nullptr, create, created);
+  const int code = DriveSession(a, run, backends, target, target.opened ? &*target.opened : nullptr, create, created);
   if (world != nullptr && a.robot_backend == "sim") *world = std::move(run.cell.value().world);
   return code;
-}
-
-Command AddRunCommand(CLI::App& app) {
-  auto a = std::make_shared<RunSettings>();
-  CLI::App* cmd = app.add_subcommand("run", "Drive a robot through a plan and record a session directory");
-  AddOutputOption(cmd, "--session", &a->session, OutputKind::kSessionDirectory,
-                  "Session directory (created, never overwritten, never inside another session)")->required();
-  cmd->add_flag("--resume", a->resume, "Continue a session after a stop or crash (checks every input's hash)");
-  cmd->add_flag("--force-resume-with-changed-config", a->force_changed_config,
-                "Resume although an input differs from the recorded one");
-  cmd->add_flag("--take-over-stale-lock", a->take_over_stale_lock,
-                "--resume: take over a lock left by a process that ended without releasing it (you confirm that "
-                "no selfcal on the host it names uses the session)");
-  cmd->add_flag("--dry-run", a->dry_run, "Check the plan and print the preview; send no motion command, create nothing");
-  cmd->add_option("--live-view", a->live_view,
-                  "Show the camera image with the tracked dots, their ids and the pose in an X11 window: auto (when "
-                  "$DISPLAY can be opened), on (refused without a display), off")
-      ->check(CLI::IsMember({"auto", "on", "off"}));
-  cmd->add_option("--revisit-skipped", a->revisit_skipped,
-                  "--resume: visit poses skipped for too few dots, not settled, a bad frame or reading again, at "
-                  "most N more times each (0: never)")
-      ->check(CLI::Range(0, 100));
-  cmd->add_option("--robot-config", a->robot_config, "Nominal robot config");
-  cmd->add_option("--plan", a->plan, "Plan (trajectory file); default: config/trajectories/initial_<robot name>.yaml");
-  cmd->add_option("--setup", a->setup, "Camera, yardstick and checks (docs/session-format.md); not with sim");
-  cmd->add_option("--robot", a->robot_backend, "Robot backend")->check(CLI::IsMember({"sim", "network", "manual"}));
-  cmd->add_option("--address", a->address, "network backend: HOST:PORT (docs/robot-protocol.md)");
-  cmd->add_option("--camera", a->camera_backend, "Camera backend")->check(CLI::IsMember({"sim", "v4l2"}));
-  cmd->add_option("--device", a->device, "v4l2 camera device");
-  cmd->add_option("--velocity-scaling", a->velocity_scaling,
-                  "Fraction of the joint velocity limits (default 1 simulated, 0.1 real)")
-      ->check(CLI::Range(1e-3, 1.0));
-  cmd->add_option("--seed", a->seed, "sim: world, noise and robot seed");
-  cmd->add_option("--grey-noise", a->grey_noise, "sim: pixel noise std, grey levels")->check(CLI::Range(0.0, 50.0));
-  cmd->add_option("--blur-px", a->blur_px, "sim: Gaussian blur sigma, px")->check(CLI::Range(0.0, 10.0));
-  cmd->add_option("--supersampling", a->supersampling, "sim: samples per pixel side")->check(CLI::Range(1, 8));
-  AddIdentifyOptions(cmd, &a->identify, "default: the simulator's truth with sim, else order");
-  auto fault = [&](const char* name, std::vector<int>* v, const char* what) {
-    cmd->add_option(name, *v, what)
-        ->delimiter(',')
-        ->check(CLI::NonNegativeNumber)
-        ->group("Simulated faults (sim robot, 0-based call counts)");
-  };
-  fault("--fault-reject-move", &a->fault_reject_moves, "reject move #k");
-  fault("--fault-protective-stop-move", &a->fault_pstop_moves, "protective stop half way through move #k");
-  fault("--fault-hang-move", &a->fault_hang_moves, "move #k never finishes");
-  fault("--fault-disconnect-move", &a->fault_disconnect_moves, "connection lost during move #k");
-  fault("--fault-jog-after-move", &a->fault_jog_after_moves, "someone jogs the arm after move #k");
-  cmd->add_option("--fault-jog-delay-s", a->fault_jog_delay_s,
-                  "the jog comes this long after the move's arrival (0.5: while settling; the simulated session "
-                  "settles 0.6 s after arrival, so a little more jogs between settle and capture)")
-      ->check(CLI::Range(0.0, 10.0))
-      ->group("Simulated faults (sim robot, 0-based call counts)");
-  fault("--fault-slow-settle-move", &a->fault_slow_settle_moves, "move #k rings 20x longer");
-  fault("--fault-stale-read", &a->fault_stale_reads, "joint reading #n is stale");
-  fault("--fault-nan-read", &a->fault_nan_reads, "joint reading #n has a NaN");
-  fault("--fault-short-read", &a->fault_short_reads, "joint reading #n misses a joint");
-  return [a]() { return RunFromSettings(*a); };
 }
 
 }  // namespace selfcal::app

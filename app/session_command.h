@@ -38,6 +38,7 @@ struct RunSettings {
   IdentifySettings identify;  // --identify: empty is the simulator's truth, or the detection order
   std::vector<int> fault_reject_moves, fault_pstop_moves, fault_hang_moves, fault_disconnect_moves,
       fault_jog_after_moves, fault_slow_settle_moves, fault_stale_reads, fault_nan_reads, fault_short_reads;
+  std::vector<int> fault_never_settle_moves;  // recorded in run.json only when given
   double fault_jog_delay_s = 0.5;  // after the jogged move's arrival (SimulatedRobotFaults::jog_delay_s)
 };
 

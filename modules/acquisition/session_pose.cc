@@ -357,10 +357,11 @@ Runner::Step Runner::Settle(int pose, double arrival_s, double* settle_s, robot:
     if (Now() - arrival_s > o_.settle.timeout_s) {
       std::ostringstream d;
       d << "joint velocities still above " << o_.settle.velocity_threshold_rad_s << " rad/s after "
-        << o_.settle.timeout_s << " s";
+        << o_.settle.timeout_s << " s (largest " << reading->velocity_rad_s.cwiseAbs().maxCoeff()
+        << " rad/s): the arm does not come to rest; check the cell, then resume";
+      // R7: an arm that keeps moving is not driven on to the next pose (a skip would send the next move).
       if (Fault("not_settled", pose, d.str()) == Step::kEnd) return Step::kEnd;
-      Skip(pose, "not_settled", d.str());
-      return Step::kSkip;
+      return Halt(RunOutcome::kHalted, ErrorCode::kHardware, "not_settled", d.str(), pose);
     }
     c_.clock->SleepFor(o_.settle.reading_period_s);
   }

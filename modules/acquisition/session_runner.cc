@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "acquisition/session_runner_internal.h"
+#include "geometry/rigid3.h"
 #include "session/samples.h"
 
 namespace selfcal::acquisition {
@@ -85,17 +86,73 @@ Runner::Step Runner::HaltOnRobotError(const Status& status, int pose, const std:
               what + ": " + status.message(), pose);
 }
 
+const std::vector<json>& Runner::Records() const {
+  return c_.dry_run_of != nullptr ? c_.dry_run_of->records : c_.session->journal().records();
+}
+
+const std::string& Runner::SessionPath() const {
+  return c_.dry_run_of != nullptr ? c_.dry_run_of->path : c_.session->path();
+}
+
+void Runner::Conclude(const std::string& message) {
+  int identification = 0;
+  if (Result<session::SessionLog> log = session::ReadSessionLog(Records()); log.ok()) {
+    for (const std::optional<session::AcceptedSample>& sample : log->accepted) {
+      identification += sample && sample->role == PoseRole::kIdentification ? 1 : 0;
+    }
+  }
+  if (identification < o_.min_identification_samples) {
+    report_.outcome = RunOutcome::kTooFewSamples;
+    report_.error = ErrorCode::kDegenerateData;
+    report_.message = "every pose was visited, but the session holds " + std::to_string(identification) +
+                      " accepted identification samples and the calibration needs at least " +
+                      std::to_string(o_.min_identification_samples) +
+                      ": the session is not complete; resume it to visit the skipped poses again";
+    return;
+  }
+  report_.outcome = RunOutcome::kCompleted;
+  report_.error = ErrorCode::kOk;
+  report_.message = message;
+}
+
+namespace {
+
+std::string DegreesText(const Eigen::VectorXd& joints_rad) {
+  std::ostringstream out;
+  out << "[";
+  for (int j = 0; j < joints_rad.size(); ++j) out << (j > 0 ? ", " : "") << RadToDeg(joints_rad[j]);
+  out << "] deg";
+  return out.str();
+}
+
+// Where the plan the journal recorded (a prefix of it if a crash came while it was being journaled)
+// first differs from `plan`: empty when it is the same plan.
+std::string FirstPlanDifference(const session::SessionLog& log, const std::vector<PlannedPose>& plan) {
+  const int given = static_cast<int>(plan.size());
+  if (log.num_poses != given || static_cast<int>(log.plan.size()) > given) {
+    return "the session recorded a plan of " + std::to_string(log.num_poses) + " poses, the plan given has " +
+           std::to_string(given);
+  }
+  for (int i = 0; i < static_cast<int>(log.plan.size()); ++i) {
+    const PlannedPose& recorded = log.plan[i];
+    if (recorded.id == plan[i].id && recorded.joints_rad.size() == plan[i].joints_rad.size() &&
+        recorded.joints_rad == plan[i].joints_rad) {
+      continue;
+    }
+    return "the first pose that differs is pose " + std::to_string(i) + " (" + recorded.id +
+           (recorded.id == plan[i].id ? "" : ", given as " + plan[i].id) + "): recorded " +
+           DegreesText(recorded.joints_rad) + ", given " + DegreesText(plan[i].joints_rad);
+  }
+  return "";
+}
+
+}  // namespace
+
 bool Runner::StartFromJournal(const session::SessionLog& log, std::vector<int>* todo) {
   const int num_poses = static_cast<int>(plan_.size());
   if (log.started) {
-    // The recorded plan (a prefix of it if a crash came while it was being journaled) must be this one.
-    bool same = log.num_poses == num_poses && static_cast<int>(log.plan.size()) <= num_poses;
-    for (int i = 0; same && i < static_cast<int>(log.plan.size()); ++i) {
-      same = log.plan[i].id == plan_[i].id && log.plan[i].joints_rad.size() == plan_[i].joints_rad.size() &&
-             log.plan[i].joints_rad == plan_[i].joints_rad;
-    }
-    if (!same) {
-      report_.message = "session " + c_.session->path() + " recorded another plan than the one given";
+    if (const std::string difference = FirstPlanDifference(log, plan_); !difference.empty()) {
+      report_.message = "session " + SessionPath() + " recorded another plan than the one given: " + difference;
       return false;
     }
     *todo = log.PosesToVisit(o_.revisit_skipped);
@@ -104,16 +161,19 @@ bool Runner::StartFromJournal(const session::SessionLog& log, std::vector<int>* 
   }
   report_.first_pose = todo->empty() ? num_poses : todo->front();
   if (!todo->empty()) return true;
-  if (c_.session == nullptr) {
+  if (!Resuming()) {
     report_.message = "the plan has no pose: nothing to record";
+    return false;
+  }
+  if (!log.finished && c_.dry_run_of != nullptr) {  // a dry run writes nothing
+    Conclude("every pose of the session is visited; a real resume would name dots later in the recorded frames "
+             "and mark the session finished (dry run: nothing written)");
     return false;
   }
   // Every pose visited, but stopped before `finished`: the end of the session (naming later in the
   // recorded frames) is done now, as an uninterrupted run does it.
   if (!log.finished && (!NameLater() || !Record({{"type", "finished"}, {"time_s", Now()}}))) return false;
-  report_.outcome = RunOutcome::kCompleted;
-  report_.error = ErrorCode::kOk;
-  report_.message = "every pose of the session is done";
+  Conclude("every pose of the session is done");
   return false;
 }
 
@@ -134,10 +194,10 @@ bool Runner::ConnectRobot(const session::SessionLog& log, RobotAtStart* robot) {
   }
   limits_ = *limits;
   if (log.started) {  // R13: the same robot as when the session started
-    const json& started = c_.session->journal().records().front();
+    const json& started = Records().front();
     if (started.value("robot_model", "") != identity->model || started.value("robot_serial", "") != identity->serial ||
         started.value("robot_calibration", identity->calibration_id) != identity->calibration_id) {
-      report_.message = "session " + c_.session->path() + " was recorded with robot " +
+      report_.message = "session " + SessionPath() + " was recorded with robot " +
                         started.value("robot_model", "?") + " serial " + started.value("robot_serial", "?") +
                         "; this robot is " + identity->model + " serial " + identity->serial + "";
       return false;
@@ -146,7 +206,7 @@ bool Runner::ConnectRobot(const session::SessionLog& log, RobotAtStart* robot) {
     // address, a transport detail that may change when the controller restarts.
     if (started.contains("robot_limits") &&
         started["robot_limits"] != json{{"lower_rad", ToJson(limits_.lower_rad)}, {"upper_rad", ToJson(limits_.upper_rad)}}) {
-      report_.message = "session " + c_.session->path() + " was recorded under the joint limits " +
+      report_.message = "session " + SessionPath() + " was recorded under the joint limits " +
                         started["robot_limits"].dump() + "; this robot reports lower " +
                         ToJson(limits_.lower_rad).dump() + ", upper " + ToJson(limits_.upper_rad).dump() + " rad";
       return false;
@@ -221,9 +281,9 @@ bool Runner::Arm(const Route& route, const RobotAtStart& robot) {
     report_.message = PreflightRefusal(preflight.problems);
     return false;
   }
-  if (!c_.confirm(report_.preview, identity)) {
-    report_.error = ErrorCode::kInterrupted;
-    report_.message = "not confirmed: nothing moved";
+  // A dry run of a resume is never armed, whatever the callback answers: it holds no session to write.
+  if (!c_.confirm(report_.preview, identity) || c_.dry_run_of != nullptr) {
+    report_.message = "not confirmed: nothing was sent to the arm";
     return false;
   }
   return true;
@@ -301,10 +361,10 @@ Runner::Step Runner::ReturnTo(const PlannedPose& target, int pose, Eigen::Vector
 }
 
 RunReport Runner::Run() {
-  SELFCAL_CHECK(c_.robot && c_.camera && c_.clock && (c_.session || c_.create_session) && c_.identifier &&
-                    c_.confirm,
-                "RunContext needs a robot, camera, clock, session (or create_session), identifier and confirm "
-                "callback");
+  SELFCAL_CHECK(c_.robot && c_.camera && c_.clock && (c_.session || c_.create_session || c_.dry_run_of) &&
+                    !(c_.session && c_.dry_run_of) && c_.identifier && c_.confirm,
+                "RunContext needs a robot, camera, clock, session (or create_session, or a dry run's snapshot), "
+                "identifier and confirm callback");
   report_.outcome = RunOutcome::kRefused;
   report_.error = ErrorCode::kInvalidInput;
   if (const std::string bad = o_.Validate(); !bad.empty()) {
@@ -313,8 +373,8 @@ RunReport Runner::Run() {
   }
   // The journal of a session to continue decides where this invocation starts; a new one starts at 0.
   session::SessionLog log;
-  if (c_.session != nullptr) {
-    Result<session::SessionLog> read = session::ReadSessionLog(c_.session->journal().records());
+  if (Resuming()) {
+    Result<session::SessionLog> read = session::ReadSessionLog(Records());
     if (!read.ok()) {
       report_.outcome = RunOutcome::kSessionError;
       report_.error = read.status().code();
@@ -330,7 +390,7 @@ RunReport Runner::Run() {
   if (!ConnectRobot(log, &robot)) return report_;
   const Route route = PlanRoute(log, todo, robot.joints.position_rad);
   if (!Arm(route, robot)) return report_;
-  if (c_.session == nullptr && !CreateSession()) return report_;
+  if (c_.session == nullptr && (c_.dry_run_of != nullptr || !CreateSession())) return report_;
   if (!JournalStart(log, todo, robot.identity)) return report_;
 
   // R4: where the arm should be before each move: the previous move's target (the reading at the start).
@@ -344,9 +404,7 @@ RunReport Runner::Run() {
   }
   if (!NameLater()) return report_;
   if (!Record({{"type", "finished"}, {"time_s", Now()}})) return report_;
-  report_.outcome = RunOutcome::kCompleted;
-  report_.error = ErrorCode::kOk;
-  report_.message = "session complete: " + std::to_string(report_.accepted) + " samples accepted by this run";
+  Conclude("session complete: " + std::to_string(report_.accepted) + " samples accepted by this run");
   return report_;
 }
 
@@ -372,6 +430,7 @@ std::string RunOptions::Validate() const {
   if (!(tracking_interval_s >= 0)) out << "tracking interval must be >= 0\n";
   if (min_dots < 1) out << "min_dots must be >= 1\n";
   if (revisit_skipped < 0) out << "revisit_skipped must be >= 0\n";
+  if (min_identification_samples < 0) out << "min_identification_samples must be >= 0\n";
   if (png_compression < 0 || png_compression > 9) out << "png_compression must lie in [0, 9]\n";
   return out.str();
 }
@@ -383,6 +442,7 @@ const char* RunOutcomeName(RunOutcome outcome) {
     case RunOutcome::kHalted: return "halted";
     case RunOutcome::kInterrupted: return "interrupted";
     case RunOutcome::kSessionError: return "session_error";
+    case RunOutcome::kTooFewSamples: return "too_few_samples";
   }
   return "unknown";
 }

@@ -4,6 +4,9 @@
 // in a session directory's journal before it counts. It never solves anything: `selfcal calibrate SESSION`
 // reads what it wrote.
 //
+// An arm that does not come to rest after a move (R7: joint velocities above the threshold until the
+// settle timeout) is a halt, not a skip: the controller still moves it, so no further move is sent.
+//
 // States: preflight (the whole plan against the robot's limits, travel bound and velocity limits, before
 // any command: motion_safety.h) -> armed (the caller's confirm callback said yes) -> per pose: moving
 // (watchdog; frames tracked) -> settling (velocities below a threshold for N readings and a dwell) ->
@@ -55,6 +58,7 @@
 #include "robot/clock.h"
 #include "robot/robot.h"
 #include "session/session_dir.h"
+#include "session/session_snapshot.h"
 #include "tracking/dot_detector.h"
 #include "tracking/dot_tracker.h"
 #include "tracking/predicted_match.h"
@@ -96,7 +100,7 @@ struct SettleOptions {
   double velocity_threshold_rad_s = 1e-3;  // R7: every joint below this...
   int consecutive_readings = 3;            // ...for this many readings in a row...
   double min_dwell_s = 0.2;                // ...and at least this long after the controller said done
-  double timeout_s = 5.0;                  // not settled by then: the pose is skipped (not_settled)
+  double timeout_s = 5.0;                  // not settled by then: the session halts (not_settled)
   double reading_period_s = 0.02;
 };
 
@@ -130,6 +134,10 @@ struct RunOptions {
   bool journal_sim_clock = false;   // simulated sessions: journal the clock with each sample (resume)
   std::string mode = "simulated";   // session_started.mode
   int revisit_skipped = 1;          // resume: further attempts per pose skipped for a revisitable reason
+  // A session whose every pose is visited with fewer accepted identification samples than this ends in
+  // kTooFewSamples, not kCompleted: the default calibration (the bundle adjustment,
+  // bundle::BundleOptions::min_identification_poses) refuses fewer.
+  int min_identification_samples = 3;
   std::string Validate() const;     // empty when valid
 };
 
@@ -139,6 +147,7 @@ enum class RunOutcome {
   kHalted,         // a stop, fault or lost device: the robot was told to stop
   kInterrupted,    // the stop request (Ctrl-C, SIGTERM) was honoured
   kSessionError,   // the session directory could not be written or read
+  kTooFewSamples,  // every pose visited, but fewer identification samples than the calibration needs
 };
 const char* RunOutcomeName(RunOutcome outcome);
 
@@ -217,6 +226,11 @@ struct RunContext {
   std::function<bool(const std::string& preview, const robot::RobotIdentity& robot)> confirm;
   // Progress lines for the operator (optional).
   std::function<void(const std::string& line)> log;
+  // A dry run of a resume (instead of `session`): the recorded session as read without changing anything
+  // (session::ReadSession). The run goes as far as the preview, which `confirm` is shown; it is never
+  // armed, whatever `confirm` answers, and nothing is written, repaired or sent to the arm beyond the
+  // questions of the preflight (identity, limits, joints).
+  const session::SessionSnapshot* dry_run_of = nullptr;
   // Told the poses of this run's route done (optional), for the operator's progress line.
   ProgressSink* progress = nullptr;
   // Every frame the loop looks at, with its dots, for a live view (optional). Called on the loop's

@@ -76,6 +76,14 @@ class Runner {
   bool StopRequested() const { return c_.stop_requested != nullptr && c_.stop_requested->load(); }
   double Now() { return c_.clock->Now(); }
 
+  // The journal records of the session to continue: the open session's, or a dry run's snapshot's.
+  const std::vector<nlohmann::json>& Records() const;
+  const std::string& SessionPath() const;
+  bool Resuming() const { return c_.session != nullptr || c_.dry_run_of != nullptr; }
+  // Every pose visited: kCompleted with `message`, or kTooFewSamples when the session holds fewer
+  // identification samples than RunOptions::min_identification_samples.
+  void Conclude(const std::string& message);
+
   // Appends a record; a failure ends the run (kSessionError, P5) after stopping the robot.
   bool Record(nlohmann::json record);
   // Ends the run in `outcome` after telling the robot to stop and journaling why (never resumes, R9).

@@ -10,6 +10,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 // Peak of ds/dtau of the quintic time scaling s = 10 tau^3 - 15 tau^4 + 6 tau^5 (at tau = 1/2).
+constexpr double kNeverSettledVelocity_rad_s = 0.05;  // R7 fault: what the restless arm reads on every joint
 constexpr double kSlowSettleFactor = 20;  // R7 fault: the ring-down's time constant times this
 constexpr double kStaleAge_s = 1;         // R8 fault: a stale reading is this much older than the last
 
@@ -69,6 +70,7 @@ Status SimulatedRobotOptions::Validate() const {
   CheckIndices("disconnect_moves", faults.disconnect_moves, &problems);
   CheckIndices("jog_after_moves", faults.jog_after_moves, &problems);
   CheckIndices("slow_settle_moves", faults.slow_settle_moves, &problems);
+  CheckIndices("never_settle_moves", faults.never_settle_moves, &problems);
   CheckIndices("stale_reads", faults.stale_reads, &problems);
   CheckIndices("nan_reads", faults.nan_reads, &problems);
   CheckIndices("short_reads", faults.short_reads, &problems);
@@ -176,6 +178,9 @@ Result<JointReading> SimulatedRobot::ReadJoints() {
   if (options_.encoder_noise_rad > 0) {
     std::normal_distribution<double> noise(0.0, options_.encoder_noise_rad);
     for (Eigen::Index j = 0; j < reading.position_rad.size(); ++j) reading.position_rad[j] += noise(rng_);
+  }
+  if (Has(options_.faults.never_settle_moves, counts_.start_move - 1)) {  // R7: the last move never rests
+    reading.velocity_rad_s.setConstant(kNeverSettledVelocity_rad_s);
   }
   const JointReading genuine = reading;
   if (Has(options_.faults.stale_reads, index)) {  // R8: an old reading delivered again, older still

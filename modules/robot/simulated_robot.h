@@ -53,6 +53,9 @@ struct SimulatedRobotFaults {
   double jog_delay_s = 0.5;
   // R7: the ring-down after move k decays 20 times slower (settle_tau_s * 20).
   std::set<int> slow_settle_moves;
+  // R7: after move k the arm never comes to rest: every reading until the next move reports 0.05 rad/s on
+  // every joint (the positions are the arm's), while GetStatus says idle at arrival.
+  std::set<int> never_settle_moves;
   // R8: reading #n carries the previous reading's values and its timestamp minus 1 s (the first reading:
   // the current values, 1 s old).
   std::set<int> stale_reads;

@@ -332,6 +332,22 @@ TEST_F(SimulatedRobotTest, SlowSettleR7) {
   EXPECT_NEAR(slow, options_.settle_amplitude_rad * std::exp(-probe_s / (20 * options_.settle_tau_s)), 1e-12);
 }
 
+TEST_F(SimulatedRobotTest, AnArmThatNeverSettlesReadsMovingAfterItsMoveR7) {
+  options_.faults.never_settle_moves = {1};
+  SimulatedRobot& robot = Make();
+  MoveAndWait(Eigen::Vector3d(0.2, 0, 0));
+  clock_.SleepFor(2);
+  EXPECT_LT(robot.ReadJoints()->velocity_rad_s.cwiseAbs().maxCoeff(), 1e-6);  // move #0 rests
+  const Eigen::VectorXd second = Eigen::Vector3d(0.2, 0, 0.1);
+  MoveAndWait(second);
+  clock_.SleepFor(10);
+  const Result<JointReading> restless = robot.ReadJoints();
+  ASSERT_TRUE(restless.ok());
+  EXPECT_EQ(restless->velocity_rad_s, Eigen::VectorXd::Constant(3, 0.05));  // every joint, long after arrival
+  EXPECT_TRUE(restless->position_rad.isApprox(second, 1e-6));
+  EXPECT_EQ(robot.GetStatus()->state, MotionState::kIdle);
+}
+
 TEST_F(SimulatedRobotTest, BadReadingsR8) {
   options_.faults.stale_reads = {0, 2};
   options_.faults.nan_reads = {3};

@@ -458,30 +458,37 @@ Result<Session> CreateSession(const std::string& path, const SessionInputs& inpu
   return Session(path, std::move(manifest), std::move(journal).value(), std::move(lock).value(), OpenReport());
 }
 
+std::vector<std::string> ChangedInputs(const SessionManifest& manifest, const SessionInputs& expected) {
+  std::vector<std::string> changed;
+  for (const SessionInput& input : expected) {
+    const InputDigest* recorded = manifest.FindInput(input.name);
+    if (recorded == nullptr) {
+      changed.push_back(input.name + " (not recorded in the session)");
+      continue;
+    }
+    const std::string sha256 = Sha256Hex(input.contents);
+    if (sha256 != recorded->sha256_hex) {
+      changed.push_back(input.name + " (recorded " + std::to_string(recorded->bytes) + " bytes, sha256 " +
+                        recorded->sha256_hex.substr(0, 12) + "...; now " + std::to_string(input.contents.size()) +
+                        " bytes, sha256 " + sha256.substr(0, 12) + "...)");
+    }
+  }
+  return changed;
+}
+
+Status ChangedInputsRefusal(const std::string& path, const std::vector<std::string>& changed) {
+  return Usage("session " + path + " was recorded with other inputs: " + JoinProblems(changed) +
+               "; resume with the same files, or allow changed inputs explicitly");
+}
+
 Result<Session> OpenSession(const std::string& path, const SessionInputs& expected, bool allow_changed_inputs,
                             const JournalLimits& journal_limits, bool take_over_stale_lock) {
   Result<SessionManifest> manifest = ReadManifest(path);
   if (!manifest.ok()) return manifest.status();
 
   OpenReport report;
-  for (const SessionInput& input : expected) {
-    const InputDigest* recorded = manifest->FindInput(input.name);
-    if (recorded == nullptr) {
-      report.changed_inputs.push_back(input.name + " (not recorded in the session)");
-      continue;
-    }
-    const std::string sha256 = Sha256Hex(input.contents);
-    if (sha256 != recorded->sha256_hex) {
-      report.changed_inputs.push_back(input.name + " (recorded " + std::to_string(recorded->bytes) + " bytes, sha256 " +
-                                      recorded->sha256_hex.substr(0, 12) + "...; now " +
-                                      std::to_string(input.contents.size()) + " bytes, sha256 " + sha256.substr(0, 12) +
-                                      "...)");
-    }
-  }
-  if (!report.changed_inputs.empty() && !allow_changed_inputs) {
-    return Usage("session " + path + " was recorded with other inputs: " + JoinProblems(report.changed_inputs) +
-                 "; resume with the same files, or allow changed inputs explicitly");
-  }
+  report.changed_inputs = ChangedInputs(*manifest, expected);
+  if (!report.changed_inputs.empty() && !allow_changed_inputs) return ChangedInputsRefusal(path, report.changed_inputs);
   if (Status s = CheckSessionLayout(path); !s.ok()) return s;
 
   Result<SessionLock> lock = SessionLock::Acquire(path, false, take_over_stale_lock);

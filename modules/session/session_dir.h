@@ -156,6 +156,13 @@ Result<Session> CreateSession(const std::string& path, const SessionInputs& inpu
 Result<Session> OpenSession(const std::string& path, const SessionInputs& expected, bool allow_changed_inputs,
                             const JournalLimits& journal_limits = JournalLimits(), bool take_over_stale_lock = false);
 
+// The `expected` inputs that differ from the ones `manifest` records (by SHA-256), each described with
+// its recorded and present size and digest, or "(not recorded in the session)": what OpenSession refuses
+// without allow_changed_inputs. Reads nothing.
+std::vector<std::string> ChangedInputs(const SessionManifest& manifest, const SessionInputs& expected);
+// The refusal of a resume for `changed` (ChangedInputs) inputs of the session at `path`.
+Status ChangedInputsRefusal(const std::string& path, const std::vector<std::string>& changed);
+
 // True when `path` holds a session.json, or the lock, inputs/ or journal.log of an interrupted creation:
 // what `selfcal calibrate` reads as a session rather than as an observations file (whether the session is
 // whole is ReadSession's to say; ReadManifest names an interrupted creation).

@@ -51,6 +51,15 @@ std::string DescribeHolder(const std::string& line) {
 
 }  // namespace
 
+std::string LockHolderNamed(const std::string& session_path) {
+  const std::string path = internal::Join(session_path, kLockFileName);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+  if (fd < 0) return "";
+  const std::string line = ReadHolder(fd);
+  ::close(fd);
+  return line.empty() ? "" : DescribeHolder(line);
+}
+
 std::string UtcNowIso8601() {
   const std::time_t now = std::time(nullptr);
   std::tm utc{};

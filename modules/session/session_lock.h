@@ -50,6 +50,11 @@ class SessionLock {
   std::string stale_from_;
 };
 
+// The holder the lock file `<session_path>/lock` names ("pid N on host H (since T)"), read without
+// creating, writing or locking it: whether that process still holds it only Acquire can tell. Empty when
+// the file is absent or empty (released cleanly). For a dry run's report of what a resume would meet.
+std::string LockHolderNamed(const std::string& session_path);
+
 // The current time (CLOCK_REALTIME) as UTC ISO 8601 with seconds, e.g. "2025-03-01T12:00:00Z". Only for
 // the lock line and for callers choosing a session's creation time; nothing recorded depends on it.
 std::string UtcNowIso8601();

@@ -88,13 +88,14 @@ void ParseFaults(const json& run, JsonFields* fields, robot::SimulatedRobotFault
       {"jog_after_moves", &faults->jog_after_moves}, {"slow_settle_moves", &faults->slow_settle_moves},
       {"stale_reads", &faults->stale_reads},         {"nan_reads", &faults->nan_reads},
       {"short_reads", &faults->short_reads}};
-  std::vector<std::string> known = {"jog_delay_s"};
+  std::vector<std::string> known = {"jog_delay_s", "never_settle_moves"};
   for (const auto& [key, set] : lists) {
     GetCallCounts(*f, at, key, fields, set);
     known.push_back(key);
   }
   fields->CheckKnown(*f, at, known);
   // Written only when not the default (docs/session-format.md).
+  if (f->contains("never_settle_moves")) GetCallCounts(*f, at, "never_settle_moves", fields, &faults->never_settle_moves);
   if (f->contains("jog_delay_s")) GetDoubleIn(*f, at, "jog_delay_s", 0, 10, fields, &faults->jog_delay_s);
 }
 

@@ -56,6 +56,7 @@ std::string Refusal(const std::string& text) {
 TEST(SimRunSettings, EveryRecordedSettingReachesTheCell) {
   nlohmann::json run = RunJson();
   run["faults"]["jog_delay_s"] = 0.75;
+  run["faults"]["never_settle_moves"] = {11};
   const Result<SimCellOptions> o = SimCellOptionsFor(Text(run));
   ASSERT_TRUE(o.ok()) << o.status().message();
   EXPECT_EQ(o->world.world_seed, 7u);
@@ -73,6 +74,7 @@ TEST(SimRunSettings, EveryRecordedSettingReachesTheCell) {
   EXPECT_EQ(o->faults.nan_reads, std::set<int>{9});
   EXPECT_EQ(o->faults.short_reads, std::set<int>{10});
   EXPECT_EQ(o->faults.jog_delay_s, 0.75);
+  EXPECT_EQ(o->faults.never_settle_moves, std::set<int>{11});
   // Without "jog_delay_s" (the default, not written) the cell keeps the simulated robot's default.
   const Result<SimCellOptions> d = SimCellOptionsFor(Text(RunJson()));
   ASSERT_TRUE(d.ok()) << d.status().message();

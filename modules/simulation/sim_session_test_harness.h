@@ -54,6 +54,8 @@ struct Harness {
     options.journal_sim_clock = true;
     options.safety.velocity_scaling = 1.0;
     options.settle.min_dwell_s = 0.6;
+    // ArcPlan(4) has two identification poses: the harness's short sessions complete with them.
+    options.min_identification_samples = 2;
   }
 
   acquisition::RunContext Context() {

@@ -66,7 +66,7 @@ TEST(SessionView, SkippedPosesKeepTheirRejectedFramesBesideTheImages) {
   acquisition::RunContext context = h.Context();
   context.observe = [recorder](const acquisition::FrameView& view) { (*recorder)(view); };
   const acquisition::RunReport report = acquisition::RunSession(h.plan, context, h.options);
-  ASSERT_EQ(report.outcome, acquisition::RunOutcome::kCompleted) << report.message;
+  ASSERT_EQ(report.outcome, acquisition::RunOutcome::kTooFewSamples) << report.message;  // no sample at all
   EXPECT_EQ(report.skips.at("too_few_dots"), 4);
   EXPECT_EQ(recorder->phases[acquisition::FramePhase::kSkipped], 4);
   EXPECT_EQ(recorder->last_detail, "too_few_dots");

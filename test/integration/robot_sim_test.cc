@@ -99,5 +99,30 @@ TEST(RobotSimBinary, MovesOverLoopbackAndSurvivesADroppedConnectionMidMove) {
   StopServer(pid);
 }
 
+// The fake controller of issue 36 on loopback: after its first move every joint reads 0.05 rad/s while
+// STATUS says idle (the session loop halts on such an arm: modules/simulation/sim_session_settle_test.cc).
+TEST(RobotSimBinary, AnArmThatNeverSettlesReadsMovingOverTheWire) {
+  int port = -1;
+  const pid_t pid = StartServer({"--never-settle-move", "0"}, &port);
+  ASSERT_GT(pid, 0);
+  ASSERT_GT(port, 0) << "selfcal-robot-sim did not print its port";
+  robot::NetworkRobot arm("127.0.0.1", port);
+  ASSERT_TRUE(arm.Connect().ok());
+  Result<robot::JointReading> start = arm.ReadJoints();
+  ASSERT_TRUE(start.ok());
+  EXPECT_LT(start->velocity_rad_s.cwiseAbs().maxCoeff(), 1e-6);  // at rest before the move
+  Eigen::VectorXd target = start->position_rad;
+  target[0] += 0.0873;
+  ASSERT_TRUE(arm.StartMove(target, 1.0).ok());
+  Result<robot::RobotStatus> done = WaitForMove(arm, 5.0);
+  ASSERT_TRUE(done.ok()) << done.status().message();
+  EXPECT_EQ(done->state, robot::MotionState::kIdle);
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));  // past any ring-down
+  Result<robot::JointReading> after = arm.ReadJoints();
+  ASSERT_TRUE(after.ok());
+  EXPECT_EQ(after->velocity_rad_s, Eigen::VectorXd::Constant(6, 0.05));
+  StopServer(pid);
+}
+
 }  // namespace
 }  // namespace selfcal
