@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "app/cli_help.h"
+#include "app/cli_numbers.h"
 #include "app/cli_output.h"
 #include "app/cli_util.h"
 
@@ -25,6 +26,7 @@ int RunCommandLine(int argc, char** argv, const std::vector<CommandEntry>& entri
   std::vector<std::pair<const char*, Command>> commands;
   for (const CommandEntry& entry : entries) commands.emplace_back(entry.name, entry.add(app));
   AddOutputFlags(app);
+  CheckNumbersStrictly(app);
   // CLI11 answers --help before it looks at the other words, so `selfcal calibrat --help` would print
   // the top-level help and exit 0: a mistyped command or option beside --help is a usage error too.
   for (int i = 1; i < argc; ++i) {

@@ -294,7 +294,9 @@ Command AddSimulateCommand(CLI::App& app) {
   cmd->add_option("--trajectory", args->trajectory,
                   "Trajectory file (for the robot); default: config/trajectories/initial_<robot name>.yaml");
   cmd->add_option("--out", args->out, "Output directory");
-  cmd->add_option("--noise-px", args->noise_px, "Pixel noise std (px)")->check(CLI::Range(0.0, 10.0));
+  CLI::Option* noise = cmd->add_option("--noise-px", args->noise_px,
+                  "--points: pixel noise std (px); a dot the noise moves out of the image is not detected")
+      ->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--seed", args->seed, "World and noise seed");
   cmd->add_flag("--perturb-gauge", args->perturb_gauge, "Also perturb the parameters the measurements cannot see");
   cmd->add_flag("--flat-sheet", args->flat_sheet,
@@ -312,10 +314,13 @@ Command AddSimulateCommand(CLI::App& app) {
                   "auto (when $DISPLAY can be opened), on (refused without a display), off")
       ->check(CLI::IsMember({"auto", "on", "off"}));
   AddMethodOption(cmd, &args->method);
-  return [args]() {
+  return [args, noise]() {
     if (!args->points) {
       if (args->flat_sheet || args->perturb_gauge) {
         return Fail(Status::Error(ErrorCode::kInvalidInput, "--flat-sheet and --perturb-gauge need --points"));
+      }
+      if (noise->count() > 0) {  // image mode renders its noise in grey levels
+        return Fail(Status::Error(ErrorCode::kInvalidInput, "--noise-px needs --points (image mode: --grey-noise)"));
       }
       return SimulateSession(*args);
     }
