@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "app/cli_help.h"
+#include "app/cli_numbers.h"
 #include "app/cli_output.h"
 #include "app/cli_util.h"
 #include "app/output_options.h"
@@ -31,6 +32,7 @@ int RunCommandLine(int argc, char** argv, const std::vector<CommandEntry>& entri
     ListOutputOptions(app, std::cout);
     return static_cast<int>(ExitCode::kOk);
   }
+  CheckNumbersStrictly(app);
   // CLI11 answers --help before it looks at the other words, so `selfcal calibrat --help` would print
   // the top-level help and exit 0: a mistyped command or option beside --help is a usage error too.
   for (int i = 1; i < argc; ++i) {

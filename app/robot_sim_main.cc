@@ -15,6 +15,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/cli_numbers.h"
 #include "app/exit_codes.h"
 #include "base/status.h"
 #include "io/robot_config.h"
@@ -97,6 +98,7 @@ int main(int argc, char** argv) {
   AddFaultOption(app, "--stale-read", &args.stale_read, "Joint reading N is stale");
   AddFaultOption(app, "--nan-read", &args.nan_read, "Joint reading N has NaN in joint 2");
   AddFaultOption(app, "--short-read", &args.short_read, "Joint reading N lacks a joint");
+  selfcal::app::CheckNumbersStrictly(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

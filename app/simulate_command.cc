@@ -304,7 +304,9 @@ Command AddSimulateCommand(CLI::App& app) {
                   "Trajectory file (for the robot); default: config/trajectories/initial_<robot name>.yaml");
   AddOutputOption(cmd, "--out", &args->out, OutputKind::kDirectory, "Output directory (created if missing; outside any session)",
                   SimulateOutputFiles());
-  cmd->add_option("--noise-px", args->noise_px, "Pixel noise std (px)")->check(CLI::Range(0.0, 10.0));
+  CLI::Option* noise = cmd->add_option("--noise-px", args->noise_px,
+                  "--points: pixel noise std (px); a dot the noise moves out of the image is not detected")
+      ->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--seed", args->seed, "World and noise seed");
   cmd->add_flag("--perturb-gauge", args->perturb_gauge, "Also perturb the parameters the measurements cannot see");
   cmd->add_flag("--flat-sheet", args->flat_sheet,
@@ -322,10 +324,13 @@ Command AddSimulateCommand(CLI::App& app) {
                   "auto (when $DISPLAY can be opened), on (refused without a display), off")
       ->check(CLI::IsMember({"auto", "on", "off"}));
   AddMethodOption(cmd, &args->method);
-  return [args]() {
+  return [args, noise]() {
     if (!args->points) {
       if (args->flat_sheet || args->perturb_gauge) {
         return Fail(Status::Error(ErrorCode::kInvalidInput, "--flat-sheet and --perturb-gauge need --points"));
+      }
+      if (noise->count() > 0) {  // image mode renders its noise in grey levels
+        return Fail(Status::Error(ErrorCode::kInvalidInput, "--noise-px needs --points (image mode: --grey-noise)"));
       }
       return SimulateSession(*args);
     }

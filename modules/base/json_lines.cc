@@ -24,7 +24,9 @@ std::string DecodeKey(std::string_view raw) {
 // exhaust the call stack): what comes next is a value, a member of an object, or what follows a value.
 class Scanner {
  public:
-  Scanner(std::string_view text, std::map<std::string, int>* lines) : text_(text), lines_(lines) {}
+  // `lines` null: only the first repeated key is looked for.
+  Scanner(std::string_view text, std::map<std::string, int>* lines, std::optional<JsonDuplicateKey>* duplicate)
+      : text_(text), lines_(lines), duplicate_(duplicate) {}
 
   void Run() {
     enum class Next { kValue, kMember, kAfterValue };
@@ -34,7 +36,7 @@ class Scanner {
       SkipSpace();
       if (next == Next::kValue) {
         if (at_ >= text_.size()) return;
-        lines_->emplace(pointer, line_);  // unless its key's line is recorded already
+        if (lines_ != nullptr) lines_->emplace(pointer, line_);  // unless its key's line is recorded already
         const char c = text_[at_];
         if (c != '{' && c != '[') {
           if (!Scalar()) return;
@@ -42,7 +44,7 @@ class Scanner {
           continue;
         }
         ++at_;
-        stack_.push_back({stack_.size() < kMaxRecordedDepth ? pointer : std::string(), c == '[', 0});
+        stack_.push_back({stack_.size() < kMaxRecordedDepth ? pointer : std::string(), c == '[', 0, {}});
         SkipSpace();
         if (At(c == '{' ? '}' : ']')) {
           ++at_;
@@ -56,9 +58,11 @@ class Scanner {
       } else if (next == Next::kMember) {
         std::string_view raw;
         if (!At('"') || !String(&raw)) return;
-        pointer = Child(JsonLines::Member(stack_.back().pointer, DecodeKey(raw)));
+        const std::string key = DecodeKey(raw);
+        pointer = Child(JsonLines::Member(stack_.back().pointer, key));
+        NoteKey(key);
         // the last of repeated keys, as nlohmann keeps the last value
-        if (stack_.size() <= kMaxRecordedDepth) (*lines_)[pointer] = line_;
+        if (lines_ != nullptr && stack_.size() <= kMaxRecordedDepth) (*lines_)[pointer] = line_;
         SkipSpace();
         if (!At(':')) return;
         ++at_;
@@ -86,7 +90,15 @@ class Scanner {
     std::string pointer;  // empty below the recorded depth
     bool array = false;
     std::size_t index = 0;
+    std::map<std::string, int> keys;  // of an object: the line of each key read so far
   };
+
+  // Records the first key that the innermost object already holds.
+  void NoteKey(const std::string& key) {
+    const auto [it, added] = stack_.back().keys.emplace(key, line_);
+    if (added || duplicate_->has_value()) return;
+    *duplicate_ = JsonDuplicateKey{JsonLines::Member(stack_.back().pointer, key), line_, it->second};
+  }
 
   bool At(char c) const { return at_ < text_.size() && text_[at_] == c; }
 
@@ -129,6 +141,7 @@ class Scanner {
 
   std::string_view text_;
   std::map<std::string, int>* lines_;
+  std::optional<JsonDuplicateKey>* duplicate_;
   std::vector<Frame> stack_;
   std::size_t at_ = 0;
   int line_ = 1;
@@ -138,7 +151,37 @@ class Scanner {
 
 JsonLines::JsonLines(std::string_view text) {
   lines_[""] = FirstValueLine(text);
-  Scanner(text, &lines_).Run();
+  Scanner(text, &lines_, &duplicate_).Run();
+}
+
+std::optional<JsonDuplicateKey> FindDuplicateJsonKey(std::string_view text) {
+  std::optional<JsonDuplicateKey> duplicate;
+  Scanner(text, nullptr, &duplicate).Run();
+  return duplicate;
+}
+
+std::string JsonPointerName(const std::string& pointer) {
+  std::string name;
+  std::size_t at = 0;
+  while (at < pointer.size()) {
+    const std::size_t end = std::min(pointer.find('/', at + 1), pointer.size());
+    std::string segment;
+    for (std::size_t i = at + 1; i < end; ++i) {
+      const bool escape = pointer[i] == '~' && i + 1 < end;
+      segment += escape ? (pointer[i + 1] == '1' ? '/' : '~') : pointer[i];
+      if (escape) ++i;
+    }
+    const bool index = !segment.empty() && segment.find_first_not_of("0123456789") == std::string::npos;
+    name += index ? "[" + segment + "]" : (name.empty() ? "" : ".") + segment;
+    at = end;
+  }
+  return name;
+}
+
+std::string DuplicateKeyProblem(const JsonDuplicateKey& duplicate) {
+  return "`" + TerminalSafe(JsonPointerName(duplicate.pointer)) + "` is given twice (lines " +
+         std::to_string(duplicate.first_line) + " and " + std::to_string(duplicate.line) +
+         "): a JSON reader would keep one of them without a word; keep one";
 }
 
 int JsonLines::Line(const std::string& pointer) const {

@@ -12,6 +12,14 @@
 
 namespace selfcal {
 
+// A key an object of a JSON text holds twice. nlohmann::json keeps the last value without a word, so a
+// reader that takes the text as it is would act on one of two values the file gives; readers refuse it.
+struct JsonDuplicateKey {
+  std::string pointer;  // of the repeated member ("/camera/fx_px")
+  int line = 1;         // of its second occurrence
+  int first_line = 1;   // of its first
+};
+
 class JsonLines {
  public:
   // Indexes `text`, which should be JSON (a reader indexes what nlohmann parsed). Text that is not stops
@@ -26,6 +34,9 @@ class JsonLines {
   // of the object that lacks it.
   int Line(const std::string& pointer) const;
 
+  // The first key repeated inside one object, in text order (scanned to any depth), or none.
+  const std::optional<JsonDuplicateKey>& duplicate() const { return duplicate_; }
+
   // The JSON pointer of member `key` of the value at `parent` (`key` escaped: "~" as "~0", "/" as "~1").
   static std::string Member(const std::string& parent, std::string_view key);
   // The JSON pointer of element `index` of the array at `parent`.
@@ -33,7 +44,19 @@ class JsonLines {
 
  private:
   std::map<std::string, int> lines_;
+  std::optional<JsonDuplicateKey> duplicate_;
 };
+
+// The first repeated key of `text` (as JsonLines::duplicate(), without indexing the lines of every value:
+// for the many small records of a journal).
+std::optional<JsonDuplicateKey> FindDuplicateJsonKey(std::string_view text);
+
+// A JSON pointer as messages show a value: "/camera/fx_px" -> "camera.fx_px", "/inputs/2/name" ->
+// "inputs[2].name" (a segment of digits is an array index), "" -> "" (the document).
+std::string JsonPointerName(const std::string& pointer);
+
+// "`camera.fx_px` is given twice (lines 4 and 9); keep one": the words of every reader's refusal.
+std::string DuplicateKeyProblem(const JsonDuplicateKey& duplicate);
 
 // The line (from 1) of byte `offset` of `text` (1 + the newlines before it; past the end: the last line).
 // For nlohmann's parse_error::byte, which counts from 1: pass byte - 1.

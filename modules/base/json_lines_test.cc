@@ -1,5 +1,6 @@
 #include "base/json_lines.h"
 
+#include <optional>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -76,6 +77,42 @@ TEST(JsonLines, LineOfAnOffsetAndOfTheFirstValue) {
   EXPECT_EQ(LineOfOffset("ab\ncd\n", 100), 3);
   EXPECT_EQ(FirstValueLine(""), 1);
   EXPECT_EQ(FirstValueLine(" \r\n\t\n 5"), 3);
+}
+
+TEST(JsonLines, TheFirstKeyGivenTwiceInOneObjectIsFoundWithBothLines) {
+  const std::string text =
+      "{\n"                                 // 1
+      "  \"a\": {\"x\": 1, \"y\": 2},\n"        // 2
+      "  \"b\": [{\"x\": 1}, {\"x\": 2}],\n"    // 3: the same key in two objects is no repeat
+      "  \"c\": {\"x\": 1,\n"                 // 4
+      "        \"\\u0078\": 2},\n"             // 5: "x" written with an escape
+      "  \"a\": 3\n"                          // 6
+      "}\n";
+  const JsonLines lines(text);
+  ASSERT_TRUE(lines.duplicate().has_value());
+  EXPECT_EQ(lines.duplicate()->pointer, "/c/x");
+  EXPECT_EQ(lines.duplicate()->line, 5);
+  EXPECT_EQ(lines.duplicate()->first_line, 4);
+  const std::optional<JsonDuplicateKey> found = FindDuplicateJsonKey(text);
+  ASSERT_TRUE(found.has_value());
+  EXPECT_EQ(found->pointer, "/c/x");
+  EXPECT_EQ(DuplicateKeyProblem(*found),
+            "`c.x` is given twice (lines 4 and 5): a JSON reader would keep one of them without a word; keep one");
+  EXPECT_FALSE(JsonLines("{\"a\": {\"x\": 1}, \"b\": {\"x\": 1}, \"l\": [1, 1]}").duplicate().has_value());
+  EXPECT_FALSE(FindDuplicateJsonKey("[{\"x\": 1}, {\"x\": 1}]").has_value());
+  // Deeper than the recorded depth too.
+  std::string deep;
+  for (int i = 0; i < 100; ++i) deep += "{\"k\": ";
+  deep += "{\"z\": 1, \"z\": 2}";
+  for (int i = 0; i < 100; ++i) deep += "}";
+  EXPECT_TRUE(FindDuplicateJsonKey(deep).has_value());
+}
+
+TEST(JsonLines, PointersReadAsDottedNames) {
+  EXPECT_EQ(JsonPointerName(""), "");
+  EXPECT_EQ(JsonPointerName("/camera/fx_px"), "camera.fx_px");
+  EXPECT_EQ(JsonPointerName("/inputs/2/name"), "inputs[2].name");
+  EXPECT_EQ(JsonPointerName("/a~1b~0c"), "a/b~c");
 }
 
 }  // namespace

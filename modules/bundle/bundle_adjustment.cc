@@ -238,6 +238,9 @@ std::string WhyNotIdentifiable(const internal::Gauge& gauge, const BundleOptions
     return std::string(k == kFx ? "f_x" : IntrinsicName(k)) + " is not identifiable from these poses (null directions: " +
            Join(gauge.null_combinations) + "): hold it, or add poses that separate it";
   }
+  // Every kinematic (or hand-eye) parameter held by request: nothing kinematic is left to identify, and
+  // that is the request, not too little motion. The intrinsics asked for are estimated on the held model.
+  if (gauge.free_kinematic.empty() && gauge.fixed_names.empty()) return "";
   if (gauge.free_kinematic.empty() ||
       (options.require_generic_rank && static_cast<int>(gauge.free_kinematic.size()) < generic_rank)) {
     std::ostringstream msg;
@@ -395,6 +398,11 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
   std::vector<int> held;
   std::string problems = CheckInputs(observations, rho_start, fx_start, options);
   problems += HeldParameters(observations.robot.num_joints(), &options, &held);
+  if (problems.empty() && static_cast<int>(held.size()) == observations.robot.num_parameters() &&
+      EstimatedIntrinsics(options.intrinsics).empty()) {
+    problems = "the held and free parameters asked for hold every kinematic, hand-eye and camera parameter: nothing "
+               "is left to estimate\n";
+  }
   if (!problems.empty()) return finish(Outcome::kInvalidInput, "invalid input:\n" + problems);
   report.intrinsics_estimated = options.intrinsics;
   const int num_poses = static_cast<int>(observations.PosesWithRole(PoseRole::kIdentification).size());

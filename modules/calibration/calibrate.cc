@@ -146,6 +146,19 @@ void CheckAcceptance(const ObservationSet& obs, const ObservationSet& original, 
     in.distances_nominal = &report->paper.verification_nominal;
   }
   report->acceptance = AcceptanceOf(in);
+  if (in.calibrated != nullptr && !in.calibrated->unused_poses.empty()) {
+    // Held out to verify, it verifies nothing: an error, not a silent drop (its joints or image are not
+    // the pose's, e.g. radians under a degree key that a reader could not tell).
+    const std::vector<std::string>& unused = in.calibrated->unused_poses;
+    report->verdict = Verdict::kInvalidInput;
+    report->message = std::string(unused.size() == 1 ? "verification pose " : "verification poses ");
+    for (std::size_t i = 0; i < unused.size(); ++i) report->message += (i ? ", " : "") + unused[i];
+    report->message += " cannot be used: none of " + std::string(unused.size() == 1 ? "its" : "their") +
+                       " dots is predicted by the calibrated model (no dot is placed by the identification images, or "
+                       "every one lies behind the camera at the recorded joint angles): fix the pose's joint angles "
+                       "(their unit?) or dots, or remove the pose";
+    return;
+  }
   if (report->acceptance.Passed()) return;
   report->verdict = Verdict::kRejected;
   report->message = "the calibrated model is refused";

@@ -1,6 +1,8 @@
 #include "calibration/calibrate.h"
 
 #include <cmath>
+#include <map>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -107,6 +109,61 @@ TEST(Calibrate, AHalfTurnCorrectionIsImplausible) {
   const Acceptance lengths = AcceptanceOf(in);
   ASSERT_EQ(lengths.Reasons().size(), 1u);
   EXPECT_NE(lengths.Reasons()[0].find("j3.d is corrected by 1.2e+04 mm"), std::string::npos) << lengths.Reasons()[0];
+}
+
+// Issue 36: with check distances none of which could be measured (their dots not triangulated), calibrate
+// said "the 40 check distances are measured at 0 mm RMS error": the 0 of an empty mean. Now no figure is
+// given as measured unless it was, and a partly measured set says how many.
+TEST(Calibrate, CheckDistancesNoneCouldMeasureGiveNoFigure) {
+  VerificationSummary none, some, all;
+  none.checks.resize(40);
+  some.checks.resize(40);
+  some.num_ok = 30;
+  some.rms_error_m = 0.002;
+  all.checks.resize(40);
+  all.num_ok = 40;
+  all.rms_error_m = 0.004;
+  const auto distances = [](const VerificationSummary& cal, const VerificationSummary& nom) {
+    AcceptanceInputs in;
+    in.distances_calibrated = &cal;
+    in.distances_nominal = &nom;
+    return AcceptanceOf(in).checks[2];
+  };
+  const AcceptanceCheck unmeasured = distances(none, all);
+  EXPECT_EQ(unmeasured.name, "beats_nominal_distances");
+  EXPECT_EQ(unmeasured.status, CheckStatus::kNotAvailable);
+  EXPECT_EQ(unmeasured.sentence.find("measured at"), std::string::npos) << unmeasured.sentence;
+  EXPECT_NE(unmeasured.sentence.find("none of the 40 check distances could be measured with the calibrated model"),
+            std::string::npos) << unmeasured.sentence;
+  EXPECT_EQ(distances(all, none).status, CheckStatus::kNotAvailable);
+  const AcceptanceCheck partly = distances(some, all);
+  EXPECT_EQ(partly.status, CheckStatus::kPassed);
+  EXPECT_NE(partly.sentence.find("30 of the 40 check distances could be measured with the calibrated model, 40 with the "
+                                 "nominal model: the 30 check distances are measured at 2 mm RMS error, 4 mm"),
+            std::string::npos) << partly.sentence;
+  EXPECT_NE(distances(all, all).sentence.find("the 40 check distances are measured at 4 mm"), std::string::npos);
+}
+
+// Issue 36: a verification pose none of whose dots could be predicted was dropped without a word, and the
+// calibration accepted on the others. It is an error naming the pose now, and no model is offered.
+TEST(Calibrate, AVerificationPoseThatCannotBeUsedIsAnErrorNamingIt) {
+  const sim::SimResult world = testing::PumaArcWorld(0.2, 3, 3);
+  ObservationSet obs = world.observations;
+  const std::vector<int> verification = obs.PosesWithRole(PoseRole::kVerification);
+  ASSERT_GE(verification.size(), 2u);
+  PoseObservation& pose = obs.poses[verification[1]];
+  std::map<int, Eigen::Vector2d> unplaced;  // dots no identification image sees
+  for (const auto& [id, uv] : pose.dots_px) unplaced[id + 100000] = uv;
+  pose.dots_px = unplaced;
+  for (const Method method : {Method::kBundle, Method::kPaper}) {
+    CalibrateOptions options;
+    options.method = method;
+    const CalibrationReport report = Calibrate(obs, options);
+    EXPECT_EQ(report.verdict, Verdict::kInvalidInput) << MethodName(method) << ": " << report.message;
+    EXPECT_FALSE(report.model.has_value());
+    EXPECT_EQ(report.message.rfind("verification pose " + pose.id + " cannot be used: none of its dots is predicted", 0),
+              0u) << report.message;
+  }
 }
 
 TEST(Calibrate, MethodNamesRoundTrip) {

@@ -285,6 +285,8 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
     if (static_cast<int>(residuals.rows.size()) > first) {
       report.poses.push_back({pose.id});
       first_row_of_pose.push_back(first);
+    } else if (!pose.dots_px.empty()) {
+      report.unused_poses.push_back(pose.id);
     }
   }
   if (residuals.rows.empty()) {

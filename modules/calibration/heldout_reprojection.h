@@ -93,6 +93,9 @@ struct HeldOutReprojection {
   bool prediction_uncertainty = false;  // the parameters' covariance is in C (the dots' always is)
   int num_not_predicted = 0;  // detections of dots that the identification images do not place
   std::vector<HeldOutFigure> poses;   // verification poses in file order (those with a residual)
+  // Verification poses with dots none of which is predicted (not placed by the identification images, or
+  // behind the camera at this pose): poses that cannot be used, in file order.
+  std::vector<std::string> unused_poses;
   HeldOutFigure overall;
   std::vector<ObservedResidual> residuals;  // every predicted detection, pose by pose (those in `overall`)
 };

@@ -17,7 +17,6 @@ namespace selfcal::io {
 
 namespace {
 
-const Range kJointValue = Range::Closed(DegToRad(-720), DegToRad(720));
 const Range kPixel = Range::Closed(-1e5, 1e5);
 
 std::string Short(double v) {
@@ -214,11 +213,12 @@ bool ReadDots(const yaml::YamlNode& node, const std::string& name, const CameraI
 }
 
 // `joints_deg` or `joints_rad` of a pose. Values outside the robot's limits are kept: the controller's
-// reading is what happened (calibrate warns, observations/joint_limits.h); only the plausible range is checked.
+// reading is what happened (calibrate warns, observations/joint_limits.h); only the plausible range is checked,
+// and radians typed under `joints_deg` are refused (yaml_schema.h: LooksLikeRadiansUnderDegrees).
 bool ReadJoints(MapReader* map, const RobotModel* robot, PoseObservation* pose) {
   std::vector<double> joints;
   const int num_joints = robot ? robot->num_joints() : -1;
-  if (!map->QuantityList("joints", Unit::kAngle, num_joints, kJointValue, &joints, true)) return false;
+  if (!map->JointAngles(num_joints, &joints)) return false;
   pose->joints_rad = Eigen::Map<const Eigen::VectorXd>(joints.data(), static_cast<Eigen::Index>(joints.size()));
   return true;
 }

@@ -233,6 +233,27 @@ TEST_F(ObservationsEdits, C3JointsOutsidePlausibleRanges) {
                       "`poses[0].joints` at " + path_ + ":13 is not allowed here: the unit goes in the key: `joints_deg` or `joints_rad`"));
 }
 
+// Issue 36: a verification pose with radians under `joints_deg` was taken as degrees (every joint within a
+// degree of its zero) and silently contributed nothing; now the reader refuses it naming the pose's line.
+TEST_F(ObservationsEdits, C4RadiansUnderADegreeKeyAreRefusedNamingTheLine) {
+  const std::string radians = "joints_deg: [0.17453, 0.61087, -2.70526, 0.08727, 0.69813, -0.17453]";
+  EXPECT_TRUE(Refused(Load("joints_deg: [10, 35, -155, 5, 40, -10]", radians),
+                      "`poses[1].joints_deg` at " + path_ + ":17 holds [0.17453, 0.61087, -2.70526, 0.08727, 0.69813, "
+                      "-0.17453]: every value within +-6.2832 (2 pi), as joint angles in radians are"));
+  EXPECT_TRUE(Refused(Load("joints_deg: [10, 35, -155, 5, 40, -10]", "joints_deg: [0, 0, 0, 0, 0, 3]"),
+                      "give radians under `joints_rad`"));
+  // The zero pose reads the same in both units; radians under their own key; degrees beyond 2 pi.
+  EXPECT_TRUE(Load("joints_deg: [10, 35, -155, 5, 40, -10]", "joints_deg: [0, 0, 0, 0, 0, 0]").ok());
+  EXPECT_TRUE(Load("joints_deg: [10, 35, -155, 5, 40, -10]", "joints_rad: [0, 0, 0, 0, 0, 0.05]").ok());
+  EXPECT_TRUE(Load("joints_deg: [10, 35, -155, 5, 40, -10]", "joints_deg: [0, 0, 0, 0, 0, 6.3]").ok());
+  // The reproducer kept for the fuzz harness: refused at its line.
+  const std::string kept = SourcePath("fuzz/regressions/observations/verification-pose-radians-under-joints-deg.yaml");
+  const Status status = LoadObservations(kept).status();
+  EXPECT_EQ(status.code(), ErrorCode::kInvalidInput);
+  EXPECT_NE(status.message().find("`poses[1].joints_deg` at " + kept + ":17 holds [0.17453,"), std::string::npos)
+      << status.ToString();
+}
+
 TEST_F(ObservationsEdits, C3DotsOutsideTheImageOrRepeated) {
   EXPECT_TRUE(Refused(Load("[1, 100.0, 20.0]", "[1, 100.0, 480.0]"), "dot 1 at (100, 480) px in `poses[0].dots[1]` at " + path_ +
                                                                      ":14 lies outside the 640x480 image"));
@@ -386,6 +407,31 @@ TEST(TrajectoryFile, C7AnEmptyPoseListIsRefusedNamingFileAndLine) {
   }
 }
 
+// Issue 36: a plan whose `poses_rad` was renamed `poses_deg` passed `plan --check` (every joint within a
+// few degrees of zero, inside every limit); the file's values, all within 2 pi, are refused as radians.
+TEST(TrajectoryFile, C4RadiansUnderPosesDegAreRefusedNamingTheLine) {
+  const std::string kept = SourcePath("fuzz/regressions/trajectory/plan-poses-rad-renamed-poses-deg.yaml");
+  const Status status = LoadTrajectory(kept, 6).status();
+  EXPECT_EQ(status.code(), ErrorCode::kInvalidInput);
+  EXPECT_NE(status.message().find("`poses_deg[0]` at " + kept + ":104 holds ["), std::string::npos) << status.ToString();
+  EXPECT_NE(status.message().find("give radians under `poses_rad`"), std::string::npos) << status.ToString();
+  EXPECT_NE(status.message().find("so do all 25 rows of `poses_deg` at " + kept + ":103"), std::string::npos)
+      << status.ToString();
+  TempDir dir;
+  const std::string path = dir.File("plan.yaml");
+  const std::string head = "format: selfcal-trajectory\nversion: 1\n";
+  WriteFile(path, head + "poses_deg:\n  - [0, 0, 0, 0, 0, 0]\n  - [0, 0.5, -1.2, 0, 0.7, 0]\n");
+  EXPECT_NE(LoadTrajectory(path, 6).status().message().find("`poses_deg[0]` at " + path + ":4 holds [0, 0, 0, 0, 0, 0]"),
+            std::string::npos);
+  // One row beyond 2 pi: degrees. All zero: the same in both units. The radians under their key.
+  WriteFile(path, head + "poses_deg:\n  - [0, 0, 0, 0, 0, 0]\n  - [0, 30, -150, 0, 45, 0]\n");
+  EXPECT_TRUE(LoadTrajectory(path, 6).ok());
+  WriteFile(path, head + "poses_deg:\n  - [0, 0, 0, 0, 0, 0]\n");
+  EXPECT_TRUE(LoadTrajectory(path, 6).ok());
+  WriteFile(path, head + "poses_rad:\n  - [0, 0.5, -1.2, 0, 0.7, 0]\n");
+  EXPECT_TRUE(LoadTrajectory(path, 6).ok());
+}
+
 TEST(TrajectoryFile, C6PosesOutsideTheLimitsAreRefused) {
   TempDir dir;
   const std::string path = dir.File("plan.yaml");
@@ -438,6 +484,11 @@ TEST(JsonFile, WriteReadRoundTripAndGuards) {
   EXPECT_NE(ReadJsonFile(path).status().message().find("nested deeper than 64"), std::string::npos);
   WriteFile(path, "{\"a\": [1, 2,");
   EXPECT_NE(ReadJsonFile(path).status().message().find("malformed JSON in " + path), std::string::npos);
+  // Issue 36: a key given twice, the last value winning, is refused naming the line.
+  WriteFile(path, "{\n  \"format\": \"selfcal-report\",\n  \"format\": \"x\"\n}\n");
+  EXPECT_EQ(ReadJsonFile(path).status().message(),
+            path + ":3: `format` is given twice (lines 2 and 3): a JSON reader would keep one of them without a word; "
+                   "keep one");
 }
 
 }  // namespace

@@ -21,7 +21,6 @@ namespace {
 
 constexpr double kMaxTranslationM = 100.0;
 const Range kTranslation = Range::Closed(-kMaxTranslationM, kMaxTranslationM);
-const Range kJointValue = Range::Closed(DegToRad(-720), DegToRad(720));
 
 std::string Short(double v) {
   char buffer[32];
@@ -139,9 +138,9 @@ bool ReadListEntry(const yaml::YamlNode& node, const std::string& name, const Ro
     ok = false;
   } else {
     // Values outside the robot's limits are kept: the controller's reading is what happened (calibrate
-    // warns, observations/joint_limits.h); only the plausible range is checked.
+    // warns, observations/joint_limits.h); only the plausible range is checked, and radians under a degree key.
     std::vector<double> joints;
-    if (map.QuantityList("joints", Unit::kAngle, robot->num_joints(), kJointValue, &joints, true)) {
+    if (map.JointAngles(robot->num_joints(), &joints)) {
       pose->joints_rad = Eigen::Map<const Eigen::VectorXd>(joints.data(), static_cast<Eigen::Index>(joints.size()));
     } else {
       ok = false;

@@ -1,7 +1,10 @@
 #include "io/report_json.h"
 
+#include <optional>
+
 #include <nlohmann/json.hpp>
 
+#include "base/json_lines.h"
 #include "io/atomic_file.h"
 #include "yaml/yaml_reader.h"
 
@@ -57,7 +60,12 @@ Result<nlohmann::json> ReadJsonFile(const std::string& path) {
                                                " levels at byte " + std::to_string(offset));
   }
   try {
-    return nlohmann::json::parse(*text);
+    nlohmann::json document = nlohmann::json::parse(*text);
+    if (const std::optional<JsonDuplicateKey> duplicate = FindDuplicateJsonKey(*text)) {
+      return Status::Error(ErrorCode::kInvalidInput,
+                           path + ":" + std::to_string(duplicate->line) + ": " + DuplicateKeyProblem(*duplicate));
+    }
+    return document;
   } catch (const nlohmann::json::parse_error& e) {
     return Status::Error(ErrorCode::kInvalidInput, "malformed JSON in " + path + " at byte " + std::to_string(e.byte) + ": " + e.what());
   } catch (const std::exception& e) {

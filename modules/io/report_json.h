@@ -15,7 +15,8 @@ namespace selfcal::io {
 Status WriteJsonFile(const nlohmann::json& document, const std::string& path);
 
 // Reads a JSON file with the same guards as YAML files: size cap (yaml/yaml_reader.h kMaxYamlBytes),
-// nesting depth cap (kMaxYamlDepth), every parse error a Status naming the file and byte offset.
+// nesting depth cap (kMaxYamlDepth), every parse error a Status naming the file and byte offset, a key
+// given twice in one object refused naming the file and line.
 Result<nlohmann::json> ReadJsonFile(const std::string& path);
 
 }  // namespace selfcal::io

@@ -123,6 +123,17 @@ Status OtherRobot(const std::string& path, const std::string& line, const std::s
                            ") or plan one with `selfcal plan --robot " + *r.config_path + "`");
 }
 
+// Radians typed under `poses_deg` (yaml_schema.h): a file has one unit, so all rows are looked at together.
+void CheckDegreeRows(const std::vector<Eigen::VectorXd>& poses, const yaml::YamlNode& list, const std::string& key_at,
+                     Problems* problems) {
+  std::vector<double> all;
+  for (const Eigen::VectorXd& pose : poses) all.insert(all.end(), pose.data(), pose.data() + pose.size());
+  if (poses.empty() || !LooksLikeRadiansUnderDegrees(all)) return;
+  const std::vector<double> first(poses.front().data(), poses.front().data() + poses.front().size());
+  problems->Add(RadiansUnderDegreesProblem("poses_deg[0]", problems->At(list.items.front().line), first, "poses_rad") +
+                "; so do all " + std::to_string(poses.size()) + " rows of `poses_deg` at " + key_at);
+}
+
 Result<TrajectoryFile> Load(const std::string& path, int num_joints, const RobotModel* robot,
                             const ForRobot* for_robot = nullptr) {
   Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(path);
@@ -193,6 +204,7 @@ Result<TrajectoryFile> Load(const std::string& path, int num_joints, const Robot
       }
       poses.push_back(pose);
     }
+    if (deg) CheckDegreeRows(poses, list, problems.At(root.KeyLine("poses_deg")), &problems);
   }
   root.Finish();
   if (file.num_identification_poses > static_cast<int>(poses.size()) && problems.empty()) {

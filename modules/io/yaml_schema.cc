@@ -211,6 +211,32 @@ MapReader::~MapReader() {
   if (!finished_) Finish();
 }
 
+bool LooksLikeRadiansUnderDegrees(const std::vector<double>& values_rad) {
+  constexpr double kTwoPiDeg = 2 * kPi;
+  bool any = false;
+  for (const double v : values_rad) {
+    const double deg = RadToDeg(v);
+    if (!(std::abs(deg) <= kTwoPiDeg + 1e-9)) return false;
+    any |= deg != 0;
+  }
+  return any;
+}
+
+std::string RadiansUnderDegreesProblem(const std::string& name, const std::string& at,
+                                       const std::vector<double>& values_rad, const std::string& radian_key) {
+  std::string list;
+  for (std::size_t i = 0; i < values_rad.size() && i < 8; ++i) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.6g", RadToDeg(values_rad[i]));
+    list += (i ? ", " : "") + std::string(text);
+  }
+  if (values_rad.size() > 8) list += ", ...";
+  return "`" + name + "` at " + at + " holds [" + list + "]: " +
+         "every value within +-6.2832 (2 pi), as joint angles in radians are" +
+         ", not degrees (that would put every joint within 6.3 deg of its zero); give radians under `" + radian_key +
+         "` (a pose truly that close to zero too)";
+}
+
 std::string MapReader::Path(const std::string& key) const { return name_.empty() ? key : name_ + "." + key; }
 
 int MapReader::KeyLine(const std::string& key) const {
@@ -316,6 +342,15 @@ bool MapReader::QuantityList(const std::string& base, Unit unit, int size, const
   if (!value) return !required && node_;
   if (key_used) *key_used = key;
   return ReadDoubleList(*value, Path(key), size, range_si, problems_, out_si, key_unit, lines);
+}
+
+bool MapReader::JointAngles(int size, std::vector<double>* out_rad) {
+  const Range plausible = Range::Closed(DegToRad(-720), DegToRad(720));
+  std::string key;
+  if (!QuantityList("joints", Unit::kAngle, size, plausible, out_rad, true, &key)) return false;
+  if (key != "joints_deg" || !LooksLikeRadiansUnderDegrees(*out_rad)) return true;
+  problems_->Add(RadiansUnderDegreesProblem(Path(key), problems_->At(KeyLine(key)), *out_rad, "joints_rad"));
+  return false;
 }
 
 void MapReader::Finish() {

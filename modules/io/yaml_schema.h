@@ -80,6 +80,16 @@ bool ReadDoubleList(const yaml::YamlNode& node, const std::string& name, int siz
                     Problems* problems, std::vector<double>* out, KeyUnit unit = KeyUnit::kSi,
                     std::vector<int>* lines = nullptr);
 
+// Radians typed under a degree key (RELIABILITY.md C4): joint angles read from `joints_deg` or
+// `poses_deg` (`values_rad`, converted) whose every value, in degrees, lies within +-2 pi (6.2832), where
+// every joint angle written in radians lies, and not all zero. In degrees such values put every joint
+// within 6.3 deg of its zero; a real pose that close is given under the radian key instead.
+bool LooksLikeRadiansUnderDegrees(const std::vector<double>& values_rad);
+// The refusal of such values: "`<name>` at <at> holds [0.58, 0.34, ...]: every value within +-6.2832, as
+// radians are: ...".
+std::string RadiansUnderDegreesProblem(const std::string& name, const std::string& at,
+                                       const std::vector<double>& values_rad, const std::string& radian_key);
+
 // EditDistance (Levenshtein with adjacent transpositions) is base/closest_name.h's.
 
 // Reads the keys of one map. Every key looked up through the reader is allowed; Finish() (or the
@@ -116,6 +126,10 @@ class MapReader {
   bool Int(const std::string& key, long long min, long long max, long long* out);
   bool String(const std::string& key, std::string* out);
   bool OptionalString(const std::string& key, std::string* out);
+
+  // A pose's joint angles, required: `joints_deg` or `joints_rad`, `size` values (any if < 0) in
+  // [-720, 720] deg, radians typed under `joints_deg` refused (LooksLikeRadiansUnderDegrees); in radians.
+  bool JointAngles(int size, std::vector<double>* out_rad);
 
   // A quantity with a unit suffix, exactly one of `<base>_mm`/`<base>_m` or `<base>_deg`/`<base>_rad`
   // (Unit::kNone: just `<base>`); returns SI.

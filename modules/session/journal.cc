@@ -7,10 +7,12 @@
 #include <cerrno>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <utility>
 
 #include "base/atomic_file.h"
 #include "base/crc32.h"
+#include "base/json_lines.h"
 #include "session/file_util.h"
 
 namespace selfcal::session {
@@ -74,6 +76,10 @@ bool ParsePayload(const std::string& text, int max_depth, nlohmann::json* out, s
   }
   if (!value.is_object()) {
     *why = "payload is not a JSON object";
+    return false;
+  }
+  if (const std::optional<JsonDuplicateKey> duplicate = FindDuplicateJsonKey(text)) {
+    *why = "payload gives `" + JsonPointerName(duplicate->pointer) + "` twice";
     return false;
   }
   const auto type = value.find("type");

@@ -168,6 +168,20 @@ TEST(JournalTest, ARecordWithAValidCrcButABadPayloadIsRefusedEvenAtTheEnd) {
   }
 }
 
+// Issue 36: a record that gives a key twice was read with the last value winning.
+TEST(JournalTest, ARecordThatGivesAKeyTwiceIsRefused) {
+  TempDir dir;
+  const std::string path = dir.File(kJournalFileName);
+  const std::string two = WriteJournal(path, 2);
+  WriteFile(path, two + FrameJournalRecord(R"({"type":"fault","kind":"a","kind":"b"})"));
+  Result<Journal> journal = Journal::Open(path);
+  ASSERT_FALSE(journal.ok());
+  EXPECT_EQ(journal.status().code(), ErrorCode::kInvalidInput);
+  EXPECT_TRUE(Contains(journal.status().message(), "record 3 at byte offset " + std::to_string(two.size()) +
+                                                       " has a correct CRC but a bad payload (payload gives `kind` twice)"))
+      << journal.status().message();
+}
+
 TEST(JournalTest, OversizeRecordsAreRefused) {
   TempDir dir;
   const std::string path = dir.File(kJournalFileName);

@@ -38,6 +38,10 @@ std::optional<json> JsonFields::ParseObject() {
     Add({}, "the document is not a JSON object (found " + JsonTypeName(document) + ")");
     return std::nullopt;
   }
+  if (const std::optional<JsonDuplicateKey>& duplicate = lines_.duplicate()) {
+    problems_.push_back(file_ + ":" + std::to_string(duplicate->line) + ": " + DuplicateKeyProblem(*duplicate));
+    return std::nullopt;
+  }
   return document;
 }
 

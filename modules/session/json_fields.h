@@ -32,8 +32,9 @@ class JsonFields {
   // `text` the document (JSON or not), `file` its name in messages.
   JsonFields(std::string_view text, std::string file);
 
-  // Parses the text: the document when it is a JSON object; otherwise nullopt after a problem
-  // ("<file>:<line>: not JSON: <why>", or "... is not a JSON object (found array)").
+  // Parses the text: the document when it is a JSON object that repeats no key in any of its objects;
+  // otherwise nullopt after a problem ("<file>:<line>: not JSON: <why>", "... is not a JSON object (found
+  // array)", "<file>:<line>: `camera.fx_px` is given twice (lines 4 and 9) ...").
   std::optional<nlohmann::json> ParseObject();
 
   // "<file>:<line>" of the value at `path`.

@@ -381,5 +381,19 @@ TEST(SessionDirTest, OpenRecoversATornJournalAndRefusesADamagedOne) {
   EXPECT_EQ(ReadFile(path + "/lock"), "");  // the refused open released the lock
 }
 
+// Issue 36: a key given twice in session.json was taken, the last value winning; refused naming the line.
+TEST(SessionDirTest, AManifestKeyGivenTwiceIsRefusedNamingItsLines) {
+  TempDir dir;
+  const std::string text =
+      ReadFile(std::string(SELFCAL_SOURCE_DIR) + "/fuzz/regressions/manifest/duplicate-key-session-id.json");
+  std::filesystem::create_directories(dir.path() + "/s");
+  WriteFile(dir.path() + "/s/session.json", text);
+  const Result<SessionManifest> read = ReadManifest(dir.path() + "/s");
+  ASSERT_FALSE(read.ok());
+  EXPECT_EQ(read.status().code(), ErrorCode::kInvalidInput);
+  EXPECT_EQ(read.status().message(), dir.path() + "/s/session.json:28: `session_id` is given twice (lines 26 and 28): "
+                                                  "a JSON reader would keep one of them without a word; keep one");
+}
+
 }  // namespace
 }  // namespace selfcal::session

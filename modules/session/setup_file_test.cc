@@ -1,7 +1,9 @@
 #include "session/setup_file.h"
 
 #include <algorithm>
+#include <fstream>
 #include <functional>
+#include <iterator>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -105,6 +107,18 @@ TEST(SetupFile, EveryRefusalNamesTheFileAndTheLineOfItsKey) {
   EXPECT_EQ(ParseSetupFile("\n[1, 2]", "setup.json", &back).message(),
             "setup.json:2: the document is not a JSON object (found array)");
   EXPECT_EQ(ParseSetupFile("", "setup.json", &back).message().rfind("setup.json:1: not JSON: ", 0), 0u);
+}
+
+// Issue 36: a key given twice in setup.json was taken, the last value (here another f_x) winning.
+TEST(SetupFile, AKeyGivenTwiceIsRefusedNamingItsLines) {
+  std::ifstream in(std::string(SELFCAL_SOURCE_DIR) + "/fuzz/regressions/setup/duplicate-key-camera-fx-px.json");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_FALSE(text.empty());
+  ObservationSet back;
+  const Status s = ParseSetupFile(text, "cell/setup.json", &back);
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidInput);
+  EXPECT_EQ(s.message(), "cell/setup.json:6: `camera.fx_px` is given twice (lines 5 and 6): a JSON reader would keep "
+                         "one of them without a word; keep one");
 }
 
 }  // namespace

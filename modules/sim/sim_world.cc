@@ -83,7 +83,10 @@ ObservationSet Observe(const SimResult& world, const std::vector<Eigen::VectorXd
     for (size_t d = 0; d < world.truth.dots_in_base.size(); ++d) {
       const auto uv = Project(world.truth.camera_true, cam_from_base * world.truth.dots_in_base[d]);
       const double du = noise(rng), dv = noise(rng);  // drawn for every dot: same stream at any level
-      pose.dots_px[static_cast<int>(d)] = *uv + noise_px * Eigen::Vector2d(du, dv);
+      const Eigen::Vector2d detected = *uv + noise_px * Eigen::Vector2d(du, dv);
+      // A detector reports no centre outside the image: a dot the noise moves out is not seen (at the
+      // larger noises of the documented range, up to 10 px, some dots near the border are).
+      if (InImage(world.truth.camera_true, detected, 0.0)) pose.dots_px[static_cast<int>(d)] = detected;
     }
     set.poses.push_back(std::move(pose));
   }

@@ -1,5 +1,6 @@
 #include "simulation/sim_run_settings.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <optional>
@@ -9,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "base/terminal_text.h"
 #include "session/json_fields.h"
 
 namespace selfcal::simulation {
@@ -99,6 +101,39 @@ void ParseFaults(const json& run, JsonFields* fields, robot::SimulatedRobotFault
   if (f->contains("jog_delay_s")) GetDoubleIn(*f, at, "jog_delay_s", 0, 10, fields, &faults->jog_delay_s);
 }
 
+// The member `key` as a string, one of `allowed`; false after a problem naming it.
+bool GetStringOf(const json& run, const std::string& key, const std::vector<std::string>& allowed, JsonFields* fields,
+                 std::string* out) {
+  if (!fields->GetString(run, {}, key, out)) return false;
+  if (std::find(allowed.begin(), allowed.end(), *out) != allowed.end()) return true;
+  std::string list;
+  for (const std::string& a : allowed) list += (list.empty() ? "" : ", ") + a;
+  fields->Add(JsonPath{}.Member(key), "`" + key + "` must be one of " + list + " (found \"" + TerminalSafe(*out) + "\")");
+  return false;
+}
+
+// What every reader of run.json checks besides the simulated cell's settings: the format and version, the
+// backends, the address and device, the velocity scaling in `selfcal run`'s range, no unknown key.
+void ReadRunHeader(const json& run, JsonFields* fields, RunBackends* backends) {
+  std::string format;
+  if (fields->GetString(run, {}, "format", &format) && format != "selfcal-run") {
+    fields->Add(JsonPath{}.Member("format"), "`format` must be \"selfcal-run\" (found \"" + TerminalSafe(format) + "\")");
+  }
+  int version = 0;
+  if (fields->GetInt(run, {}, "version", &version) && version != 1) {
+    fields->Add(JsonPath{}.Member("version"), "`version` must be 1 (found " + std::to_string(version) + ")");
+  }
+  GetStringOf(run, "robot", {"sim", "network", "manual"}, fields, &backends->robot);
+  GetStringOf(run, "camera", {"sim", "v4l2"}, fields, &backends->camera);
+  std::string text;
+  fields->GetString(run, {}, "address", &text);
+  fields->GetString(run, {}, "device", &text);
+  double scaling = 0;
+  GetDoubleIn(run, {}, "velocity_scaling", 1e-3, 1, fields, &scaling);
+  fields->CheckKnown(run, {}, {"format", "version", "robot", "address", "camera", "device", "velocity_scaling", "seed",
+                               "grey_noise", "blur_px", "supersampling", "faults"});
+}
+
 }  // namespace
 
 Result<SimCellOptions> SimCellOptionsFor(const std::string& run_json_text, const std::string& name) {
@@ -106,6 +141,8 @@ Result<SimCellOptions> SimCellOptionsFor(const std::string& run_json_text, const
   const std::optional<json> parsed = fields.ParseObject();
   if (!parsed) return fields.ToStatus();
   const json& run = *parsed;
+  RunBackends backends;
+  ReadRunHeader(run, &fields, &backends);
   SimCellOptions o;
   uint64_t seed = 0;
   GetSeed(run, &fields, &seed);
@@ -128,8 +165,7 @@ Result<RunBackends> ReadRunBackends(const std::string& run_json_text, const std:
   const std::optional<json> parsed = fields.ParseObject();
   if (!parsed) return fields.ToStatus();
   RunBackends backends;
-  fields.GetString(*parsed, {}, "robot", &backends.robot);
-  fields.GetString(*parsed, {}, "camera", &backends.camera);
+  ReadRunHeader(*parsed, &fields, &backends);
   if (!fields.ok()) return fields.ToStatus();
   backends.robot_at = fields.At(JsonPath{}.Member("robot"));
   return backends;

@@ -6,8 +6,10 @@
 //
 // Both readers take run.json's text and refuse with kInvalidInput naming the file and line
 // ("<file>:<line>: `faults.nan_reads` must be an array (found string)", session/json_fields.h): text
-// that is not JSON, not an object, a missing or mistyped key, a value out of the range `selfcal run`
-// accepts, an unknown key in "faults".
+// that is not JSON, not an object, a key given twice, a missing or mistyped key, a value out of the range
+// `selfcal run` accepts, an unknown key. Both check every key docs/session-format.md lists for run.json:
+// "format" "selfcal-run", "version" 1, "robot" sim|network|manual, "camera" sim|v4l2, "address" and
+// "device" strings, "velocity_scaling" in [0.001, 1], and the cell's settings below.
 #pragma once
 
 #include <string>

@@ -5,6 +5,8 @@
 #include "simulation/sim_run_settings.h"
 
 #include <algorithm>
+#include <fstream>
+#include <iterator>
 #include <set>
 #include <string>
 #include <utility>
@@ -16,7 +18,8 @@ namespace selfcal::simulation {
 namespace {
 
 nlohmann::json RunJson() {
-  return {{"format", "selfcal-run"}, {"version", 1}, {"robot", "sim"}, {"camera", "sim"}, {"seed", 7},
+  return {{"format", "selfcal-run"}, {"version", 1}, {"robot", "sim"}, {"address", ""}, {"camera", "sim"},
+          {"device", ""}, {"velocity_scaling", 1.0}, {"seed", 7},
           {"grey_noise", 3.5}, {"blur_px", 0.25}, {"supersampling", 2},
           {"faults",
            {{"reject_moves", {1}}, {"protective_stop_moves", {2}}, {"hang_moves", {3}}, {"disconnect_moves", {4}},
@@ -193,6 +196,55 @@ TEST(SimRunSettings, RefusesBackendsThatAreNotNamesNamingTheLine) {
   const Result<RunBackends> array = ReadRunBackends("[]", "s/inputs/run.json");
   ASSERT_FALSE(array.ok());
   EXPECT_TRUE(NamesLine(array.status().message(), 1, "not a JSON object"));
+}
+
+// A reproducer kept in fuzz/regressions/run_settings/.
+std::string Reproducer(const std::string& name) {
+  std::ifstream in(std::string(SELFCAL_SOURCE_DIR) + "/fuzz/regressions/run_settings/" + name);
+  EXPECT_TRUE(in.good()) << name;
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// Issue 36: a key given twice was taken, the last value winning; both readers refuse it naming the line of
+// the second and the first.
+TEST(SimRunSettings, RefusesAKeyGivenTwiceNamingBothLines) {
+  const std::string seed = Reproducer("duplicate-key-seed.json");
+  EXPECT_TRUE(NamesLine(Refusal(seed), LineOf(seed, "\"seed\": 2"), "`seed` is given twice (lines " +
+                                                                       std::to_string(LineOf(seed, "\"seed\": 1")) + " and "));
+  const Result<RunBackends> backends = ReadRunBackends(seed, "s/inputs/run.json");
+  ASSERT_FALSE(backends.ok());
+  EXPECT_TRUE(NamesLine(backends.status().message(), LineOf(seed, "\"seed\": 2"), "`seed` is given twice"));
+  const std::string faults = Reproducer("duplicate-key-in-faults.json");
+  EXPECT_TRUE(NamesLine(Refusal(faults), LineOf(faults, "\"nan_reads\": [3]"), "`faults.nan_reads` is given twice"));
+}
+
+// Issue 36: `selfcal audit` took these although docs/session-format.md says run.json's readers check them.
+TEST(SimRunSettings, ChecksEveryKeyTheFormatDocumentsNamingTheLine) {
+  const std::pair<const char*, std::pair<std::string, std::string>> cases[] = {
+      {"velocity-scaling-text.json", {"\"velocity_scaling\"", "`velocity_scaling` must be a finite number (found string)"}},
+      {"velocity-scaling-negative.json", {"\"velocity_scaling\"", "`velocity_scaling` must be in [0.001, 1] (found -999999"}},
+      {"version-negative.json", {"\"version\"", "`version` must be 1 (found -3)"}},
+      {"address-missing.json", {"{", "missing key `address`"}},
+  };
+  for (const auto& [file, expected] : cases) {
+    const std::string text = Reproducer(file);
+    const int line = LineOf(text, expected.first);
+    EXPECT_TRUE(NamesLine(Refusal(text), line, expected.second)) << file;
+    const Result<RunBackends> backends = ReadRunBackends(text, "s/inputs/run.json");
+    ASSERT_FALSE(backends.ok()) << file;
+    EXPECT_TRUE(NamesLine(backends.status().message(), line, expected.second)) << file;
+  }
+  const std::pair<const char*, nlohmann::json> more[] = {
+      {"format", "selfcal-runs"}, {"version", "1"}, {"robot", "ur5"},     {"camera", "usb"},
+      {"address", 5},             {"device", nullptr}, {"velocity_scaling", 0.0}, {"velocity_scaling", 1.5},
+      {"extra", 1}};
+  for (const auto& [key, value] : more) {
+    nlohmann::json run = RunJson();
+    run[key] = value;
+    const std::string text = Text(run);
+    EXPECT_TRUE(NamesLine(Refusal(text), LineOf(text, "\"" + std::string(key) + "\""), "`" + std::string(key) + "`"))
+        << key << " = " << value;
+  }
 }
 
 }  // namespace

@@ -131,6 +131,21 @@ TEST(HostileInput, ForgedJournalRecordIsRefusedNamingTheLineAndLeavesNoOutput) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// Issue 36: a plan whose `poses_rad` was renamed `poses_deg` passed `plan --check`, and a verification pose
+// with radians under `joints_deg` was dropped without a word while calibrate exited 0. Both are refused
+// now, exit 2, naming the file and line, nothing written.
+TEST(HostileInput, RadiansUnderADegreeKeyAreRefusedNamingTheLine) {
+  const fs::path dir = FreshDir("radians");
+  const std::string plan = "fuzz/regressions/trajectory/plan-poses-rad-renamed-poses-deg.yaml";
+  std::string output;
+  EXPECT_EQ(RunSelfcal("plan --check " + plan + " --robot config/robots/ur5e.yaml", &output), 2) << output;
+  EXPECT_TRUE(Has(output, "`poses_deg[0]` at " + plan + ":104 holds [")) << output;
+  const std::string observations = "fuzz/regressions/observations/verification-pose-radians-under-joints-deg.yaml";
+  EXPECT_EQ(RunSelfcal("calibrate " + observations + " --out " + (dir / "out").string(), &output), 2) << output;
+  EXPECT_TRUE(Has(output, "`poses[1].joints_deg` at " + observations + ":17 holds [0.17453,")) << output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
 // The halt message said "The robot was told to stop." whether or not STOP reached the arm: a lost
 // connection cannot carry it, a protective stop can.
 TEST(HostileInput, HaltSaysTheRobotWasToldToStopOnlyWhenTheStopWasSent) {
