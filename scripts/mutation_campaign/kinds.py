@@ -1,9 +1,10 @@
 """The file kinds of scripts/mutation-campaign: where their valid seeds come from, and the command that
 reads a mutant of each.
 
-A kind's prepare(ctx, seed, work, index) lays out the mutant's work directory (the files the command needs
+A kind's prepare(ctx, seed, work, variant) lays out the mutant's work directory (the files the command needs
 beside the mutant, copied or linked from the seeds) and returns {"file": the mutant's path relative to work,
-"cmd": the command line (run in work), "names": other names the file may be called in a message}. Every
+"cmd": the command line (run in work), "names": other names the file may be called in a message}; variant (the kind's own count of mutants)
+chooses among the commands that read the kind. Every
 output goes to work/out, a fresh directory outside any session.
 """
 import glob
