@@ -1,0 +1,317 @@
+"""Why a mutant that selfcal accepted (exit 0) is a valid input, or that it is not explained (a finding).
+
+Both the seed and the mutant are parsed by a strict reader of this script (YAML without duplicate keys,
+JSON without duplicate keys or NaN, XML, the journal's framing and CRC, CSV numbers). Then:
+  1. the same data: the mutation was semantics-preserving (white space, a comment, line ends, a byte order
+     mark, the spelling of a number, key order);
+  2. otherwise every difference must fall under a stated rule: free text, an optional key removed, a list
+     of records shortened, repeated or reordered, a joint inside the robot config's limits, a finite
+     measured value within 10x of the seed's magnitude, a number of a report (only rendered), a torn
+     journal tail (documented as ignored);
+  3. anything else, including a mutant the strict reader refuses, is unexplained.
+"""
+import json
+import math
+import os
+import re
+import xml.etree.ElementTree as ET
+import zlib
+
+import yaml
+
+FREE_TEXT = {"description", "source", "planner", "comment", "note", "notes", "software_version", "title"}
+OPTIONAL = {
+    "trajectory": {"robot", "description", "planner"},
+    "targets": {"robot", "seed_deg", "seed_rad"},
+    "robot_config": {"source", "name", "home_deg"},
+    "calibrated_model": {"source", "intrinsics_stddev"},
+    "urdf": {"<origin>", "<inertial>", "<visual>", "<collision>", "<dynamics>", "<safety_controller>",
+             "<calibration>", "<material>", "<mass>", "<inertia>", "<geometry>", "@name"},
+}
+RECORD_LISTS = {"poses_deg", "poses_rad", "targets", "samples", "observations", "poses", "rows", "images", "joints",
+                "dots"}
+MEASURED = re.compile(r"(_mm|_m|_deg|_rad|_px|^u$|^v$|^uv|^xyz|^rpy|^quat|^rotvec|^joints|^data|^x$|^y$|^z$|"
+                      r"^q[xyzw]$|^fx|^fy|^cx|^cy|^k\d|^p\d|^mu$|^rotation|^[abd]$|^alpha|^theta)")
+
+
+class StrictLoader(yaml.SafeLoader):
+    pass
+
+
+def _mapping(loader, node, deep=False):
+    loader.flatten_mapping(node)
+    keys = set()
+    for key_node, _ in node.value:
+        key = loader.construct_object(key_node, deep=True)
+        if key in keys:
+            raise ValueError("duplicate key %r" % (key,))
+        keys.add(key)
+    return loader.construct_mapping(node, deep=True)
+
+
+def _any_tag(loader, suffix, node):
+    if isinstance(node, yaml.MappingNode):
+        return _mapping(loader, node)
+    if isinstance(node, yaml.SequenceNode):
+        return loader.construct_sequence(node, deep=True)
+    return loader.construct_scalar(node)
+
+
+StrictLoader.add_implicit_resolver(  # YAML 1.2's floats (1e3, 1.0e0), which selfcal's reader takes too
+    "tag:yaml.org,2002:float", re.compile(r"^[-+]?([0-9][0-9_]*)?\.?[0-9]+([eE][-+]?[0-9]+)$|^[-+]?[0-9]+\.[0-9]*([eE][-+]?[0-9]+)?$"),
+    list("-+0123456789."))
+StrictLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _mapping)
+StrictLoader.add_multi_constructor("tag:yaml.org,2002:opencv", _any_tag)
+StrictLoader.add_multi_constructor("!", _any_tag)
+
+
+def _text(data):
+    text = data.decode("utf-8")  # invalid UTF-8 raises
+    if "\x00" in text:
+        raise ValueError("NUL")
+    return text
+
+
+def parse(fmt, data):
+    if fmt in ("yaml", "opencv"):
+        text = _text(data)
+        if text.startswith("\ufeff"):
+            text = text[1:]
+        if fmt == "opencv" and text.startswith("%YAML:"):
+            text = text.split("\n", 1)[1] if "\n" in text else ""
+        docs = list(yaml.load_all(text, Loader=StrictLoader))
+        if len(docs) != 1:
+            raise ValueError("%d documents" % len(docs))
+        return docs[0]
+    if fmt == "json":
+        def pairs(items):
+            keys = [k for k, _ in items]
+            if len(keys) != len(set(keys)):
+                raise ValueError("duplicate key")
+            return dict(items)
+        return json.loads(_text(data).lstrip("\ufeff"), object_pairs_hook=pairs,
+                          parse_constant=lambda c: (_ for _ in ()).throw(ValueError(c)))
+    if fmt == "xml":
+        return _xml(ET.fromstring(data))
+    if fmt == "journal":
+        return _journal(data)
+    if fmt == "csv":
+        rows = []
+        for row in _text(data).splitlines():
+            cells = [c for c in re.split(r"[,;\s]+", row) if c]
+            if cells:
+                rows.append([_num(c) for c in cells])
+        return {"rows": rows}
+    raise ValueError(fmt)
+
+
+def _num(cell):
+    try:
+        return float(cell)
+    except ValueError:
+        return cell
+
+
+def _xml(e, depth=0):
+    """An element as {"@attr": value, "#text": text, "<child>": [elements]}: a URDF's or ViSP file's tree
+    (below 100 levels: deeper ones are one marker, which no rule explains)."""
+    if depth > 100:
+        return {"#deeper-than-100-levels": True}
+    out = {"@" + k: v for k, v in e.attrib.items()}
+    if (e.text or "").strip():
+        out["#text"] = e.text.strip()
+    for c in e:
+        out.setdefault("<%s>" % c.tag, []).append(_xml(c, depth + 1))
+    return out
+
+
+def _journal(data):
+    records, lines = [], data.split(b"\n")
+    for i, line in enumerate(lines):
+        if not line and i == len(lines) - 1:
+            break
+        m = re.match(rb"^J1 ([0-9a-f]{8}) ([0-9a-f]{8}) (.*)$", line, re.S)
+        ok = bool(m) and int(m.group(1), 16) == len(m.group(3)) and int(m.group(2), 16) == zlib.crc32(m.group(3)) & 0xffffffff
+        if not ok:
+            if i == len(lines) - 1 or (i == len(lines) - 2 and not lines[-1]):
+                return {"records": records, "torn_tail": True}
+            raise ValueError("bad record %d" % (i + 1))
+        records.append(parse("json", m.group(3)))
+    return {"records": records, "torn_tail": False}
+
+
+def flatten(value, path=()):
+    if isinstance(value, dict):
+        out = {path + ("{}",): len(value)}
+        for k, v in value.items():
+            out.update(flatten(v, path + (str(k),)))
+        return out
+    if isinstance(value, list):
+        out = {path + ("[]",): len(value)}
+        for i, v in enumerate(value):
+            out.update(flatten(v, path + (i,)))
+        return out
+    return {path: value}
+
+
+def _is_number(v):
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def _keys_of(path):
+    return [p for p in path if isinstance(p, str) and p not in ("{}", "[]")]
+
+
+def _joint_limits(ctx, kind, path):
+    """(min_deg, max_deg) of the joint a trajectory value is, from the robot config of the seed."""
+    robot = ctx.get("current_robot")
+    if not robot or not os.path.isfile(robot):
+        return None
+    try:
+        joints = yaml.safe_load(open(robot))["joints"]
+        j = path[-1]
+        return float(joints[j]["min_deg"]), float(joints[j]["max_deg"])
+    except (KeyError, IndexError, TypeError, ValueError):
+        return None
+
+
+def _plausible(old, new):
+    """A measured value, changed to a finite one of the same sign within 10x of the seed's magnitude."""
+    return math.isfinite(new) and abs(new) <= 10 * max(abs(old), 1.0) and \
+        (old == 0 or new == 0 or (old > 0) == (new > 0) or abs(old) < 1e-3)
+
+
+def _rule_for_value(kind, ctx, path, old, new):
+    keys = _keys_of(path)
+    last = keys[-1] if keys else ""
+    if any(k in FREE_TEXT for k in keys):
+        return "free text key `%s`" % last
+    if isinstance(old, str) and isinstance(new, str) and last.startswith("@") or last == "#text":
+        a, b = old.split(), new.split()
+        try:
+            pairs = [(float(x), float(y)) for x, y in zip(a, b)]
+        except ValueError:
+            return None
+        if len(a) != len(b) or not all(_plausible(x, y) for x, y in pairs):
+            return None
+        return "a finite geometric or camera value within 10x of the seed's (`%s`)" % "/".join(keys[-2:])
+    if kind.name == "observations" and last == "id" and isinstance(new, str) and new.strip():
+        return "a pose's id is a label: any non-empty one"
+    if kind.name == "camera_visp" and "<name>" in keys and ctx.get("seed_name") == "cam_visp.xml":
+        return "the name of the only camera of a file read without --camera-name"
+    if kind.name == "ros_pose" and last in ("qx", "qy", "qz", "qw") and _is_number(new) and isinstance(ctx.get("new_doc"), dict):
+        try:
+            norm = math.sqrt(sum(float(ctx["new_doc"][k]) ** 2 for k in ("qx", "qy", "qz", "qw")))
+        except (KeyError, TypeError, ValueError):
+            norm = 0
+        if abs(norm - 1) <= 1e-3:
+            return "a unit quaternion (norm within 1e-3 of 1, detect.md)"
+        return None
+    if not (_is_number(old) and _is_number(new)):
+        return None
+    if not math.isfinite(float(new)) if abs(new) < 1e308 else True:
+        return None
+    if kind.name in ("report_json", "study_json"):
+        return "a finite number of a report: report only renders it"
+    if kind.name == "trajectory" and last in ("poses_deg", "poses_rad"):
+        limits = _joint_limits(ctx, kind, path)
+        if limits:
+            deg = new if last == "poses_deg" else math.degrees(new)
+            if limits[0] <= deg <= limits[1]:
+                return "a joint inside the robot config's limits [%g, %g] deg" % limits
+        return None
+    if kind.name in ("observations", "tracker", "robot_config", "calibrated_model", "camera_opencv", "camera_visp",
+                     "ros_pose", "visp_pose", "targets", "journal", "session_inputs") and \
+            (MEASURED.search(last) or kind.name in ("tracker", "journal") or isinstance(path[-1], int)):
+        if _plausible(old, new):
+            return "a finite measured or geometric value within 10x of the seed's (any such value is a valid measurement)"
+    return None
+
+
+def _record_list_change(old, new, key_path):
+    def get(doc, path):
+        for p in path:
+            doc = doc[p]
+        return doc
+    try:
+        a, b = get(old, key_path), get(new, key_path)
+    except (KeyError, IndexError, TypeError):
+        return False
+    if not isinstance(a, list) or not isinstance(b, list):
+        return False
+    norm = lambda v: json.dumps(v, sort_keys=True, default=str)  # noqa: E731
+    items = {norm(x) for x in a}
+    return all(norm(x) in items for x in b) and len(b) >= 1
+
+
+def _normal(data):
+    data = data[3:] if data.startswith(b"\xef\xbb\xbf") else data
+    return b"\n".join(line.rstrip(b" \t\r") for line in data.split(b"\n"))
+
+
+def explain(kind, ctx, original, mutant, ops):
+    names = [o["desc"].split(" ")[0] for o in ops]
+    try:
+        old = parse(kind.fmt, original)
+    except Exception as e:  # noqa: BLE001
+        return True, "seed not parsed by this script's reader (%s): not judged" % type(e).__name__
+    if kind.fmt != "journal" and {o["op"] for o in ops} <= {"trailing_space", "crlf", "bom"} and _normal(mutant) == _normal(original):
+        return True, "semantics-preserving (%s): the same text but for white space at line ends, line ends or a BOM" % \
+            ", ".join(sorted({o["op"] for o in ops}))
+    if len(mutant) > 2 * len(original) + (1 << 20):
+        huge = [o for o in ops if o["op"] == "huge"]
+        line = huge[0].get("line", b"x") if huge else b"x"
+        if huge and len(ops) == 1 and (not line.strip() or line.strip().startswith((b"#", b"<!--"))):
+            return True, "semantics-preserving (huge): a comment or blank line repeated"
+        return False, "a file of %.1f MiB accepted (%s)" % (len(mutant) / 2.0 ** 20, ", ".join(names))
+    try:
+        new = parse(kind.fmt, mutant)
+    except Exception as e:  # noqa: BLE001
+        return False, "not a valid %s file for a strict reader: %s" % (kind.fmt, str(e).splitlines()[0][:160] if str(e) else type(e).__name__)
+    if kind.fmt == "journal" and new["torn_tail"] and new["records"] == old["records"][:len(new["records"])]:
+        return True, "torn journal tail: the records before it unchanged (a torn tail is ignored, session-format.md)"
+    if old == new:
+        preserving = {"trailing_space", "comment", "crlf", "bom", "respell_number", "reorder_json"}
+        ops_set = {o["op"] for o in ops}
+        if ops_set <= preserving:
+            return True, "semantics-preserving (%s): the same data" % ", ".join(sorted(ops_set))
+        return True, "the same data after parsing (%s)" % ", ".join(sorted(ops_set))
+    fa, fb = flatten(old), flatten(new)
+    ctx = dict(ctx, new_doc=new)
+    reasons = set()
+    differing = (set(fa) ^ set(fb)) | {q for q in fa if q in fb and fa[q] != fb[q]}
+    for p in fa:
+        if len(p) >= 2 and p[-1] == "[]" and p[-2] in RECORD_LISTS:
+            prefix = p[:-1]
+            if all(q[:len(prefix)] == prefix for q in differing) and _record_list_change(old, new, prefix):
+                return True, "records of `%s` removed, repeated or reordered: a list of any length (%s)" % (p[-2], ", ".join(names))
+    for path in sorted(set(fa) | set(fb), key=str):
+        a, b = fa.get(path, None), fb.get(path, None)
+        if path in fa and path in fb and a == b:
+            continue
+        keys = _keys_of(path)
+        if path not in fb:
+            if keys and (keys[-1] in OPTIONAL.get(kind.name, ()) or keys[-1] in FREE_TEXT or
+                         any(k in OPTIONAL.get(kind.name, ()) for k in keys)):
+                reasons.add("optional key `%s` removed" % keys[-1])
+                continue
+            if path[-1] == "{}" and any(k in OPTIONAL.get(kind.name, ()) for k in keys):
+                continue
+            if path[-1] in ("{}",):
+                continue
+            return False, "key %s removed and the reader did not ask for it" % "/".join(map(str, path))
+        if path not in fa:
+            if path[-1] == "{}":
+                continue
+            if kind.name == "urdf" and len(path) >= 2 and path[0].startswith("<") and \
+                    path[0] not in ("<link>", "<joint>", "<material>") and not any("deeper" in str(p) for p in path):
+                reasons.add("an element URDF does not define, directly under <robot> (ignored, like <gazebo>)")
+                continue
+            return False, "key %s added and accepted" % "/".join(map(str, path))
+        if path[-1] == "{}":
+            continue
+        rule = _rule_for_value(kind, ctx, path, a, b)
+        if not rule:
+            return False, "value of %s changed %r -> %r and accepted" % ("/".join(map(str, path)), a, b)
+        reasons.add(rule)
+    return True, "; ".join(sorted(reasons)) or "no difference"
