@@ -175,6 +175,22 @@ std::string DirectoryOf(const std::string& path) {
   return parent.empty() ? "." : parent;
 }
 
+// Lines of `data` from `pos` on that hold anything but NUL bytes (a crash on some file systems leaves a tail
+// of zeros).
+int NonEmptyLines(const std::string& data, std::size_t pos) {
+  int lines = 0;
+  bool content = false;
+  for (std::size_t k = pos; k < data.size(); ++k) {
+    if (data[k] == '\n') {
+      lines += content ? 1 : 0;
+      content = false;
+    } else if (data[k] != '\0') {
+      content = true;
+    }
+  }
+  return lines + (content ? 1 : 0);
+}
+
 // Parses the whole journal `data` into *records. A torn tail is only reported in *recovery (valid_bytes:
 // where it starts, dropped_bytes: its length); damage and faulty writers are refused (kInvalidInput).
 Status ParseJournal(const std::string& data, const std::string& path, const JournalLimits& limits,
@@ -199,6 +215,16 @@ Status ParseJournal(const std::string& data, const std::string& path, const Jour
                                                  std::to_string(later) +
                                                  ": the journal is damaged, not torn by a crash; refusing to drop "
                                                  "records (nothing was changed)");
+    }
+    // One interrupted append leaves one line at most (a prefix of a record, or a record whose bytes did not
+    // all reach the disk); several lines of text after the last valid record are not a tail torn by a
+    // crash but a damaged or replaced journal, which a resume would otherwise cut to its valid part.
+    if (const int lines = NonEmptyLines(data, pos); lines > 1) {
+      return Status::Error(ErrorCode::kInvalidInput, where + " is corrupt (" + record.reason + ") and " +
+                                                 std::to_string(lines) +
+                                                 " lines follow the last valid record: the journal is damaged or "
+                                                 "replaced, not torn by a crash; refusing to drop them (nothing was "
+                                                 "changed)");
     }
     recovery->dropped_bytes = data.size() - pos;
     recovery->reason = record.reason + ": " + RecordName(records->size(), pos);

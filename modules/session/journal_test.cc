@@ -118,6 +118,24 @@ TEST(JournalTest, GarbageAfterTheLastRecordIsATornTail) {
   }
 }
 
+// A journal replaced or overwritten by text (several lines after the last valid record, none of them a
+// record) is damage, not a torn tail: refused, and the file left as it was.
+TEST(JournalTest, SeveralLinesOfTextAfterTheLastRecordAreRefusedNotCut) {
+  TempDir dir;
+  const std::string path = dir.File(kJournalFileName);
+  const std::string two = WriteJournal(path, 2);
+  for (const std::string& prefix : {std::string(), two}) {
+    const std::string text = prefix + "this is not a journal\n\x01\x02\x03 nor this";
+    WriteFile(path, text);
+    Result<Journal> journal = Journal::Open(path);
+    ASSERT_FALSE(journal.ok());
+    EXPECT_EQ(journal.status().code(), ErrorCode::kInvalidInput);
+    EXPECT_TRUE(Contains(journal.status().message(), "2 lines follow the last valid record"))
+        << journal.status().message();
+    EXPECT_EQ(FileSize(path), text.size());
+  }
+}
+
 TEST(JournalTest, CorruptLastRecordIsATornTail) {
   TempDir dir;
   const std::string path = dir.File(kJournalFileName);
