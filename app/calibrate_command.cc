@@ -12,6 +12,7 @@
 #include "app/model_exports.h"
 #include "app/output_options.h"
 #include "app/report_command.h"
+#include "geometry/rigid3.h"
 #include "io/camera_file.h"
 #include "io/hand_eye_file.h"
 #include "io/observations_file.h"
@@ -269,11 +270,22 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   if (from_session) {
     std::cout << "session " << request.input << ": " << loaded->observations.poses.size() << " accepted samples\n";
   }
+  const int identification = static_cast<int>(loaded->observations.PosesWithRole(PoseRole::kIdentification).size());
+  if (request.folds_given && request.folds > 0 && identification < 2 * request.folds) {
+    return Fail(Status::Error(ErrorCode::kInvalidInput,
+                              "--folds " + std::to_string(request.folds) + ": " + request.input + " has " +
+                                  std::to_string(identification) + " identification poses, and " +
+                                  std::to_string(request.folds) + " folds need at least " +
+                                  std::to_string(2 * request.folds) + " (two a fold); nothing was written"));
+  }
   calibration::CalibrateOptions options;
   options.method = request.method;
+  options.cross_validation_folds = request.folds;
   options.paper.two_view.seed = request.seed;
   options.bundle.bundle.held_parameters = request.fix;
   options.bundle.bundle.free_parameters = request.free;
+  options.bundle.bundle.weak_length_tolerance_m = request.weak_tolerance_mm * 1e-3;
+  options.bundle.bundle.weak_angle_tolerance_rad = DegToRad(request.weak_tolerance_deg);
   options.flange_scale_from_yardsticks = request.scale_from == "yardstick";
   options.progress = Progress();
   calibration::CalibrationReport report = calibration::Calibrate(loaded->observations, options);
@@ -314,6 +326,18 @@ Command AddCalibrateCommand(CLI::App& app) {
   cmd->add_option("--seed", request->seed, "Seed of the RANSAC sampling (results are deterministic per seed)");
   AddMethodOption(cmd, method.get());
   AddParameterMaskOptions(cmd, &request->fix, &request->free);
+  cmd->add_option("--weak-tolerance-mm", request->weak_tolerance_mm,
+                  "Hold a joint length the poses determine worse than this at the robot description's value, named "
+                  "in the output (0: never)")
+      ->check(CLI::Range(0.0, 1000.0));
+  cmd->add_option("--weak-tolerance-deg", request->weak_tolerance_deg,
+                  "The same for a joint angle, deg (0: never)")
+      ->check(CLI::Range(0.0, 180.0));
+  CLI::Option* folds = cmd->add_option("--folds", request->folds,
+                                       "Without verification poses: hold out each of K folds of the poses in turn "
+                                       "and predict them (the held-out figure of report.json's cross_validation; 0: "
+                                       "not run)")
+                           ->check(CLI::Range(0, 1000));
   cmd->add_option("--scale-from", request->scale_from,
                   "Flange poses: what fixes the metric scale. flange: the flange translations (yardsticks are checks); "
                   "yardstick: the yardsticks as length constraints beside them")
@@ -331,7 +355,8 @@ Command AddCalibrateCommand(CLI::App& app) {
                   "written, for a lens with k2, p1, p2 or k3)");
   auto no_html = std::make_shared<bool>(false);
   cmd->add_flag("--no-html", *no_html, "Do not write report.html (report.json and the model are written as always)");
-  return [request, method, no_html]() {
+  return [request, method, no_html, folds]() {
+    request->folds_given = folds->count() > 0;
     request->method = MethodFromName(*method);
     request->html = !*no_html;
     return CalibrateAndWrite(*request);

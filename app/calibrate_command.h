@@ -32,6 +32,13 @@ struct CalibrateRequest {
   calibration::Method method = calibration::Method::kBundle;
   std::vector<std::string> fix{}, free{};  // parameter names and groups (bundle::BundleOptions::held_parameters)
   std::string scale_from = "flange";   // flange-pose sets: "flange" or "yardstick" (CalibrateOptions)
+  // Weak directions: the manufacturing tolerances above which a poorly determined joint parameter is held at
+  // the robot description's value (bundle::BundleOptions::weak_length_tolerance_m; 0: never held).
+  double weak_tolerance_mm = 5.0, weak_tolerance_deg = 0.5;
+  // Without verification poses: k-fold cross-validation over the identification poses (0: not run);
+  // folds_given: named on the command line, so that too few poses for it is an error, not a note.
+  int folds = 4;
+  bool folds_given = false;
   // A camera file (io/camera_file.h) whose intrinsics replace the observations' camera, and the camera
   // chosen in a ViSP file (empty: its only one; also the name written to write_camera_visp).
   std::string camera_file{}, camera_name{};

@@ -218,6 +218,11 @@ CalibrationReport CalibrateSteps(const ObservationSet& observations, const Calib
     }
     report.verdict = VerdictFor(report.bundle->bundle.outcome);
     report.message = report.bundle->bundle.message;
+    if (report.bundle->bundle.outcome == bundle::Outcome::kConverged && options.cross_validation_folds > 0 &&
+        obs.PosesWithRole(PoseRole::kVerification).empty()) {
+      report.cross_validation =
+          CrossValidate(obs, *report.bundle, stage_options, options.cross_validation_folds, options.paper.two_view.seed);
+    }
     progress.Advance();
   }
   if (flange_poses && report.bundle) CheckFlangePoses(observations, obs, options, &report);

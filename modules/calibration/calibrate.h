@@ -25,6 +25,7 @@
 
 #include "calibration/acceptance.h"
 #include "calibration/bundle_stage.h"
+#include "calibration/cross_validation.h"
 #include "calibration/hand_eye_start.h"
 #include "bundle/pose_noise_bundle.h"
 #include "calibration/motion_check.h"
@@ -57,6 +58,9 @@ struct CalibrateOptions {
   Method method = Method::kBundle;
   PaperPipelineOptions paper;  // paper.two_view.seed seeds the RANSAC sampling
   BundleStageOptions bundle;
+  // Without verification poses: k-fold cross-validation of the bundle's model over the identification poses
+  // (cross_validation.h; seeded by paper.two_view.seed). 0: not run.
+  int cross_validation_folds = 4;
   HandEyeStartOptions hand_eye;  // flange-pose sets (its two-view seed is paper.two_view.seed)
   bundle::FreeCameraOptions motion_check;  // flange-pose sets: the images' own camera motions
   // Flange-pose sets: false, the flange translations alone give the metric scale and the yardsticks are
@@ -107,6 +111,8 @@ struct CalibrationReport {
   // flange translations alone; the yardsticks were checks).
   int flange_scale_yardsticks = 0;
   std::optional<BundleStageReport> bundle;  // when method == kBundle
+  // The bundle converged and the set names no verification pose: its k-fold held-out figure.
+  std::optional<CrossValidationReport> cross_validation;
   std::optional<CalibratedModel> model;    // the chosen method's model, only when accepted
   // The acceptance checks of the chosen method's converged model (empty when it did not converge).
   Acceptance acceptance;

@@ -62,6 +62,23 @@ json VerificationJson(const ObservationSet& obs, const calibration::Verification
           {"calibrated_model", VerificationSummaryJson(calibrated)}};
 }
 
+json HeldOutFigureJson(const calibration::HeldOutFigure& f);
+
+// The k-fold held-out figure (calibration/cross_validation.h).
+json CrossValidationJson(const calibration::CrossValidationReport& cv) {
+  json folds = json::array();
+  for (const calibration::CrossValidationFold& f : cv.per_fold) {
+    folds.push_back({{"held_out", f.held_out},
+                     {"outcome", bundle::OutcomeName(f.outcome)},
+                     {"message", f.message},
+                     {"figure", f.figure.num_residuals > 0 ? HeldOutFigureJson(f.figure) : json()}});
+  }
+  return {{"ran", cv.ran},           {"message", cv.message},       {"folds", cv.folds},
+          {"seed", cv.seed},         {"num_residuals", cv.num_residuals}, {"rms_px", Finite(cv.rms_px)},
+          {"mm_per_px", Finite(cv.mm_per_px)}, {"rms_mm", Finite(cv.rms_mm)}, {"folds_passed", cv.folds_passed},
+          {"per_fold", folds}};
+}
+
 // The parameters held because these poses determine them worse than their tolerance, and the joints that
 // barely move (mm and deg, as the rest of the report's parameters).
 json WeakJson(const bundle::BundleReport& b) {
@@ -452,6 +469,7 @@ json CalibrationReportJson(const ObservationSet& obs, const calibration::Calibra
   j["verification"] = field("verification");
   j["predicted_3d_error"] = field("predicted_3d_error");
   j["heldout_reprojection"] = field("heldout_reprojection");
+  j["cross_validation"] = report.cross_validation ? CrossValidationJson(*report.cross_validation) : json();
   j["methods"] = methods;
   j["session"] = context.session ? SessionJson(context.input, *context.session) : json();
   if (report.hand_eye_start) j["hand_eye"] = HandEyeJson(report);

@@ -1,3 +1,4 @@
+#include <cmath>
 #include <iomanip>
 #include <sstream>
 #include <string>
@@ -177,6 +178,23 @@ void PrintHandEye(const calibration::CalibrationReport& report, std::ostream& ou
   }
 }
 
+// The k-fold held-out figure of a set without verification poses.
+void PrintCrossValidation(const calibration::CrossValidationReport& cv, std::ostream& out) {
+  out << "  cross-validation (" << cv.folds << " folds over the identification poses, seed " << cv.seed << "): ";
+  if (!cv.ran || cv.num_residuals == 0) {
+    out << cv.message << "\n";
+    return;
+  }
+  out << "held-out RMS " << std::fixed << std::setprecision(3) << cv.rms_px << " px per coordinate";
+  if (std::isfinite(cv.rms_mm)) out << " (" << cv.rms_mm << " mm at the scene)";
+  out << "; folds";
+  for (const calibration::CrossValidationFold& f : cv.per_fold) {
+    out << " " << (f.figure.num_residuals > 0 ? std::to_string(f.figure.rms_px).substr(0, 5) : std::string("-"));
+  }
+  out << " px; " << cv.folds_passed << " of " << cv.folds << " pass the held-out test at the stated noise\n";
+  out.unsetf(std::ios::floatfield);
+}
+
 void PrintCalibrationSummary(const calibration::CalibrationReport& report, std::ostream& out) {
   if (report.hand_eye_start) {
     PrintHandEye(report, out);
@@ -187,6 +205,7 @@ void PrintCalibrationSummary(const calibration::CalibrationReport& report, std::
   if (report.bundle) {
     out << "\n";
     PrintBundleSummary(*report.bundle, report.hand_eye_start.has_value(), out);
+    if (report.cross_validation) PrintCrossValidation(*report.cross_validation, out);
   }
   if (!report.acceptance.checks.empty()) {
     out << "\nacceptance of the " << calibration::MethodName(report.method) << " model:\n";

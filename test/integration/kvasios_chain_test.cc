@@ -79,6 +79,14 @@ TEST(KvasiosChain, EverySessionCalibratesWithTheDefaultsNamingWhatTheDataCannotD
     EXPECT_TRUE(j4d) << weak.dump();
     EXPECT_NE(output.find("joint 3 barely moves"), std::string::npos) << output;
     EXPECT_NE(output.find("held (weak): j4.d"), std::string::npos) << output;
+    // No verification poses: the held-out figure of 4 folds of the session's own poses, every pose held out
+    // once; within the goal set for another session's poses (1.2 px per coordinate).
+    const nlohmann::json& cv = report.at("cross_validation");
+    ASSERT_TRUE(cv.at("ran").get<bool>()) << cv.dump();
+    EXPECT_EQ(cv.at("per_fold").size(), 4u);
+    EXPECT_GT(cv.at("num_residuals").get<int>(), 12 * 24 - 12) << cv.dump();
+    EXPECT_LT(cv.at("rms_px").get<double>(), 1.2) << cv.dump();
+    EXPECT_NE(output.find("cross-validation (4 folds"), std::string::npos) << output;
     // The camera's start came from the images, not from the shipped mount 44 deg away.
     EXPECT_NE(bundle.at("start_note").get<std::string>().find("camera correction from the images"), std::string::npos)
         << bundle.at("start_note");

@@ -1,0 +1,119 @@
+#include "calibration/cross_validation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+namespace selfcal::calibration {
+
+namespace {
+
+// Identification pose indices in a seeded order (Fisher-Yates on mt19937_64: the same on every platform).
+std::vector<int> ShuffledPoses(const ObservationSet& obs, std::uint64_t seed) {
+  std::vector<int> poses = obs.PosesWithRole(PoseRole::kIdentification);
+  std::mt19937_64 rng(seed);
+  for (size_t k = poses.size(); k > 1; --k) std::swap(poses[k - 1], poses[rng() % k]);
+  return poses;
+}
+
+// The median distance from the identification cameras of `full` to the dots they see.
+double MedianDepth(const ObservationSet& obs, const BundleStageReport& full) {
+  std::vector<double> depths;
+  for (const CameraPose& camera : full.fit_geometry.camera_poses) {
+    if (camera.role != PoseRole::kIdentification) continue;
+    for (const PoseObservation& pose : obs.poses) {
+      if (pose.id != camera.pose_id) continue;
+      for (const auto& entry : pose.dots_px) {
+        auto dot = full.bundle.dots_in_base.find(entry.first);
+        if (dot != full.bundle.dots_in_base.end()) {
+          depths.push_back((dot->second - camera.base_from_cam.translation).norm());
+        }
+      }
+    }
+  }
+  if (depths.empty()) return NAN;
+  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  return depths[depths.size() / 2];
+}
+
+// One fold: the bundle without `held_out`, started from the whole solve, and its prediction of them.
+CrossValidationFold RunFold(const ObservationSet& obs, const BundleStageReport& full, const BundleStageOptions& options,
+                            const std::vector<int>& held_out) {
+  CrossValidationFold fold;
+  ObservationSet train = obs;
+  for (int p : held_out) {
+    train.poses[p].role = PoseRole::kVerification;
+    fold.held_out.push_back(obs.poses[p].id);
+  }
+  const bundle::BundleReport b = bundle::RunBundleAdjustment(train, full.bundle.rho, full.bundle.fx_px, options.bundle);
+  fold.outcome = b.outcome;
+  if (b.outcome != bundle::Outcome::kConverged) {
+    fold.message = b.message;
+    return fold;
+  }
+  PredictionModel model;
+  model.robot = obs.robot;
+  model.rho = b.rho;
+  model.camera = WithIntrinsics(obs.camera, b.intrinsics);
+  model.free_indices = b.free_indices;
+  model.intrinsics_estimated = b.intrinsics_estimated;
+  if (b.covariance_available) model.covariance = b.covariance_free;
+  ExcludedObservations excluded;
+  for (const bundle::RemovedObservation& o : b.removed) excluded.insert({o.pose_id, o.dot_id});
+  const bool estimated = std::isfinite(b.pixel_noise_estimate_px) && b.pixel_noise_estimate_px > 0;
+  const double noise = estimated ? b.pixel_noise_estimate_px : obs.pixel_noise_px;
+  const HeldOutReprojection h = HeldOutReprojectionOf(train, model, b.dots_in_base, excluded, noise, 0);
+  if (!h.ok) {
+    fold.message = h.message;
+    return fold;
+  }
+  fold.figure = Renormalised(h.overall, noise, obs.pixel_noise_px);
+  return fold;
+}
+
+}  // namespace
+
+CrossValidationReport CrossValidate(const ObservationSet& obs, const BundleStageReport& full,
+                                    const BundleStageOptions& options, int folds, std::uint64_t seed) {
+  CrossValidationReport report;
+  report.folds = folds;
+  report.seed = seed;
+  const std::vector<int> poses = ShuffledPoses(obs, seed);
+  if (!obs.PosesWithRole(PoseRole::kVerification).empty()) {
+    report.message = "not run: the verification poses give the held-out figure";
+    return report;
+  }
+  if (folds < 2) {
+    report.message = "not run (folds = " + std::to_string(folds) + ")";
+    return report;
+  }
+  if (static_cast<int>(poses.size()) < 2 * folds) {
+    report.message = "not run: " + std::to_string(poses.size()) + " identification poses are too few for " +
+                     std::to_string(folds) + " folds (two poses a fold at least)";
+    return report;
+  }
+  report.ran = true;
+  double sum2 = 0;
+  for (int f = 0; f < folds; ++f) {
+    std::vector<int> held_out;
+    for (size_t k = f; k < poses.size(); k += folds) held_out.push_back(poses[k]);
+    std::sort(held_out.begin(), held_out.end());
+    report.per_fold.push_back(RunFold(obs, full, options, held_out));
+    const HeldOutFigure& figure = report.per_fold.back().figure;
+    if (figure.num_residuals > 0) {
+      report.num_residuals += figure.num_residuals;
+      sum2 += figure.rms_px * figure.rms_px * figure.num_residuals;
+      report.folds_passed += figure.test_passed ? 1 : 0;
+    }
+  }
+  if (report.num_residuals > 0) report.rms_px = std::sqrt(sum2 / report.num_residuals);
+  const double depth = MedianDepth(obs, full);
+  if (std::isfinite(depth) && full.bundle.fx_px > 0) {
+    report.mm_per_px = depth * 1e3 / full.bundle.fx_px;
+    report.rms_mm = report.rms_px * report.mm_per_px;
+  }
+  report.message = "held-out RMS over " + std::to_string(folds) + " folds";
+  return report;
+}
+
+}  // namespace selfcal::calibration

@@ -1,0 +1,46 @@
+// A held-out figure for every calibration: when the observations name no verification pose, the
+// identification poses are split into k folds (a seeded shuffle), the kinematic bundle adjustment is run
+// again without each fold (started from the whole solve), and the fold's detections are predicted from its
+// joint angles (or flange poses) alone (heldout_reprojection.h). The prediction error of poses the fit never
+// saw, in px per coordinate and in mm at the scene (px times the median camera-to-dot distance over f_x).
+//
+// A figure, not yet a verdict: the held-out test at the stated pixel noise is reported per fold.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "calibration/bundle_stage.h"
+#include "calibration/heldout_reprojection.h"
+#include "observations/observation_set.h"
+
+namespace selfcal::calibration {
+
+struct CrossValidationFold {
+  std::vector<std::string> held_out;  // pose ids
+  bundle::Outcome outcome = bundle::Outcome::kNotRun;
+  std::string message;                // the fold's bundle message when it did not converge
+  HeldOutFigure figure;               // at the stated pixel noise
+};
+
+struct CrossValidationReport {
+  bool ran = false;
+  std::string message;  // why not, or a summary
+  int folds = 0;
+  std::uint64_t seed = 0;
+  std::vector<CrossValidationFold> per_fold;
+  int num_residuals = 0;         // predicted detections over every fold
+  double rms_px = NAN;           // per coordinate, pooled over every fold
+  double mm_per_px = NAN;        // at the scene: median camera-to-dot distance / f_x
+  double rms_mm = NAN;           // rms_px * mm_per_px
+  int folds_passed = 0;          // folds whose held-out test passed at the stated noise
+};
+
+// k-fold cross-validation of `full` (the bundle stage of the whole set, converged): fold f holds out every
+// k-th pose of the seeded order from f on. Not run (ran false, with the reason) when the set has
+// verification poses, folds < 2, or fewer than two identification poses a fold.
+CrossValidationReport CrossValidate(const ObservationSet& observations, const BundleStageReport& full,
+                                    const BundleStageOptions& options, int folds, std::uint64_t seed);
+
+}  // namespace selfcal::calibration
