@@ -72,6 +72,10 @@ AcceptanceCheck HeldOutTest(const AcceptanceInputs& in) {
 
 AcceptanceCheck BeatsNominalHeldOut(const AcceptanceInputs& in) {
   AcceptanceCheck check{"beats_nominal_heldout", CheckStatus::kNotAvailable, ""};
+  if (!in.no_nominal_reason.empty()) {
+    check.sentence = "no held-out comparison with a nominal model: " + in.no_nominal_reason;
+    return check;
+  }
   if (in.calibrated == nullptr || in.nominal == nullptr || !in.calibrated->ok || !in.nominal->ok) {
     check.sentence = "no held-out comparison with the nominal model: the verification images have no predicted dot";
     return check;

@@ -57,6 +57,9 @@ struct Acceptance {
 struct AcceptanceInputs {
   const HeldOutReprojection* calibrated = nullptr;  // the chosen model's held-out figures (null: none)
   const HeldOutReprojection* nominal = nullptr;     // the nominal model's
+  // Why no nominal model is to be compared with (empty: there is one): a flange-pose set that names no
+  // hand-eye transform has no nominal model, only the solver's own start, which is no one's model.
+  std::string no_nominal_reason;
   // The chosen model's overall figure at the stated noise; null with a reason when the test does not apply.
   const HeldOutFigure* test_at_stated_noise = nullptr;
   std::string no_test_reason;

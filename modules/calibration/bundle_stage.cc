@@ -75,19 +75,21 @@ void VerifyHeldOutReprojection(const ObservationSet& obs, BundleStageReport* rep
   report->heldout_nominal.noise_source = report->heldout.noise_source;
 }
 
-// A nominal start of a joint-angle set: its camera correction from the images (StartCameraFromImages).
-void CameraStartFromImages(const ObservationSet& obs, const BundleStageOptions& options, Eigen::VectorXd* rho,
+// A nominal start of a joint-angle set: its camera correction from the images (StartCameraFromImages). True
+// when the images gave it.
+bool CameraStartFromImages(const ObservationSet& obs, const BundleStageOptions& options, Eigen::VectorXd* rho,
                            std::string* note) {
-  if (!options.camera_start_from_images || obs.UsesFlangePoses()) return;
+  if (!options.camera_start_from_images || obs.UsesFlangePoses()) return false;
   const std::vector<int> held = bundle::HeldParameterIndices(options.bundle, obs.robot.num_joints());
   const int cam = KinematicParameters(obs.robot.num_joints()).CamOffset();
   for (int i = cam; i < cam + 6; ++i) {
-    if (std::find(held.begin(), held.end(), i) != held.end()) return;  // the mount is held: trusted
+    if (std::find(held.begin(), held.end(), i) != held.end()) return false;  // the mount is held: trusted
   }
   const HandEyeStartReport start = StartCameraFromImages(obs, options.hand_eye, rho);
   *note += start.ok ? "; camera correction from the images (hand-eye on the nominal flange poses, " +
                           std::to_string(start.rotation_pairs) + " rotation pairs)"
                     : "; camera at the robot description's mount (no hand-eye start from the images: " + start.message + ")";
+  return start.ok;
 }
 
 }  // namespace
@@ -106,7 +108,9 @@ BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineR
     for (const int i : held) rho_start[i] = nominal[i];
     report.start_note += "; held parameters at nominal";
   }
-  if (report.start == BundleStart::kNominal) CameraStartFromImages(obs, options, &rho_start, &report.start_note);
+  if (report.start == BundleStart::kNominal) {
+    report.camera_from_images = CameraStartFromImages(obs, options, &rho_start, &report.start_note);
+  }
   // A held f_x is the one the user stated (the observations' camera), not the paper's estimate.
   if (!bundle::EstimatedIntrinsicsOf(options.bundle, obs.robot.num_joints())[kFx]) {
     report.fx_start_px = obs.camera.fx_px;
@@ -120,7 +124,7 @@ BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineR
     const std::string first = bundle::OutcomeName(report.bundle.outcome);
     std::string note = "nominal model and prior f_x (the start from the paper pipeline's result ended " + first + ")";
     Eigen::VectorXd nominal = KinematicParameters::Nominal(obs.robot);
-    CameraStartFromImages(obs, options, &nominal, &note);
+    report.camera_from_images = CameraStartFromImages(obs, options, &nominal, &note);
     bundle::BundleReport again = bundle::RunBundleAdjustment(obs, nominal, obs.camera.fx_px, options.bundle);
     again.seconds += report.bundle.seconds;
     report.bundle = std::move(again);

@@ -45,6 +45,7 @@ struct BundleStageReport {
   bundle::BundleReport bundle;          // outcome, free/fixed names, rho (on observations.robot), covariance
   BundleStart start = BundleStart::kNotRun;
   std::string start_note;               // why this start, in words
+  bool camera_from_images = false;      // the camera correction's start came from the images (StartCameraFromImages)
   double fx_start_px = 0;
   // The calibrated model ready for writing: ApplyParameters(observations.robot, bundle.rho), and its
   // rho (= Nominal(calibrated_robot), zero corrections). Empty unless the bundle produced a full rho.

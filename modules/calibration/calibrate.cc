@@ -120,6 +120,10 @@ void CheckAcceptance(const ObservationSet& obs, const ObservationSet& original, 
     in.calibrated = &stage.heldout;
     in.nominal = &stage.heldout_nominal;
     in.test_at_stated_noise = &stage.heldout_at_stated_noise;
+    if (original.UsesFlangePoses() && !original.flange_from_cam_known) {
+      in.no_nominal_reason = "the set names no hand-eye transform, and the start the solver found from the images is "
+                             "not a nominal model (give one with detect --hand-eye to compare with it)";
+    }
     if (original.flange_translation_sigma_m > 0) {
       in.test_at_stated_noise = nullptr;
       in.no_test_reason = "the flange poses have a stated noise, which the test does not model";
@@ -132,7 +136,7 @@ void CheckAcceptance(const ObservationSet& obs, const ObservationSet& original, 
       in.corrections = stage.bundle.rho - KinematicParameters::Nominal(obs.robot);
       // A flange-pose set's nominal hand-eye transform is a guess (or the start from the images): a large
       // correction of it is the calibration's answer, not a wrong description.
-      if (original.UsesFlangePoses()) {
+      if (original.UsesFlangePoses() || stage.camera_from_images) {
         in.corrections.segment<6>(KinematicParameters(obs.robot.num_joints()).CamOffset()).setZero();
       }
     }

@@ -176,3 +176,28 @@ TEST(Calibrate, MethodNamesRoundTrip) {
 
 }  // namespace
 }  // namespace selfcal::calibration
+
+namespace selfcal::calibration {
+namespace {
+
+// Issue 35: "better than the nominal model" only against a nominal someone gave. A held-out figure whose
+// nominal is the solver's own start (a flange-pose set that names no hand-eye transform) is no comparison:
+// not available, whatever the two figures are, and so never the reason for a refusal.
+TEST(Calibrate, NoComparisonWithANominalModelNobodyGave) {
+  HeldOutReprojection calibrated, nominal;
+  calibrated.ok = nominal.ok = true;
+  calibrated.overall.rms_px = 1.67;
+  nominal.overall.rms_px = 1.61;
+  AcceptanceInputs in;
+  in.calibrated = &calibrated;
+  in.nominal = &nominal;
+  EXPECT_EQ(AcceptanceOf(in).checks[1].status, CheckStatus::kFailed);
+  in.no_nominal_reason = "the set names no hand-eye transform";
+  const AcceptanceCheck check = AcceptanceOf(in).checks[1];
+  EXPECT_EQ(check.name, "beats_nominal_heldout");
+  EXPECT_EQ(check.status, CheckStatus::kNotAvailable);
+  EXPECT_NE(check.sentence.find("the set names no hand-eye transform"), std::string::npos) << check.sentence;
+}
+
+}  // namespace
+}  // namespace selfcal::calibration
