@@ -267,6 +267,14 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   if (!loaded.ok()) return Fail(loaded.status());
   const bool from_session = loaded->session.has_value();
   WarnOfJointsOutsideLimits(loaded->observations);
+  std::vector<std::string> scenes;
+  loaded.value().observations = SeparateScenes(loaded->observations, &scenes);
+  if (scenes.size() > 1) {
+    std::cout << "scenes: " << scenes.size() << ", each its own points (scene k's dot n is dot k x "
+              << kSceneDotStride << " + n):";
+    for (size_t k = 0; k < scenes.size(); ++k) std::cout << (k ? ", " : " ") << k << " `" << scenes[k] << "`";
+    std::cout << "\n";
+  }
   if (from_session) {
     std::cout << "session " << request.input << ": " << loaded->observations.poses.size() << " accepted samples\n";
   }

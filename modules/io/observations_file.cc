@@ -242,6 +242,11 @@ bool ReadPose(const yaml::YamlNode& node, const std::string& name, const RobotMo
       ok = false;
     }
   }
+  if (map.Optional("scene") != nullptr && map.OptionalString("scene", &pose->scene) && pose->scene.empty()) {
+    problems->Add("`" + map.Path("scene") + "` at " + problems->At(map.KeyLine("scene")) +
+                  " is empty (leave the key out for the set's one scene)");
+    ok = false;
+  }
   const bool has_flange = map.Optional("base_from_flange") != nullptr;
   if (has_flange) {
     // Set even when unreadable (its problem is recorded): the set is still one of flange poses.
@@ -434,6 +439,7 @@ Status SaveObservations(const ObservationSet& set, const std::string& path) {
   for (const PoseObservation& pose : set.poses) {
     out << "  - id: " << YamlQuoted(pose.id) << "\n"
         << "    role: " << PoseRoleName(pose.role) << "\n";
+    if (!pose.scene.empty()) out << "    scene: " << YamlQuoted(pose.scene) << "\n";
     if (pose.base_from_flange) {
       out << "    base_from_flange: " << TransformYaml(*pose.base_from_flange, TransformStyle::kExact) << "\n";
     } else {

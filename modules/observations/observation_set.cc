@@ -1,5 +1,7 @@
 #include "observations/observation_set.h"
 
+#include <algorithm>
+
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -100,6 +102,36 @@ Matches MatchById(const PoseObservation& a, const PoseObservation& b) {
     m.pixels_b.push_back(it->second);
   }
   return m;
+}
+
+ObservationSet SeparateScenes(const ObservationSet& observations, std::vector<std::string>* scenes) {
+  std::vector<std::string> names;
+  for (const PoseObservation& pose : observations.poses) {
+    if (std::find(names.begin(), names.end(), pose.scene) == names.end()) names.push_back(pose.scene);
+  }
+  if (scenes != nullptr) *scenes = names;
+  if (names.size() <= 1) return observations;
+  ObservationSet out = observations;
+  for (PoseObservation& pose : out.poses) {
+    const int k = static_cast<int>(std::find(names.begin(), names.end(), pose.scene) - names.begin());
+    std::map<int, Eigen::Vector2d> moved;
+    for (const auto& [dot, pixel] : pose.dots_px) moved[k * kSceneDotStride + dot] = pixel;
+    pose.dots_px = std::move(moved);
+  }
+  const auto repeat = [&](const std::vector<KnownDistance>& list) {
+    std::vector<KnownDistance> all;
+    for (size_t k = 0; k < names.size(); ++k) {
+      for (KnownDistance d : list) {
+        d.dot_a += static_cast<int>(k) * kSceneDotStride;
+        d.dot_b += static_cast<int>(k) * kSceneDotStride;
+        all.push_back(d);
+      }
+    }
+    return all;
+  };
+  out.yardsticks = repeat(observations.yardsticks);
+  out.check_distances = repeat(observations.check_distances);
+  return out;
 }
 
 }  // namespace selfcal

@@ -27,6 +27,9 @@ struct PoseObservation {
   Eigen::VectorXd joints_rad;                   // one per robot joint (none for a flange-pose set)
   std::optional<Rigid3> base_from_flange;       // the controller's flange pose, m and rad (flange-pose sets)
   std::map<int, Eigen::Vector2d> dots_px;       // dot id -> pixel (u right, v down, origin top-left centre)
+  // The scene the pose sees (empty: the set's one scene). Poses of different scenes see different points
+  // even where their dot ids are the same (a board that moved between recordings): SeparateScenes.
+  std::string scene;
 };
 
 // A known distance between two dots: the yardstick(s) that fix the metric scale, or held-out checks.
@@ -81,5 +84,14 @@ struct Matches {
   std::vector<Eigen::Vector2d> pixels_a, pixels_b;
 };
 Matches MatchById(const PoseObservation& a, const PoseObservation& b);
+
+// Dot ids of scene k (k > 0, in the order the scenes first appear among the poses; the first scene keeps its
+// ids): k * kSceneDotStride + id.
+inline constexpr int kSceneDotStride = 1000000;
+
+// A set whose poses name more than one scene, with the dots of each scene made separate points: scene k's dot
+// ids moved by k * kSceneDotStride, and every yardstick and check distance repeated for every scene. A set of
+// one scene is returned as it is. *scenes (optional): the scene names in that order.
+ObservationSet SeparateScenes(const ObservationSet& observations, std::vector<std::string>* scenes = nullptr);
 
 }  // namespace selfcal

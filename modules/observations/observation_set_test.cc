@@ -46,3 +46,43 @@ TEST(ObservationSet, ValidateNamesPoseAndDot) {
 
 }  // namespace
 }  // namespace selfcal
+
+namespace selfcal {
+namespace {
+
+// Two recordings of one board that moved between them: the same dot ids are different points.
+TEST(SeparateScenes, EachSceneGetsItsOwnDotsAndEveryKnownDistance) {
+  ObservationSet set;
+  for (const char* scene : {"s1", "s1", "s3", ""}) {
+    PoseObservation pose;
+    pose.id = std::string("p") + std::to_string(set.poses.size());
+    pose.scene = scene;
+    pose.dots_px[5] = Eigen::Vector2d(1, 2);
+    pose.dots_px[18] = Eigen::Vector2d(3, 4);
+    set.poses.push_back(pose);
+  }
+  set.yardsticks.push_back({5, 18, 0.198252});
+  set.check_distances.push_back({5, 18, 0.2});
+  std::vector<std::string> scenes;
+  const ObservationSet out = SeparateScenes(set, &scenes);
+  EXPECT_EQ(scenes, (std::vector<std::string>{"s1", "s3", ""}));
+  EXPECT_EQ(out.poses[0].dots_px.begin()->first, 5);
+  EXPECT_EQ(out.poses[1].dots_px.begin()->first, 5);
+  EXPECT_EQ(out.poses[2].dots_px.begin()->first, kSceneDotStride + 5);
+  EXPECT_EQ(out.poses[3].dots_px.rbegin()->first, 2 * kSceneDotStride + 18);
+  EXPECT_EQ(out.poses[2].dots_px.at(kSceneDotStride + 18), Eigen::Vector2d(3, 4));
+  ASSERT_EQ(out.yardsticks.size(), 3u);
+  EXPECT_EQ(out.yardsticks[1].dot_a, kSceneDotStride + 5);
+  EXPECT_EQ(out.yardsticks[2].dot_b, 2 * kSceneDotStride + 18);
+  EXPECT_EQ(out.yardsticks[2].length_m, 0.198252);
+  EXPECT_EQ(out.check_distances.size(), 3u);
+  // One scene (named or not): the set as it is.
+  for (PoseObservation& pose : set.poses) pose.scene = "only";
+  const ObservationSet same = SeparateScenes(set, &scenes);
+  EXPECT_EQ(same.poses[2].dots_px.begin()->first, 5);
+  EXPECT_EQ(same.yardsticks.size(), 1u);
+  EXPECT_EQ(scenes.size(), 1u);
+}
+
+}  // namespace
+}  // namespace selfcal
