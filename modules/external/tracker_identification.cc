@@ -418,6 +418,41 @@ void IdentifyFromRows(const std::vector<Eigen::VectorXd>& q, const std::vector<R
   report->rho_identified = report->identification.rho;
 }
 
+// The first row whose SMRs give no nest frame (collinear or coincident) or whose SMR distances differ from
+// the median over all rows by more than kMaxNestDistanceChangeM (the row of the largest difference), with
+// *why; else -1.
+int RowOfAPlacelessNest(const std::vector<SmrTriple>& points, std::string* why) {
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d e12 = points[i][1] - points[i][0], e13 = points[i][2] - points[i][0];
+    if (!(e12.norm() > 0 && e12.cross(e13).norm() > 1e-6 * e12.norm() * e13.norm())) {
+      *why = "row " + std::to_string(i + 1) + ": the three SMRs are collinear or coincident: they give the nest no frame";
+      return static_cast<int>(i);
+    }
+  }
+  constexpr int kPairs[3][2] = {{0, 1}, {1, 2}, {0, 2}};
+  double worst = 0;
+  int worst_row = -1;
+  for (int k = 0; k < 3; ++k) {
+    std::vector<double> d;
+    for (const SmrTriple& r : points) d.push_back((r[kPairs[k][0]] - r[kPairs[k][1]]).norm());
+    std::vector<double> sorted = d;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+    const double median = sorted[sorted.size() / 2];
+    for (size_t i = 0; i < d.size(); ++i) {
+      if (std::abs(d[i] - median) > worst) {
+        worst = std::abs(d[i] - median);
+        worst_row = static_cast<int>(i);
+      }
+    }
+  }
+  if (worst <= kMaxNestDistanceChangeM) return -1;
+  std::ostringstream out;
+  out << "row " << worst_row + 1 << ": an SMR distance differs from the median over all rows by " << worst * 1e3
+      << " mm, more than the " << kMaxNestDistanceChangeM * 1e3 << " mm a rigid nest allows: a wrong value";
+  *why = out.str();
+  return worst_row;
+}
+
 }  // namespace
 
 TrackerIdentificationReport RunTrackerIdentification(const std::vector<SmrTriple>& points,
@@ -441,6 +476,11 @@ TrackerIdentificationReport RunTrackerIdentification(const std::vector<SmrTriple
   }
 
   report.distances = NestDistances(points);
+  std::string why;
+  if (const int row = RowOfAPlacelessNest(points, &why); row >= 0) {
+    report.problem_row = row;
+    return fail(Outcome::kDegenerate, why);
+  }
   std::vector<Rigid3> tracker_from_nest;
   std::vector<Eigen::VectorXd> q;
   for (int i = 0; i < num_rows; ++i) {
@@ -451,7 +491,6 @@ TrackerIdentificationReport RunTrackerIdentification(const std::vector<SmrTriple
   SplitRows(q, options.holdout_every, &report);
   MeasureRepeats(q, tracker_from_nest, &report);
 
-  std::string why;
   if (!FitAxes(points, tracker_from_nest, q, &report, &why)) return fail(Outcome::kDegenerate, why);
   std::vector<Eigen::Vector3d> directions, axis_points;
   for (const AxisFit& fit : report.axes) {
