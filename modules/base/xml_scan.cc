@@ -1,6 +1,7 @@
 #include "base/xml_scan.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <set>
 
 namespace selfcal {
@@ -174,6 +175,18 @@ Status ScanXml(const std::string& text, const std::string& name, const XmlScanLi
     return Status::Error(ErrorCode::kInvalidInput, name + " is " + std::to_string(text.size()) +
                                                        " bytes, more than the limit of " +
                                                        std::to_string(limits.max_bytes) + " bytes for " + limits.kind);
+  }
+  // XML 1.0 allows no control character but tab, newline and carriage return (tinyxml stops at a NUL).
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c < 0x20 && c != '\t' && c != '\n' && c != '\r') {
+      const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(i), '\n'));
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02X", c);
+      return Status::Error(ErrorCode::kInvalidInput, name + ":" + std::to_string(line) + ": control character " + hex +
+                                                         " (XML allows none but tab and line ends in " + limits.kind +
+                                                         ")");
+    }
   }
   if (limits.require_utf8) {
     if (const int line = FirstInvalidUtf8Line(text); line > 0) {
