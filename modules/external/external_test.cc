@@ -130,6 +130,18 @@ TEST(TrackerIdentification, AMovedReflectorIsRefusedByRow) {
   EXPECT_NE(r.message.find("row 8: an SMR distance differs from the median"), std::string::npos) << r.message;
 }
 
+// Axis lines 12 m apart (consistent rows: the nest is rigid) give a model that cannot be written; refused
+// before identification, with the rows of the two sweeps, not when the model is written.
+TEST(TrackerIdentification, AxisLinesFarApartAreRefusedWithTheirRows) {
+  RobotModel far = FanucLikeArm();
+  far.links[2].a = 12.0;
+  const std::vector<Eigen::VectorXd> controller = SweepJoints();
+  const TrackerIdentificationReport r = RunTrackerIdentification(SimulateSmrs(far, controller), controller, {});
+  EXPECT_EQ(r.outcome, Outcome::kDegenerate);
+  EXPECT_NE(r.message.find("joint 3: |a| or |d| above 10 m between the axis lines fitted to the rows (joint 2:"),
+            std::string::npos) << r.message;
+}
+
 TEST(TrackerIdentification, SyntheticRecoversFromPerturbedStart) {
   const RobotModel truth = FanucLikeArm();
   const std::vector<Eigen::VectorXd> controller = SweepJoints();

@@ -453,6 +453,23 @@ int RowOfAPlacelessNest(const std::vector<SmrTriple>& points, std::string* why) 
   return worst_row;
 }
 
+// "" when every link of the model from the axis lines is within 10 m (RobotModel::Validate's bound), else
+// the first link that is not, with the rows of the two sweeps its axis lines were fitted to.
+std::string FarAxisLines(const TrackerIdentificationReport& report) {
+  for (int j = 0; j < report.nominal.num_joints(); ++j) {
+    const LinkParameters& l = report.nominal.links[j];
+    if (std::abs(l.a) <= 10 && std::abs(l.d) <= 10) continue;
+    std::string rows;
+    for (int k = std::max(0, j - 1); k <= j && k < static_cast<int>(report.axes.size()); ++k) {
+      rows += std::string(rows.empty() ? "" : "; ") + "joint " + std::to_string(k + 1) + ":";
+      for (int r : report.axes[k].rows) rows += " " + std::to_string(r + 1);
+    }
+    return "joint " + std::to_string(j + 1) + ": |a| or |d| above 10 m between the axis lines fitted to the rows (" +
+           rows + "): a wrong value in one of them";
+  }
+  return "";
+}
+
 }  // namespace
 
 TrackerIdentificationReport RunTrackerIdentification(const std::vector<SmrTriple>& points,
@@ -498,6 +515,7 @@ TrackerIdentificationReport RunTrackerIdentification(const std::vector<SmrTriple
     axis_points.push_back(fit.point);
   }
   report.nominal = ModelFromAxisLines("axis-fit", directions, axis_points, report.q_ref, options.parallel_tol_rad);
+  if (const std::string far = FarAxisLines(report); !far.empty()) return fail(Outcome::kDegenerate, far);
   const Eigen::VectorXd rho0 = KinematicParameters::Nominal(report.nominal);
   report.nominal.flange_from_cam =
       BaseFromFlange(report.nominal, rho0, q[report.reference_row]).Inverse() * tracker_from_nest[report.reference_row];
