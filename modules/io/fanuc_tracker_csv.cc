@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "base/terminal_text.h"
 #include "geometry/rigid3.h"
 
 namespace selfcal::io {
@@ -23,7 +24,8 @@ bool ParseDouble(const std::string& token, double* value) {
   errno = 0;
   char* end = nullptr;
   *value = std::strtod(token.c_str(), &end);
-  return errno == 0 && end != token.c_str() && *end == '\0' && std::isfinite(*value);
+  // The whole token (a NUL byte inside it would end strtod's reading early).
+  return errno == 0 && end != token.c_str() && end == token.c_str() + token.size() && std::isfinite(*value);
 }
 
 // The three SMRs of a row span the nest frame (external::FrameFromThreePoints, the same test).
@@ -80,7 +82,7 @@ Result<std::vector<FanucTrackerRow>> LoadFanucTrackerCsv(const std::string& path
     while (tokens >> token) {
       double v = 0;
       if (!ParseDouble(token, &v)) {
-        problems += where + "'" + token + "' is not a finite number\n";
+        problems += where + "'" + TerminalSafe(token) + "' is not a finite number\n";
         bad = true;
         break;
       }

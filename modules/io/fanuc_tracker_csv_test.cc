@@ -56,6 +56,15 @@ TEST(FanucTrackerCsv, RefusesARowWhoseReflectorsAreCollinear) {
   std::filesystem::remove(path);
 }
 
+// A NUL byte inside a number ended strtod's reading: "600\0" "5" was read as 600 without a word.
+TEST(FanucTrackerCsv, RefusesANulByteInsideANumber) {
+  const std::string path = WriteCsv("selfcal_fanuc_nul.csv", Row("600") + Row(std::string("600\0" "5", 5)));
+  const auto rows = LoadFanucTrackerCsv(path);
+  ASSERT_FALSE(rows.ok());
+  EXPECT_NE(rows.status().message().find(path + ":2: '600"), std::string::npos) << rows.status().message();
+  std::filesystem::remove(path);
+}
+
 TEST(FanucTrackerCsv, NoDataRowsNamesTheLinesRead) {
   const std::string path = WriteCsv("selfcal_fanuc_empty.csv", "");
   const auto rows = LoadFanucTrackerCsv(path);
