@@ -203,7 +203,9 @@ Command AddTrackerCommand(CLI::App& app) {
       if (const Status s = WriteTrackerModel(*args, path, r); !s.ok()) return Fail(s);
     }
     if (r.outcome != external::Outcome::kSuccess) {
-      std::cerr << "selfcal: identify-tracker: " << external::OutcomeName(r.outcome) << ": " << r.message << "\n";
+      std::cerr << "selfcal: identify-tracker: " << external::OutcomeName(r.outcome) << ": " << path;
+      if (r.problem_row >= 0) std::cerr << ":" << (*rows)[static_cast<size_t>(r.problem_row)].line;
+      std::cerr << ": " << r.message << "\n";
       const ExitCode code = r.outcome == external::Outcome::kInvalidInput  ? ExitCode::kUsage
                             : r.outcome == external::Outcome::kDegenerate ? ExitCode::kDegenerateData
                                                                            : ExitCode::kSolverFailure;

@@ -1,6 +1,7 @@
 #include "base/xml_scan.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <set>
 
 namespace selfcal {
@@ -169,11 +170,39 @@ int FirstInvalidUtf8Line(const std::string& text) {
   return 0;
 }
 
+namespace {
+int LineAt(const std::string& text, std::size_t at) {
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+}
+}  // namespace
+
 Status ScanXml(const std::string& text, const std::string& name, const XmlScanLimits& limits) {
   if (text.size() > limits.max_bytes) {
     return Status::Error(ErrorCode::kInvalidInput, name + " is " + std::to_string(text.size()) +
                                                        " bytes, more than the limit of " +
                                                        std::to_string(limits.max_bytes) + " bytes for " + limits.kind);
+  }
+  // XML 1.0 allows no control character but tab, newline and carriage return (tinyxml stops at a NUL).
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c < 0x20 && c != '\t' && c != '\n' && c != '\r') {
+      const int line = LineAt(text, i);
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02X", c);
+      return Status::Error(ErrorCode::kInvalidInput, name + ":" + std::to_string(line) + ": control character " + hex +
+                                                         " (XML allows none but tab and line ends in " + limits.kind +
+                                                         ")");
+    }
+  }
+  // The XML declaration may only open the document (after a byte order mark at most).
+  const std::size_t start = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
+  for (std::size_t at = text.find("<?xml"); at != std::string::npos; at = text.find("<?xml", at + 1)) {
+    const char next = at + 5 < text.size() ? text[at + 5] : '\0';
+    if (at == start || (next != ' ' && next != '\t' && next != '\r' && next != '\n')) continue;
+    const int line = LineAt(text, at);
+    return Status::Error(ErrorCode::kInvalidInput, name + ":" + std::to_string(line) +
+                                                       ": an XML declaration <?xml ...?> that does not open the file "
+                                                       "(it may only be its first text)");
   }
   if (limits.require_utf8) {
     if (const int line = FirstInvalidUtf8Line(text); line > 0) {

@@ -71,6 +71,16 @@ TEST(XmlScan, RefusesInvalidUtf8AndRepeatedSiblingsWhenAsked) {
             "c.xml:4: element <b> appears twice in <a> (line 1); give each key once");
   EXPECT_TRUE(ScanXml("<a><d><_>1</_><_>2</_></d><e><b/></e><b/></a>", "c.xml", limits).ok());
   EXPECT_TRUE(ScanXml("<a>\n<b>\xc3\xa9</b></a>", "c.xml", limits).ok());
+  // The mutation campaign's NUL byte inside an element (camera_visp-00185) was accepted.
+  EXPECT_EQ(ScanXml(std::string("<a>\n<b>1\0 2</b></a>", 19), "c.xml", limits).message(),
+            "c.xml:2: control character 0x00 (XML allows none but tab and line ends in a camera file)");
+  EXPECT_FALSE(ScanXml("<a>\x01</a>", "c.xml", Urdf()).ok());
+  EXPECT_TRUE(ScanXml("<a>\t1\r\n</a>", "c.xml", limits).ok());
+  // ... and an XML declaration that does not open the file (the campaign swapped lines 1 and 2).
+  EXPECT_EQ(ScanXml("<!-- c -->\n<?xml version=\"1.0\"?>\n<a/>", "c.xml", limits).message(),
+            "c.xml:2: an XML declaration <?xml ...?> that does not open the file (it may only be its first text)");
+  EXPECT_TRUE(ScanXml("<?xml version=\"1.0\"?>\n<a/>", "c.xml", limits).ok());
+  EXPECT_TRUE(ScanXml("\xEF\xBB\xBF<?xml version=\"1.0\"?>\n<a><?xml-stylesheet x?></a>", "c.xml", limits).ok());
   EXPECT_EQ(FirstInvalidUtf8Line("a\n\xc0\x80"), 2);  // overlong
   EXPECT_EQ(FirstInvalidUtf8Line("a\n\xed\xa0\x80"), 2);  // surrogate
   EXPECT_EQ(FirstInvalidUtf8Line("\xf0\x9f\x98\x80"), 0);

@@ -106,6 +106,42 @@ TEST(TrackerIdentification, SyntheticAxesAndPredictionsExact) {
   EXPECT_LT(r.insample_after.max_m, 1e-9);
 }
 
+// A row whose reflectors are collinear (a file's value of 1e308) was an internal error; it is a degenerate
+// input, named by its row.
+TEST(TrackerIdentification, CollinearReflectorsAreRefusedByRow) {
+  const std::vector<Eigen::VectorXd> controller = SweepJoints();
+  std::vector<SmrTriple> points = SimulateSmrs(FanucLikeArm(), controller);
+  points[4][2] = points[4][0] + 2.0 * (points[4][1] - points[4][0]);
+  const TrackerIdentificationReport r = RunTrackerIdentification(points, controller, {});
+  EXPECT_EQ(r.outcome, Outcome::kDegenerate);
+  EXPECT_NE(r.message.find("row 5: the three SMRs are collinear"), std::string::npos) << r.message;
+  EXPECT_EQ(r.problem_row, 4);
+}
+
+// The mutation campaign's 1e-300 for one coordinate (-804.9 mm) moved one SMR: an arm of 10 m links, refused
+// when the model was written, naming no row. The rigid nest's distances name it.
+TEST(TrackerIdentification, AMovedReflectorIsRefusedByRow) {
+  const std::vector<Eigen::VectorXd> controller = SweepJoints();
+  std::vector<SmrTriple> points = SimulateSmrs(FanucLikeArm(), controller);
+  points[7][1].x() += 0.8;
+  const TrackerIdentificationReport r = RunTrackerIdentification(points, controller, {});
+  EXPECT_EQ(r.outcome, Outcome::kDegenerate);
+  EXPECT_EQ(r.problem_row, 7);
+  EXPECT_NE(r.message.find("row 8: an SMR distance differs from the median"), std::string::npos) << r.message;
+}
+
+// Axis lines 12 m apart (consistent rows: the nest is rigid) give a model that cannot be written; refused
+// before identification, with the rows of the two sweeps, not when the model is written.
+TEST(TrackerIdentification, AxisLinesFarApartAreRefusedWithTheirRows) {
+  RobotModel far = FanucLikeArm();
+  far.links[2].a = 12.0;
+  const std::vector<Eigen::VectorXd> controller = SweepJoints();
+  const TrackerIdentificationReport r = RunTrackerIdentification(SimulateSmrs(far, controller), controller, {});
+  EXPECT_EQ(r.outcome, Outcome::kDegenerate);
+  EXPECT_NE(r.message.find("joint 3: |a| or |d| above 10 m between the axis lines fitted to the rows (joint 2:"),
+            std::string::npos) << r.message;
+}
+
 TEST(TrackerIdentification, SyntheticRecoversFromPerturbedStart) {
   const RobotModel truth = FanucLikeArm();
   const std::vector<Eigen::VectorXd> controller = SweepJoints();

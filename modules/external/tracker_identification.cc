@@ -418,6 +418,58 @@ void IdentifyFromRows(const std::vector<Eigen::VectorXd>& q, const std::vector<R
   report->rho_identified = report->identification.rho;
 }
 
+// The first row whose SMRs give no nest frame (collinear or coincident) or whose SMR distances differ from
+// the median over all rows by more than kMaxNestDistanceChangeM (the row of the largest difference), with
+// *why; else -1.
+int RowOfAPlacelessNest(const std::vector<SmrTriple>& points, std::string* why) {
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d e12 = points[i][1] - points[i][0], e13 = points[i][2] - points[i][0];
+    if (!(e12.norm() > 0 && e12.cross(e13).norm() > 1e-6 * e12.norm() * e13.norm())) {
+      *why = "row " + std::to_string(i + 1) + ": the three SMRs are collinear or coincident: they give the nest no frame";
+      return static_cast<int>(i);
+    }
+  }
+  constexpr int kPairs[3][2] = {{0, 1}, {1, 2}, {0, 2}};
+  double worst = 0;
+  int worst_row = -1;
+  for (int k = 0; k < 3; ++k) {
+    std::vector<double> d;
+    for (const SmrTriple& r : points) d.push_back((r[kPairs[k][0]] - r[kPairs[k][1]]).norm());
+    std::vector<double> sorted = d;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+    const double median = sorted[sorted.size() / 2];
+    for (size_t i = 0; i < d.size(); ++i) {
+      if (std::abs(d[i] - median) > worst) {
+        worst = std::abs(d[i] - median);
+        worst_row = static_cast<int>(i);
+      }
+    }
+  }
+  if (worst <= kMaxNestDistanceChangeM) return -1;
+  std::ostringstream out;
+  out << "row " << worst_row + 1 << ": an SMR distance differs from the median over all rows by " << worst * 1e3
+      << " mm, more than the " << kMaxNestDistanceChangeM * 1e3 << " mm a rigid nest allows: a wrong value";
+  *why = out.str();
+  return worst_row;
+}
+
+// "" when every link of the model from the axis lines is within 10 m (RobotModel::Validate's bound), else
+// the first link that is not, with the rows of the two sweeps its axis lines were fitted to.
+std::string FarAxisLines(const TrackerIdentificationReport& report) {
+  for (int j = 0; j < report.nominal.num_joints(); ++j) {
+    const LinkParameters& l = report.nominal.links[j];
+    if (std::abs(l.a) <= 10 && std::abs(l.d) <= 10) continue;
+    std::string rows;
+    for (int k = std::max(0, j - 1); k <= j && k < static_cast<int>(report.axes.size()); ++k) {
+      rows += std::string(rows.empty() ? "" : "; ") + "joint " + std::to_string(k + 1) + ":";
+      for (int r : report.axes[k].rows) rows += " " + std::to_string(r + 1);
+    }
+    return "joint " + std::to_string(j + 1) + ": |a| or |d| above 10 m between the axis lines fitted to the rows (" +
+           rows + "): a wrong value in one of them";
+  }
+  return "";
+}
+
 }  // namespace
 
 TrackerIdentificationReport RunTrackerIdentification(const std::vector<SmrTriple>& points,
@@ -441,6 +493,11 @@ TrackerIdentificationReport RunTrackerIdentification(const std::vector<SmrTriple
   }
 
   report.distances = NestDistances(points);
+  std::string why;
+  if (const int row = RowOfAPlacelessNest(points, &why); row >= 0) {
+    report.problem_row = row;
+    return fail(Outcome::kDegenerate, why);
+  }
   std::vector<Rigid3> tracker_from_nest;
   std::vector<Eigen::VectorXd> q;
   for (int i = 0; i < num_rows; ++i) {
@@ -451,7 +508,6 @@ TrackerIdentificationReport RunTrackerIdentification(const std::vector<SmrTriple
   SplitRows(q, options.holdout_every, &report);
   MeasureRepeats(q, tracker_from_nest, &report);
 
-  std::string why;
   if (!FitAxes(points, tracker_from_nest, q, &report, &why)) return fail(Outcome::kDegenerate, why);
   std::vector<Eigen::Vector3d> directions, axis_points;
   for (const AxisFit& fit : report.axes) {
@@ -459,6 +515,7 @@ TrackerIdentificationReport RunTrackerIdentification(const std::vector<SmrTriple
     axis_points.push_back(fit.point);
   }
   report.nominal = ModelFromAxisLines("axis-fit", directions, axis_points, report.q_ref, options.parallel_tol_rad);
+  if (const std::string far = FarAxisLines(report); !far.empty()) return fail(Outcome::kDegenerate, far);
   const Eigen::VectorXd rho0 = KinematicParameters::Nominal(report.nominal);
   report.nominal.flange_from_cam =
       BaseFromFlange(report.nominal, rho0, q[report.reference_row]).Inverse() * tracker_from_nest[report.reference_row];

@@ -90,6 +90,11 @@ struct ErrorStats {
   double rms_rotation_rad = 0;
 };
 
+// The most a row's SMR distance may differ from the median over all rows: the nest is rigid (the Fanuc data
+// spread 0.17 mm); more is a wrong value (the mutation campaign's 1e-300 for -804.9 mm gave an arm of
+// 10 m links), refused naming the row.
+inline constexpr double kMaxNestDistanceChangeM = 5e-3;
+
 struct TrackerIdentificationOptions {
   // Rows i (0-based) with i % N == 1 are held out (0: none). With N = 3 on 6-row sweeps these are the 2nd
   // and 5th row of each sweep: interior, so every joint keeps its full range in the identification set.
@@ -111,6 +116,7 @@ const char* OutcomeName(Outcome outcome);
 struct TrackerIdentificationReport {
   Outcome outcome = Outcome::kNotRun;
   std::string message;
+  int problem_row = -1;  // the input row (0-based) a refusal names ("row N" in `message`), else -1
   NestDistanceStats distances;
   Eigen::VectorXd q_ref;                 // model joints of the most common configuration
   // Rows at q_ref modulo 2 pi (the same pose reached again, e.g. J4 = +-360 deg) and the largest distance

@@ -158,5 +158,15 @@ TEST(TargetsFile, RoundTripIsExactAndProblemsNameTheLine) {
   EXPECT_NE(bad.message().find("seed_deg"), std::string::npos) << bad.message();
 }
 
+// The mutation campaign's `robot: ""` (test/data/mutation-findings/targets-03614-unexplained) was accepted.
+TEST(TargetsFile, AnEmptyRobotNameIsRefusedByLine) {
+  TempDir dir;
+  WriteFile(dir.File("t.yaml"), "format: selfcal-targets\nversion: 1\nrobot: \"\"\nframe: flange\ntargets:\n"
+                                "  - {pose: {xyz_mm: [700, 0, 40], rpy_deg: [0, 90, 0]}}\n");
+  const Status bad = LoadTargetsFile(dir.File("t.yaml"), 6).status();
+  EXPECT_EQ(bad.code(), ErrorCode::kInvalidInput);
+  EXPECT_NE(bad.message().find("`robot` at " + dir.File("t.yaml") + ":3 is empty"), std::string::npos) << bad.message();
+}
+
 }  // namespace
 }  // namespace selfcal::io

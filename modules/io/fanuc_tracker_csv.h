@@ -23,8 +23,9 @@ struct FanucTrackerRow {
 };
 
 // Reads every row. The whole file is refused (ErrorCode::kInvalidInput, naming file:line) if a row does not have
-// exactly 21 numbers, a number does not parse or is not finite, a joint lies outside [-720, 720] deg, or
-// the file holds no row. Blank lines and lines starting with '#' are skipped.
+// exactly 21 numbers, a number does not parse or is not finite, an SMR coordinate lies beyond 100 m (1e5 mm:
+// a tracker's range), a row's three SMRs are collinear or coincident (no nest frame), a joint lies outside
+// [-720, 720] deg, or the file holds no row. Blank lines and lines starting with '#' are skipped.
 Result<std::vector<FanucTrackerRow>> LoadFanucTrackerCsv(const std::string& path);
 
 }  // namespace selfcal::io

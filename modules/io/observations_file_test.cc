@@ -394,6 +394,30 @@ TEST(TrajectoryFile, C5WrongJointCountNamesEveryBadPose) {
             std::string::npos) << LoadTrajectory(path, 6).status().message();
 }
 
+// The mutation campaign's plan of 42,000 poses (one row repeated to 8 MiB) made `plan --check` grow to 22 GB:
+// a plan over the limit is refused naming the file, the line, the count and the limit.
+TEST(TrajectoryFile, MorePosesThanTheLimitAreRefused) {
+  TempDir dir;
+  const std::string path = dir.File("plan.yaml");
+  std::string text = "format: selfcal-trajectory\nversion: 1\nposes_deg:\n";
+  for (int i = 0; i <= kMaxTrajectoryPoses; ++i) text += "  - [0, 30, -150, 0, 45, 0]\n";
+  WriteFile(path, text);
+  const Status status = LoadTrajectoryFile(path, 6).status();
+  EXPECT_EQ(status.code(), ErrorCode::kInvalidInput);
+  EXPECT_NE(status.message().find("`poses_deg` at " + path + ":4 holds 5001 poses, more than the limit of 5000"),
+            std::string::npos) << status.message();
+}
+
+// An empty `robot:` (the mutation campaign's `robot: ""`) was accepted as no robot at all.
+TEST(TrajectoryFile, AnEmptyRobotNameIsRefused) {
+  TempDir dir;
+  const std::string path = dir.File("plan.yaml");
+  WriteFile(path, "format: selfcal-trajectory\nversion: 1\nrobot: \"\"\nposes_deg:\n  - [0, 30, -150, 0, 45, 0]\n");
+  const Status status = LoadTrajectoryFile(path, 6).status();
+  EXPECT_EQ(status.code(), ErrorCode::kInvalidInput);
+  EXPECT_NE(status.message().find("`robot` at " + path + ":3 is empty"), std::string::npos) << status.message();
+}
+
 // Issue 16: an empty plan crashed run (with and without --dry-run) and simulate --trajectory at its first
 // pose; it is a config error naming the file and the line.
 TEST(TrajectoryFile, C7AnEmptyPoseListIsRefusedNamingFileAndLine) {
@@ -482,10 +506,16 @@ TEST(JsonFile, WriteReadRoundTripAndGuards) {
   EXPECT_TRUE((*read)["sigma"].is_null());
   EXPECT_EQ(dir.List(), std::vector<std::string>{"report.json"});
   EXPECT_EQ(WriteJsonFile(nlohmann::json{{"bad", "\xC3\x28"}}, dir.File("bad.json")).code(), ErrorCode::kInvalidInput);
-  WriteFile(path, std::string(10000, '[') + std::string(10000, ']'));
-  EXPECT_NE(ReadJsonFile(path).status().message().find("nested deeper than 64"), std::string::npos);
-  WriteFile(path, "{\"a\": [1, 2,");
-  EXPECT_NE(ReadJsonFile(path).status().message().find("malformed JSON in " + path), std::string::npos);
+  // The mutation campaign's refusals of nesting ("at byte N") and of number overflow (nlohmann's text) named
+  // no line.
+  WriteFile(path, "{\n  \"a\":\n" + std::string(10000, '[') + std::string(10000, ']') + "\n}\n");
+  EXPECT_NE(ReadJsonFile(path).status().message().find(path + ":3: JSON nested deeper than 64"), std::string::npos)
+      << ReadJsonFile(path).status().message();
+  WriteFile(path, "{\n  \"a\": 1,\n  \"b\": 1e400\n}\n");
+  EXPECT_EQ(ReadJsonFile(path).status().message(), path + ":3: the number 1e400 is beyond the range of a double");
+  WriteFile(path, "{\"a\":\n [1, 2,");
+  EXPECT_NE(ReadJsonFile(path).status().message().find(path + ":2: malformed JSON: "), std::string::npos)
+      << ReadJsonFile(path).status().message();
   // Issue 36: a key given twice, the last value winning, is refused naming the line.
   WriteFile(path, "{\n  \"format\": \"selfcal-report\",\n  \"format\": \"x\"\n}\n");
   EXPECT_EQ(ReadJsonFile(path).status().message(),

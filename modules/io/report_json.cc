@@ -1,5 +1,8 @@
 #include "io/report_json.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <optional>
 
 #include <nlohmann/json.hpp>
@@ -12,21 +15,26 @@ namespace selfcal::io {
 
 namespace {
 
+// The index of the quote that closes the JSON string opening at text[open] (or text.size()).
+size_t StringEnd(const std::string& text, size_t open) {
+  for (size_t i = open + 1; i < text.size(); ++i) {
+    if (text[i] == '\\') {
+      ++i;
+    } else if (text[i] == '"') {
+      return i;
+    }
+  }
+  return text.size();
+}
+
 // Nesting depth of a JSON text (brackets outside strings), so that deep documents are refused before
 // parsing.
 int JsonDepth(const std::string& text, size_t* offset) {
   int depth = 0, max_depth = 0;
-  bool in_string = false;
   for (size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
-    if (in_string) {
-      if (c == '\\') {
-        ++i;
-      } else if (c == '"') {
-        in_string = false;
-      }
-    } else if (c == '"') {
-      in_string = true;
+    if (c == '"') {
+      i = StringEnd(text, i);
     } else if (c == '[' || c == '{') {
       if (++depth > max_depth) {
         max_depth = depth;
@@ -37,6 +45,29 @@ int JsonDepth(const std::string& text, size_t* offset) {
     }
   }
   return max_depth;
+}
+
+// The line (from 1) of byte `offset` of `text`.
+int LineAt(const std::string& text, size_t offset) {
+  const size_t end = std::min(offset, text.size());
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(end), '\n'));
+}
+
+// The first number outside strings that a double cannot hold (nlohmann's "number overflow" names no place):
+// its text in *number and its line, or 0.
+int OverflowingNumberLine(const std::string& text, std::string* number) {
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '"') {
+      i = StringEnd(text, i);
+    } else if (c == '-' || (c >= '0' && c <= '9')) {
+      const size_t end = text.find_first_not_of("+-.0123456789eE", i);
+      *number = text.substr(i, end == std::string::npos ? std::string::npos : end - i);
+      if (!std::isfinite(std::strtod(number->c_str(), nullptr))) return LineAt(text, i);
+      i = end == std::string::npos ? text.size() : end - 1;
+    }
+  }
+  return 0;
 }
 
 }  // namespace
@@ -56,8 +87,9 @@ Result<nlohmann::json> ReadJsonFile(const std::string& path) {
   if (!text.ok()) return text.status();
   size_t offset = 0;
   if (JsonDepth(*text, &offset) > yaml::kMaxYamlDepth) {
-    return Status::Error(ErrorCode::kInvalidInput, path + ": JSON nested deeper than " + std::to_string(yaml::kMaxYamlDepth) +
-                                               " levels at byte " + std::to_string(offset));
+    return Status::Error(ErrorCode::kInvalidInput, path + ":" + std::to_string(LineAt(*text, offset)) +
+                                                       ": JSON nested deeper than " +
+                                                       std::to_string(yaml::kMaxYamlDepth) + " levels");
   }
   try {
     nlohmann::json document = nlohmann::json::parse(*text);
@@ -67,8 +99,14 @@ Result<nlohmann::json> ReadJsonFile(const std::string& path) {
     }
     return document;
   } catch (const nlohmann::json::parse_error& e) {
-    return Status::Error(ErrorCode::kInvalidInput, "malformed JSON in " + path + " at byte " + std::to_string(e.byte) + ": " + e.what());
+    return Status::Error(ErrorCode::kInvalidInput, path + ":" + std::to_string(LineAt(*text, e.byte > 0 ? e.byte - 1 : 0)) +
+                                                       ": malformed JSON: " + e.what());
   } catch (const std::exception& e) {
+    std::string number;
+    if (const int line = OverflowingNumberLine(*text, &number); line > 0) {
+      return Status::Error(ErrorCode::kInvalidInput, path + ":" + std::to_string(line) + ": the number " + number +
+                                                         " is beyond the range of a double");
+    }
     return Status::Error(ErrorCode::kInvalidInput, "cannot read JSON " + path + ": " + e.what());
   }
 }

@@ -43,7 +43,7 @@ Result<TargetsFile> LoadTargetsFile(const std::string& path, int num_joints) {
     return problems.ToStatus("targets");
   }
   TargetsFile file;
-  root.OptionalString("robot", &file.robot);
+  root.OptionalName("robot", &file.robot);
   std::string frame;
   if (root.String("frame", &frame)) {
     if (frame == "camera" || frame == "flange") {

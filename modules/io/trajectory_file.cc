@@ -146,7 +146,7 @@ Result<TrajectoryFile> Load(const std::string& path, int num_joints, const Robot
   }
   TrajectoryFile file;
   std::string& robot_name = file.robot;
-  root.OptionalString("robot", &robot_name);
+  root.OptionalName("robot", &robot_name);
   if (for_robot && !robot_name.empty() && robot_name != for_robot->robot->name) {
     const std::string line = problems.At(root.KeyLine("robot"));
     root.Abandon();
@@ -179,8 +179,12 @@ Result<TrajectoryFile> Load(const std::string& path, int num_joints, const Robot
                    list.KindName() + ")");
     } else if (list.items.empty()) {  // a run, a simulation and a plan check all start at the first pose
       problems.Add("`" + key + "` at " + problems.At(list.line) + " is empty: a plan needs at least one pose");
+    } else if (list.items.size() > static_cast<size_t>(kMaxTrajectoryPoses)) {
+      problems.Add("`" + key + "` at " + problems.At(list.line) + " holds " + std::to_string(list.items.size()) +
+                   " poses, more than the limit of " + std::to_string(kMaxTrajectoryPoses) + " poses per plan");
     }
-    for (size_t i = 0; list.IsSequence() && i < list.items.size(); ++i) {
+    for (size_t i = 0; list.IsSequence() && i < list.items.size() && i < static_cast<size_t>(kMaxTrajectoryPoses);
+         ++i) {
       const yaml::YamlNode& row = list.items[i];
       const std::string name = key + "[" + std::to_string(i) + "]";
       if (row.IsSequence() && static_cast<int>(row.items.size()) != num_joints) {

@@ -26,6 +26,11 @@ namespace selfcal::io {
 inline constexpr const char* kTrajectoryFormat = "selfcal-trajectory";
 inline constexpr int kTrajectoryVersion = 1;
 
+// The most poses a trajectory file may hold (50 times the largest shipped plan's 105): more is refused naming
+// the file, the line of the list, the count and this limit. A plan of 42,000 poses (the mutation campaign's one
+// line repeated to 8 MiB) made `plan --check` grow to 22 GB.
+inline constexpr int kMaxTrajectoryPoses = 5000;
+
 // A trajectory or measurement plan: a plan is a trajectory with num_identification_poses (the first poses
 // identify, the rest verify) and the planner's provenance (docs/trajectory-format.md).
 struct TrajectoryFile {

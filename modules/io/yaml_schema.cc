@@ -292,6 +292,16 @@ bool MapReader::OptionalString(const std::string& key, std::string* out) {
   return !value || ReadString(*value, Path(key), problems_, out);
 }
 
+bool MapReader::OptionalName(const std::string& key, std::string* out) {
+  const yaml::YamlNode* value = Optional(key);
+  if (!value) return true;
+  if (!ReadString(*value, Path(key), problems_, out)) return false;
+  if (!out->empty()) return true;
+  problems_->Add("`" + Path(key) + "` at " + problems_->At(value->line) +
+                 " is empty: give the name or leave the key out");
+  return false;
+}
+
 const yaml::YamlNode* MapReader::FindWithUnit(const std::string& base, Unit unit, bool required, std::string* key,
                                         KeyUnit* key_unit) {
   std::vector<std::pair<std::string, KeyUnit>> variants;

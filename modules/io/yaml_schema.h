@@ -126,6 +126,8 @@ class MapReader {
   bool Int(const std::string& key, long long min, long long max, long long* out);
   bool String(const std::string& key, std::string* out);
   bool OptionalString(const std::string& key, std::string* out);
+  // An optional name (e.g. `robot`): when the key is given, its string must not be empty.
+  bool OptionalName(const std::string& key, std::string* out);
 
   // A pose's joint angles, required: `joints_deg` or `joints_rad`, `size` values (any if < 0) in
   // [-720, 720] deg, radians typed under `joints_deg` refused (LooksLikeRadiansUnderDegrees); in radians.

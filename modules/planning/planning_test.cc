@@ -184,6 +184,16 @@ TEST(Planning, CheckRefusesEachViolationWithTheReason) {
     EXPECT_NE(check.Summary().find("pose p08 and pose p09"), std::string::npos) << check.Summary();
   }
   {
+    // 40 copies of one pose: each named once with the first (not 780 pairs: a plan of 42,000 copies made
+    // plan --check grow to 22 GB).
+    const std::vector<Eigen::VectorXd> plan(40, w.start[3]);
+    const PlanCheck check = CheckPlan(w.problem, plan);
+    int too_close = 0;
+    for (const PlanProblemItem& item : check.problems) too_close += item.issue == PlanIssue::kTooClose ? 1 : 0;
+    EXPECT_EQ(too_close, 39);
+    EXPECT_NE(check.Summary().find("pose p00 and pose p39"), std::string::npos);
+  }
+  {
     std::vector<Eigen::VectorXd> plan = w.start;
     plan[5][0] += DegToRad(40.0);  // the arm turns away from the scene
     const PlanCheck check = CheckPlan(w.problem, plan);

@@ -29,6 +29,7 @@ enum class Parsed {
   kIncomplete,  // a prefix of a record: the file ends inside it
   kInvalid,     // framing, length, CRC or terminator wrong
   kBadPayload,  // framing and CRC right, payload not a JSON object with a "type" string
+  kCarriageReturn,  // a carriage return where the record's newline belongs: line ends converted
 };
 
 struct ParseResult {
@@ -121,6 +122,7 @@ ParseResult ParseRecordAt(const std::string& data, std::size_t pos, const Journa
   }
   if (data[pos + total - 1] != '\n') {
     result.reason = "no newline at the end of the record";
+    if (data[pos + total - 1] == '\r') result.kind = Parsed::kCarriageReturn;
     return result;
   }
   const std::string payload = data.substr(pos + kHeaderBytes, length);
@@ -207,6 +209,12 @@ Status ParseJournal(const std::string& data, const std::string& path, const Jour
     if (record.kind == Parsed::kBadPayload) {
       return Status::Error(ErrorCode::kInvalidInput, where + " has a correct CRC but a bad payload (" + record.reason +
                                                  "): written by a faulty writer, not torn by a crash; refusing it");
+    }
+    if (record.kind == Parsed::kCarriageReturn) {  // a crash never writes one there: CRLF or CR line ends
+      return Status::Error(ErrorCode::kInvalidInput,
+                           where + " ends with a carriage return where its newline belongs: the journal's line ends "
+                                   "were converted (CRLF or CR: an editor, git's autocrlf); it is damaged, refusing "
+                                   "it (nothing was changed)");
     }
     const std::size_t later = FindLaterRecord(data, pos, limits);
     if (later != std::string::npos) {

@@ -136,6 +136,29 @@ TEST(JournalTest, SeveralLinesOfTextAfterTheLastRecordAreRefusedNotCut) {
   }
 }
 
+// A journal whose line ends an editor or git's autocrlf converted (CRLF or CR) was read as a torn tail of
+// its first record: 0 records, and `calibrate` said "too few to calibrate". It is damage, refused at the
+// first record, whatever the number of records.
+TEST(JournalTest, ConvertedLineEndsAreRefusedAsDamage) {
+  TempDir dir;
+  const std::string path = dir.File(kJournalFileName);
+  for (int count : {1, 3}) {
+    const std::string lf = WriteJournal(dir.File("lf" + std::to_string(count) + ".log"), count);
+    for (const std::string& end : {std::string("\r\n"), std::string("\r")}) {
+      std::string text;
+      for (char c : lf) text += c == '\n' ? end : std::string(1, c);
+      WriteFile(path, text);
+      Result<Journal> journal = Journal::Open(path);
+      ASSERT_FALSE(journal.ok()) << count << " records";
+      EXPECT_EQ(journal.status().code(), ErrorCode::kInvalidInput);
+      EXPECT_TRUE(Contains(journal.status().message(), "journal " + path + ": record 1 at byte offset 0 ends with a "
+                                                                           "carriage return"))
+          << journal.status().message();
+      EXPECT_EQ(FileSize(path), text.size());
+    }
+  }
+}
+
 TEST(JournalTest, CorruptLastRecordIsATornTail) {
   TempDir dir;
   const std::string path = dir.File(kJournalFileName);

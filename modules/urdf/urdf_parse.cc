@@ -11,6 +11,7 @@
 
 #include "base/terminal_text.h"
 #include "base/xml_scan.h"
+#include "urdf/urdf_values.h"
 
 namespace selfcal::urdf {
 namespace {
@@ -94,6 +95,7 @@ Result<std::shared_ptr<::urdf::ModelInterface>> ParseUrdfText(const std::string&
     return Status::Error(ErrorCode::kInvalidInput, name + ":" + std::to_string(std::max(1, xml.ErrorRow())) +
                                                        ": not well-formed XML (tinyxml: " + xml.ErrorDesc() + ")");
   }
+  if (Status s = CheckUrdfValues(xml, name); !s.ok()) return s;
   Capture capture;
   ::urdf::ModelInterfaceSharedPtr model;
   {

@@ -2,6 +2,8 @@
 #include "urdf/urdf_parse.h"
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -78,6 +80,31 @@ TEST(UrdfParse, UrdfdomModelErrorsNameTheElementAndItsLine) {
   const std::string second = Refusal(untyped);
   EXPECT_EQ(second.rfind("arm.urdf:" + std::to_string(LineOf(untyped, "name=\"joint2\"")) + ": the <joint> named `joint2`", 0), 0u)
       << second;
+}
+
+// urdfdom takes these without a word (the mutation campaign's urdf-02503 and urdf-02539): a misspelt <axis>
+// (the joint turns about x), an axis of 1e23 (it becomes x), an origin of 1e308, a misspelt `upper=` (0 rad).
+TEST(UrdfParse, ValuesUrdfdomTakesSilentlyAreRefusedByLine) {
+  const std::string joint2 = "name=\"joint2\"";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"<axis xyz=\"0 0 1\"/>", "<aixs xyz=\"0 0 1\"/>"},
+      {"<axis xyz=\"0 0 1\"/>", "<axis xyz=\"99999999999999999999999 0 1\"/>"},
+      {"<origin xyz=\"0 0 0.1625\"", "<origin xyz=\"0 0 1e308\""},
+      {"rpy=\"1.5707963267948966 0 0\"", "rpy=\"1e308 0 0\""},
+      {"upper=\"6.283185307179586\"", "upepr=\"6.283185307179586\""}};
+  const std::vector<std::string> expected = {"<aixs> is not an element of a joint", "1e+23 is beyond the limit",
+                                             "1e+308 m is beyond the limit", "1e+308 rad is beyond the limit",
+                                             "a revolute joint needs `upper=`"};
+  for (size_t k = 0; k < cases.size(); ++k) {
+    std::string text = Ur5e();
+    const size_t line_at = text.find(joint2);
+    const size_t at = text.find(cases[k].first, line_at);
+    ASSERT_NE(at, std::string::npos) << cases[k].first;
+    text.replace(at, cases[k].first.size(), cases[k].second);
+    const std::string message = Refusal(text);
+    EXPECT_EQ(message.rfind("arm.urdf:" + std::to_string(LineOf(text, joint2)) + ": ", 0), 0u) << message;
+    EXPECT_NE(message.find(expected[k]), std::string::npos) << message;
+  }
 }
 
 // selfcal's own refusals of the chain (a joint it cannot take, a missing link) name the joint's line too, or
