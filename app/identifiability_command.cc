@@ -4,7 +4,9 @@
 
 #include "app/cli_util.h"
 #include "app/commands.h"
+#include "geometry/rigid3.h"
 #include "identification/identifiability.h"
+#include "kinematics/joint_motion.h"
 #include "io/robot_config.h"
 #include "io/trajectory_file.h"
 
@@ -41,6 +43,11 @@ Command AddIdentifiabilityCommand(CLI::App& app) {
     if (static_cast<int>(poses.size()) > args->identification_poses) poses.resize(args->identification_poses);
     const Eigen::VectorXd rho = KinematicParameters::Nominal(*robot);
     std::cout << "robot " << robot->name << ", " << poses.size() << " poses, measurements cam_1_from_cam_i\n";
+    for (const BarelyMovingJoint& j : BarelyMovingJoints(poses)) {
+      std::cout << "warning: joint " << j.joint << " barely moves (" << RadToDeg(j.range_rad)
+                << " deg over these poses): the parameters beside it are hard to tell apart, and calibrate holds "
+                   "those the data determine worse than their tolerance at the robot description's value\n";
+    }
     identification::IdentifiabilityOptions options;
     Print("metric relative poses", identification::AnalyzeIdentifiability(*robot, rho, poses, 0, options));
     options.scale_known = false;

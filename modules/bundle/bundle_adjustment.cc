@@ -196,14 +196,7 @@ bool AnalyzeStartGauge(const BundleData& data, const BundleState& state, const B
 // move. False when the nominal model cannot be evaluated (a dot behind a camera).
 bool HoldWeakParameters(const BundleData& data, const BundleOptions& options, internal::Gauge* gauge,
                         BundleState* state, BundleReport* report) {
-  for (int j = 0; j < data.robot.num_joints() && data.base_from_flange.empty(); ++j) {
-    double lo = 0, hi = 0;
-    for (size_t p = 0; p < data.joints.size(); ++p) {
-      lo = p == 0 ? data.joints[p][j] : std::min(lo, data.joints[p][j]);
-      hi = p == 0 ? data.joints[p][j] : std::max(hi, data.joints[p][j]);
-    }
-    if (!data.joints.empty() && hi - lo < kBarelyMovingRad) report->barely_moving.push_back({j + 1, hi - lo});
-  }
+  if (data.base_from_flange.empty()) report->barely_moving = BarelyMovingJoints(data.joints);
   if (options.weak_length_tolerance_m <= 0 && options.weak_angle_tolerance_rad <= 0) return true;
   BundleState nominal = *state;
   const Eigen::VectorXd nominal_rho = KinematicParameters::Nominal(data.robot);

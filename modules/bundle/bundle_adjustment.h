@@ -54,6 +54,7 @@
 #include <Eigen/Core>
 
 #include "camera/camera.h"
+#include "kinematics/joint_motion.h"
 #include "kinematics/robot_model.h"
 #include "observations/observation_set.h"
 
@@ -132,14 +133,6 @@ struct WeakParameter {
   std::string combination;     // "0.71 j2.d - 0.71 j4.d": what it trades off with
 };
 
-// A joint whose recorded angle varies by less than kBarelyMovingRad over the identification poses: its
-// neighbours' offsets are then hard to tell apart.
-constexpr double kBarelyMovingRad = 0.0349065850398866;  // 2 deg
-struct BarelyMovingJoint {
-  int joint = 0;  // 1-based
-  double range_rad = 0;
-};
-
 struct BundleReport {
   Outcome outcome = Outcome::kNotRun;
   std::string message;
@@ -155,7 +148,7 @@ struct BundleReport {
   std::vector<std::string> held_names;        // held by request (BundleOptions::held_parameters, free_parameters)
   std::vector<std::string> null_combinations; // "1.00 base.tx", "0.71 j2.d - 0.71 j3.d", ...
   std::vector<WeakParameter> weak;            // held at the description's value: the data determine them too poorly
-  std::vector<BarelyMovingJoint> barely_moving;
+  std::vector<BarelyMovingJoint> barely_moving;  // over the identification poses (kinematics/joint_motion.h)
   int generic_rank = 0;                       // free kinematic count for generic poses of this robot
   double condition_number = 0;                // column-normalised reduced Jacobian of the free set
   // Marginal standard deviations, dots as nuisance: s^2 (J_g^T (I - P_dots) J_g)^-1 over the free

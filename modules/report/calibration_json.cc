@@ -93,7 +93,7 @@ json WeakJson(const bundle::BundleReport& b) {
                     {"combination", w.combination}});
   }
   json joints = json::array();
-  for (const bundle::BarelyMovingJoint& j : b.barely_moving) {
+  for (const BarelyMovingJoint& j : b.barely_moving) {
     joints.push_back({{"joint", j.joint}, {"range_deg", RadToDeg(j.range_rad)}});
   }
   return {{"held", held}, {"barely_moving_joints", joints}};

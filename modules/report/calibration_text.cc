@@ -91,7 +91,7 @@ void PrintLensSummary(const bundle::BundleReport& b, std::ostream& out) {
 
 // The joints that barely move and the parameters held because the data determine them too poorly.
 void PrintWeakDirections(const bundle::BundleReport& b, std::ostream& out) {
-  for (const bundle::BarelyMovingJoint& j : b.barely_moving) {
+  for (const BarelyMovingJoint& j : b.barely_moving) {
     out << "  joint " << j.joint << " barely moves (" << std::fixed << std::setprecision(1) << RadToDeg(j.range_rad)
         << " deg over the identification poses): the parameters beside it are hard to tell apart\n";
     out.unsetf(std::ios::floatfield);

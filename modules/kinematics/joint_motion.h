@@ -1,0 +1,24 @@
+// How far each joint moves over a set of poses: a joint that barely moves leaves the offsets of the links
+// beside it hard to tell apart (the kinematic bundle adjustment holds what the data cannot determine, and
+// `identifiability` warns of it from the poses alone).
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace selfcal {
+
+inline constexpr double kBarelyMovingRad = 0.0349065850398866;  // 2 deg
+
+struct BarelyMovingJoint {
+  int joint = 0;          // 1-based
+  double range_rad = 0;   // max - min of its angle over the poses
+};
+
+// The joints whose angle varies by less than `threshold_rad` over `joints` (one vector per pose, all of one
+// size); none for an empty list.
+std::vector<BarelyMovingJoint> BarelyMovingJoints(const std::vector<Eigen::VectorXd>& joints,
+                                                  double threshold_rad = kBarelyMovingRad);
+
+}  // namespace selfcal
