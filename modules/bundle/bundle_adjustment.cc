@@ -214,9 +214,9 @@ bool HoldWeakParameters(const BundleData& data, const BundleOptions& options, in
     state->rho[w.column] = nominal_rho[w.column];
     auto it = std::find(gauge->free_kinematic.begin(), gauge->free_kinematic.end(), w.column);
     if (it != gauge->free_kinematic.end()) gauge->free_kinematic.erase(it);
-    auto name = std::find(gauge->free_names.begin(), gauge->free_names.end(), params.name(w.column));
-    if (name != gauge->free_names.end()) gauge->free_names.erase(name);
   }
+  gauge->free_names.clear();
+  for (int i : gauge->free_kinematic) gauge->free_names.push_back(params.name(i));
   report->free_indices = gauge->free_kinematic;
   report->free_names = gauge->free_names;
   return true;
@@ -268,6 +268,16 @@ void WriteBack(const BundleState& state, const std::vector<int>& dot_map, Bundle
   for (size_t c = 0; c < dot_map.size(); ++c) full_state->dots[dot_map[c]] = state.dots[c];
 }
 
+// The observations the screen left out (keep false), each with its residual at `state`, into the report.
+void ReportRemoved(const BundleData& full, const BundleState& state, const std::vector<bool>& keep, BundleReport* report) {
+  const std::vector<double> errors = ReprojectionErrors(full, state);
+  for (size_t k = 0; k < keep.size(); ++k) {
+    if (keep[k]) continue;
+    const internal::Observation& o = full.observations[k];
+    report->removed.push_back({full.pose_ids[o.pose], full.dot_ids[o.dot], errors[k]});
+  }
+}
+
 struct ScreenedFit {
   bool scale_lost = false;  // the screen removed the yardstick's views (S1)
   internal::LmSummary summary;  // of the final solve
@@ -289,10 +299,7 @@ ScreenedFit SolveScreened(const std::vector<int>& free, const BundleOptions& opt
     Subset(full, full_state, keep, data, state, &dot_map);
     if (data->yardsticks.empty() && data->base_from_flange.empty()) {
       fit.scale_lost = true;
-      const std::vector<double> errors = ReprojectionErrors(full, full_state);
-      for (size_t k = 0; k < keep.size(); ++k) {
-        if (!keep[k]) report->removed.push_back({full.pose_ids[full.observations[k].pose], full.dot_ids[full.observations[k].dot], errors[k]});
-      }
+      ReportRemoved(full, full_state, keep, report);
       return fit;
     }
     summary = Solve(*data, free, options, true, state);
@@ -314,12 +321,7 @@ ScreenedFit SolveScreened(const std::vector<int>& free, const BundleOptions& opt
       WriteBack(*state, dot_map, &full_state);
     }
   }
-  const std::vector<double> errors = ReprojectionErrors(full, full_state);
-  for (size_t k = 0; k < keep.size(); ++k) {
-    if (keep[k]) continue;
-    const internal::Observation& o = full.observations[k];
-    report->removed.push_back({full.pose_ids[o.pose], full.dot_ids[o.dot], errors[k]});
-  }
+  ReportRemoved(full, full_state, keep, report);
   std::vector<bool> in_solve(full.dot_ids.size(), false);
   for (int d : dot_map) in_solve[d] = true;
   for (size_t d = 0; d < full.dot_ids.size(); ++d) {

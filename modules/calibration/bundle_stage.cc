@@ -54,21 +54,9 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 // estimated intrinsic's uncertainty in the calibrated model's prediction.
 void VerifyHeldOutReprojection(const ObservationSet& obs, BundleStageReport* report) {
   const bundle::BundleReport& b = report->bundle;
-  const bool estimated = std::isfinite(b.pixel_noise_estimate_px) && b.pixel_noise_estimate_px > 0;
-  const double noise = estimated ? b.pixel_noise_estimate_px : obs.pixel_noise_px;
-  PredictionModel calibrated;
-  calibrated.robot = obs.robot;
-  calibrated.rho = b.rho;
-  calibrated.camera = report->calibrated_camera;
-  calibrated.free_indices = b.free_indices;
-  calibrated.intrinsics_estimated = b.intrinsics_estimated;
-  if (b.covariance_available) calibrated.covariance = b.covariance_free;
-  ExcludedObservations excluded;
-  for (const bundle::RemovedObservation& o : b.removed) excluded.insert({o.pose_id, o.dot_id});
-  const int noise_dof = estimated ? b.residual_dof : 0;
-  report->heldout = HeldOutReprojectionOf(obs, calibrated, b.dots_in_base, excluded, noise, noise_dof);
-  report->heldout.noise_source = estimated ? "the bundle's estimate from its identification residuals"
-                                           : "the stated pixel noise (the bundle has no redundancy to estimate it)";
+  double noise = 0;
+  int noise_dof = 0;
+  report->heldout = HeldOutReprojectionOfBundle(obs, b, &noise, &noise_dof);
   if (!b.covariance_available) report->heldout.message = "prediction uncertainty of the parameters left out: " + b.covariance_message;
   report->heldout_at_stated_noise = Renormalised(report->heldout.overall, noise, obs.pixel_noise_px);
   report->heldout_nominal = NominalHeldOutReprojection(obs, noise, noise_dof);
@@ -93,6 +81,26 @@ bool CameraStartFromImages(const ObservationSet& obs, const BundleStageOptions& 
 }
 
 }  // namespace
+
+HeldOutReprojection HeldOutReprojectionOfBundle(const ObservationSet& obs, const bundle::BundleReport& b,
+                                                double* noise_px, int* noise_dof) {
+  const bool estimated = std::isfinite(b.pixel_noise_estimate_px) && b.pixel_noise_estimate_px > 0;
+  *noise_px = estimated ? b.pixel_noise_estimate_px : obs.pixel_noise_px;
+  *noise_dof = estimated ? b.residual_dof : 0;
+  PredictionModel calibrated;
+  calibrated.robot = obs.robot;
+  calibrated.rho = b.rho;
+  calibrated.camera = WithIntrinsics(obs.camera, b.intrinsics);
+  calibrated.free_indices = b.free_indices;
+  calibrated.intrinsics_estimated = b.intrinsics_estimated;
+  if (b.covariance_available) calibrated.covariance = b.covariance_free;
+  ExcludedObservations excluded;
+  for (const bundle::RemovedObservation& o : b.removed) excluded.insert({o.pose_id, o.dot_id});
+  HeldOutReprojection heldout = HeldOutReprojectionOf(obs, calibrated, b.dots_in_base, excluded, *noise_px, *noise_dof);
+  heldout.noise_source = estimated ? "the bundle's estimate from its identification residuals"
+                                   : "the stated pixel noise (the bundle has no redundancy to estimate it)";
+  return heldout;
+}
 
 BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineReport& paper,
                                  const BundleStageOptions& options) {

@@ -79,6 +79,14 @@ struct BundleStageReport {
   double seconds_total = 0;
 };
 
+// The held-out reprojection of a bundle's model on the verification poses of `observations`: the model with
+// the bundle's intrinsics (observations.camera's otherwise) and covariance, the dots as the bundle placed
+// them, the observations its screen removed left out, normalised with the bundle's pixel noise estimate
+// where it has one, else the stated noise (*noise_px, *noise_dof: the normalisation's, noise_dof 0 for the
+// stated noise; noise_source says which). Shared by the stage and the cross-validation's folds.
+HeldOutReprojection HeldOutReprojectionOfBundle(const ObservationSet& observations, const bundle::BundleReport& b,
+                                                double* noise_px, int* noise_dof);
+
 // Runs the bundle adjustment on `observations` started as described above from `paper` (the report of
 // RunPaperPipeline on the same observations; any outcome). kInvalidInput from the bundle's own checks when
 // the observations or options are invalid.

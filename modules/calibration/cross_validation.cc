@@ -16,18 +16,17 @@ std::vector<int> ShuffledPoses(const ObservationSet& obs, std::uint64_t seed) {
   return poses;
 }
 
-// The median distance from the identification cameras of `full` to the dots they see.
+// The median distance from the identification cameras of `full` to the dots they see (fit_geometry's
+// camera_poses are every pose of `obs`, in file order).
 double MedianDepth(const ObservationSet& obs, const BundleStageReport& full) {
   std::vector<double> depths;
-  for (const CameraPose& camera : full.fit_geometry.camera_poses) {
-    if (camera.role != PoseRole::kIdentification) continue;
-    for (const PoseObservation& pose : obs.poses) {
-      if (pose.id != camera.pose_id) continue;
-      for (const auto& entry : pose.dots_px) {
-        auto dot = full.bundle.dots_in_base.find(entry.first);
-        if (dot != full.bundle.dots_in_base.end()) {
-          depths.push_back((dot->second - camera.base_from_cam.translation).norm());
-        }
+  const std::vector<CameraPose>& cameras = full.fit_geometry.camera_poses;
+  for (size_t p = 0; p < cameras.size() && p < obs.poses.size(); ++p) {
+    if (cameras[p].role != PoseRole::kIdentification) continue;
+    for (const auto& entry : obs.poses[p].dots_px) {
+      auto dot = full.bundle.dots_in_base.find(entry.first);
+      if (dot != full.bundle.dots_in_base.end()) {
+        depths.push_back((dot->second - cameras[p].base_from_cam.translation).norm());
       }
     }
   }
@@ -51,18 +50,9 @@ CrossValidationFold RunFold(const ObservationSet& obs, const BundleStageReport& 
     fold.message = b.message;
     return fold;
   }
-  PredictionModel model;
-  model.robot = obs.robot;
-  model.rho = b.rho;
-  model.camera = WithIntrinsics(obs.camera, b.intrinsics);
-  model.free_indices = b.free_indices;
-  model.intrinsics_estimated = b.intrinsics_estimated;
-  if (b.covariance_available) model.covariance = b.covariance_free;
-  ExcludedObservations excluded;
-  for (const bundle::RemovedObservation& o : b.removed) excluded.insert({o.pose_id, o.dot_id});
-  const bool estimated = std::isfinite(b.pixel_noise_estimate_px) && b.pixel_noise_estimate_px > 0;
-  const double noise = estimated ? b.pixel_noise_estimate_px : obs.pixel_noise_px;
-  const HeldOutReprojection h = HeldOutReprojectionOf(train, model, b.dots_in_base, excluded, noise, 0);
+  double noise = 0;
+  int noise_dof = 0;
+  const HeldOutReprojection h = HeldOutReprojectionOfBundle(train, b, &noise, &noise_dof);
   if (!h.ok) {
     fold.message = h.message;
     return fold;

@@ -72,6 +72,39 @@ std::vector<int> PreferredParameterOrder(int num_joints) {
   return order;
 }
 
+namespace {
+
+// *v minus its projection on the first num_basis columns of the orthonormal `basis`, re-orthogonalised once.
+void OrthogonaliseAgainst(const Eigen::MatrixXd& basis, int num_basis, Eigen::VectorXd* v) {
+  for (int pass = 0; pass < 2; ++pass) {
+    const auto q = basis.leftCols(num_basis);
+    *v -= q * (q.transpose() * *v);
+  }
+}
+
+// The columns `which` of `m`, in that order.
+Eigen::MatrixXd ColumnsOf(const Eigen::MatrixXd& m, const std::vector<int>& which) {
+  Eigen::MatrixXd sub(m.rows(), which.size());
+  for (size_t k = 0; k < which.size(); ++k) sub.col(k) = m.col(which[k]);
+  return sub;
+}
+
+// The direction unit column c minus its least-squares expansion on the `kept` columns (qr: of those
+// columns), normalised, over `cols` parameters: what the data cannot tell from the kept ones. With
+// `expand` false (no kept column, or c is zero) the unit column alone.
+Eigen::VectorXd NullDirection(const Eigen::ColPivHouseholderQR<Eigen::MatrixXd>& qr, const std::vector<int>& kept,
+                              const Eigen::VectorXd& column, int c, int cols, bool expand) {
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(cols);
+  x[c] = 1.0;
+  if (expand) {
+    const Eigen::VectorXd a = qr.solve(column);
+    for (size_t k = 0; k < kept.size(); ++k) x[kept[k]] = -a[k];
+  }
+  return x.normalized();
+}
+
+}  // namespace
+
 RankSelection SelectColumns(const Eigen::MatrixXd& jacobian, const std::vector<int>& order, double tolerance,
                             const std::vector<std::string>& names) {
   const int rows = static_cast<int>(jacobian.rows()), cols = static_cast<int>(jacobian.cols());
@@ -95,10 +128,7 @@ RankSelection SelectColumns(const Eigen::MatrixXd& jacobian, const std::vector<i
     bool keep = false;
     if (!zero[c] && sigma_max > 0 && num_basis < rows) {
       Eigen::VectorXd v = normalized.col(c);
-      for (int pass = 0; pass < 2; ++pass) {  // re-orthogonalised once
-        const auto q = basis.leftCols(num_basis);
-        v -= q * (q.transpose() * v);
-      }
+      OrthogonaliseAgainst(basis, num_basis, &v);
       const double residual = v.norm();
       if (residual > threshold) {
         basis.col(num_basis++) = v / residual;
@@ -110,9 +140,7 @@ RankSelection SelectColumns(const Eigen::MatrixXd& jacobian, const std::vector<i
   std::sort(out.kept.begin(), out.kept.end());
   std::sort(out.dependent.begin(), out.dependent.end());
   if (!out.kept.empty()) {
-    Eigen::MatrixXd sub(rows, out.kept.size());
-    for (size_t k = 0; k < out.kept.size(); ++k) sub.col(k) = normalized.col(out.kept[k]);
-    const Eigen::VectorXd s = Eigen::JacobiSVD<Eigen::MatrixXd>(sub).singularValues();
+    const Eigen::VectorXd s = Eigen::JacobiSVD<Eigen::MatrixXd>(ColumnsOf(normalized, out.kept)).singularValues();
     out.condition_number =
         s[s.size() - 1] > 0 ? s[0] / s[s.size() - 1] : std::numeric_limits<double>::infinity();
   } else {
@@ -124,17 +152,9 @@ RankSelection SelectColumns(const Eigen::MatrixXd& jacobian, const std::vector<i
   for (int k = 0; k < sv.size(); ++k) svd_rank += sv[k] > threshold ? 1 : 0;
   std::vector<Eigen::VectorXd> null_vectors;
   if (cols - svd_rank == static_cast<int>(out.dependent.size())) {
-    Eigen::MatrixXd sub(rows, out.kept.size());
-    for (size_t k = 0; k < out.kept.size(); ++k) sub.col(k) = normalized.col(out.kept[k]);
-    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(sub);
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(ColumnsOf(normalized, out.kept));
     for (int c : out.dependent) {
-      Eigen::VectorXd x = Eigen::VectorXd::Zero(cols);
-      x[c] = 1.0;
-      if (!out.kept.empty() && !zero[c]) {
-        const Eigen::VectorXd a = qr.solve(normalized.col(c));
-        for (size_t k = 0; k < out.kept.size(); ++k) x[out.kept[k]] = -a[k];
-      }
-      null_vectors.push_back(x.normalized());
+      null_vectors.push_back(NullDirection(qr, out.kept, normalized.col(c), c, cols, !out.kept.empty() && !zero[c]));
     }
   } else if (v_full.size() > 0) {
     for (int k = svd_rank; k < cols; ++k) null_vectors.push_back(v_full.col(k));
@@ -145,7 +165,11 @@ RankSelection SelectColumns(const Eigen::MatrixXd& jacobian, const std::vector<i
 
 std::vector<WeakColumn> FindWeakColumns(const Eigen::MatrixXd& whitened, const std::vector<int>& order,
                                         const Eigen::VectorXd& tolerance, const std::vector<std::string>& names) {
-  const int rows = static_cast<int>(whitened.rows());
+  const int rows = static_cast<int>(whitened.rows()), cols = static_cast<int>(whitened.cols());
+  Eigen::MatrixXd normalized = whitened;  // for the combinations
+  for (int c = 0; c < cols; ++c) {
+    if (whitened.col(c).norm() > 0) normalized.col(c) = whitened.col(c) / whitened.col(c).norm();
+  }
   std::vector<WeakColumn> weak;
   Eigen::MatrixXd basis(rows, std::min<int>(rows, static_cast<int>(order.size())));
   std::vector<int> kept;
@@ -153,28 +177,14 @@ std::vector<WeakColumn> FindWeakColumns(const Eigen::MatrixXd& whitened, const s
     Eigen::VectorXd v = whitened.col(c);
     const double norm = v.norm();
     const int num_basis = static_cast<int>(kept.size());
-    for (int pass = 0; pass < 2; ++pass) {  // re-orthogonalised once
-      const auto q = basis.leftCols(num_basis);
-      v -= q * (q.transpose() * v);
-    }
+    OrthogonaliseAgainst(basis, num_basis, &v);
     const double residual = v.norm();
     const double conditional_std = residual > 0 ? 1.0 / residual : std::numeric_limits<double>::infinity();
     if (tolerance[c] > 0 && conditional_std > tolerance[c]) {
-      WeakColumn w;
-      w.column = c;
-      w.conditional_std = conditional_std;
-      w.tolerance = tolerance[c];
       // The column on the earlier kept ones, all normalised: the direction the data cannot see.
-      Eigen::VectorXd x = Eigen::VectorXd::Zero(whitened.cols());
-      x[c] = 1.0;
-      if (!kept.empty() && norm > 0) {
-        Eigen::MatrixXd sub(rows, kept.size());
-        for (size_t k = 0; k < kept.size(); ++k) sub.col(k) = whitened.col(kept[k]) / whitened.col(kept[k]).norm();
-        const Eigen::VectorXd a = sub.colPivHouseholderQr().solve(whitened.col(c) / norm);
-        for (size_t k = 0; k < kept.size(); ++k) x[kept[k]] = -a[k];
-      }
-      w.combination = FormatCombination(x.normalized(), names);
-      weak.push_back(w);
+      const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(ColumnsOf(normalized, kept));
+      const Eigen::VectorXd x = NullDirection(qr, kept, normalized.col(c), c, cols, !kept.empty() && norm > 0);
+      weak.push_back({c, conditional_std, tolerance[c], FormatCombination(x, names)});
       continue;
     }
     if (residual > 0 && num_basis < rows) {

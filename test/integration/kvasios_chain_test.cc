@@ -8,7 +8,9 @@
 // `detect` reads it today (images in one folder, a poses list of the recorded joints).
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -53,6 +55,30 @@ std::string Detect(const std::string& session, const fs::path& dir) {
       &output);
   EXPECT_EQ(code, 0) << output;
   return obs;
+}
+
+// An observations file's text split into its head (robot, camera, yardstick) and its pose blocks, each
+// starting at `  - id: "pose_NN"`.
+std::vector<std::string> PoseBlocks(const std::string& text, std::string* head) {
+  std::vector<std::string> out;
+  size_t at = text.find("  - id: ");
+  *head = text.substr(0, at);
+  while (at != std::string::npos) {
+    const size_t next = text.find("  - id: ", at + 1);
+    out.push_back(text.substr(at, next == std::string::npos ? std::string::npos : next - at));
+    at = next;
+  }
+  return out;
+}
+
+// A pose block of another session for a combined file: its id prefixed with `prefix` and `_`, made a
+// verification pose when asked, and given `scene:` (after its role line) when `scene` is not empty.
+std::string Relabel(std::string block, const std::string& prefix, bool verification, const std::string& scene = "") {
+  block.replace(block.find("id: \"") + 5, 0, prefix + "_");
+  if (verification) block.replace(block.find("role: identification"), 20, "role: verification");
+  const size_t role_end = block.find('\n', block.find("role: ")) + 1;
+  if (!scene.empty()) block.insert(role_end, "    scene: " + scene + "\n");
+  return block;
 }
 
 TEST(KvasiosChain, EverySessionCalibratesWithTheDefaultsNamingWhatTheDataCannotDetermine) {
@@ -101,34 +127,17 @@ TEST(KvasiosChain, ACalibrationOnOneSessionPredictsAnotherSessionsHeldOutTargets
   std::ifstream s1(Detect("s1", dir / "s1")), s2(Detect("s2", dir / "s2"));
   std::string train((std::istreambuf_iterator<char>(s1)), std::istreambuf_iterator<char>());
   std::string test((std::istreambuf_iterator<char>(s2)), std::istreambuf_iterator<char>());
-  // Each pose is a block starting at `  - id: "pose_NN"`; the file's head (robot, camera, yardstick) is
-  // s1's. Fold 0: targets 0, 4, 8.
-  auto blocks = [](const std::string& text, std::string* head) {
-    std::vector<std::string> out;
-    size_t at = text.find("  - id: ");
-    *head = text.substr(0, at);
-    while (at != std::string::npos) {
-      const size_t next = text.find("  - id: ", at + 1);
-      out.push_back(text.substr(at, next == std::string::npos ? std::string::npos : next - at));
-      at = next;
-    }
-    return out;
-  };
+  // The file's head is s1's. Fold 0: targets 0, 4, 8.
   std::string head, ignored;
-  const std::vector<std::string> train_poses = blocks(train, &head);
-  const std::vector<std::string> test_poses = blocks(test, &ignored);
+  const std::vector<std::string> train_poses = PoseBlocks(train, &head);
+  const std::vector<std::string> test_poses = PoseBlocks(test, &ignored);
   ASSERT_EQ(train_poses.size(), 12u);
   ASSERT_EQ(test_poses.size(), 12u);
   std::string combined = head;
   for (int n = 0; n < 12; ++n) {
     if (n % 4 != 0) combined += train_poses[n];
   }
-  for (int n = 0; n < 12; n += 4) {
-    std::string pose = test_poses[n];
-    pose.replace(pose.find("id: \"") + 5, 0, "s2_");
-    pose.replace(pose.find("role: identification"), 20, "role: verification");
-    combined += pose;
-  }
+  for (int n = 0; n < 12; n += 4) combined += Relabel(test_poses[n], "s2", true);
   const fs::path obs = dir / "fold0.yaml";
   std::ofstream(obs) << combined;
   std::string output;
@@ -147,29 +156,17 @@ TEST(KvasiosChain, ACalibrationOnOneSessionPredictsAnotherSessionsHeldOutTargets
 // one-scene pool is several px off.
 TEST(KvasiosChain, TwoRecordingsOfAMovedBoardCalibrateTogetherWithASceneEach) {
   const fs::path dir = FreshDir("kvasios", "scenes");
-  std::string heads[3], texts[3];
+  std::string heads[3];
   const char* sessions[3] = {"s1", "s3", "s2"};
   std::vector<std::string> blocks[3];
   for (int s = 0; s < 3; ++s) {
     std::ifstream in(Detect(sessions[s], dir / sessions[s]));
-    texts[s].assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    size_t at = texts[s].find("  - id: ");
-    heads[s] = texts[s].substr(0, at);
-    while (at != std::string::npos) {
-      const size_t next = texts[s].find("  - id: ", at + 1);
-      blocks[s].push_back(texts[s].substr(at, next == std::string::npos ? std::string::npos : next - at));
-      at = next;
-    }
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    blocks[s] = PoseBlocks(text, &heads[s]);
     ASSERT_EQ(blocks[s].size(), 12u);
   }
-  // Each pose block: its id prefixed with the session, `scene:` after the role line when asked.
   auto pose = [&](int s, int n, const std::string& scene, bool verification) {
-    std::string text = blocks[s][n];
-    text.replace(text.find("id: \"") + 5, 0, std::string(sessions[s]) + "_");
-    if (verification) text.replace(text.find("role: identification"), 20, "role: verification");
-    const size_t role_end = text.find('\n', text.find("role: ")) + 1;
-    if (!scene.empty()) text.insert(role_end, "    scene: " + scene + "\n");
-    return text;
+    return Relabel(blocks[s][n], sessions[s], verification, scene);
   };
   double rms[2];
   for (int separate = 0; separate < 2; ++separate) {
