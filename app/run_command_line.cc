@@ -1,7 +1,5 @@
 // The command line of `selfcal run` (RunSettings, session_command.h): every value checked here, before
 // anything is read, connected or written.
-#include <cmath>
-#include <cstdlib>
 #include <memory>
 #include <string>
 
@@ -11,25 +9,6 @@
 #include "app/session_command.h"
 
 namespace selfcal::app {
-
-namespace {
-
-// A finite number in (0, 1]: CLI::Range lets NaN through (every comparison with it is false).
-CLI::Validator FractionInUnitInterval() {
-  return CLI::Validator(
-      [](std::string& text) -> std::string {
-        char* end = nullptr;
-        const double value = std::strtod(text.c_str(), &end);
-        if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(value) || !(value > 0) ||
-            value > 1) {
-          return "must be a finite number in (0, 1], got \"" + text + "\"";
-        }
-        return "";
-      },
-      "FRACTION in (0, 1]");
-}
-
-}  // namespace
 
 Command AddRunCommand(CLI::App& app) {
   auto a = std::make_shared<RunSettings>();
@@ -64,7 +43,7 @@ Command AddRunCommand(CLI::App& app) {
   cmd->add_option("--device", a->device, "v4l2 camera device");
   cmd->add_option("--velocity-scaling", a->velocity_scaling,
                   "Fraction of the joint velocity limits (default 1 simulated, 0.1 real)")
-      ->check(FractionInUnitInterval());
+      ->check(CLI::Range(1e-3, 1.0));  // NaN and inf: CheckNumbersStrictly (cli_numbers.h)
   cmd->add_option("--seed", a->seed, "sim: world, noise and robot seed");
   cmd->add_option("--grey-noise", a->grey_noise, "sim: pixel noise std, grey levels")->check(CLI::Range(0.0, 50.0));
   cmd->add_option("--blur-px", a->blur_px, "sim: Gaussian blur sigma, px")->check(CLI::Range(0.0, 10.0));
