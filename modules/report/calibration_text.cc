@@ -189,7 +189,11 @@ void PrintCrossValidation(const calibration::CrossValidationReport& cv, std::ost
   if (std::isfinite(cv.rms_mm)) out << " (" << cv.rms_mm << " mm at the scene)";
   out << "; folds";
   for (const calibration::CrossValidationFold& f : cv.per_fold) {
-    out << " " << (f.figure.num_residuals > 0 ? std::to_string(f.figure.rms_px).substr(0, 5) : std::string("-"));
+    if (f.figure.num_residuals > 0) {
+      out << " " << f.figure.rms_px;  // fixed, 3 decimals as above
+    } else {
+      out << " -";
+    }
   }
   out << " px; " << cv.folds_passed << " of " << cv.folds << " pass the held-out test at the stated noise\n";
   out.unsetf(std::ios::floatfield);
