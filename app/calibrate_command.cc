@@ -293,6 +293,7 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   options.bundle.bundle.held_parameters = request.fix;
   options.bundle.bundle.free_parameters = request.free;
   options.bundle.bundle.weak_length_tolerance_m = request.weak_tolerance_mm * 1e-3;
+  options.bundle.bundle.estimate_pose_error = !request.pixel_noise_only;
   options.bundle.bundle.weak_angle_tolerance_rad = DegToRad(request.weak_tolerance_deg);
   options.flange_scale_from_yardsticks = request.scale_from == "yardstick";
   options.progress = Progress();
@@ -341,6 +342,9 @@ Command AddCalibrateCommand(CLI::App& app) {
   cmd->add_option("--weak-tolerance-deg", request->weak_tolerance_deg,
                   "The same for a joint angle, deg (0: never)")
       ->check(CLI::Range(0.0, 180.0));
+  cmd->add_flag("--pixel-noise-only", request->pixel_noise_only,
+               "Sigmas from the pixel noise alone, without the pose error estimated from the residuals (the model of "
+               "a simulation without pose error)");
   CLI::Option* folds = cmd->add_option("--folds", request->folds,
                                        "Without verification poses: hold out each of K folds of the poses in turn "
                                        "and predict them (the held-out figure of report.json's cross_validation; 0: "

@@ -35,6 +35,7 @@ struct CalibrateRequest {
   // Weak directions: the manufacturing tolerances above which a poorly determined joint parameter is held at
   // the robot description's value (bundle::BundleOptions::weak_length_tolerance_m; 0: never held).
   double weak_tolerance_mm = 5.0, weak_tolerance_deg = 0.5;
+  bool pixel_noise_only = false;  // no estimated pose error in the covariance
   // Without verification poses: k-fold cross-validation over the identification poses (0: not run);
   // folds_given: named on the command line, so that too few poses for it is an error, not a note.
   int folds = 4;

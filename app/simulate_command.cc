@@ -32,6 +32,7 @@ struct SimulateArgs {
   std::string trajectory;  // default: the robot's shipped trajectory (TrajectoryForRobot)
   std::string out = "out/simulate";
   double noise_px = 0.2;
+  double joint_noise_deg = 0;
   uint64_t seed = 1;
   bool perturb_gauge = false;
   std::string method = "bundle";
@@ -307,6 +308,10 @@ Command AddSimulateCommand(CLI::App& app) {
   CLI::Option* noise = cmd->add_option("--noise-px", args->noise_px,
                   "--points: pixel noise std (px); a dot the noise moves out of the image is not detected")
       ->check(CLI::Range(0.0, 10.0));
+  CLI::Option* joint_noise = cmd->add_option("--joint-noise-deg", args->joint_noise_deg,
+                  "--points: joint reading noise std (deg): the recorded joint angles are the true ones plus this "
+                  "noise, the images are taken at the true ones")
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--seed", args->seed, "World and noise seed");
   cmd->add_flag("--perturb-gauge", args->perturb_gauge, "Also perturb the parameters the measurements cannot see");
   cmd->add_flag("--flat-sheet", args->flat_sheet,
@@ -324,10 +329,11 @@ Command AddSimulateCommand(CLI::App& app) {
                   "auto (when $DISPLAY can be opened), on (refused without a display), off")
       ->check(CLI::IsMember({"auto", "on", "off"}));
   AddMethodOption(cmd, &args->method);
-  return [args, noise]() {
+  return [args, noise, joint_noise]() {
     if (!args->points) {
-      if (args->flat_sheet || args->perturb_gauge) {
-        return Fail(Status::Error(ErrorCode::kInvalidInput, "--flat-sheet and --perturb-gauge need --points"));
+      if (args->flat_sheet || args->perturb_gauge || joint_noise->count() > 0) {
+        return Fail(Status::Error(ErrorCode::kInvalidInput,
+                                  "--flat-sheet, --perturb-gauge and --joint-noise-deg need --points"));
       }
       if (noise->count() > 0) {  // image mode renders its noise in grey levels
         return Fail(Status::Error(ErrorCode::kInvalidInput, "--noise-px needs --points (image mode: --grey-noise)"));
@@ -347,6 +353,7 @@ Command AddSimulateCommand(CLI::App& app) {
     sim::SimOptions options;
     options.world_seed = options.noise_seed = args->seed;
     options.pixel_noise_px = args->noise_px;
+    options.joint_noise_rad = DegToRad(args->joint_noise_deg);
     options.perturb_gauge_parameters = args->perturb_gauge;
     options.flat_sheet = args->flat_sheet;
     const sim::SimResult world = sim::Simulate(*robot, *joints, options);

@@ -340,18 +340,29 @@ void EstimateCovariance(const BundleData& data, const BundleState& state, const 
   const int num_unknowns = columns.size() + 3 * static_cast<int>(data.dot_ids.size());
   const int dof = 2 * report->num_observations + static_cast<int>(data.yardsticks.size()) - num_unknowns;
   Eigen::MatrixXd reduced, covariance;
+  internal::PoseErrorColumns pose_errors;
   if (dof > 0) {
     report->pixel_noise_estimate_px = data.sigma_px * std::sqrt(2.0 * final_cost / dof);
     report->residual_dof = dof;
   }
   if (dof <= 0) {
     report->covariance_message = "uncertainty unavailable (no redundancy)";
-  } else if (!internal::ReducedJacobian(data, state, columns, &reduced)) {
+  } else if (!internal::ReducedJacobian(data, state, columns, &reduced,
+                                        options.estimate_pose_error ? &pose_errors : nullptr)) {
     report->covariance_message = "uncertainty unavailable (a dot ended behind a camera)";
-  } else if (internal::CovarianceFromJacobian(reduced, internal::GlobalNames(columns, data.robot.num_joints()),
-                                              &covariance, &report->covariance_message)) {
+  } else if (internal::CovarianceFromJacobian(reduced.leftCols(columns.size()),
+                                              internal::GlobalNames(columns, data.robot.num_joints()), &covariance,
+                                              &report->covariance_message)) {
     const double s2 = 2.0 * final_cost / dof;
     report->covariance_free = s2 * covariance;
+    if (options.estimate_pose_error) {
+      report->error_model = internal::EstimateErrorModel(reduced, columns.size(), pose_errors.gradient,
+                                                         pose_errors.residual_sq, dof, data.sigma_px);
+      if (report->error_model.estimated) {
+        report->covariance_free = internal::ModelCovariance(reduced, columns.size(), covariance, report->error_model,
+                                                            data.sigma_px, &report->covariance_pose_part);
+      }
+    }
     report->covariance_available = true;
     const Eigen::VectorXd sd = report->covariance_free.diagonal().array().sqrt();
     report->correlation_free = report->covariance_free;

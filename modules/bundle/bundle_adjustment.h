@@ -53,6 +53,7 @@
 
 #include <Eigen/Core>
 
+#include "bundle/error_model.h"
 #include "camera/camera.h"
 #include "kinematics/joint_motion.h"
 #include "kinematics/robot_model.h"
@@ -102,6 +103,9 @@ struct BundleOptions {
   // better estimate. The camera, base and intrinsics are never held this way. 0 turns a kind off.
   double weak_length_tolerance_m = 5e-3;
   double weak_angle_tolerance_rad = 8.726646259971648e-3;  // 0.5 deg
+  // Estimate the cell's pose error beside the pixel noise (error_model.h) and state the covariance under
+  // that model; false: pixel noise only (the covariance of the stated model, as before).
+  bool estimate_pose_error = true;
   // Empty when valid; otherwise every problem, one per line.
   std::string Validate() const;
 };
@@ -151,8 +155,11 @@ struct BundleReport {
   std::vector<BarelyMovingJoint> barely_moving;  // over the identification poses (kinematics/joint_motion.h)
   int generic_rank = 0;                       // free kinematic count for generic poses of this robot
   double condition_number = 0;                // column-normalised reduced Jacobian of the free set
-  // Marginal standard deviations, dots as nuisance: s^2 (J_g^T (I - P_dots) J_g)^-1 over the free
-  // columns, s^2 = 2 final_cost / (residuals - unknowns). NaN for fixed entries or when unavailable (K8).
+  // The estimated error model of the cell (BundleOptions::estimate_pose_error; error_model.h).
+  ErrorModel error_model;
+  // Marginal standard deviations, dots as nuisance, under error_model when it was estimated (error_model.h's
+  // sandwich), else s^2 (J_g^T (I - P_dots) J_g)^-1 over the free columns, s^2 = 2 final_cost /
+  // (residuals - unknowns). NaN for fixed entries or when unavailable (K8).
   Eigen::VectorXd stddev;                     // rho size
   double fx_stddev = 0;                       // = intrinsics_stddev[kFx]
   IntrinsicsVector intrinsics_stddev{};       // NaN when not estimated or unavailable
@@ -160,6 +167,9 @@ struct BundleReport {
   std::string covariance_message;
   // Order: free_indices, then the estimated intrinsics in Intrinsic order (EstimatedIntrinsics).
   Eigen::MatrixXd covariance_free, correlation_free;
+  // The part of covariance_free that the images' pose errors give (error_model.h); the rest scales with the
+  // pixel variance. Empty when no pose error was estimated.
+  Eigen::MatrixXd covariance_pose_part;
   std::vector<RemovedObservation> removed;    // by the screen
   std::vector<int> dropped_dots;              // seen fewer than twice, or not triangulable at the start
   int num_observations = 0;                   // used in the final fit

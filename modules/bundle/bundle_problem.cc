@@ -250,12 +250,41 @@ class RowFolder {
 
 }  // namespace
 
+namespace {
+
+// The rows of one observation in the columns of its pose's camera motion (v, omega): d r / d p_cam =
+// d_dot R^T (d_dot is d r / d p_base, p_cam = R p_base + t), d p_cam / d v = I, d p_cam / d omega =
+// -[p_cam]x.
+void AddPoseErrorColumns(const PoseCache& cache, const Eigen::Vector3d& dot, const double* d_dot,
+                         const double* residual, int num_global, int pose, int row, Eigen::MatrixXd* b,
+                         PoseErrorColumns* pose_errors) {
+  const Eigen::Matrix<double, 2, 3, Eigen::RowMajor> d_base(d_dot);
+  const Eigen::Matrix<double, 2, 3> d_cam = d_base * cache.rotation.transpose();
+  const Eigen::Vector3d p = cache.rotation * dot + cache.translation;
+  Eigen::Matrix3d cross;
+  cross << 0, -p.z(), p.y(), p.z(), 0, -p.x(), -p.y(), p.x(), 0;
+  Eigen::Matrix<double, 2, 6> j;
+  j.leftCols<3>() = d_cam;
+  j.rightCols<3>() = -d_cam * cross;
+  b->block<2, 6>(row, num_global + 6 * pose) = j;
+  const Eigen::Vector2d r(residual[0], residual[1]);
+  pose_errors->gradient.segment<6>(6 * pose) += j.transpose() * r;
+  pose_errors->residual_sq += r.squaredNorm();
+}
+
+}  // namespace
+
 bool ReducedJacobian(const BundleData& data, const BundleState& state, const GlobalColumns& columns,
-                     Eigen::MatrixXd* reduced) {
+                     Eigen::MatrixXd* reduced, PoseErrorColumns* pose_errors) {
   const int num_poses = static_cast<int>(data.joints.size());
   const int num_dots = static_cast<int>(data.dot_ids.size());
   const int num_kinematic = static_cast<int>(columns.kinematic.size());
   const int num_global = columns.size();
+  const int width = num_global + (pose_errors != nullptr ? 6 * num_poses : 0);
+  if (pose_errors != nullptr) {
+    pose_errors->gradient = Eigen::VectorXd::Zero(6 * num_poses);
+    pose_errors->residual_sq = 0;
+  }
   std::vector<PoseCache> caches(num_poses);
   for (int p = 0; p < num_poses; ++p) {
     ComputePoseCache(data, p, state.rho.data(), columns.kinematic, true, &caches[p]);
@@ -286,12 +315,12 @@ bool ReducedJacobian(const BundleData& data, const BundleState& state, const Glo
 
   // The groups' rows are folded into one triangular factor as they come (RowFolder): the stacked matrix of
   // every group's rows, 3 x dots + yardsticks by the globals, was tens of megabytes at 2000 dots.
-  RowFolder folder(num_global);
+  RowFolder folder(width);
   std::vector<double> d_columns(2 * std::max(num_kinematic, 1));
   for (int g = 0; g < num_groups; ++g) {
     const int rows = 2 * static_cast<int>(group_observations[g].size()) + static_cast<int>(group_yardsticks[g].size());
     Eigen::MatrixXd a = Eigen::MatrixXd::Zero(rows, 3 * group_size[g]);
-    Eigen::MatrixXd b = Eigen::MatrixXd::Zero(rows, num_global);
+    Eigen::MatrixXd b = Eigen::MatrixXd::Zero(rows, width);
     int row = 0;
     for (int k : group_observations[g]) {
       const Observation& o = data.observations[k];
@@ -305,6 +334,9 @@ bool ReducedJacobian(const BundleData& data, const BundleState& state, const Glo
         int col = num_kinematic;
         for (int i : columns.intrinsics) b(row + r, col++) = d_intrinsics[r * kNumIntrinsics + i];
         for (int c = 0; c < 3; ++c) a(row + r, 3 * slot_of[o.dot] + c) = d_dot[3 * r + c];
+      }
+      if (pose_errors != nullptr) {
+        AddPoseErrorColumns(caches[o.pose], state.dots[o.dot], d_dot, residual, num_global, o.pose, row, &b, pose_errors);
       }
       row += 2;
     }

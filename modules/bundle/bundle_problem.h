@@ -83,8 +83,17 @@ bool EvaluateReprojection(const IntrinsicsVector& intrinsics, double sigma_px, c
 // the Schur complement of the dots in the whitened normal matrix (J_g: global columns, P_dots: projection
 // onto the dots' columns). Dots are eliminated group by group (dots joined by a yardstick form one
 // group). Returns false when an observation cannot be evaluated at `state`.
+//
+// With `pose_errors` the matrix has 6 more columns per pose after the globals: the derivative of the
+// whitened residuals with respect to a small motion (v, omega) of that pose's camera in its own frame
+// (p_cam -> p_cam + omega x p_cam + v; m and rad), reduced the same way (error_model.h); pose_errors
+// receives those columns' gradient J^T r and the whitened residuals' sum of squares at `state`.
+struct PoseErrorColumns {
+  Eigen::VectorXd gradient;  // 6 per pose: (v, omega)
+  double residual_sq = 0;
+};
 bool ReducedJacobian(const BundleData& data, const BundleState& state, const GlobalColumns& columns,
-                     Eigen::MatrixXd* reduced);
+                     Eigen::MatrixXd* reduced, PoseErrorColumns* pose_errors = nullptr);
 
 // Names of the global columns: rho names, then the intrinsics' ("fx", "cx", ...).
 std::vector<std::string> GlobalNames(const GlobalColumns& columns, int num_joints);

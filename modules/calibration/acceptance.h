@@ -2,7 +2,8 @@
 // explains images it was not fitted to and predicts them better than the nominal model did.
 //
 //   heldout_test             the held-out reprojection test (heldout_reprojection.h) of the chosen model,
-//                            normalised with the stated pixel noise, at kHeldOutTestLevel
+//                            normalised with the stated pixel noise and, when the bundle estimated one,
+//                            each verification image's pose error (bundle/error_model.h), at kHeldOutTestLevel
 //   beats_nominal_heldout    its held-out reprojection RMS below the nominal model's
 //   beats_nominal_distances  the 3-D RMS error of the check distances below the nominal model's (only
 //                            when the set has check distances). It decides only for a model without a

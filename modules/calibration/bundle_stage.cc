@@ -58,7 +58,10 @@ void VerifyHeldOutReprojection(const ObservationSet& obs, BundleStageReport* rep
   int noise_dof = 0;
   report->heldout = HeldOutReprojectionOfBundle(obs, b, &noise, &noise_dof);
   if (!b.covariance_available) report->heldout.message = "prediction uncertainty of the parameters left out: " + b.covariance_message;
-  report->heldout_at_stated_noise = Renormalised(report->heldout.overall, noise, obs.pixel_noise_px);
+  double stated = 0;
+  int stated_dof = 0;
+  report->heldout_at_stated_noise =
+      HeldOutReprojectionOfBundle(obs, b, &stated, &stated_dof, obs.pixel_noise_px).overall;
   report->heldout_nominal = NominalHeldOutReprojection(obs, noise, noise_dof);
   report->heldout_nominal.noise_source = report->heldout.noise_source;
 }
@@ -83,22 +86,41 @@ bool CameraStartFromImages(const ObservationSet& obs, const BundleStageOptions& 
 }  // namespace
 
 HeldOutReprojection HeldOutReprojectionOfBundle(const ObservationSet& obs, const bundle::BundleReport& b,
-                                                double* noise_px, int* noise_dof) {
+                                                double* noise_px, int* noise_dof, double at_noise_px) {
   const bool estimated = std::isfinite(b.pixel_noise_estimate_px) && b.pixel_noise_estimate_px > 0;
-  *noise_px = estimated ? b.pixel_noise_estimate_px : obs.pixel_noise_px;
-  *noise_dof = estimated ? b.residual_dof : 0;
+  const bool model = b.error_model.estimated;
+  const double fitted_px = model ? b.error_model.pixel_px : estimated ? b.pixel_noise_estimate_px : obs.pixel_noise_px;
+  *noise_px = at_noise_px > 0 ? at_noise_px : fitted_px;
+  *noise_dof = at_noise_px > 0 || !estimated ? 0 : b.residual_dof;
   PredictionModel calibrated;
   calibrated.robot = obs.robot;
   calibrated.rho = b.rho;
   calibrated.camera = WithIntrinsics(obs.camera, b.intrinsics);
   calibrated.free_indices = b.free_indices;
   calibrated.intrinsics_estimated = b.intrinsics_estimated;
-  if (b.covariance_available) calibrated.covariance = b.covariance_free;
+  if (b.covariance_available) {
+    calibrated.covariance = b.covariance_free;
+    if (*noise_px != fitted_px) {  // the pixel part scales with the pixel variance, the pose part does not
+      const bool split = b.covariance_pose_part.rows() == b.covariance_free.rows();
+      const Eigen::MatrixXd pose_part = split ? b.covariance_pose_part : Eigen::MatrixXd::Zero(0, 0);
+      const double ratio = (*noise_px / fitted_px) * (*noise_px / fitted_px);
+      calibrated.covariance = split ? Eigen::MatrixXd(ratio * (b.covariance_free - pose_part) + pose_part)
+                                    : Eigen::MatrixXd(ratio * b.covariance_free);
+    }
+  }
+  if (model) {
+    calibrated.pose_translation_m = b.error_model.pose_translation_m;
+    calibrated.pose_rotation_rad = b.error_model.pose_rotation_rad;
+  }
   ExcludedObservations excluded;
   for (const bundle::RemovedObservation& o : b.removed) excluded.insert({o.pose_id, o.dot_id});
   HeldOutReprojection heldout = HeldOutReprojectionOf(obs, calibrated, b.dots_in_base, excluded, *noise_px, *noise_dof);
-  heldout.noise_source = estimated ? "the bundle's estimate from its identification residuals"
-                                   : "the stated pixel noise (the bundle has no redundancy to estimate it)";
+  heldout.noise_source = at_noise_px > 0 ? "the stated pixel noise"
+                         : estimated    ? "the bundle's estimate from its identification residuals"
+                                        : "the stated pixel noise (the bundle has no redundancy to estimate it)";
+  if (model && (b.error_model.pose_translation_m > 0 || b.error_model.pose_rotation_rad > 0)) {
+    heldout.noise_source += ", with each image's pose error as estimated";
+  }
   return heldout;
 }
 

@@ -83,9 +83,12 @@ struct BundleStageReport {
 // the bundle's intrinsics (observations.camera's otherwise) and covariance, the dots as the bundle placed
 // them, the observations its screen removed left out, normalised with the bundle's pixel noise estimate
 // where it has one, else the stated noise (*noise_px, *noise_dof: the normalisation's, noise_dof 0 for the
-// stated noise; noise_source says which). Shared by the stage and the cross-validation's folds.
+// stated noise; noise_source says which). With the bundle's estimated error model, each verification
+// image's pose error is in the test too. at_noise_px > 0: normalised with that pixel noise instead, taken as
+// known, the pixel part of the covariance scaled to it (the pose part as estimated). Shared by the stage and
+// the cross-validation's folds.
 HeldOutReprojection HeldOutReprojectionOfBundle(const ObservationSet& observations, const bundle::BundleReport& b,
-                                                double* noise_px, int* noise_dof);
+                                                double* noise_px, int* noise_dof, double at_noise_px = 0);
 
 // Runs the bundle adjustment on `observations` started as described above from `paper` (the report of
 // RunPaperPipeline on the same observations; any outcome). kInvalidInput from the bundle's own checks when

@@ -52,12 +52,12 @@ CrossValidationFold RunFold(const ObservationSet& obs, const BundleStageReport& 
   }
   double noise = 0;
   int noise_dof = 0;
-  const HeldOutReprojection h = HeldOutReprojectionOfBundle(train, b, &noise, &noise_dof);
+  const HeldOutReprojection h = HeldOutReprojectionOfBundle(train, b, &noise, &noise_dof, obs.pixel_noise_px);
   if (!h.ok) {
     fold.message = h.message;
     return fold;
   }
-  fold.figure = Renormalised(h.overall, noise, obs.pixel_noise_px);
+  fold.figure = h.overall;
   return fold;
 }
 

@@ -225,10 +225,65 @@ HeldOutFigure FigureOf(const std::string& pose_id, int begin, int end, const Res
   return f;
 }
 
+// The rows of one dot's prediction error in the 6 columns of its image's camera motion (v, omega in the
+// camera frame), scaled by the pose error's standard deviations: d uv / d p_cam = jd R^T (jd = d uv / d
+// p_base, p_cam = R p_base + t), d p_cam / d v = I, d p_cam / d omega = -[p_cam]x.
+Eigen::Matrix<double, 2, 6> PoseErrorRows(const Rigid3& cam_from_base, const Eigen::Vector3d& p_base,
+                                          const Matrix23& jd, double translation_sd, double rotation_sd) {
+  const Matrix23 d_cam = jd * cam_from_base.rotation.transpose();
+  const Eigen::Vector3d p = cam_from_base * p_base;
+  Eigen::Matrix3d cross;
+  cross << 0, -p.z(), p.y(), p.z(), 0, -p.x(), -p.y(), p.x(), 0;
+  Eigen::Matrix<double, 2, 6> rows;
+  rows.leftCols<3>() = translation_sd * d_cam;
+  rows.rightCols<3>() = -rotation_sd * d_cam * cross;
+  return rows;
+}
+
 // The square root of the parameters' covariance (Sigma = L L^T; semi-definite allowed).
 Eigen::MatrixXd CovarianceRoot(const Eigen::MatrixXd& covariance) {
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(0.5 * (covariance + covariance.transpose()));
   return eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+}
+
+// Leaves the gross detection errors out of `residuals` (HeldOutReprojection::gross_errors): each residual's
+// own covariance sigma^2 I + G G^T + D D^T against kGrossErrorChiSquare, applied only when at most
+// kMaxGrossErrorShare of them exceed it. `observed` (the report's residuals) and the poses' first rows follow.
+void ScreenGrossErrors(double sigma, Residuals* residuals, std::vector<int>* first_row_of_pose,
+                       std::vector<ObservedResidual>* observed, std::vector<ObservedResidual>* gross) {
+  const int width = residuals->num_theta;
+  const int n = static_cast<int>(residuals->rows.size());
+  std::vector<bool> out(n, false);
+  int count = 0;
+  for (int k = 0; k < n; ++k) {
+    const Residual& e = residuals->rows[k];
+    const Eigen::Map<const RowMajor> g(residuals->g.data() + static_cast<size_t>(2 * width) * k, 2, width);
+    Eigen::Matrix2d c = sigma * sigma * Eigen::Matrix2d::Identity() + e.d * e.d.transpose();
+    if (width > 0) c += g * g.transpose();
+    out[k] = e.r.dot(c.ldlt().solve(e.r)) > kGrossErrorChiSquare;
+    count += out[k];
+  }
+  if (count == 0 || count > kMaxGrossErrorShare * n) return;
+  Residuals kept;
+  kept.num_theta = width;
+  std::vector<ObservedResidual> kept_observed;
+  std::vector<int> first(first_row_of_pose->size(), 0);
+  size_t pose = 0;
+  for (int k = 0; k < n; ++k) {
+    while (pose < first_row_of_pose->size() && (*first_row_of_pose)[pose] <= k) first[pose++] = static_cast<int>(kept.rows.size());
+    if (out[k]) {
+      gross->push_back((*observed)[k]);
+      continue;
+    }
+    kept.rows.push_back(residuals->rows[k]);
+    kept.g.insert(kept.g.end(), residuals->g.begin() + static_cast<std::ptrdiff_t>(2 * width) * k,
+                  residuals->g.begin() + static_cast<std::ptrdiff_t>(2 * width) * (k + 1));
+    kept_observed.push_back((*observed)[k]);
+  }
+  while (pose < first_row_of_pose->size()) first[pose++] = static_cast<int>(kept.rows.size());
+  *residuals = std::move(kept);
+  *observed = std::move(kept_observed);
+  *first_row_of_pose = std::move(first);
 }
 
 }  // namespace
@@ -251,12 +306,16 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
   for (auto& [id, d] : info) {
     if (d.usable) d.column = num_dots++;
   }
+  // With a pose error, 6 more columns of U per verification image, zero outside its rows.
+  const std::vector<int> verification = obs.PosesWithRole(PoseRole::kVerification);
+  const bool pose_error = model.pose_translation_m > 0 || model.pose_rotation_rad > 0;
+  const int width = nt + (pose_error ? 6 * static_cast<int>(verification.size()) : 0);
   Residuals residuals;
-  residuals.num_theta = nt;
+  residuals.num_theta = width;
   std::vector<int> first_row_of_pose;  // per report.poses entry, and one past the end
-  Eigen::Matrix<double, 2, Eigen::Dynamic> g(2, nt);
-  for (int v : obs.PosesWithRole(PoseRole::kVerification)) {
-    const PoseObservation& pose = obs.poses[v];
+  Eigen::Matrix<double, 2, Eigen::Dynamic> g(2, width);
+  for (size_t slot = 0; slot < verification.size(); ++slot) {
+    const PoseObservation& pose = obs.poses[verification[slot]];
     const PoseFrames frames = projector.Frames(pose);
     const int first = static_cast<int>(residuals.rows.size());
     for (const auto& [id, pixel] : pose.dots_px) {
@@ -271,10 +330,15 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
       Residual e;
       e.slot = static_cast<int>(report.poses.size());
       e.r = pixel - uv;
-      if (nt > 0) {
-        g.noalias() = (jt - jd * d->second.k) * theta_root;
+      if (width > 0) {
+        g.setZero();
+        if (nt > 0) g.leftCols(nt).noalias() = (jt - jd * d->second.k) * theta_root;
+        if (pose_error) {
+          g.middleCols<6>(nt + 6 * static_cast<int>(slot)) =
+              PoseErrorRows(frames.cam_from_base, dots_in_base.at(id), jd, model.pose_translation_m, model.pose_rotation_rad);
+        }
         for (int i = 0; i < 2; ++i) {
-          for (int c = 0; c < nt; ++c) residuals.g.push_back(g(i, c));
+          for (int c = 0; c < width; ++c) residuals.g.push_back(g(i, c));
         }
       }
       e.d = jd * d->second.sqrt_inverse * noise_px;
@@ -294,6 +358,7 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
     return report;
   }
   first_row_of_pose.push_back(static_cast<int>(residuals.rows.size()));
+  ScreenGrossErrors(noise_px, &residuals, &first_row_of_pose, &report.residuals, &report.gross_errors);
   for (size_t s = 0; s < report.poses.size(); ++s) {
     report.poses[s] = FigureOf(report.poses[s].pose_id, first_row_of_pose[s], first_row_of_pose[s + 1], residuals,
                                num_dots, noise_px, noise_dof);

@@ -9,6 +9,9 @@
 //
 //   C = sigma^2 I  +  J_d H_dd^-1 J_d^T  +  G Sigma G^T,      G = J_theta - J_d H_dd^-1 H_dtheta
 //
+// (plus, with an estimated error model, each verification image's pose error J_e Theta J_e^T, J_e the
+// derivative of its pixels with respect to a small motion of its camera; PredictionModel)
+//
 // sigma^2 I: the detection noise of the verification image; J_d H_dd^-1 J_d^T: the dot's position error
 // given the parameters (H_dd = sum over its identification views of J^T J / sigma^2, the same dot seen in
 // several verification images correlates them); G Sigma G^T: the parameters' error (Sigma: the bundle's
@@ -61,6 +64,9 @@ struct PredictionModel {
   std::vector<int> free_indices;
   IntrinsicsMask intrinsics_estimated{};
   Eigen::MatrixXd covariance;
+  // Each verification image's own camera pose error (bundle/error_model.h), per axis in the camera frame:
+  // C gains J_e diag(s_t^2 I, s_r^2 I) J_e^T over the dots of that image. 0: none.
+  double pose_translation_m = 0, pose_rotation_rad = 0;
 };
 
 // One detection beside the model's prediction of it (for plots of the residuals over the image).
@@ -98,7 +104,14 @@ struct HeldOutReprojection {
   std::vector<std::string> unused_poses;
   HeldOutFigure overall;
   std::vector<ObservedResidual> residuals;  // every predicted detection, pose by pose (those in `overall`)
+  // Gross detection errors left out of the figures: a detection whose residual lies beyond
+  // kGrossErrorChiSquare of its own predicted 2 x 2 covariance (4.4 sigma), when such are at most
+  // kMaxGrossErrorShare of the predicted detections (a wrong model moves many, a misdetected corner one).
+  std::vector<ObservedResidual> gross_errors;
 };
+
+inline constexpr double kGrossErrorChiSquare = 19.3;  // P = 6.5e-5 for 2 degrees of freedom
+inline constexpr double kMaxGrossErrorShare = 0.05;
 
 // The identification observations (pose id, dot id) that a solve left out, e.g. by its screen.
 using ExcludedObservations = std::set<std::pair<std::string, int>>;

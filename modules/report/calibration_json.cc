@@ -99,6 +99,18 @@ json WeakJson(const bundle::BundleReport& b) {
   return {{"held", held}, {"barely_moving_joints", joints}};
 }
 
+json ErrorModelJson(const bundle::ErrorModel& m) {
+  return {{"estimated", m.estimated},
+          {"message", m.message},
+          {"pixel_noise_px", Finite(m.pixel_px)},
+          {"pose_translation_m", Finite(m.pose_translation_m)},
+          {"pose_rotation_rad", Finite(m.pose_rotation_rad)},
+          {"redundancy", {{"pixel", Finite(m.pixel_redundancy)},
+                          {"translation", Finite(m.translation_redundancy)},
+                          {"rotation", Finite(m.rotation_redundancy)}}},
+          {"iterations", m.iterations}};
+}
+
 json PredictedErrorJson(const calibration::PredictedDistanceErrors& p) {
   json distances = json::array();
   for (const calibration::PredictedDistanceError& e : p.distances) {
@@ -142,6 +154,7 @@ json HeldOutModelJson(const calibration::HeldOutReprojection& h) {
           {"message", h.message},
           {"prediction_uncertainty", h.prediction_uncertainty},
           {"num_not_predicted", h.num_not_predicted},
+          {"gross_errors", ResidualsJson(h.gross_errors)},
           {"overall", h.ok ? HeldOutFigureJson(h.overall) : json()},
           {"poses", poses}};
 }
@@ -300,6 +313,7 @@ json BundleSectionJson(const ObservationSet& obs, const calibration::BundleStage
           {"condition_number", Finite(b.condition_number)},
           {"covariance_available", b.covariance_available},
           {"covariance_message", b.covariance_message},
+          {"error_model", ErrorModelJson(b.error_model)},
           {"parameters", ParametersJson(obs, b.rho, b.stddev, b.free_indices, "value", true)},
           {"verification", VerificationJson(obs, stage.verification_nominal, stage.verification)},
           {"predicted_3d_error", PredictedErrorJson(stage.predicted_error)},

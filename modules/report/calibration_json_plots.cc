@@ -12,16 +12,6 @@ using nlohmann::json;
 
 json Vector(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
-json ResidualsJson(const std::vector<calibration::ObservedResidual>& residuals) {
-  json rows = json::array();
-  for (const calibration::ObservedResidual& r : residuals) {
-    rows.push_back({{"pose", r.pose_id},
-                    {"dot", r.dot_id},
-                    {"pixel_px", {r.pixel_px.x(), r.pixel_px.y()}},
-                    {"residual_px", {r.residual_px.x(), r.residual_px.y()}}});
-  }
-  return rows;
-}
 
 // The correlations of the estimated entries, named (order: free parameters, then the estimated intrinsics).
 json CorrelationJson(const ObservationSet& obs, const bundle::BundleReport& b) {
@@ -41,6 +31,17 @@ json CorrelationJson(const ObservationSet& obs, const bundle::BundleReport& b) {
 }
 
 }  // namespace
+
+json ResidualsJson(const std::vector<calibration::ObservedResidual>& residuals) {
+  json rows = json::array();
+  for (const calibration::ObservedResidual& r : residuals) {
+    rows.push_back({{"pose", r.pose_id},
+                    {"dot", r.dot_id},
+                    {"pixel_px", {r.pixel_px.x(), r.pixel_px.y()}},
+                    {"residual_px", {r.residual_px.x(), r.residual_px.y()}}});
+  }
+  return rows;
+}
 
 json BundlePlotDataJson(const ObservationSet& obs, const calibration::BundleStageReport& stage) {
   const calibration::FitGeometry& g = stage.fit_geometry;

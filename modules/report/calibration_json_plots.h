@@ -11,6 +11,9 @@
 namespace selfcal::report {
 
 // null when the bundle gave no model (its fit geometry is empty).
+// Residual rows {pose, dot, pixel_px, residual_px}.
+nlohmann::json ResidualsJson(const std::vector<calibration::ObservedResidual>& residuals);
+
 nlohmann::json BundlePlotDataJson(const ObservationSet& observations, const calibration::BundleStageReport& stage);
 
 }  // namespace selfcal::report

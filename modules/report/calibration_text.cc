@@ -122,6 +122,11 @@ void PrintBundleSummary(const calibration::BundleStageReport& stage, bool flange
       << b.rms_reprojection_px << " px; f_x = " << std::fixed << std::setprecision(3) << b.fx_px << " +- "
       << b.fx_stddev << " px\n";
   out.unsetf(std::ios::floatfield);
+  if (b.error_model.estimated) {
+    out << "  error model from the residuals: pixel noise " << std::setprecision(3) << b.error_model.pixel_px
+        << " px, each image's camera pose " << b.error_model.pose_translation_m * kMm << " mm / "
+        << RadToDeg(b.error_model.pose_rotation_rad) << " deg per axis (the sigmas are under this model)\n";
+  }
   PrintLensSummary(b, out);
   if (stage.verification.num_ok > 0) {
     out << "  3-D error on " << stage.verification.num_ok << " held-out distances: nominal model " << std::fixed

@@ -20,6 +20,7 @@ std::string SimOptions::Validate() const {
   non_negative(cam_angle_error_std_rad, "cam_angle_error_std_rad");
   non_negative(fx_relative_error_std, "fx_relative_error_std");
   non_negative(pixel_noise_px, "pixel_noise_px");
+  non_negative(joint_noise_rad, "joint_noise_rad");
   if (!(fx_nominal_px > 0)) out << "fx_nominal_px = " << fx_nominal_px << " must be > 0\n";
   if (sheet_grid.rows > 0 || sheet_grid.cols > 0) {
     if (!flat_sheet) out << "sheet_grid needs flat_sheet\n";
@@ -64,7 +65,7 @@ Eigen::Vector3d ConvergencePoint(const std::vector<Rigid3>& cams) {
 }
 
 ObservationSet Observe(const SimResult& world, const std::vector<Eigen::VectorXd>& joints, double noise_px,
-                       uint64_t noise_seed, int num_identification) {
+                       uint64_t noise_seed, int num_identification, double joint_noise_rad = 0) {
   ObservationSet set;
   set.robot = world.truth.nominal;
   set.camera = world.truth.camera_true;
@@ -74,11 +75,15 @@ ObservationSet Observe(const SimResult& world, const std::vector<Eigen::VectorXd
   set.check_distances = world.observations.check_distances;
   std::mt19937_64 rng(noise_seed);
   std::normal_distribution<double> noise(0.0, 1.0);
+  std::mt19937_64 joint_rng(noise_seed ^ 0x6a6f696e74ULL);
   for (size_t i = 0; i < joints.size(); ++i) {
     PoseObservation pose;
     pose.id = (i < 10 ? "p0" : "p") + std::to_string(i);
     pose.role = static_cast<int>(i) < num_identification ? PoseRole::kIdentification : PoseRole::kVerification;
     pose.joints_rad = joints[i];
+    if (joint_noise_rad > 0) {
+      for (Eigen::Index j = 0; j < pose.joints_rad.size(); ++j) pose.joints_rad[j] += joint_noise_rad * noise(joint_rng);
+    }
     const Rigid3 cam_from_base = world.truth.base_from_cam[i].Inverse();
     for (size_t d = 0; d < world.truth.dots_in_base.size(); ++d) {
       const auto uv = Project(world.truth.camera_true, cam_from_base * world.truth.dots_in_base[d]);
@@ -337,7 +342,7 @@ SimResult Simulate(const RobotModel& nominal, const std::vector<Eigen::VectorXd>
       {0, far_end, grid ? (truth.dots_in_base[0] - truth.dots_in_base[far_end]).norm() : options.yardstick_length_m}};
   result.observations.check_distances = CheckPairs(truth.dots_in_base);
   result.observations = Observe(result, trajectory, options.pixel_noise_px, options.noise_seed,
-                                options.num_identification_poses);
+                                options.num_identification_poses, options.joint_noise_rad);
   result.ok = true;
   return result;
 }

@@ -64,6 +64,10 @@ struct SimOptions {
   double separation_dot_radius_m = 0;
   double min_rim_gap_diameters = 0.5;
   double pixel_noise_px = 0.2;      // Gaussian, std per coordinate (the paper's Table 1, read as a std)
+  // Gaussian, std per joint: the recorded joint readings are the true angles plus this noise (the images
+  // are taken at the true angles). Drawn from its own stream (noise_seed), so the pixel noise is the same at
+  // any level. 0: readings exact.
+  double joint_noise_rad = 0;
   int num_identification_poses = 15;  // the first ones; the rest are verification poses
   std::string Validate() const;
 };

@@ -146,8 +146,14 @@ TEST(KvasiosChain, ACalibrationOnOneSessionPredictsAnotherSessionsHeldOutTargets
   const nlohmann::json report = nlohmann::json::parse(in);
   const nlohmann::json& heldout = report.at("heldout_reprojection");
   const double rms = heldout.at("calibrated_model").at("overall").at("rms_px").get<double>();
-  EXPECT_EQ(heldout.at("calibrated_model").at("overall").at("num_residuals").get<int>(), 3 * 24) << output;
+  // s2's pose_04 has one corner 7.4 px off its prediction (a detection error, the other 23 within 0.9 px): the
+  // held-out test leaves it out and names it.
+  const nlohmann::json& gross = heldout.at("calibrated_model").at("gross_errors");
+  EXPECT_EQ(heldout.at("calibrated_model").at("overall").at("num_residuals").get<int>() + gross.size(), 3u * 24) << output;
+  EXPECT_LE(gross.size(), 1u) << gross.dump();
   EXPECT_LT(rms, 1.2) << output;
+  // With the cell's error model estimated (pose error beside the pixel noise) the held-out test passes.
+  EXPECT_EQ(report.at("verdict").get<std::string>(), "accepted") << output;
 }
 
 // s3 was recorded the next day after the board moved by about 7 mm and 2.1 deg. Pooled with s1 as one scene the

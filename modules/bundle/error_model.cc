@@ -1,0 +1,118 @@
+#include "bundle/error_model.h"
+
+#include <algorithm>
+
+#include <Eigen/Cholesky>
+
+namespace selfcal::bundle::internal {
+
+namespace {
+
+// Below these the pose error moves no dot by a thousandth of a pixel: the component is taken as absent.
+constexpr double kTranslationFloorM = 1e-6;
+constexpr double kRotationFloorRad = 1e-6;
+constexpr int kMaxIterations = 60;
+constexpr double kRelativeTolerance = 1e-3;  // on the standard deviations
+constexpr double kMinRedundancy = 1.0;
+
+// The inverse of a symmetric positive definite matrix, Jacobi-scaled (the prior's weights and the
+// pixels' differ by many orders of magnitude). False when it is not positive definite.
+bool InverseSpd(const Eigen::MatrixXd& s, Eigen::MatrixXd* inverse) {
+  const Eigen::VectorXd scale = s.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+  const Eigen::MatrixXd scaled = scale.asDiagonal() * s * scale.asDiagonal();
+  const Eigen::LLT<Eigen::MatrixXd> llt(scaled);
+  if (llt.info() != Eigen::Success) return false;
+  *inverse = scale.asDiagonal() * llt.solve(Eigen::MatrixXd::Identity(s.rows(), s.cols())) * scale.asDiagonal();
+  return inverse->allFinite();
+}
+
+}  // namespace
+
+ErrorModel EstimateErrorModel(const Eigen::MatrixXd& reduced, int num_global, const Eigen::VectorXd& gradient,
+                              double residual_sq, int dof, double sigma_px) {
+  ErrorModel model;
+  const int width = static_cast<int>(reduced.cols());
+  const int num_poses = (width - num_global) / 6;
+  if (num_poses < 2 || dof <= 0 || gradient.size() != 6 * num_poses || !(residual_sq > 0)) {
+    model.message = "no redundancy to estimate a pose error from";
+    return model;
+  }
+  const Eigen::MatrixXd normal = reduced.transpose() * reduced;
+  // Variances: pixels in units of sigma_px^2, translations m^2, rotations rad^2 (starts: the residuals'
+  // own pixel variance, 0.1 mm and 0.01 deg).
+  double var_px = residual_sq / dof, var_t = 1e-8, var_r = 3e-8;
+  const double floor_t = kTranslationFloorM * kTranslationFloorM, floor_r = kRotationFloorRad * kRotationFloorRad;
+  Eigen::MatrixXd s, inverse;
+  for (model.iterations = 1; model.iterations <= kMaxIterations; ++model.iterations) {
+    const double w = 1.0 / var_px;
+    s = w * normal;
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(width);
+    rhs.tail(6 * num_poses) = w * gradient;
+    for (int i = 0; i < num_poses; ++i) {
+      for (int k = 0; k < 6; ++k) s(num_global + 6 * i + k, num_global + 6 * i + k) += 1.0 / (k < 3 ? var_t : var_r);
+    }
+    if (!InverseSpd(s, &inverse)) {
+      model.message = "the pose-error normal matrix is not positive definite";
+      return model;
+    }
+    const Eigen::VectorXd step = inverse * rhs;
+    double sum_t = 0, sum_r = 0, trace_t = 0, trace_r = 0;
+    for (int i = 0; i < num_poses; ++i) {
+      for (int k = 0; k < 6; ++k) {
+        const int c = num_global + 6 * i + k;
+        (k < 3 ? sum_t : sum_r) += step[c] * step[c];
+        (k < 3 ? trace_t : trace_r) += inverse(c, c);
+      }
+    }
+    const double energy_px = w * residual_sq - step.dot(rhs) - sum_t / var_t - sum_r / var_r;
+    const double red_t = 3.0 * num_poses - trace_t / var_t, red_r = 3.0 * num_poses - trace_r / var_r;
+    const double red_px = dof - red_t - red_r;
+    model.pixel_redundancy = red_px;
+    model.translation_redundancy = red_t;
+    model.rotation_redundancy = red_r;
+    if (!(red_px > 0) || !(energy_px > 0)) {
+      model.message = "the pixel residuals have no redundancy left beside the pose errors";
+      return model;
+    }
+    const double new_px = var_px * energy_px / red_px;
+    const double new_t = red_t > 1e-9 ? std::max(sum_t / red_t, floor_t) : floor_t;
+    const double new_r = red_r > 1e-9 ? std::max(sum_r / red_r, floor_r) : floor_r;
+    const auto settled = [](double a, double b, double floor) {
+      return (a <= floor && b <= floor) || std::abs(std::sqrt(a) - std::sqrt(b)) <= kRelativeTolerance * std::sqrt(b);
+    };
+    const bool done = settled(new_px, var_px, 0) && settled(new_t, var_t, floor_t) && settled(new_r, var_r, floor_r);
+    var_px = new_px;
+    var_t = new_t;
+    var_r = new_r;
+    if (done) break;
+  }
+  model.iterations = std::min(model.iterations, kMaxIterations);
+  model.estimated = true;
+  model.pixel_px = sigma_px * std::sqrt(var_px);
+  // A component resting on less than one degree of freedom is not seen in the data (without pose error the
+  // iteration drifts towards zero with redundancies of a few hundredths): absent.
+  model.pose_translation_m = var_t > floor_t && model.translation_redundancy >= kMinRedundancy ? std::sqrt(var_t) : 0.0;
+  model.pose_rotation_rad = var_r > floor_r && model.rotation_redundancy >= kMinRedundancy ? std::sqrt(var_r) : 0.0;
+  return model;
+}
+
+Eigen::MatrixXd ModelCovariance(const Eigen::MatrixXd& reduced, int num_global, const Eigen::MatrixXd& inverse,
+                                const ErrorModel& model, double sigma_px, Eigen::MatrixXd* pose_part) {
+  const double ratio = model.pixel_px / sigma_px;
+  Eigen::MatrixXd covariance = ratio * ratio * inverse;
+  const int num_pose_columns = static_cast<int>(reduced.cols()) - num_global;
+  *pose_part = Eigen::MatrixXd::Zero(inverse.rows(), inverse.cols());
+  if (num_pose_columns <= 0) return covariance;
+  Eigen::VectorXd theta(num_pose_columns);
+  for (int c = 0; c < num_pose_columns; ++c) {
+    const double sd = c % 6 < 3 ? model.pose_translation_m : model.pose_rotation_rad;
+    theta[c] = sd * sd;
+  }
+  const Eigen::MatrixXd cross =
+      inverse * (reduced.leftCols(num_global).transpose() * reduced.rightCols(num_pose_columns));
+  *pose_part = cross * theta.asDiagonal() * cross.transpose();
+  covariance += *pose_part;
+  return covariance;
+}
+
+}  // namespace selfcal::bundle::internal

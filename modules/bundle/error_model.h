@@ -1,0 +1,62 @@
+// The error model of a real cell, estimated from the bundle's own residuals (issue 35, item 1).
+//
+// Beside the detection noise (sigma_px per coordinate, independent), every image carries a pose error:
+// its camera is where the model puts it only up to a small motion e_i = (v_i, omega_i) in the camera's own
+// frame (the joint readings' noise and what the kinematic model does not hold, for a joint set; the
+// controller's pose error, for a flange set), the same for all the image's dots:
+//
+//   pixel_ij = project(Exp(e_i) * cam_i_from_base(rho) * p_j) + n_ij,   n_ij ~ N(0, sigma_px^2 I),
+//   v_i ~ N(0, s_t^2 I),   omega_i ~ N(0, s_r^2 I).
+//
+// The three variances are variance components, estimated by Foerstner's iteration (Koch, "Parameter
+// estimation and hypothesis testing in linear models", 3.6): with the e_i as unknowns under the prior
+// above, each component's new variance is its residuals' sum of squares over its redundancy number,
+// r_k = n_k - tr(N^-1 N_k), until they settle; a pose component whose redundancy stays below one is taken as
+// absent (zero). The dots are eliminated (bundle_problem.h's reduced
+// Jacobian with the pose columns), so the iteration works on a matrix of (globals + 6 x poses) squared.
+// Linearised at the bundle's solution: the pixel-only least-squares estimate, which stays the estimate
+// (in simulation without pose error the components vanish and nothing changes).
+//
+// Its covariance under the model (the "sandwich"): with S = J_g^T (I - P_dots) J_g and
+// S_ge = J_g^T (I - P_dots) J_e (whitened by the stated noise),
+//
+//   Cov(g) = S^-1 (s_px^2 S + S_ge Theta S_eg) S^-1,   Theta = diag(s_t^2 I, s_r^2 I) per pose,
+//
+// s_px the estimated pixel noise over the stated one. A pose error moves every dot of an image
+// together, so n dots of one image are not n independent measurements: the pixel-only covariance was
+// 3-50 times too small on real recordings.
+#pragma once
+
+#include <cmath>
+#include <string>
+
+#include <Eigen/Core>
+
+namespace selfcal::bundle {
+
+struct ErrorModel {
+  bool estimated = false;
+  std::string message;                 // why not, when not estimated
+  double pixel_px = NAN;               // per coordinate
+  double pose_translation_m = NAN;     // per axis, camera frame, per image
+  double pose_rotation_rad = NAN;      // per axis (rotation vector)
+  // Redundancy numbers (the degrees of freedom each component's estimate rests on).
+  double pixel_redundancy = NAN, translation_redundancy = NAN, rotation_redundancy = NAN;
+  int iterations = 0;
+};
+
+namespace internal {
+
+// reduced: the reduced Jacobian with the pose columns (bundle_problem.h, whitened by sigma_px: the
+// stated noise), num_global columns of globals first; gradient, residual_sq: its PoseErrorColumns; dof:
+// residuals (pixel coordinates and yardsticks) minus unknowns (globals and dots).
+ErrorModel EstimateErrorModel(const Eigen::MatrixXd& reduced, int num_global, const Eigen::VectorXd& gradient,
+                              double residual_sq, int dof, double sigma_px);
+
+// The globals' covariance under `model` (above), given inverse = S^-1 of the globals' reduced matrix
+// (CovarianceFromJacobian of reduced's first num_global columns); *pose_part: its pose-error term.
+Eigen::MatrixXd ModelCovariance(const Eigen::MatrixXd& reduced, int num_global, const Eigen::MatrixXd& inverse,
+                                const ErrorModel& model, double sigma_px, Eigen::MatrixXd* pose_part);
+
+}  // namespace internal
+}  // namespace selfcal::bundle
