@@ -161,10 +161,7 @@ void ReportRotationCorrections(const io::ImagesAndPoses& inputs) {
   for (size_t i = 0; i < inputs.poses.size(); ++i) {
     const io::ImagePose& p = inputs.poses[i];
     if (p.rotation_correction_rad > 0) {
-      std::fprintf(stderr, "note: %s: pose %s: its rotation matrix was not orthonormal; taken as the nearest rotation "
-                           "(corrected by %.2g deg, within the tolerance of max |R^T R - I| <= %.0e)\n",
-                   p.source.c_str(), inputs.ids[i].c_str(), RadToDeg(p.rotation_correction_rad),
-                   io::kRecordedRotationTolerance);
+      std::cerr << "selfcal: note: " << io::RotationCorrectionNote(p.source, inputs.ids[i], p.rotation_correction_rad) << "\n";
     }
   }
 }

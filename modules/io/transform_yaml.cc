@@ -85,6 +85,14 @@ RotationFromMatrix MakeRotation(const Eigen::Matrix3d& r, double tolerance) {
   return out;
 }
 
+std::string RotationCorrectionNote(const std::string& source, const std::string& pose_id, double correction_rad) {
+  char detail[160];
+  std::snprintf(detail, sizeof(detail), "corrected by %.2g deg, within the tolerance of max |R^T R - I| <= %.0e",
+                RadToDeg(correction_rad), kRecordedRotationTolerance);
+  return source + ": pose " + pose_id + ": its rotation matrix was not orthonormal; taken as the nearest rotation (" +
+         detail + ")";
+}
+
 Eigen::Matrix3d RotationFromRpy(double roll_rad, double pitch_rad, double yaw_rad) {
   return RotZ(yaw_rad) * RotY(pitch_rad) * RotX(roll_rad);
 }

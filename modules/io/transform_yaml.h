@@ -57,6 +57,10 @@ struct RotationFromMatrix {
 // by the nearest rotation within `tolerance`, else refused. A reflection (det R < 0) is always refused.
 RotationFromMatrix MakeRotation(const Eigen::Matrix3d& r, double tolerance);
 
+// "SOURCE: pose ID: its rotation matrix was not orthonormal; taken as the nearest rotation (corrected by
+// 0.00055 deg, ...)": the note of a recorded rotation made a rotation, as detect and calibrate print it.
+std::string RotationCorrectionNote(const std::string& source, const std::string& pose_id, double correction_rad);
+
 // Reads the map under `key` of `parent` into *out. When the key is absent: a missing-key problem if
 // required, else *out is left unchanged and true is returned. A `rotation` matrix must be orthonormal to
 // kExactRotationTolerance, or, when `rotation_correction_rad` is given (a recorded pose), to
