@@ -102,8 +102,10 @@ Result<LoadedInput> LoadInput(const CalibrateRequest& request) {
   } else {
     Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(request.input);
     if (!doc.ok()) return doc.status();
-    Result<ObservationSet> obs = io::ParseObservations(*doc);
+    std::vector<std::string> notes;
+    Result<ObservationSet> obs = io::ParseObservations(*doc, &notes);
     if (!obs.ok()) return obs.status();
+    for (const std::string& note : notes) std::cerr << "selfcal: note: " << TerminalSafe(note) << "\n";
     loaded.observations = std::move(obs).value();
     Result<io::RobotOrigin> origin = io::RobotOriginOfObservations(*doc);
     loaded.origin = origin.ok() ? *origin : io::RobotOrigin{};

@@ -23,6 +23,7 @@
 #include "io/observations_file.h"
 #include "io/pose_files.h"
 #include "io/robot_config.h"
+#include "io/transform_yaml.h"
 
 namespace selfcal::app {
 
@@ -43,6 +44,9 @@ struct DetectSettings {
   double tag_tolerance_px = 3.0;
   int sheet_tile_px = 640;
   bool skip_failed = false;
+  io::JsonPoseKeys json;                    // --pose-*-key: the keys of JSON pose files
+  std::string joints_unit = "rad", matrix_order = "row", quaternion_order = "xyzw";
+  std::vector<double> flange_from_tool;     // --flange-from-tool-mm-deg X,Y,Z,ROLL,PITCH,YAW
 };
 
 Status Usage(const std::string& message) { return Status::Error(ErrorCode::kInvalidInput, message); }
@@ -134,6 +138,34 @@ Result<detection::ObservationSetup> ToSetup(const DetectSettings& a, const vpIma
   return setup;
 }
 
+// The pose files' reading: JSON keys, and the tool frame (mm and deg on the command line, SI inside).
+Result<io::PoseReadOptions> ToPoseReadOptions(const DetectSettings& a) {
+  io::PoseReadOptions o;
+  o.json = a.json;
+  o.json.joints_deg = a.joints_unit == "deg";
+  o.json.column_major = a.matrix_order == "column";
+  o.json.quaternion_wxyz = a.quaternion_order == "wxyz";
+  if (!o.json.empty()) {
+    if (Status s = o.json.Validate(); !s.ok()) return Usage(s.message());
+  }
+  if (!a.flange_from_tool.empty()) {
+    const std::vector<double>& v = a.flange_from_tool;
+    o.flange_from_tool = Rigid3(io::RotationFromRpy(DegToRad(v[3]), DegToRad(v[4]), DegToRad(v[5])),
+                                Eigen::Vector3d(v[0], v[1], v[2]) * 1e-3);
+  }
+  return o;
+}
+
+// A rotation made orthonormal is said per pose, on stderr: what was read is not what the file holds.
+void ReportRotationCorrections(const io::ImagesAndPoses& inputs) {
+  for (size_t i = 0; i < inputs.poses.size(); ++i) {
+    const io::ImagePose& p = inputs.poses[i];
+    if (p.rotation_correction_rad > 0) {
+      std::cerr << "selfcal: note: " << io::RotationCorrectionNote(p.source, inputs.ids[i], p.rotation_correction_rad) << "\n";
+    }
+  }
+}
+
 void PrintPerImage(const std::vector<io::NamedImage>& images, const std::vector<detection::ImagePoints>& points) {
   for (size_t i = 0; i < images.size(); ++i) {
     std::cout << (points[i].ok ? "  " : "  FAILED ") << images[i].path << ": " << points[i].message << "\n";
@@ -179,13 +211,13 @@ int DetectFromSettings(const DetectSettings& a) {
     if (!loaded.ok()) return Fail(loaded.status());
     robot = std::make_unique<RobotModel>(*loaded);
   }
-  Result<std::vector<std::string>> paths = io::ListFiles(a.images, io::ImageExtensions(), "images");
-  if (!paths.ok()) return Fail(paths.status());
-  Result<std::vector<io::ImagePose>> poses = io::LoadImagePoses(a.poses, robot.get());
-  if (!poses.ok()) return Fail(poses.status());
-  Result<std::vector<io::ImagePose>> matched = io::MatchPosesToImages(*paths, *poses);
-  if (!matched.ok()) return Fail(matched.status());
-  Result<std::vector<io::NamedImage>> images = io::ReadGreyImages(*paths);
+  Result<io::PoseReadOptions> pose_options = ToPoseReadOptions(a);
+  if (!pose_options.ok()) return Fail(pose_options.status());
+  Result<io::ImagesAndPoses> inputs = io::LoadImagesAndPoses(a.images, a.poses, robot.get(), *pose_options);
+  if (!inputs.ok()) return Fail(inputs.status());
+  ReportRotationCorrections(*inputs);
+  const std::vector<io::ImagePose>& matched = inputs->poses;
+  Result<std::vector<io::NamedImage>> images = io::ReadGreyImages(inputs->images);
   if (!images.ok()) return Fail(images.status());
   Result<detection::ObservationSetup> setup = ToSetup(a, images->front().image, robot.get());
   if (!setup.ok()) return Fail(setup.status());
@@ -195,9 +227,9 @@ int DetectFromSettings(const DetectSettings& a) {
   std::vector<detection::ImageRobotPose> robot_poses;
   for (size_t i = 0; i < images->size(); ++i) {
     pixels.push_back(&(*images)[i].image);
-    ids.push_back(io::FileStem((*images)[i].path));
-    robot_poses.push_back({(*matched)[i].base_from_flange, (*matched)[i].joints_rad,
-                           (*matched)[i].verification ? PoseRole::kVerification : PoseRole::kIdentification});
+    ids.push_back(inputs->ids[i]);
+    robot_poses.push_back({matched[i].base_from_flange, matched[i].joints_rad,
+                           matched[i].verification ? PoseRole::kVerification : PoseRole::kIdentification});
   }
   detection::DetectionOptions detect_options = *options;
   detect_options.progress = Progress();
@@ -209,7 +241,7 @@ int DetectFromSettings(const DetectSettings& a) {
   std::string sheet_png;
   if (!a.contact_sheet.empty()) {
     std::vector<detection::SheetImage> sheet;
-    for (size_t i = 0; i < images->size(); ++i) sheet.push_back({io::FileStem((*images)[i].path), pixels[i], &points[i]});
+    for (size_t i = 0; i < images->size(); ++i) sheet.push_back({ids[i], pixels[i], &points[i]});
     detection::ContactSheetOptions so;
     so.max_tile_width_px = a.sheet_tile_px;
     if (options->identity == detection::Identity::kGrid) so.grid_cols = options->cols;
@@ -246,9 +278,25 @@ Command AddDetectCommand(CLI::App& app) {
   cmd->add_option("--images", a->images, "Directory of images (png, jpg, pgm, ...) or a glob ('shots/img_*.png')")
       ->required();
   cmd->add_option("--poses", a->poses,
-                  "Robot poses: a directory or glob of per-image files (ROS x,y,z,qx..qw or ViSP vpPoseVector), "
-                  "or a selfcal-poses list")
-      ->required();
+                  "Robot poses: a directory or glob of per-image files (ROS x,y,z,qx..qw, ViSP vpPoseVector, or JSON "
+                  "with --pose-*-key), or a selfcal-poses list; not needed when --images holds a folder per pose");
+  cmd->add_option("--pose-joints-key", a->json.joints, "JSON pose files: the key of the joint angles");
+  cmd->add_option("--pose-joints-unit", a->joints_unit, "JSON pose files: the joint angles' unit, rad (default) or deg")
+      ->check(CLI::IsMember({"rad", "deg"}));
+  cmd->add_option("--pose-matrix-key", a->json.matrix,
+                  "JSON pose files: the key of a 4x4 pose (16 numbers or 4 rows of 4, m) of the flange or the tool");
+  cmd->add_option("--pose-matrix-order", a->matrix_order,
+                  "JSON pose files: the 16 numbers row by row (row, default) or column by column (column)")
+      ->check(CLI::IsMember({"row", "column"}));
+  cmd->add_option("--pose-position-key", a->json.position, "JSON pose files: the key of the position (3 numbers, m)");
+  cmd->add_option("--pose-quaternion-key", a->json.quaternion, "JSON pose files: the key of the unit quaternion");
+  cmd->add_option("--pose-quaternion-order", a->quaternion_order, "JSON pose files: xyzw (default) or wxyz")
+      ->check(CLI::IsMember({"xyzw", "wxyz"}));
+  cmd->add_option("--flange-from-tool-mm-deg", a->flange_from_tool,
+                  "X,Y,Z,ROLL,PITCH,YAW: the recorded poses are of a tool (TCP) frame, whose pose in the flange frame "
+                  "this is (mm; deg, R = Rz(yaw) Ry(pitch) Rx(roll)); they become flange poses")
+      ->delimiter(',')
+      ->expected(6);
   AddOutputOption(cmd, "--out", &a->out, OutputKind::kFile, "Observations file to write (docs/observations-format.md)")->required();
   AddOutputOption(cmd, "--contact-sheet", &a->contact_sheet, OutputKind::kFile,
                   "Also write every image with its points and ids as one PNG");

@@ -77,7 +77,10 @@ ObservationSet PrepareFlangePoseSet(const ObservationSet& observations, const Ca
   report->hand_eye_start = StartHandEye(observations, start_options);
   if (!observations.flange_from_cam_known && report->hand_eye_start->ok) {
     prepared.robot.flange_from_cam = report->hand_eye_start->flange_from_cam;
-    prepared.camera.fx_px = report->hand_eye_start->fx_px;
+    // A held f_x is the stated one (a camera file's, to the bit), in this bundle and every solve after it.
+    if (bundle::EstimatedIntrinsicsOf(options.bundle.bundle, prepared.robot.num_joints())[kFx]) {
+      prepared.camera.fx_px = report->hand_eye_start->fx_px;
+    }
     prepared.flange_from_cam_known = true;
   }
   return prepared;

@@ -53,6 +53,82 @@ const std::vector<std::string>& ImageExtensions() {
   return kExtensions;
 }
 
+const std::vector<std::string>& PoseFileExtensions() {
+  static const std::vector<std::string> kExtensions = {".yaml", ".yml", ".json"};
+  return kExtensions;
+}
+
+namespace {
+
+bool HasExtension(const std::filesystem::path& path, const std::vector<std::string>& extensions) {
+  const std::string ext = Lower(path.extension().string());
+  return std::find(extensions.begin(), extensions.end(), ext) != extensions.end();
+}
+
+// The regular files of `folder` with one of `extensions`, sorted by name.
+std::vector<std::string> FilesIn(const std::filesystem::path& folder, const std::vector<std::string>& extensions,
+                                 std::error_code* ec) {
+  std::vector<std::string> files;
+  for (std::filesystem::directory_iterator it(folder, *ec), end; !*ec && it != end; it.increment(*ec)) {
+    if (HasExtension(it->path(), extensions) && IsRegularFile(it->path().string())) files.push_back(it->path().string());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// "image.png" or "none" or "a.png and b.png": what a folder holds of one kind.
+std::string Holding(const std::vector<std::string>& files) {
+  if (files.empty()) return "none";
+  std::string out;
+  for (const std::string& f : files) out += (out.empty() ? "" : " and ") + std::filesystem::path(f).filename().string();
+  return out;
+}
+
+}  // namespace
+
+bool IsPoseFolderDirectory(const std::string& dir) {
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) return false;
+  bool folders = false;
+  for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    if (it->is_directory(ec)) folders = true;
+    if (HasExtension(it->path(), ImageExtensions()) && IsRegularFile(it->path().string())) return false;
+  }
+  return folders && !ec;
+}
+
+Result<std::vector<PoseFolder>> ListPoseFolders(const std::string& dir) {
+  std::error_code ec;
+  std::vector<std::filesystem::path> folders;
+  for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    if (it->is_directory(ec)) folders.push_back(it->path());
+  }
+  if (ec) return Status::Error(ErrorCode::kInvalidInput, dir + ": cannot list the directory: " + ec.message());
+  std::vector<PoseFolder> out;
+  std::string problems;
+  for (const std::filesystem::path& folder : folders) {
+    const std::vector<std::string> images = FilesIn(folder, ImageExtensions(), &ec);
+    const std::vector<std::string> poses = FilesIn(folder, PoseFileExtensions(), &ec);
+    if (ec) return Status::Error(ErrorCode::kInvalidInput, folder.string() + ": cannot list the folder: " + ec.message());
+    if (images.size() != 1 || poses.size() != 1) {
+      problems += "\n  - " + folder.string() + ": holds " + Holding(images) + " as its image and " + Holding(poses) +
+                  " as its pose file; each pose's folder holds one image and one pose file (.json, .yaml or .yml)";
+      continue;
+    }
+    out.push_back({folder.filename().string(), images[0], poses[0]});
+  }
+  if (!problems.empty()) {
+    return Status::Error(ErrorCode::kInvalidInput, dir + ": a folder per pose expected:" + problems);
+  }
+  if (out.empty()) return Status::Error(ErrorCode::kInvalidInput, dir + ": no pose folders found");
+  std::sort(out.begin(), out.end(), [](const PoseFolder& a, const PoseFolder& b) {
+    const std::string ka = ImageKey(a.id), kb = ImageKey(b.id);
+    if (ka != kb) return KeyLess(ka, kb);
+    return a.id < b.id;
+  });
+  return out;
+}
+
 Result<std::vector<std::string>> ListFiles(const std::string& spec, const std::vector<std::string>& extensions,
                                            const std::string& what) {
   std::vector<std::string> files;

@@ -24,6 +24,26 @@ std::string ImageKey(const std::string& path);
 Result<std::vector<std::string>> ListFiles(const std::string& spec, const std::vector<std::string>& extensions,
                                            const std::string& what);
 
+// One pose of a folder-per-pose recording (`DIR/<id>/image.png` + `DIR/<id>/data.json`, as the kvasios
+// Franka recorder stores them): the folder's name and its image and pose file.
+struct PoseFolder {
+  std::string id;         // the folder's name ("pose_03")
+  std::string image;      // its one image file
+  std::string pose_file;  // its one pose file (.json, .yaml or .yml)
+};
+
+// Whether `dir` is a folder-per-pose directory: a directory with subdirectories and no image file.
+bool IsPoseFolderDirectory(const std::string& dir);
+
+// Every subdirectory of `dir`, sorted as ListFiles sorts (by the ImageKey of the folder's name), each with
+// exactly one image file (ImageExtensions) and one pose file (PoseFileExtensions); a folder without either,
+// or with two, is refused naming it (ErrorCode::kInvalidInput, every such folder listed). Files directly
+// in `dir` (a recorder's own results) are not looked at.
+Result<std::vector<PoseFolder>> ListPoseFolders(const std::string& dir);
+
+// The extensions of per-image pose files: .yaml .yml .json.
+const std::vector<std::string>& PoseFileExtensions();
+
 // The extensions of the image files `ListFiles` takes from a directory: .png .jpg .jpeg .pgm .ppm .bmp
 // .tif .tiff.
 const std::vector<std::string>& ImageExtensions();

@@ -224,7 +224,7 @@ bool ReadJoints(MapReader* map, const RobotModel* robot, PoseObservation* pose) 
 }
 
 bool ReadPose(const yaml::YamlNode& node, const std::string& name, const RobotModel* robot, const CameraIntrinsics* camera,
-              Problems* problems, PoseObservation* pose) {
+              Problems* problems, PoseObservation* pose, std::vector<std::string>* notes) {
   MapReader map(node, name, problems);
   if (!map.ok()) return false;
   bool ok = map.String("id", &pose->id);
@@ -251,8 +251,12 @@ bool ReadPose(const yaml::YamlNode& node, const std::string& name, const RobotMo
   if (has_flange) {
     // Set even when unreadable (its problem is recorded): the set is still one of flange poses.
     Rigid3 base_from_flange;
-    ok &= ReadTransform(&map, "base_from_flange", /*required=*/true, &base_from_flange);
+    double correction_rad = 0;
+    ok &= ReadTransform(&map, "base_from_flange", /*required=*/true, &base_from_flange, &correction_rad);
     pose->base_from_flange = base_from_flange;
+    if (correction_rad > 0 && notes != nullptr) {
+      notes->push_back(RotationCorrectionNote(problems->At(map.KeyLine("base_from_flange")), pose->id, correction_rad));
+    }
     for (const char* joint_key : {"joints_deg", "joints_rad"}) {
       if (map.Optional(joint_key)) {
         problems->Add("`" + map.Path(joint_key) + "` at " + problems->At(map.KeyLine(joint_key)) +
@@ -309,7 +313,7 @@ int LineOfSubject(const std::map<std::string, int>& lines, const std::string& pr
 
 }  // namespace
 
-Result<ObservationSet> ParseObservations(const yaml::YamlDocument& doc) {
+Result<ObservationSet> ParseObservations(const yaml::YamlDocument& doc, std::vector<std::string>* notes) {
   Problems problems(doc.path);
   MapReader root(doc.root, "", &problems);
   if (!CheckFormatAndVersion(&root, kObservationsFormat, kObservationsVersion)) {
@@ -367,7 +371,7 @@ Result<ObservationSet> ParseObservations(const yaml::YamlDocument& doc) {
       set.poses.resize(poses->items.size());
       for (size_t i = 0; i < poses->items.size(); ++i) {
         ReadPose(poses->items[i], "poses[" + std::to_string(i) + "]", robot_ok ? &set.robot : nullptr,
-                 camera_ok ? &set.camera : nullptr, &problems, &set.poses[i]);
+                 camera_ok ? &set.camera : nullptr, &problems, &set.poses[i], notes);
       }
     }
   }

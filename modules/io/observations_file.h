@@ -20,6 +20,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "base/status.h"
 #include "io/yaml_schema.h"
@@ -37,8 +38,10 @@ inline constexpr int kObservationsVersion = 1;
 // (ErrorCode::kInvalidInput), naming the file, line and key.
 Result<ObservationSet> LoadObservations(const std::string& path);
 
-// The same for a document already parsed; robot_file is resolved relative to doc.path's directory.
-Result<ObservationSet> ParseObservations(const yaml::YamlDocument& doc);
+// The same for a document already parsed; robot_file is resolved relative to doc.path's directory. A pose's
+// `base_from_flange` rotation is a recorded one (io/transform_yaml.h, kRecordedRotationTolerance): made a
+// rotation when it is not one to 1e-12, and said in *notes (RotationCorrectionNote) when given.
+Result<ObservationSet> ParseObservations(const yaml::YamlDocument& doc, std::vector<std::string>* notes = nullptr);
 
 // Writes the set atomically (P4) in SI units (joints_rad, length_m, robot in exact form) with
 // shortest round-trip numbers, so that LoadObservations returns a bit-identical set. Refuses a set

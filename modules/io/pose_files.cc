@@ -1,5 +1,6 @@
 #include "io/pose_files.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -125,7 +126,7 @@ bool ReadListEntry(const yaml::YamlNode& node, const std::string& name, const Ro
   }
   if (has_flange) {
     Rigid3 flange;
-    if (ReadTransform(&map, "base_from_flange", true, &flange)) {
+    if (ReadTransform(&map, "base_from_flange", true, &flange, &pose->rotation_correction_rad)) {
       pose->base_from_flange = flange;
     } else {
       ok = false;
@@ -157,7 +158,45 @@ bool IsDirectory(const std::string& path) {
 
 bool HasGlobCharacters(const std::string& spec) { return spec.find_first_of("*?[") != std::string::npos; }
 
+bool IsJson(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".json";
+}
+
+// A recorded tool pose made the flange's: base_from_flange = base_from_tool * flange_from_tool^-1.
+Status ToolToFlange(const PoseReadOptions& options, ImagePose* pose) {
+  if (!options.flange_from_tool) return Status::Ok();
+  if (!pose->base_from_flange) {
+    return Status::Error(ErrorCode::kInvalidInput,
+                         pose->source + ": gives joint angles; a tool frame (--flange-from-tool-mm-deg) applies to "
+                                        "recorded tool poses only");
+  }
+  pose->base_from_flange = *pose->base_from_flange * options.flange_from_tool->Inverse();
+  return Status::Ok();
+}
+
 }  // namespace
+
+Result<ImagePose> LoadPoseFile(const std::string& path, const RobotModel* robot, const PoseReadOptions& options) {
+  ImagePose pose;
+  pose.key = ImageKey(path);
+  pose.source = path;
+  if (IsJson(path)) {
+    if (options.json.empty()) {
+      return Status::Error(ErrorCode::kInvalidInput,
+                           path + ": a JSON pose file: name the key of its pose (--pose-joints-key, --pose-matrix-key, "
+                                  "or --pose-position-key with --pose-quaternion-key)");
+    }
+    if (Status s = LoadJsonPoseFile(path, options.json, robot, &pose); !s.ok()) return s;
+  } else {
+    Result<Rigid3> transform = LoadPerImagePoseFile(path);
+    if (!transform.ok()) return transform.status();
+    pose.base_from_flange = *transform;
+  }
+  if (Status s = ToolToFlange(options, &pose); !s.ok()) return s;
+  return pose;
+}
 
 Result<Rigid3> LoadPerImagePoseFile(const std::string& path) {
   Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(path);
@@ -222,9 +261,15 @@ Status SavePosesList(const std::vector<PosesListEntry>& entries, const std::stri
   return WriteFileAtomically(path, out.str());
 }
 
-Result<std::vector<ImagePose>> LoadImagePoses(const std::string& spec, const RobotModel* robot) {
+Result<std::vector<ImagePose>> LoadImagePoses(const std::string& spec, const RobotModel* robot,
+                                              const PoseReadOptions& options) {
   std::vector<ImagePose> poses;
   if (!IsDirectory(spec) && !HasGlobCharacters(spec)) {
+    if (IsJson(spec)) {
+      return Status::Error(ErrorCode::kInvalidInput,
+                           spec + ": is the pose of one image; give the directory or a glob of every image's pose "
+                                  "file (--poses DIR or 'DIR/pose_*.json')");
+    }
     Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(spec);
     if (!doc.ok()) return doc.status();
     const yaml::YamlNode& root = doc->root;
@@ -237,17 +282,16 @@ Result<std::vector<ImagePose>> LoadImagePoses(const std::string& spec, const Rob
     Result<std::vector<ImagePose>> list = LoadPosesList(spec, robot);
     if (!list.ok()) return list.status();
     poses = std::move(*list);
+    for (ImagePose& pose : poses) {
+      if (Status s = ToolToFlange(options, &pose); !s.ok()) return s;
+    }
   } else {
-    Result<std::vector<std::string>> files = ListFiles(spec, {".yaml", ".yml"}, "pose files");
+    Result<std::vector<std::string>> files = ListFiles(spec, PoseFileExtensions(), "pose files");
     if (!files.ok()) return files.status();
     for (const std::string& file : *files) {
-      Result<Rigid3> pose = LoadPerImagePoseFile(file);
+      Result<ImagePose> pose = LoadPoseFile(file, robot, options);
       if (!pose.ok()) return pose.status();
-      ImagePose p;
-      p.key = ImageKey(file);
-      p.source = file;
-      p.base_from_flange = *pose;
-      poses.push_back(std::move(p));
+      poses.push_back(std::move(*pose));
     }
   }
   std::map<std::string, std::string> seen;  // key -> source
@@ -291,6 +335,44 @@ Result<std::vector<ImagePose>> MatchPosesToImages(const std::vector<std::string>
     return Status::Error(ErrorCode::kInvalidInput, "images and poses do not match:" + problems);
   }
   return matched;
+}
+
+Result<ImagesAndPoses> LoadImagesAndPoses(const std::string& images_spec, const std::string& poses_spec,
+                                          const RobotModel* robot, const PoseReadOptions& options) {
+  ImagesAndPoses out;
+  if (IsPoseFolderDirectory(images_spec)) {
+    if (!poses_spec.empty() && std::filesystem::path(poses_spec).lexically_normal() !=
+                                   std::filesystem::path(images_spec).lexically_normal()) {
+      return Status::Error(ErrorCode::kInvalidInput,
+                           images_spec + " holds a folder per pose, each with its image and pose file: leave out "
+                                         "--poses " + poses_spec);
+    }
+    Result<std::vector<PoseFolder>> folders = ListPoseFolders(images_spec);
+    if (!folders.ok()) return folders.status();
+    for (const PoseFolder& folder : *folders) {
+      Result<ImagePose> pose = LoadPoseFile(folder.pose_file, robot, options);
+      if (!pose.ok()) return pose.status();
+      out.images.push_back(folder.image);
+      out.ids.push_back(folder.id);
+      out.poses.push_back(std::move(*pose));
+    }
+    return out;
+  }
+  if (poses_spec.empty()) {
+    return Status::Error(ErrorCode::kInvalidInput,
+                         "--poses is required unless --images is a directory of one folder per pose (DIR/<id>/image + "
+                         "pose file); " + images_spec + " is not");
+  }
+  Result<std::vector<std::string>> paths = ListFiles(images_spec, ImageExtensions(), "images");
+  if (!paths.ok()) return paths.status();
+  Result<std::vector<ImagePose>> poses = LoadImagePoses(poses_spec, robot, options);
+  if (!poses.ok()) return poses.status();
+  Result<std::vector<ImagePose>> matched = MatchPosesToImages(*paths, *poses);
+  if (!matched.ok()) return matched.status();
+  out.images = std::move(*paths);
+  for (const std::string& image : out.images) out.ids.push_back(FileStem(image));
+  out.poses = std::move(*matched);
+  return out;
 }
 
 }  // namespace selfcal::io

@@ -17,7 +17,15 @@
 //          - {image: 1.png, joints_deg: [0, -30, 120, 0, 45, 0]}     # or joints_rad; needs a robot
 //          - {image: 2.png, joints_deg: [5, -30, 120, 0, 45, 0], role: verification}
 //      (base_from_flange in any form of io/transform_yaml.h; `role`, optional: identification (default)
-//      or verification, an image held out from the solve to test the calibration).
+//      or verification, an image held out from the solve to test the calibration);
+//  (d) JSON, one file per image, the pose under keys the user names (io/json_pose_file.h).
+// A rotation matrix is taken as controllers write it (kRecordedRotationTolerance of io/transform_yaml.h):
+// made a rotation, the correction kept per pose for the caller to report. With a tool frame
+// (PoseReadOptions::flange_from_tool) the recorded transforms are the tool's, base_from_tool, and become
+// base_from_flange = base_from_tool * flange_from_tool^-1.
+//
+// The images and poses of `selfcal detect` come either as two lists (images, and poses of forms (a)-(d))
+// or as one folder per pose (`DIR/<id>/image.png` + `DIR/<id>/data.json`: io/file_lists.h, PoseFolder).
 //
 // Images and poses are matched by ImageKey (io/file_lists.h) of their names: "franka_image-3.png" and
 // "franka_pose_rPe_3.yaml" both have the key "3". Every problem names the file (and the line and key when
@@ -33,6 +41,7 @@
 #include "base/status.h"
 #include "geometry/rigid3.h"
 #include "io/file_lists.h"
+#include "io/json_pose_file.h"
 #include "kinematics/robot_model.h"
 
 namespace selfcal::io {
@@ -49,6 +58,13 @@ struct ImagePose {
   std::optional<Rigid3> base_from_flange;
   Eigen::VectorXd joints_rad;  // empty unless a poses list gave joints
   bool verification = false;   // a poses list's `role: verification`
+  double rotation_correction_rad = 0;  // how far the rotation as written was moved to a rotation (MakeRotation)
+};
+
+// How per-image pose files are read.
+struct PoseReadOptions {
+  JsonPoseKeys json;                       // the keys of JSON pose files (needed for them)
+  std::optional<Rigid3> flange_from_tool;  // the recorded poses are of this tool frame (flange_from_tool, m)
 };
 
 // One per-image file of form (a) or (b), told apart by its keys (`rows`, `cols` or `data`: ViSP).
@@ -69,9 +85,25 @@ struct PosesListEntry {
 // atomically. kInvalidInput for an empty list, an empty image name or a non-finite joint.
 Status SavePosesList(const std::vector<PosesListEntry>& entries, const std::string& path);
 
-// `spec` is a directory (every *.yaml / *.yml file in it is a per-image pose file), a glob of per-image
+// One per-image pose file of any form: (d) by its extension `.json`, else (a) or (b). Its key and source are
+// the file's; with options.flange_from_tool its transform is the tool's (made the flange's here).
+Result<ImagePose> LoadPoseFile(const std::string& path, const RobotModel* robot, const PoseReadOptions& options);
+
+// `spec` is a directory (every *.yaml / *.yml / *.json file in it is a per-image pose file), a glob of per-image
 // pose files (`poses/pose_*.yaml`), or one poses list. Two files with one key are refused.
-Result<std::vector<ImagePose>> LoadImagePoses(const std::string& spec, const RobotModel* robot);
+Result<std::vector<ImagePose>> LoadImagePoses(const std::string& spec, const RobotModel* robot,
+                                              const PoseReadOptions& options = {});
+
+// The images of `selfcal detect` with the pose of each, in order.
+struct ImagesAndPoses {
+  std::vector<std::string> images;  // image paths
+  std::vector<std::string> ids;     // the pose ids: the image's file stem, or the pose's folder name
+  std::vector<ImagePose> poses;
+};
+// `images_spec` is a folder-per-pose directory (io/file_lists.h; `poses_spec` then empty or the same
+// directory), or images (ListFiles) whose poses `poses_spec` gives (LoadImagePoses, MatchPosesToImages).
+Result<ImagesAndPoses> LoadImagesAndPoses(const std::string& images_spec, const std::string& poses_spec,
+                                          const RobotModel* robot, const PoseReadOptions& options);
 
 // The pose of every image, in the order of `image_paths`: an image without a pose, or a pose without an
 // image, is refused, naming the image or the pose's file.

@@ -15,15 +15,8 @@ namespace selfcal::io {
 namespace {
 
 using testing::TempDir;
+using testing::MessageHas;
 using testing::WriteFile;
-
-::testing::AssertionResult MessageHas(const Status& s, const std::string& part) {
-  if (s.ok()) return ::testing::AssertionFailure() << "OK, expected an error with `" << part << "`";
-  if (s.message().find(part) == std::string::npos) {
-    return ::testing::AssertionFailure() << "`" << part << "` not in:\n" << s.message();
-  }
-  return ::testing::AssertionSuccess();
-}
 
 TEST(FileLists, KeysAndStems) {
   EXPECT_EQ(ImageKey("a/b/franka_image-3.png"), "3");

@@ -13,9 +13,8 @@ namespace selfcal::io {
 namespace {
 
 constexpr double kMaxTranslationM = 10.0;
-constexpr double kRotationTolerance = 1e-9;
-
-bool ReadRotationMatrix(const yaml::YamlNode& node, const std::string& name, Problems* problems, Eigen::Matrix3d* out) {
+bool ReadRotationMatrix(const yaml::YamlNode& node, const std::string& name, double tolerance, Problems* problems,
+                        Eigen::Matrix3d* out, double* correction_rad) {
   if (!node.IsSequence() || node.items.size() != 3) {
     problems->Add("`" + name + "` at " + problems->At(node.line) + " must be 3 rows of 3 numbers: [[r00, r01, r02], " +
                   "[r10, r11, r12], [r20, r21, r22]]");
@@ -25,22 +24,20 @@ bool ReadRotationMatrix(const yaml::YamlNode& node, const std::string& name, Pro
   bool ok = true;
   for (int i = 0; i < 3; ++i) {
     std::vector<double> row;
-    if (ReadDoubleList(node.items[i], name + "[" + std::to_string(i) + "]", 3, Range::Closed(-1.0 - kRotationTolerance, 1.0 + kRotationTolerance), problems, &row)) {
+    if (ReadDoubleList(node.items[i], name + "[" + std::to_string(i) + "]", 3, Range::Closed(-1.0 - tolerance, 1.0 + tolerance), problems, &row)) {
       r.row(i) << row[0], row[1], row[2];
     } else {
       ok = false;
     }
   }
   if (!ok) return false;
-  const double orthogonality = (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-  const double det = r.determinant();
-  if (orthogonality > kRotationTolerance || std::abs(det - 1.0) > kRotationTolerance) {
-    char detail[96];
-    std::snprintf(detail, sizeof(detail), "max |R^T R - I| = %.3g, det R = %.12g", orthogonality, det);
-    problems->Add("`" + name + "` at " + problems->At(node.line) + " is not a rotation matrix (" + detail + ")");
+  const RotationFromMatrix rotation = MakeRotation(r, tolerance);
+  if (!rotation.ok) {
+    problems->Add("`" + name + "` at " + problems->At(node.line) + " " + rotation.problem);
     return false;
   }
-  *out = r;
+  *out = rotation.rotation;
+  if (correction_rad != nullptr) *correction_rad = rotation.correction_rad;
   return true;
 }
 
@@ -61,6 +58,41 @@ bool ReadQuaternion(const std::vector<double>& q, const std::string& name, const
 
 }  // namespace
 
+RotationFromMatrix MakeRotation(const Eigen::Matrix3d& r, double tolerance) {
+  RotationFromMatrix out;
+  out.orthogonality = (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  const double det = r.determinant();
+  const double as_written = tolerance <= kExactRotationTolerance ? tolerance : kRecordedRotationAsWritten;
+  const bool exact = out.orthogonality <= as_written && std::abs(det - 1.0) <= as_written;
+  // Within the tolerance |det R| is within 2e-4 of 1: its sign tells a rotation from a reflection.
+  if (!exact && !(out.orthogonality <= tolerance && det > 0)) {
+    char detail[160];
+    std::snprintf(detail, sizeof(detail), "max |R^T R - I| = %.3g, det R = %.12g; a rotation is orthonormal to %.0e",
+                  out.orthogonality, det, tolerance);
+    out.problem = std::string("is not a rotation matrix (") + detail +
+                  (det < 0 ? ", with determinant +1: this one is a reflection)" : ")");
+    return out;
+  }
+  out.ok = true;
+  if (exact) {
+    out.rotation = r;
+    return out;
+  }
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(r, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  out.rotation = svd.matrixU() * svd.matrixV().transpose();
+  const Eigen::JacobiSVD<Eigen::Matrix3d> change(out.rotation - r);
+  out.correction_rad = change.singularValues()[0];
+  return out;
+}
+
+std::string RotationCorrectionNote(const std::string& source, const std::string& pose_id, double correction_rad) {
+  char detail[160];
+  std::snprintf(detail, sizeof(detail), "corrected by %.2g deg, within the tolerance of max |R^T R - I| <= %.0e",
+                RadToDeg(correction_rad), kRecordedRotationTolerance);
+  return source + ": pose " + pose_id + ": its rotation matrix was not orthonormal; taken as the nearest rotation (" +
+         detail + ")";
+}
+
 Eigen::Matrix3d RotationFromRpy(double roll_rad, double pitch_rad, double yaw_rad) {
   return RotZ(yaw_rad) * RotY(pitch_rad) * RotX(roll_rad);
 }
@@ -77,7 +109,8 @@ Eigen::Vector3d RpyFromRotation(const Eigen::Matrix3d& r) {
   return Eigen::Vector3d(std::atan2(r(2, 1), r(2, 2)), pitch, std::atan2(r(1, 0), r(0, 0)));
 }
 
-bool ReadTransform(MapReader* parent, const std::string& key, bool required, Rigid3* out) {
+bool ReadTransform(MapReader* parent, const std::string& key, bool required, Rigid3* out,
+                   double* rotation_correction_rad) {
   const yaml::YamlNode* node = required ? parent->Required(key) : parent->Optional(key);
   if (!node) return !required;
   MapReader map(*node, parent->Path(key), parent->problems());
@@ -109,7 +142,8 @@ bool ReadTransform(MapReader* parent, const std::string& key, bool required, Rig
                   problems->At(map.KeyLine(given[1])) + " both give the rotation; keep one");
     ok = false;
   } else if (matrix_node) {
-    ok &= ReadRotationMatrix(*matrix_node, map.Path("rotation"), problems, &rotation);
+    const double tolerance = rotation_correction_rad != nullptr ? kRecordedRotationTolerance : kExactRotationTolerance;
+    ok &= ReadRotationMatrix(*matrix_node, map.Path("rotation"), tolerance, problems, &rotation, rotation_correction_rad);
   } else if (!rpy_key.empty()) {
     ok &= rpy_ok;
     if (rpy_ok) rotation = RotationFromRpy(rpy[0], rpy[1], rpy[2]);

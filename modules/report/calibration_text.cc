@@ -119,8 +119,13 @@ void PrintBundleSummary(const calibration::BundleStageReport& stage, bool flange
       << b.dropped_dots.size() << " dots dropped\n";
   PrintWeakDirections(b, out);
   out << "  " << b.iterations << " iterations (" << b.termination << "), reprojection RMS " << std::setprecision(4)
-      << b.rms_reprojection_px << " px; f_x = " << std::fixed << std::setprecision(3) << b.fx_px << " +- "
-      << b.fx_stddev << " px\n";
+      << b.rms_reprojection_px << " px; f_x = " << std::fixed << std::setprecision(3) << b.fx_px;
+  // A held f_x has no std: it is the stated camera's value.
+  if (b.intrinsics_estimated[kFx]) {
+    out << " +- " << b.fx_stddev << " px\n";
+  } else {
+    out << " px (held)\n";
+  }
   out.unsetf(std::ios::floatfield);
   if (b.error_model.estimated) {
     out << "  error model from the residuals: pixel noise " << std::setprecision(3) << b.error_model.pixel_px

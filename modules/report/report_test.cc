@@ -1,5 +1,6 @@
 #include "report/calibration_report.h"
 
+#include <iomanip>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -99,6 +100,27 @@ TEST(CalibrationReport, SummaryNamesTheEstimatedIntrinsics) {
   const nlohmann::json j = CalibrationReportJson(world.observations, report, {});
   EXPECT_TRUE(j["methods"]["bundle"]["intrinsics"]["cy"]["estimated"].get<bool>());
   EXPECT_GT(j["methods"]["bundle"]["intrinsics"]["cy"]["stddev_px"].get<double>(), 0);
+}
+
+// A held f_x is stated as held, never with a nan std: the summary says `(held)`, report.json gives its value
+// with estimated false and a null std.
+TEST(CalibrationReport, AHeldFocalLengthIsStatedAsHeld) {
+  const sim::SimResult world = testing::PumaArcWorld(0.2, 2, 2);
+  calibration::CalibrateOptions options;
+  options.bundle.bundle.held_parameters = {"fx"};
+  const calibration::CalibrationReport report = calibration::Calibrate(world.observations, options);
+  ASSERT_TRUE(report.bundle.has_value());
+  std::ostringstream text;
+  PrintCalibrationSummary(report, text);
+  EXPECT_EQ(text.str().find("nan"), std::string::npos) << text.str();
+  std::ostringstream fx;
+  fx << std::fixed << std::setprecision(3) << world.observations.camera.fx_px;
+  EXPECT_NE(text.str().find("f_x = " + fx.str() + " px (held)"), std::string::npos) << text.str();
+  const nlohmann::json j = CalibrationReportJson(world.observations, report, {});
+  const nlohmann::json& in = j["methods"]["bundle"]["intrinsics"]["fx"];
+  EXPECT_FALSE(in["estimated"].get<bool>());
+  EXPECT_TRUE(in["stddev_px"].is_null());
+  EXPECT_EQ(in["value_px"].get<double>(), world.observations.camera.fx_px);
 }
 
 // One key style: SI values with the unit in the key; no mm or degree keys anywhere in report.json.

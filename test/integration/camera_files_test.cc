@@ -155,6 +155,59 @@ TEST(CameraFilesCli, CameraFileReplacesTheObservationsCameraOfAJointAngleSet) {
   EXPECT_EQ(report.at("input").at("camera_file").at("sha256").get<std::string>().size(), 64u);
 }
 
+// `--fix fx` with a camera file holds the file's f_x to the bit in every solve, stated as held (never
+// `+- nan`): on the ViSP Franka set (flange poses, whose start from the flat board's images gives another
+// f_x) in hand_eye.yaml and report.json, and on a joint-angle set (the paper pipeline's f_x another start)
+// in calibrated_model.yaml, where the observations file states an f_x 1 % off the file's.
+TEST(CameraFilesCli, AHeldFocalLengthIsTheCameraFilesToTheBit) {
+  const fs::path dir = FreshDir("camera_files", "held_fx");
+  const std::string obs = (dir / "franka.yaml").string();
+  std::string output;
+  ASSERT_EQ(RunSelfcalInSource(kFrankaDetect + "--camera-file " + kFrankaCamera + " --out " + obs, &output), 0) << output;
+  Result<CameraIntrinsics> file = io::LoadCameraFile(fs::path(SELFCAL_SOURCE_DIR) / kFrankaCamera);
+  ASSERT_TRUE(file.ok()) << file.status().ToString();
+  const fs::path out = dir / "franka_cal";
+  ASSERT_EQ(RunSelfcalInSource("calibrate " + obs + " --camera-file " + kFrankaCamera + " --fix fx --no-html --out " +
+                                   out.string(),
+                               &output),
+            0)
+      << output;
+  EXPECT_EQ(output.find("nan"), std::string::npos) << output;
+  EXPECT_NE(output.find("f_x = 607.593 px (held)"), std::string::npos) << output;
+  const nlohmann::json fx = ReadJson(out / "report.json").at("methods").at("bundle").at("intrinsics").at("fx");
+  EXPECT_EQ(fx.at("value_px").get<double>(), file->fx_px);
+  EXPECT_FALSE(fx.at("estimated").get<bool>());
+  EXPECT_TRUE(fx.at("stddev_px").is_null());
+  Result<io::HandEyeResult> hand_eye = io::LoadHandEye((out / "hand_eye.yaml").string());
+  ASSERT_TRUE(hand_eye.ok()) << hand_eye.status().ToString();
+  ASSERT_TRUE(hand_eye->camera.has_value());
+  EXPECT_EQ(hand_eye->camera->fx_px, file->fx_px);
+  EXPECT_TRUE(std::isnan(hand_eye->intrinsics_stddev[kFx]));
+
+  const sim::SimResult world = testing::PumaArcWorld(0.2);
+  ObservationSet joints = world.observations;
+  const CameraIntrinsics truth = world.truth.camera_true;
+  joints.camera.fx_px = 1.01 * truth.fx_px;
+  const std::string joints_path = (dir / "puma.yaml").string(), camera_path = (dir / "puma_camera.yaml").string();
+  ASSERT_TRUE(io::SaveObservations(joints, joints_path).ok());
+  ASSERT_TRUE(io::SaveCameraOpenCv(truth, camera_path).ok());
+  Result<CameraIntrinsics> puma_file = io::LoadCameraFile(camera_path);
+  ASSERT_TRUE(puma_file.ok()) << puma_file.status().ToString();
+  const fs::path puma_out = dir / "puma_cal";
+  ASSERT_EQ(RunSelfcal("calibrate " + joints_path + " --camera-file " + camera_path + " --fix fx --no-html --out " +
+                           puma_out.string(),
+                       &output),
+            0)
+      << output;
+  EXPECT_EQ(output.find("nan"), std::string::npos) << output;
+  EXPECT_NE(output.find(" px (held)"), std::string::npos) << output;
+  Result<io::CalibratedModel> model = io::LoadCalibratedModel((puma_out / "calibrated_model.yaml").string());
+  ASSERT_TRUE(model.ok()) << model.status().ToString();
+  ASSERT_TRUE(model->camera.has_value());
+  EXPECT_EQ(model->camera->fx_px, puma_file->fx_px);
+  EXPECT_TRUE(std::isnan(model->intrinsics_stddev[kFx]));
+}
+
 // Bad camera files and options: exit 2, the message names the file (and what is wrong), nothing written.
 TEST(CameraFilesCli, BadCameraFilesAreRefusedNamingTheFileAndNothingIsWritten) {
   const fs::path dir = FreshDir("camera_files", "bad");

@@ -4,8 +4,7 @@
 // yardstick: corners 5-18, 198.252 mm). Joint 3 stays within 0.5 deg in every session, so j2.d and j4.d
 // cannot be told apart; the shipped Panda camera mount is 44 deg from this cell's camera. With the defaults
 // the calibration must converge, name what the data cannot determine and hold it at the robot description,
-// and start the camera from the images. The session's one-folder-per-pose layout is laid out here as
-// `detect` reads it today (images in one folder, a poses list of the recorded joints).
+// and start the camera from the images. `detect` reads each session's one-folder-per-pose layout as stored.
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -26,31 +25,15 @@ using testing::RunSelfcalInSource;
 
 const fs::path kData = fs::path(SELFCAL_SOURCE_DIR) / "test/data/kvasios-franka-handeye";
 
-// DIR/images/pose_NN.png (links to the recording) and DIR/poses.yaml; pose numbers in `verification` get
-// that role, and `skip` are left out.
-void LayOut(const std::string& session, const fs::path& dir) {
-  fs::create_directories(dir / "images");
-  std::ofstream poses(dir / "poses.yaml");
-  poses << "format: selfcal-poses\nversion: 1\nposes:\n";
-  for (int n = 0; n < 12; ++n) {
-    char name[16];
-    std::snprintf(name, sizeof(name), "pose_%02d", n);
-    const fs::path folder = kData / session / name;
-    fs::create_symlink(folder / "image.png", dir / "images" / (std::string(name) + ".png"));
-    std::ifstream in(folder / "data.json");
-    const nlohmann::json data = nlohmann::json::parse(in);
-    poses << "  - {image: " << name << ".png, joints_rad: " << data.at("joint_pose").dump() << "}\n";
-  }
-}
-
-// detect on one session: the observations file's path.
+// detect on one session as it is stored (a folder per pose, the joints under `joint_pose`): the
+// observations file's path.
 std::string Detect(const std::string& session, const fs::path& dir) {
-  LayOut(session, dir);
+  fs::create_directories(dir);
   const std::string obs = (dir / "obs.yaml").string();
   std::string output;
   const int code = RunSelfcalInSource(
-      "detect --images " + (dir / "images").string() + " --poses " + (dir / "poses.yaml").string() +
-          " --robot config/robots/panda.yaml --detector chessboard --grid 4x6 --camera-file " +
+      "detect --images " + (kData / session).string() +
+          " --pose-joints-key joint_pose --robot config/robots/panda.yaml --detector chessboard --grid 4x6 --camera-file " +
           (kData / "realsense_factory.yaml").string() + " --yardstick 5,18,198.252 --pixel-noise-px 0.5 --out " + obs,
       &output);
   EXPECT_EQ(code, 0) << output;
