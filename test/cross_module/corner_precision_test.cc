@@ -167,6 +167,20 @@ void ExpectAtTheNoiseLimit(const Measured& clean, const Measured& noisy, int min
   EXPECT_LT(noisy.selfcal.RmsPerAxis(), noisy.subpix.RmsPerAxis());
 }
 
+// The chessboard detector's corners, each named by the true corner nearest it (within 3 px): the ordering's
+// cues are the detector's business (chessboard_test.cc).
+auto ChessboardByNearestTruth(const detection::ChessboardOptions& options) {
+  return [options](const vpImage<unsigned char>& image, const std::map<int, Eigen::Vector2d>& truth) {
+    std::map<int, Eigen::Vector2d> out;
+    for (const Eigen::Vector2d& p : detection::DetectChessboard(image, options, {}).corners_px) {
+      for (const auto& [id, t] : truth) {
+        if ((p - t).norm() < 3) out[id] = p;
+      }
+    }
+    return out;
+  };
+}
+
 detection::CharucoOptions KvasiosBoard() {
   detection::CharucoOptions o;
   o.dictionary = "DICT_6X6_250";
@@ -200,17 +214,7 @@ TEST(CornerPrecision, ChessboardCornersAreUnbiasedAndAtTheNoiseLimitOnRenderedBo
   detection::ChessboardOptions options;
   options.rows = 6;
   options.cols = 9;
-  // Each corner named by the true corner nearest it (within 3 px): the ordering's cues are the detector's
-  // business (chessboard_test.cc).
-  auto detect = [&](const vpImage<unsigned char>& image, const std::map<int, Eigen::Vector2d>& truth) {
-    std::map<int, Eigen::Vector2d> out;
-    for (const Eigen::Vector2d& p : detection::DetectChessboard(image, options, {}).corners_px) {
-      for (const auto& [id, t] : truth) {
-        if ((p - t).norm() < 3) out[id] = p;
-      }
-    }
-    return out;
-  };
+  const auto detect = ChessboardByNearestTruth(options);
   const Eigen::Vector2d centre(0.125, 0.0875);
   const Measured clean = Measure(texture, corners_m, centre, 0.025, 12, 0, detect);
   const Measured noisy = Measure(texture, corners_m, centre, 0.025, 12, 2.0, detect);
@@ -228,15 +232,7 @@ TEST(CornerPrecision, ChessboardCornersOfACharucoBoardAreNotPulledByTheMarkers) 
   detection::ChessboardOptions options;
   options.rows = 6;  // the 4 x 6 inner corners in whichever order: named by the nearest true corner
   options.cols = 4;
-  auto detect = [&](const vpImage<unsigned char>& image, const std::map<int, Eigen::Vector2d>& truth) {
-    std::map<int, Eigen::Vector2d> out;
-    for (const Eigen::Vector2d& p : detection::DetectChessboard(image, options, {}).corners_px) {
-      for (const auto& [id, t] : truth) {
-        if ((p - t).norm() < 3) out[id] = p;
-      }
-    }
-    return out;
-  };
+  const auto detect = ChessboardByNearestTruth(options);
   const Eigen::Vector2d centre(0.5 * 5 * 0.034, 0.5 * 7 * 0.034);
   // 4 boards: cv::findChessboardCorners takes ~4 s on each of these images (the markers are squares too).
   const Measured clean = Measure(texture, pattern.corners_m(), centre, 0.034, 4, 0, detect);
