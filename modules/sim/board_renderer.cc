@@ -105,7 +105,7 @@ vpImage<unsigned char> BoardRenderer::Render(const Rigid3& cam_from_board, const
       if (corner[k00] != c || corner[k01] != c || corner[k10] != c || corner[k11] != c) {
         double sum = 0;
         for (int b = 0; b < s; ++b) {
-          for (int a = 0; a < s; ++a) sum += ray.GreyAt(ray_at((a + 0.5) / s, (b + 0.5) / s));
+          for (int a = 0; a < s; ++a) sum += ray.GreyAt(ray_at((a + (b + 0.5) / s) / s, (b + (a + 0.5) / s) / s));
         }
         g = sum / (s * s);
       }

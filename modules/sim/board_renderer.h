@@ -5,8 +5,10 @@
 // Geometry. The board is the plane z = 0 of its frame; `grey_at(x, y)` gives the printed grey level at the
 // board point (x, y) (metres), or any level for points off the board (the surround). A pixel (u, v) covers
 // [u - 0.5, u + 0.5] x [v - 0.5, v + 0.5] (camera/camera.h: pixel centres at integers). Its grey level is
-// the mean of S x S samples (S = supersampling) at ((i + 0.5) / S - 0.5, (j + 0.5) / S - 0.5) from its
-// centre, each back-projected (every lens coefficient inverted: PixelToNormalized at the pixels' corners,
+// the mean of S x S samples (S = supersampling) on a rotated grid: sample (i, j) at
+// ((i + (j + 0.5) / S) / S - 0.5, (j + (i + 0.5) / S) / S - 0.5) from the pixel's centre, every sample at a
+// column and a row of its own, so that an edge along u or v is resolved to 1 / S^2 of the pixel, not 1 / S;
+// each back-projected (every lens coefficient inverted: PixelToNormalized at the pixels' corners,
 // computed once per camera, interpolated bilinearly inside the pixel, where the lens is smooth to ~1e-9 of a
 // pixel), its ray intersected with the board's plane and the plane point's grey read; a ray that misses the plane (parallel
 // or behind the camera) reads `off_plane_grey`. A pixel whose four corners and centre read the same level
@@ -14,9 +16,10 @@
 // Gaussian blur (sigma px, border replicated), additive Gaussian noise (sim/image_formation.h's
 // GaussianNoise, seeded, row-major), rounding and clamping to [0, 255].
 //
-// Truth: a board point X projects to Project(camera, cam_from_board * X). Sampling with S = 8 puts an
-// edge's area to within 1/64 of a pixel's area per pixel, and the errors of the two sides of a corner
-// cancel: the image's corners lie at their projections to ~1e-3 px (board_renderer_test.cc).
+// Truth: a board point X projects to Project(camera, cam_from_board * X). A pixel's coverage by each
+// colour is exact to the sampling: within 1 / S^2 of the pixel for an edge along u or v, ~1 / S at a
+// corner's own pixel (board_renderer_test.cc); the errors of neighbouring pixels along an edge at any other
+// angle average out.
 #pragma once
 
 #include <cstdint>
