@@ -32,6 +32,7 @@ namespace {
 struct DetectSettings {
   std::string images, poses, out, contact_sheet;
   std::string detector = "dots", identity = "grid", grid;
+  std::string dictionary, board;  // charuco: the markers' dictionary and the board's squares ROWSxCOLS
   std::string robot, hand_eye;
   double fx_px = 0, cx_px = NAN, cy_px = NAN, mu = 1.0, k1 = 0.0;
   std::string camera_file, camera_name;  // instead of the --camera-* values
@@ -76,8 +77,21 @@ Result<detection::DetectionOptions> ToDetectionOptions(const DetectSettings& a) 
   if (a.grid.empty() && o.detector == detection::Detector::kChessboard) {
     return Usage("--detector chessboard needs --grid ROWSxCOLS (inner corners, e.g. 6x9)");
   }
+  const bool charuco = o.detector == detection::Detector::kCharuco;
+  if (charuco != !a.board.empty() || charuco != !a.dictionary.empty() || (charuco && !a.grid.empty())) {
+    return Usage("--detector charuco takes --dictionary NAME and --board XxY (squares, e.g. 5x7) instead of --grid; "
+                 "--dictionary and --board apply to charuco only");
+  }
   if (!a.grid.empty()) {
     if (Status s = ParseGrid(a.grid, &o.rows, &o.cols); !s.ok()) return s;
+  }
+  if (charuco) {
+    // OpenCV's squaresX x squaresY: the columns first.
+    if (!ParseGrid(a.board, &o.cols, &o.rows).ok()) {
+      return Usage("--board `" + a.board + "`: XxY expected, the board's squares along its x and y as OpenCV's "
+                   "CharucoBoard takes them, e.g. 5x7");
+    }
+    o.charuco.dictionary = a.dictionary;
   }
   o.tag_side_m = a.tag_side_mm * 1e-3;
   if (a.tag_dots_mm.size() % 2 != 0) return Usage("--tag-dots-mm: x,y pairs expected");
@@ -244,7 +258,10 @@ int DetectFromSettings(const DetectSettings& a) {
     for (size_t i = 0; i < images->size(); ++i) sheet.push_back({ids[i], pixels[i], &points[i]});
     detection::ContactSheetOptions so;
     so.max_tile_width_px = a.sheet_tile_px;
-    if (options->identity == detection::Identity::kGrid) so.grid_cols = options->cols;
+    if (options->identity == detection::Identity::kGrid) {
+      // A ChArUco board of cols squares has cols - 1 corners a row.
+      so.grid_cols = options->detector == detection::Detector::kCharuco ? options->cols - 1 : options->cols;
+    }
     Result<std::string> png = detection::ContactSheetPng(sheet, so);
     if (!png.ok()) return Fail(png.status());
     sheet_png = std::move(*png);
@@ -302,8 +319,11 @@ Command AddDetectCommand(CLI::App& app) {
                   "Also write every image with its points and ids as one PNG");
   cmd->add_option("--contact-sheet-tile-px", a->sheet_tile_px, "Largest thumbnail width on the contact sheet, px")
       ->check(CLI::Range(64, 8192));
-  cmd->add_option("--detector", a->detector, "dots or chessboard")->check(CLI::IsMember({"dots", "chessboard"}));
+  cmd->add_option("--detector", a->detector, "dots, chessboard or charuco")
+      ->check(CLI::IsMember({"dots", "chessboard", "charuco"}));
   cmd->add_option("--grid", a->grid, "ROWSxCOLS: the dot grid (default 10x10) or the chessboard's inner corners");
+  cmd->add_option("--dictionary", a->dictionary, "charuco: the markers' OpenCV dictionary, e.g. DICT_6X6_250");
+  cmd->add_option("--board", a->board, "charuco: the board's squares XxY (OpenCV's squaresX x squaresY), e.g. 5x7");
   cmd->add_option("--identity", a->identity, "How dots are named: grid (larger origin dot), apriltag, order")
       ->check(CLI::IsMember({"grid", "apriltag", "order"}));
   cmd->add_option("--tag-side-mm", a->tag_side_mm, "apriltag: outer side of the tags' black border, mm")

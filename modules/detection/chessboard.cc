@@ -8,6 +8,8 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "detection/corner_refine.h"
+
 namespace selfcal::detection {
 
 namespace {
@@ -134,6 +136,39 @@ double MinSpacing(const std::vector<cv::Point2f>& c, int rows, int cols) {
   return best;
 }
 
+// Each corner refined by RefineCorner along its two edges (towards its grid neighbours), from OpenCV's
+// unrefined corner, over a radius of 0.45 times the distance to its nearest neighbour; a corner it cannot
+// refine keeps cornerSubPix's position in *refined.
+void RefineAlongEdges(const vpImage<unsigned char>& image, const std::vector<cv::Point2f>& rough,
+                      const ChessboardOptions& options, std::vector<cv::Point2f>* refined) {
+  const int rows = options.rows, cols = options.cols;
+  auto at = [&](int r, int c) {
+    const cv::Point2f& p = rough[static_cast<size_t>(r * cols + c)];
+    return Eigen::Vector2d(p.x, p.y);
+  };
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const Eigen::Vector2d along_col = at(r, std::min(c + 1, cols - 1)) - at(r, std::max(c - 1, 0));
+      const Eigen::Vector2d along_row = at(std::min(r + 1, rows - 1), c) - at(std::max(r - 1, 0), c);
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const auto& [dr, dc] : {std::pair{0, 1}, std::pair{0, -1}, std::pair{1, 0}, std::pair{-1, 0}}) {
+        if (r + dr >= 0 && r + dr < rows && c + dc >= 0 && c + dc < cols) nearest = std::min(nearest, (at(r + dr, c + dc) - at(r, c)).norm());
+      }
+      CornerRefineOptions ro;
+      ro.radius_px = 0.45 * nearest;
+      ro.edge_directions_px = {along_col.normalized(), along_row.normalized()};
+      // Narrow: a ChArUco board's markers (unknown here) may run parallel to the edges a few pixels away.
+      ro.band_px = 1.5;
+      if (!(ro.radius_px >= 1.5) || !ro.edge_directions_px[0].allFinite() || !ro.edge_directions_px[1].allFinite()) continue;
+      const CheckedCorner checked = RefineCornerChecked(image, at(r, c), ro, 1.5);
+      const RefinedCorner& chosen = checked.agree ? checked.large : checked.small;
+      if (chosen.ok) {
+        (*refined)[static_cast<size_t>(r * cols + c)] = cv::Point2f(static_cast<float>(chosen.px.x()), static_cast<float>(chosen.px.y()));
+      }
+    }
+  }
+}
+
 }  // namespace
 
 Status ChessboardOptions::Validate() const {
@@ -222,8 +257,10 @@ ChessboardDetection DetectChessboard(const vpImage<unsigned char>& image, const 
   }
   const double spacing = MinSpacing(found, options.rows, options.cols);
   const int half = std::clamp(static_cast<int>(std::floor(0.4 * spacing)), 1, options.max_subpix_half_window_px);
+  std::vector<cv::Point2f> rough = found;
   cv::cornerSubPix(mat, found, cv::Size(half, half), cv::Size(-1, -1),
                    cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-3));
+  RefineAlongEdges(image, rough, options, &found);
   std::vector<Eigen::Vector2d> corners;
   for (const cv::Point2f& p : found) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y)) {

@@ -1,10 +1,13 @@
 // Chessboard inner corners as unknown points with ids that name the same physical corner in every image.
 //
 // Corners: cv::findChessboardCorners (adaptive threshold, normalised image) on a board of rows x cols
-// inner corners, refined by cv::cornerSubPix with a window of 0.4 times the smallest corner spacing in the
-// image (at most 11 px either side) so that the window never reaches a neighbouring corner. The board's
-// square size is not used. Pixels as tracking/dot_detector.h (origin at the centre of the top-left pixel;
-// OpenCV's corner coordinates follow the same convention).
+// inner corners, each refined by RefineCornerChecked (detection/corner_refine.h) along its two edges (the
+// directions to its grid neighbours), out to 0.45 times the distance to its nearest neighbour, in a band of
+// 1.5 px (narrow enough to miss a ChArUco marker's border beside the edge); where the small and the large
+// window disagree by more than 1.5 px or the large one fails, the small window's corner, and where that
+// fails too cv::cornerSubPix's with a window of 0.4 times the smallest corner spacing in the image (at most 11 px
+// either side). The board's square size is not used. Pixels as tracking/dot_detector.h (origin at the
+// centre of the top-left pixel; OpenCV's corner coordinates follow the same convention).
 //
 // Ids: corner (row, col) has id row * cols + col. OpenCV returns the grid in one of several orderings
 // (a 9 x 6 board looks the same turned by 180 degrees, and OpenCV may start at either end), so each image's

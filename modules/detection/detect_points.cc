@@ -90,9 +90,29 @@ ImagePoints ChessboardPoints(const vpImage<unsigned char>& image, const Detectio
   return out;
 }
 
+ImagePoints CharucoPoints(const vpImage<unsigned char>& image, const DetectionOptions& options) {
+  CharucoOptions co = options.charuco;
+  co.rows = options.rows;
+  co.cols = options.cols;
+  const CharucoDetection c = DetectCharuco(image, co);
+  ImagePoints out;
+  out.ok = c.found;
+  out.message = c.message;
+  out.points_px = c.corners_px;
+  out.candidates = c.markers;
+  return out;
+}
+
 }  // namespace
 
-const char* DetectorName(Detector detector) { return detector == Detector::kDots ? "dots" : "chessboard"; }
+const char* DetectorName(Detector detector) {
+  switch (detector) {
+    case Detector::kDots: return "dots";
+    case Detector::kChessboard: return "chessboard";
+    case Detector::kCharuco: return "charuco";
+  }
+  return "unknown";
+}
 
 const char* IdentityName(Identity identity) {
   switch (identity) {
@@ -106,7 +126,8 @@ const char* IdentityName(Identity identity) {
 Result<Detector> ParseDetector(const std::string& name) {
   if (name == "dots") return Detector::kDots;
   if (name == "chessboard") return Detector::kChessboard;
-  return Status::Error(ErrorCode::kInvalidInput, "unknown detector `" + name + "`: dots or chessboard");
+  if (name == "charuco") return Detector::kCharuco;
+  return Status::Error(ErrorCode::kInvalidInput, "unknown detector `" + name + "`: dots, chessboard or charuco");
 }
 
 Result<Identity> ParseIdentity(const std::string& name) {
@@ -118,9 +139,17 @@ Result<Identity> ParseIdentity(const std::string& name) {
 
 Status DetectionOptions::Validate() const {
   std::ostringstream s;
+  if (detector != Detector::kDots && identity != Identity::kGrid) {
+    s << "a " << DetectorName(detector) << " board's corners are named by the board; identity " << IdentityName(identity)
+      << " applies to dots only\n";
+  }
   if (detector == Detector::kChessboard) {
-    if (identity != Identity::kGrid) s << "a chessboard's corners are named by the grid; identity " << IdentityName(identity) << " applies to dots only\n";
     ChessboardOptions co = chessboard;
+    co.rows = rows;
+    co.cols = cols;
+    if (Status v = co.Validate(); !v.ok()) s << v.message();
+  } else if (detector == Detector::kCharuco) {
+    CharucoOptions co = charuco;
     co.rows = rows;
     co.cols = cols;
     if (Status v = co.Validate(); !v.ok()) s << v.message();
@@ -147,6 +176,7 @@ ImagePoints DetectImagePoints(const vpImage<unsigned char>& image, const Detecti
   const Status valid = options.Validate();
   SELFCAL_CHECK(valid.ok(), "invalid DetectionOptions:\n" << valid.message());
   if (options.detector == Detector::kChessboard) return ChessboardPoints(image, options, previous);
+  if (options.detector == Detector::kCharuco) return CharucoPoints(image, options);
   const tracking::DetectionReport det = tracking::DetectDots(image, options.dots);
   switch (options.identity) {
     case Identity::kGrid: return GridPoints(det, options);

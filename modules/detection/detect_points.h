@@ -14,7 +14,10 @@
 //   dots + order      tracking::DetectDots: id = the dot's index in the detector's raster order. The same
 //                     id names the same dot only when every image shows the dots in the same raster order
 //                     (a nearly still camera); for anything else use grid or apriltag;
-//   chessboard        inner corners, ordered consistently (detection/chessboard.h): id = row * cols + col.
+//   chessboard        inner corners, ordered consistently (detection/chessboard.h): id = row * cols + col;
+//   charuco           a ChArUco board's inner corners named by its ArUco markers (detection/charuco.h):
+//                     OpenCV's ChArUco corner ids, the same physical corner in every image however much of
+//                     the board is seen.
 // Pixels as tracking/dot_detector.h.
 #pragma once
 
@@ -28,6 +31,7 @@
 
 #include "base/progress.h"
 #include "base/status.h"
+#include "detection/charuco.h"
 #include "detection/chessboard.h"
 #include "geometry/rigid3.h"
 #include "observations/observation_set.h"
@@ -37,18 +41,18 @@
 
 namespace selfcal::detection {
 
-enum class Detector { kDots, kChessboard };
+enum class Detector { kDots, kChessboard, kCharuco };
 enum class Identity { kGrid, kAprilTag, kOrder };
 const char* DetectorName(Detector detector);
 const char* IdentityName(Identity identity);
-// "dots" / "chessboard", "grid" / "apriltag" / "order"; kInvalidInput otherwise.
+// "dots" / "chessboard" / "charuco", "grid" / "apriltag" / "order"; kInvalidInput otherwise.
 Result<Detector> ParseDetector(const std::string& name);
 Result<Identity> ParseIdentity(const std::string& name);
 
 struct DetectionOptions {
   Detector detector = Detector::kDots;
   Identity identity = Identity::kGrid;  // dots only; a chessboard names its corners by the grid
-  int rows = 10;  // dots + grid: the dot grid; chessboard: inner corners
+  int rows = 10;  // dots + grid: the dot grid; chessboard: inner corners; charuco: squares
   int cols = 10;
   tracking::DotDetectorOptions dots;
   tracking::GridIdentityOptions grid;  // rows and cols are taken from above
@@ -57,6 +61,7 @@ struct DetectionOptions {
   std::vector<Eigen::Vector2d> tag_dots_m;  // apriltag: the layout around every tag, (x, y) in its frame
   double tag_tolerance_px = 3.0;
   ChessboardOptions chessboard;  // rows and cols are taken from above
+  CharucoOptions charuco;        // the dictionary; rows and cols (squares) are taken from above
   ProgressSink* progress = nullptr;  // DetectAllImagePoints: told each image done; null: nothing reported
 
   // Every problem, one per line (kInvalidInput).
@@ -67,7 +72,7 @@ struct ImagePoints {
   bool ok = false;
   std::string message;                     // why not (ok false), or how the ids were chosen
   std::map<int, Eigen::Vector2d> points_px;  // id -> pixel
-  int candidates = 0;                      // dots detected (dots) or corners found (chessboard)
+  int candidates = 0;                      // dots detected (dots), corners found (chessboard), markers (charuco)
 };
 
 // The points of one image. `previous` is the previous image's result (chessboard continuity), or nullptr.
