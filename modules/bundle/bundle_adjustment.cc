@@ -379,6 +379,63 @@ void EstimateCovariance(const BundleData& data, const BundleState& state, const 
   }
 }
 
+// The score test of the parameters held by request (`held`, and the intrinsics the request estimates
+// but the names hold) at the solution, under the estimated error model (error_model.h).
+void TestHeldParameters(const BundleData& data, const BundleState& state, const std::vector<int>& free,
+                        const BundleOptions& options, const std::vector<int>& held, const IntrinsicsMask& requested,
+                        BundleReport* report) {
+  internal::GlobalColumns columns;
+  columns.kinematic = free;
+  columns.intrinsics = EstimatedIntrinsics(options.intrinsics);
+  const int num_free = columns.size();
+  std::vector<int> held_intrinsics;
+  for (int i = 0; i < kNumIntrinsics; ++i) {
+    if (requested[i] && !options.intrinsics[i]) held_intrinsics.push_back(i);
+  }
+  if ((held.empty() && held_intrinsics.empty()) || !report->covariance_available) return;
+  // Order [free kinematic | held kinematic], [free intrinsics | held intrinsics]; permuted to free | held below.
+  columns.kinematic.insert(columns.kinematic.end(), held.begin(), held.end());
+  const int num_kinematic = static_cast<int>(columns.kinematic.size());
+  const int num_estimated = static_cast<int>(columns.intrinsics.size());
+  columns.intrinsics.insert(columns.intrinsics.end(), held_intrinsics.begin(), held_intrinsics.end());
+  Eigen::MatrixXd reduced;
+  internal::PoseErrorColumns pose;
+  if (!internal::ReducedJacobian(data, state, columns, &reduced, &pose)) return;
+  const std::vector<std::string> all = internal::GlobalNames(columns, data.robot.num_joints());
+  std::vector<int> order;
+  for (int c = 0; c < static_cast<int>(free.size()); ++c) order.push_back(c);
+  for (int c = 0; c < num_estimated; ++c) order.push_back(num_kinematic + c);
+  std::vector<std::string> names;
+  for (int c = static_cast<int>(free.size()); c < num_kinematic; ++c) order.push_back(c);
+  for (int c = num_kinematic + num_estimated; c < columns.size(); ++c) order.push_back(c);
+  for (int k = num_free; k < columns.size(); ++k) names.push_back(all[order[k]]);
+  Eigen::MatrixXd permuted(reduced.rows(), reduced.cols());
+  Eigen::VectorXd gradient(columns.size() - num_free), norm_sq(columns.size() - num_free);
+  for (int k = 0; k < columns.size(); ++k) permuted.col(k) = reduced.col(order[k]);
+  permuted.rightCols(reduced.cols() - columns.size()) = reduced.rightCols(reduced.cols() - columns.size());
+  for (int k = num_free; k < columns.size(); ++k) {
+    gradient[k - num_free] = pose.global_gradient[order[k]];
+    norm_sq[k - num_free] = pose.global_norm_sq[order[k]];
+  }
+  const double s = report->pixel_noise_estimate_px / data.sigma_px;
+  // The error model of the fit with the held parameters freed (one linear step): a wrong held value leaves a
+  // pose error behind that would otherwise be taken as the cell's noise and hide it.
+  ErrorModel freed = report->error_model;
+  if (options.estimate_pose_error) {
+    Eigen::VectorXd global_gradient = Eigen::VectorXd::Zero(columns.size());
+    global_gradient.tail(gradient.size()) = gradient;
+    freed = internal::EstimateErrorModel(permuted, columns.size(), pose.gradient, pose.residual_sq,
+                                         report->residual_dof - static_cast<int>(gradient.size()), data.sigma_px,
+                                         global_gradient);
+    if (!freed.estimated) freed = report->error_model;
+  }
+  report->held_values =
+      internal::TestHeldValues(permuted, num_free, names, gradient, norm_sq, freed, data.sigma_px, s * s);
+  report->held_values.decisive =
+      options.free_parameters.empty() &&
+      std::find(options.held_parameters.begin(), options.held_parameters.end(), "kinematics") == options.held_parameters.end();
+}
+
 }  // namespace
 
 BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen::VectorXd& rho_start,
@@ -465,6 +522,7 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
     report.rms_reprojection_px = report.num_observations > 0 ? std::sqrt(sum2 / report.num_observations) : 0.0;
   }
   EstimateCovariance(data, state, gauge.free_kinematic, options, summary.final_cost, &report);
+  TestHeldParameters(data, state, gauge.free_kinematic, options, held, requested.intrinsics, &report);
 
   std::ostringstream msg;
   msg << (converged ? "converged" : "not converged") << ": "

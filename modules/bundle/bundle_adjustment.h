@@ -157,6 +157,8 @@ struct BundleReport {
   double condition_number = 0;                // column-normalised reduced Jacobian of the free set
   // The estimated error model of the cell (BundleOptions::estimate_pose_error; error_model.h).
   ErrorModel error_model;
+  // The parameters held by request tested against the data (error_model.h's score test).
+  HeldValueTest held_values;
   // Marginal standard deviations, dots as nuisance, under error_model when it was estimated (error_model.h's
   // sandwich), else s^2 (J_g^T (I - P_dots) J_g)^-1 over the free columns, s^2 = 2 final_cost /
   // (residuals - unknowns). NaN for fixed entries or when unavailable (K8).

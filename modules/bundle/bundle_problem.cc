@@ -283,6 +283,8 @@ bool ReducedJacobian(const BundleData& data, const BundleState& state, const Glo
   const int width = num_global + (pose_errors != nullptr ? 6 * num_poses : 0);
   if (pose_errors != nullptr) {
     pose_errors->gradient = Eigen::VectorXd::Zero(6 * num_poses);
+    pose_errors->global_gradient = Eigen::VectorXd::Zero(num_global);
+    pose_errors->global_norm_sq = Eigen::VectorXd::Zero(num_global);
     pose_errors->residual_sq = 0;
   }
   std::vector<PoseCache> caches(num_poses);
@@ -337,6 +339,8 @@ bool ReducedJacobian(const BundleData& data, const BundleState& state, const Glo
       }
       if (pose_errors != nullptr) {
         AddPoseErrorColumns(caches[o.pose], state.dots[o.dot], d_dot, residual, num_global, o.pose, row, &b, pose_errors);
+        pose_errors->global_gradient += b.block(row, 0, 2, num_global).transpose() * Eigen::Vector2d(residual[0], residual[1]);
+        pose_errors->global_norm_sq += b.block(row, 0, 2, num_global).colwise().squaredNorm().transpose();
       }
       row += 2;
     }

@@ -90,6 +90,8 @@ bool EvaluateReprojection(const IntrinsicsVector& intrinsics, double sigma_px, c
 // receives those columns' gradient J^T r and the whitened residuals' sum of squares at `state`.
 struct PoseErrorColumns {
   Eigen::VectorXd gradient;  // 6 per pose: (v, omega)
+  Eigen::VectorXd global_gradient;  // J^T r of the global columns
+  Eigen::VectorXd global_norm_sq;   // their squared norms before the dots are eliminated
   double residual_sq = 0;
 };
 bool ReducedJacobian(const BundleData& data, const BundleState& state, const GlobalColumns& columns,

@@ -1,8 +1,10 @@
 #include "bundle/error_model.h"
 
 #include <algorithm>
+#include <cstdio>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 namespace selfcal::bundle::internal {
 
@@ -29,7 +31,7 @@ bool InverseSpd(const Eigen::MatrixXd& s, Eigen::MatrixXd* inverse) {
 }  // namespace
 
 ErrorModel EstimateErrorModel(const Eigen::MatrixXd& reduced, int num_global, const Eigen::VectorXd& gradient,
-                              double residual_sq, int dof, double sigma_px) {
+                              double residual_sq, int dof, double sigma_px, const Eigen::VectorXd& global_gradient) {
   ErrorModel model;
   const int width = static_cast<int>(reduced.cols());
   const int num_poses = (width - num_global) / 6;
@@ -48,6 +50,7 @@ ErrorModel EstimateErrorModel(const Eigen::MatrixXd& reduced, int num_global, co
     s = w * normal;
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(width);
     rhs.tail(6 * num_poses) = w * gradient;
+    if (global_gradient.size() == num_global) rhs.head(num_global) = w * global_gradient;
     for (int i = 0; i < num_poses; ++i) {
       for (int k = 0; k < 6; ++k) s(num_global + 6 * i + k, num_global + 6 * i + k) += 1.0 / (k < 3 ? var_t : var_r);
     }
@@ -113,6 +116,72 @@ Eigen::MatrixXd ModelCovariance(const Eigen::MatrixXd& reduced, int num_global, 
   *pose_part = cross * theta.asDiagonal() * cross.transpose();
   covariance += *pose_part;
   return covariance;
+}
+
+HeldValueTest TestHeldValues(const Eigen::MatrixXd& reduced, int num_free, const std::vector<std::string>& names,
+                             const Eigen::VectorXd& gradient, const Eigen::VectorXd& norm_sq, const ErrorModel& model,
+                             double sigma_px, double pixel_variance) {
+  HeldValueTest test;
+  const int num_held = static_cast<int>(names.size());
+  const int num_pose = static_cast<int>(reduced.cols()) - num_free - num_held;
+  if (num_held == 0 || num_pose < 0 || gradient.size() != num_held || norm_sq.size() != num_held) return test;
+  const Eigen::MatrixXd a = reduced.transpose() * reduced;
+  const Eigen::MatrixXd a_ff = a.topLeftCorner(num_free, num_free);
+  Eigen::MatrixXd a_ff_inverse;
+  if (num_free > 0 && !InverseSpd(a_ff, &a_ff_inverse)) return test;
+  // The held and pose columns with the free ones projected out.
+  const Eigen::MatrixXd rest = a.block(num_free, num_free, num_held + num_pose, num_held + num_pose) -
+                               (num_free > 0 ? Eigen::MatrixXd(a.block(num_free, 0, num_held + num_pose, num_free) *
+                                                               a_ff_inverse * a.block(0, num_free, num_free, num_held + num_pose))
+                                             : Eigen::MatrixXd::Zero(num_held + num_pose, num_held + num_pose));
+  const Eigen::MatrixXd s_hh = rest.topLeftCorner(num_held, num_held);
+  const Eigen::MatrixXd s_he = rest.topRightCorner(num_held, num_pose);
+  const double var_px = model.estimated ? (model.pixel_px / sigma_px) * (model.pixel_px / sigma_px) : pixel_variance;
+  Eigen::MatrixXd covariance = var_px * s_hh;
+  if (model.estimated && num_pose > 0) {
+    Eigen::VectorXd theta(num_pose);
+    for (int c = 0; c < num_pose; ++c) {
+      const double sd = c % 6 < 3 ? model.pose_translation_m : model.pose_rotation_rad;
+      theta[c] = sd * sd;
+    }
+    covariance += s_he * theta.asDiagonal() * s_he.transpose();
+  }
+  // A held column in the span of the free ones and the dots (the gauge's, or one the poses cannot see)
+  // carries no information: left out.
+  // (Its squared norm after the eliminations is then ~1e-15 of its norm before them.)
+  constexpr double kSeenFraction = 1e-8;
+  std::vector<int> seen;
+  for (int h = 0; h < num_held; ++h) {
+    if (s_hh(h, h) > kSeenFraction * norm_sq[h] && covariance(h, h) > 0) seen.push_back(h);
+  }
+  if (seen.empty()) return test;
+  const int n = static_cast<int>(seen.size());
+  Eigen::MatrixXd c(n, n);
+  Eigen::VectorXd g(n), scale(n);
+  for (int i = 0; i < n; ++i) {
+    scale[i] = 1.0 / std::sqrt(covariance(seen[i], seen[i]));
+    g[i] = gradient[seen[i]] * scale[i];
+    for (int j = 0; j < n; ++j) c(i, j) = covariance(seen[i], seen[j]) * scale[i] * scale[j];
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(c);
+  const double top = eigen.eigenvalues().maxCoeff();
+  test.chi_square = 0;
+  for (int k = 0; k < n; ++k) {
+    if (!(eigen.eigenvalues()[k] > 1e-10 * top)) continue;
+    const double projection = eigen.eigenvectors().col(k).dot(g);
+    test.chi_square += projection * projection / eigen.eigenvalues()[k];
+    ++test.dof;
+  }
+  int worst = 0;
+  for (int i = 0; i < n; ++i) {
+    test.names.push_back(names[seen[i]]);
+    if (std::abs(g[i]) > std::abs(g[worst])) worst = i;
+  }
+  char words[160];
+  std::snprintf(words, sizeof words, "%s (its own score %.1f sigma)", names[seen[worst]].c_str(), std::abs(g[worst]));
+  test.largest = words;
+  test.tested = test.dof > 0;
+  return test;
 }
 
 }  // namespace selfcal::bundle::internal

@@ -29,6 +29,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -45,18 +46,46 @@ struct ErrorModel {
   int iterations = 0;
 };
 
+// The parameters held by request (--fix) tested against the data: the score test. At the solution the
+// cost's gradient with respect to a held parameter, s = J_h^T r, is zero on average when its value is right;
+// its covariance under the error model, with the free parameters and the dots projected out, is
+// s_px^2 S_hh + S_he Theta S_eh, and T = s^T Cov(s)^-1 s is chi-square with as many degrees of freedom as held
+// parameters the data can see (the others, e.g. the gauge's, are left out). A held value the images
+// disagree with shows here long before it shows in the pose error it leaves behind.
+struct HeldValueTest {
+  bool tested = false;
+  std::vector<std::string> names;  // the held parameters the data can see
+  int dof = 0;
+  double chi_square = NAN;
+  std::string largest;  // the parameter whose own score is the largest, in words
+  // False when the request trusts a whole model (`kinematics`, or a free list holding everything else): the
+  // hand-eye-only solve takes the arm's model as it is, its errors part of each image's pose error.
+  bool decisive = true;
+};
+
 namespace internal {
 
 // reduced: the reduced Jacobian with the pose columns (bundle_problem.h, whitened by sigma_px: the
 // stated noise), num_global columns of globals first; gradient, residual_sq: its PoseErrorColumns; dof:
 // residuals (pixel coordinates and yardsticks) minus unknowns (globals and dots).
+// global_gradient (optional): J^T r of the global columns, for columns that are not at their optimum (held
+// ones taken as free: the error model of the fit with them freed, one linear step away).
 ErrorModel EstimateErrorModel(const Eigen::MatrixXd& reduced, int num_global, const Eigen::VectorXd& gradient,
-                              double residual_sq, int dof, double sigma_px);
+                              double residual_sq, int dof, double sigma_px,
+                              const Eigen::VectorXd& global_gradient = Eigen::VectorXd());
 
 // The globals' covariance under `model` (above), given inverse = S^-1 of the globals' reduced matrix
 // (CovarianceFromJacobian of reduced's first num_global columns); *pose_part: its pose-error term.
 Eigen::MatrixXd ModelCovariance(const Eigen::MatrixXd& reduced, int num_global, const Eigen::MatrixXd& inverse,
                                 const ErrorModel& model, double sigma_px, Eigen::MatrixXd* pose_part);
+
+// reduced: the reduced Jacobian with pose columns over [free globals (num_free) | held (num_held)]; names:
+// the held columns'; gradient, norm_sq: J^T r and the squared norms (before the dots' elimination) of the held
+// columns; pixel_variance: the pixel variance in units of the stated noise's square (used when no pose error
+// was estimated).
+HeldValueTest TestHeldValues(const Eigen::MatrixXd& reduced, int num_free, const std::vector<std::string>& names,
+                             const Eigen::VectorXd& gradient, const Eigen::VectorXd& norm_sq, const ErrorModel& model,
+                             double sigma_px, double pixel_variance);
 
 }  // namespace internal
 }  // namespace selfcal::bundle

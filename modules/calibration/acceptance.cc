@@ -174,12 +174,29 @@ AcceptanceCheck PlausibleCorrections(const AcceptanceInputs& in) {
   return check;
 }
 
+AcceptanceCheck HeldValues(const AcceptanceInputs& in) {
+  AcceptanceCheck check{"held_values", CheckStatus::kNotAvailable, "no parameter held by request that the images can see"};
+  if (in.held_values == nullptr || !in.held_values->tested) return check;
+  const bundle::HeldValueTest& t = *in.held_values;
+  const double limit = ChiSquareQuantile(kHeldOutTestLevel, t.dof);
+  std::string names;
+  for (const std::string& n : t.names) names += (names.empty() ? "" : ", ") + n;
+  check.status = t.chi_square <= limit ? CheckStatus::kPassed : CheckStatus::kFailed;
+  check.decisive = t.decisive;
+  check.sentence = "the values held by request (" + names + ") against the images: score " +
+                   Format("chi-square %.4g over %.0f degrees of freedom, ", t.chi_square, t.dof) +
+                   Format(t.chi_square <= limit ? "within its 95 %% limit of %.4g" : "above its 95 %% limit of %.4g", limit) +
+                   (t.chi_square <= limit ? "" : ": the images disagree with a held value, most with " + t.largest +
+                                                     "; free it or correct it in the robot description or camera file");
+  return check;
+}
+
 }  // namespace
 
 Acceptance AcceptanceOf(const AcceptanceInputs& inputs) {
   Acceptance a;
   a.checks = {HeldOutTest(inputs), BeatsNominalHeldOut(inputs), BeatsNominalDistances(inputs),
-              PlausibleCorrections(inputs)};
+              PlausibleCorrections(inputs), HeldValues(inputs)};
   return a;
 }
 

@@ -11,6 +11,9 @@
 //                            the prediction's uncertainty, it is a figure, because a correct model at its
 //                            own uncertainty measures worse than a lucky nominal model (measured: 4 of 50
 //                            correct simulated calibrations, each within its predicted distance error).
+//   held_values              the parameters held by request (--fix) agree with the images: the score test
+//                            of bundle/error_model.h at kHeldOutTestLevel (a held value the data disagree
+//                            with leaves a pose error behind that the held-out test would take as noise)
 //   plausible_corrections    no angular correction of the kinematic model beyond kMaxAngularCorrectionRad
 //                            (45 deg) and no length correction beyond kMaxLengthCorrectionM (100 mm): a
 //                            calibration corrects a description by small amounts, and a model
@@ -33,6 +36,7 @@
 
 #include <Eigen/Core>
 
+#include "bundle/error_model.h"
 #include "calibration/heldout_reprojection.h"
 #include "calibration/paper_pipeline.h"
 
@@ -72,6 +76,8 @@ struct AcceptanceInputs {
   // empty for the paper's method.
   const RobotModel* robot = nullptr;
   Eigen::VectorXd corrections;
+  // The score test of the parameters held by request (bundle/error_model.h); null: none.
+  const bundle::HeldValueTest* held_values = nullptr;
 };
 
 inline constexpr double kMaxAngularCorrectionRad = 0.7853981633974483;  // 45 deg

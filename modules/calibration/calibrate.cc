@@ -131,6 +131,7 @@ void CheckAcceptance(const ObservationSet& obs, const ObservationSet& original, 
       in.test_at_stated_noise = nullptr;
       in.no_test_reason = "the flange poses have a stated noise, which the test does not model";
     }
+    in.held_values = &stage.bundle.held_values;
     in.distances_calibrated = &stage.verification;
     in.distances_nominal = &stage.verification_nominal;
     in.distances_decisive = false;

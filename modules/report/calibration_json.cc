@@ -111,6 +111,11 @@ json ErrorModelJson(const bundle::ErrorModel& m) {
           {"iterations", m.iterations}};
 }
 
+json HeldValuesJson(const bundle::HeldValueTest& t) {
+  return {{"tested", t.tested}, {"names", t.names}, {"dof", t.dof}, {"chi_square", Finite(t.chi_square)},
+          {"largest", t.largest}, {"decisive", t.decisive}};
+}
+
 json PredictedErrorJson(const calibration::PredictedDistanceErrors& p) {
   json distances = json::array();
   for (const calibration::PredictedDistanceError& e : p.distances) {
@@ -314,6 +319,7 @@ json BundleSectionJson(const ObservationSet& obs, const calibration::BundleStage
           {"covariance_available", b.covariance_available},
           {"covariance_message", b.covariance_message},
           {"error_model", ErrorModelJson(b.error_model)},
+          {"held_values", HeldValuesJson(b.held_values)},
           {"parameters", ParametersJson(obs, b.rho, b.stddev, b.free_indices, "value", true)},
           {"verification", VerificationJson(obs, stage.verification_nominal, stage.verification)},
           {"predicted_3d_error", PredictedErrorJson(stage.predicted_error)},
