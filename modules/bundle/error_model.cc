@@ -13,7 +13,9 @@ namespace {
 // Below these the pose error moves no dot by a thousandth of a pixel: the component is taken as absent.
 constexpr double kTranslationFloorM = 1e-6;
 constexpr double kRotationFloorRad = 1e-6;
-constexpr int kMaxIterations = 60;
+constexpr int kMaxIterations = 40;
+constexpr int kFreezeAfter = 3;
+constexpr double kFreezeRedundancy = 0.1;
 constexpr double kRelativeTolerance = 1e-3;  // on the standard deviations
 constexpr double kMinRedundancy = 1.0;
 
@@ -78,8 +80,11 @@ ErrorModel EstimateErrorModel(const Eigen::MatrixXd& reduced, int num_global, co
       return model;
     }
     const double new_px = var_px * energy_px / red_px;
-    const double new_t = red_t > 1e-9 ? std::max(sum_t / red_t, floor_t) : floor_t;
-    const double new_r = red_r > 1e-9 ? std::max(sum_r / red_r, floor_r) : floor_r;
+    // A component whose redundancy has fallen far below one is absent (it only drifts further towards zero,
+    // iteration after iteration): held at its floor from then on.
+    const bool freeze = model.iterations >= kFreezeAfter;
+    const double new_t = red_t > (freeze ? kFreezeRedundancy : 1e-9) ? std::max(sum_t / red_t, floor_t) : floor_t;
+    const double new_r = red_r > (freeze ? kFreezeRedundancy : 1e-9) ? std::max(sum_r / red_r, floor_r) : floor_r;
     const auto settled = [](double a, double b, double floor) {
       return (a <= floor && b <= floor) || std::abs(std::sqrt(a) - std::sqrt(b)) <= kRelativeTolerance * std::sqrt(b);
     };
