@@ -202,6 +202,16 @@ Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationRep
     WriteHtmlBeside(document, html_path);
     if (std::filesystem::exists(html_path)) AddOutputFile("report_html", html_path);
   }
+  // An earlier run's model files in this directory (there only with --force, output_options.h) would sit
+  // beside a report of this run: gone before this run writes its own, or none.
+  for (const char* name : {"calibrated_model.yaml", "calibrated.urdf", "calibrated_robot.yaml",
+                           "camera_static_transform.yaml", "hand_eye.yaml"}) {
+    std::error_code error;
+    if (std::filesystem::remove(out / name, error)) {
+      std::cout << "removed the earlier run's " << (out / name).string() << (report.model ? "" : " (this run wrote no model)")
+                << "\n";
+    }
+  }
   if (!report.model) return Status::Ok();
   const io::RobotOrigin origin = request.robot_config.empty() && loaded.origin
                                      ? *loaded.origin

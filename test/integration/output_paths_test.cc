@@ -258,6 +258,20 @@ TEST_F(OutputPathsTest, AnEarlierRunsOutputsAreReplacedOnlyWithForce) {
   EXPECT_EQ(forced.code, 0) << forced.out << forced.err;
   EXPECT_NE(ReadFile((*root_ / "again" / "report.json").string()), "mine\n");
 
+  // A forced run that writes no model (f_x held 2 % off: refused) removes the earlier run's model: it would sit
+  // beside a report that says rejected.
+  ASSERT_TRUE(fs::exists(*root_ / "again" / "calibrated_model.yaml"));
+  std::string observations = ReadFile((*root_ / "in" / "obs.yaml").string());
+  const size_t fx = observations.find("fx_px: 1000,");
+  ASSERT_NE(fx, std::string::npos);
+  observations.replace(fx, 12, "fx_px: 1020,");
+  WriteFile((*root_ / "fx_off.yaml").string(), observations);
+  const Output refused = RunIn(*root_, "calibrate fx_off.yaml --out again --force --fix fx");
+  EXPECT_EQ(refused.code, 6) << refused.out << refused.err;
+  EXPECT_FALSE(fs::exists(*root_ / "again" / "calibrated_model.yaml"));
+  EXPECT_FALSE(fs::exists(*root_ / "again" / "calibrated.urdf"));
+  EXPECT_TRUE(Contains(refused.out, "removed the earlier run's")) << refused.out;
+
   WriteFile((*root_ / "mine.yaml").string(), "mine\n");
   const Output trajectory = RunIn(*root_, "make-trajectory --robot in/robot.yaml --out mine.yaml");
   EXPECT_EQ(trajectory.code, 2) << trajectory.out << trajectory.err;
