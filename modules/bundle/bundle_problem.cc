@@ -10,6 +10,8 @@
 #include <Eigen/Dense>
 #include <ceres/jet.h>
 
+#include "geometry/rigid3.h"
+
 namespace selfcal::bundle::internal {
 
 namespace {
@@ -259,13 +261,8 @@ void AddPoseErrorColumns(const PoseCache& cache, const Eigen::Vector3d& dot, con
                          const double* residual, int num_global, int pose, int row, Eigen::MatrixXd* b,
                          PoseErrorColumns* pose_errors) {
   const Eigen::Matrix<double, 2, 3, Eigen::RowMajor> d_base(d_dot);
-  const Eigen::Matrix<double, 2, 3> d_cam = d_base * cache.rotation.transpose();
-  const Eigen::Vector3d p = cache.rotation * dot + cache.translation;
-  Eigen::Matrix3d cross;
-  cross << 0, -p.z(), p.y(), p.z(), 0, -p.x(), -p.y(), p.x(), 0;
-  Eigen::Matrix<double, 2, 6> j;
-  j.leftCols<3>() = d_cam;
-  j.rightCols<3>() = -d_cam * cross;
+  const Eigen::Matrix<double, 2, 6> j =
+      d_base * cache.rotation.transpose() * SmallMotionJacobian(cache.rotation * dot + cache.translation);
   b->block<2, 6>(row, num_global + 6 * pose) = j;
   const Eigen::Vector2d r(residual[0], residual[1]);
   pose_errors->gradient.segment<6>(6 * pose) += j.transpose() * r;

@@ -30,6 +30,16 @@ bool InverseSpd(const Eigen::MatrixXd& s, Eigen::MatrixXd* inverse) {
   return inverse->allFinite();
 }
 
+// Theta's diagonal over `num_columns` pose columns (v, omega per pose): the model's variances.
+Eigen::VectorXd PoseVariances(const ErrorModel& model, int num_columns) {
+  Eigen::VectorXd theta(num_columns);
+  for (int c = 0; c < num_columns; ++c) {
+    const double sd = c % 6 < 3 ? model.pose_translation_m : model.pose_rotation_rad;
+    theta[c] = sd * sd;
+  }
+  return theta;
+}
+
 }  // namespace
 
 ErrorModel EstimateErrorModel(const Eigen::MatrixXd& reduced, int num_global, const Eigen::VectorXd& gradient,
@@ -111,14 +121,9 @@ Eigen::MatrixXd ModelCovariance(const Eigen::MatrixXd& reduced, int num_global, 
   const int num_pose_columns = static_cast<int>(reduced.cols()) - num_global;
   *pose_part = Eigen::MatrixXd::Zero(inverse.rows(), inverse.cols());
   if (num_pose_columns <= 0) return covariance;
-  Eigen::VectorXd theta(num_pose_columns);
-  for (int c = 0; c < num_pose_columns; ++c) {
-    const double sd = c % 6 < 3 ? model.pose_translation_m : model.pose_rotation_rad;
-    theta[c] = sd * sd;
-  }
   const Eigen::MatrixXd cross =
       inverse * (reduced.leftCols(num_global).transpose() * reduced.rightCols(num_pose_columns));
-  *pose_part = cross * theta.asDiagonal() * cross.transpose();
+  *pose_part = cross * PoseVariances(model, num_pose_columns).asDiagonal() * cross.transpose();
   covariance += *pose_part;
   return covariance;
 }
@@ -143,14 +148,7 @@ HeldValueTest TestHeldValues(const Eigen::MatrixXd& reduced, int num_free, const
   const Eigen::MatrixXd s_he = rest.topRightCorner(num_held, num_pose);
   const double var_px = model.estimated ? (model.pixel_px / sigma_px) * (model.pixel_px / sigma_px) : pixel_variance;
   Eigen::MatrixXd covariance = var_px * s_hh;
-  if (model.estimated && num_pose > 0) {
-    Eigen::VectorXd theta(num_pose);
-    for (int c = 0; c < num_pose; ++c) {
-      const double sd = c % 6 < 3 ? model.pose_translation_m : model.pose_rotation_rad;
-      theta[c] = sd * sd;
-    }
-    covariance += s_he * theta.asDiagonal() * s_he.transpose();
-  }
+  if (model.estimated && num_pose > 0) covariance += s_he * PoseVariances(model, num_pose).asDiagonal() * s_he.transpose();
   // A held column in the span of the free ones and the dots (the gauge's, or one the poses cannot see)
   // carries no information: left out.
   // (Its squared norm after the eliminations is then ~1e-15 of its norm before them.)

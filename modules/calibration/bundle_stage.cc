@@ -101,11 +101,11 @@ HeldOutReprojection HeldOutReprojectionOfBundle(const ObservationSet& obs, const
   if (b.covariance_available) {
     calibrated.covariance = b.covariance_free;
     if (*noise_px != fitted_px) {  // the pixel part scales with the pixel variance, the pose part does not
-      const bool split = b.covariance_pose_part.rows() == b.covariance_free.rows();
-      const Eigen::MatrixXd pose_part = split ? b.covariance_pose_part : Eigen::MatrixXd::Zero(0, 0);
+      const Eigen::Index n = b.covariance_free.rows();
+      const Eigen::MatrixXd pose_part =
+          b.covariance_pose_part.rows() == n ? b.covariance_pose_part : Eigen::MatrixXd::Zero(n, n);
       const double ratio = (*noise_px / fitted_px) * (*noise_px / fitted_px);
-      calibrated.covariance = split ? Eigen::MatrixXd(ratio * (b.covariance_free - pose_part) + pose_part)
-                                    : Eigen::MatrixXd(ratio * b.covariance_free);
+      calibrated.covariance = ratio * (b.covariance_free - pose_part) + pose_part;
     }
   }
   if (model) {

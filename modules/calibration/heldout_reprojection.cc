@@ -5,6 +5,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
+#include "geometry/rigid3.h"
 #include "identification/triangulation.h"
 
 namespace selfcal::calibration {
@@ -230,13 +231,9 @@ HeldOutFigure FigureOf(const std::string& pose_id, int begin, int end, const Res
 // p_base, p_cam = R p_base + t), d p_cam / d v = I, d p_cam / d omega = -[p_cam]x.
 Eigen::Matrix<double, 2, 6> PoseErrorRows(const Rigid3& cam_from_base, const Eigen::Vector3d& p_base,
                                           const Matrix23& jd, double translation_sd, double rotation_sd) {
-  const Matrix23 d_cam = jd * cam_from_base.rotation.transpose();
-  const Eigen::Vector3d p = cam_from_base * p_base;
-  Eigen::Matrix3d cross;
-  cross << 0, -p.z(), p.y(), p.z(), 0, -p.x(), -p.y(), p.x(), 0;
-  Eigen::Matrix<double, 2, 6> rows;
-  rows.leftCols<3>() = translation_sd * d_cam;
-  rows.rightCols<3>() = -rotation_sd * d_cam * cross;
+  Eigen::Matrix<double, 2, 6> rows = jd * cam_from_base.rotation.transpose() * SmallMotionJacobian(cam_from_base * p_base);
+  rows.leftCols<3>() *= translation_sd;
+  rows.rightCols<3>() *= rotation_sd;
   return rows;
 }
 
@@ -314,8 +311,8 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
   residuals.num_theta = width;
   std::vector<int> first_row_of_pose;  // per report.poses entry, and one past the end
   Eigen::Matrix<double, 2, Eigen::Dynamic> g(2, width);
-  for (size_t slot = 0; slot < verification.size(); ++slot) {
-    const PoseObservation& pose = obs.poses[verification[slot]];
+  for (size_t index = 0; index < verification.size(); ++index) {
+    const PoseObservation& pose = obs.poses[verification[index]];
     const PoseFrames frames = projector.Frames(pose);
     const int first = static_cast<int>(residuals.rows.size());
     for (const auto& [id, pixel] : pose.dots_px) {
@@ -334,7 +331,7 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
         g.setZero();
         if (nt > 0) g.leftCols(nt).noalias() = (jt - jd * d->second.k) * theta_root;
         if (pose_error) {
-          g.middleCols<6>(nt + 6 * static_cast<int>(slot)) =
+          g.middleCols<6>(nt + 6 * static_cast<int>(index)) =
               PoseErrorRows(frames.cam_from_base, dots_in_base.at(id), jd, model.pose_translation_m, model.pose_rotation_rad);
         }
         for (int i = 0; i < 2; ++i) {
@@ -374,17 +371,6 @@ HeldOutReprojection NominalHeldOutReprojection(const ObservationSet& obs, double
   nominal.rho = KinematicParameters::Nominal(obs.robot);
   nominal.camera = obs.camera;
   return HeldOutReprojectionOf(obs, nominal, TriangulateIdentificationDots(obs, nominal), {}, noise_px, noise_dof);
-}
-
-HeldOutFigure Renormalised(const HeldOutFigure& figure, double from_noise_px, double to_noise_px) {
-  HeldOutFigure f = figure;
-  if (f.dof == 0) return f;
-  f.chi_square = figure.chi_square * (from_noise_px * from_noise_px) / (to_noise_px * to_noise_px);
-  f.noise_dof = 0;
-  f.chi_square_limit = ChiSquareQuantile(kHeldOutTestLevel, f.dof);
-  f.p_value = ChiSquareUpperTail(f.chi_square, f.dof);
-  f.test_passed = f.chi_square <= f.chi_square_limit;
-  return f;
 }
 
 std::map<int, Eigen::Vector3d> TriangulateIdentificationDots(const ObservationSet& obs, const PredictionModel& model) {

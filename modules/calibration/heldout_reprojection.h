@@ -123,11 +123,6 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& observations, co
                                           const std::map<int, Eigen::Vector3d>& dots_in_base,
                                           const ExcludedObservations& excluded, double noise_px, int noise_dof);
 
-// The same figure normalised with another noise: every term of C is proportional to sigma^2 (the
-// parameters' covariance too, as the bundle scales it by its residual variance), so the statistic scales
-// by (from / to)^2; the new noise is taken as known.
-HeldOutFigure Renormalised(const HeldOutFigure& figure, double from_noise_px, double to_noise_px);
-
 // The dots triangulated from the identification images with a model taken as exact (every dot seen in
 // at least two of them; those not triangulable are left out).
 std::map<int, Eigen::Vector3d> TriangulateIdentificationDots(const ObservationSet& observations,

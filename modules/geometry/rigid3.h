@@ -24,6 +24,15 @@ Mat3T<T> Skew(const Vec3T<T>& v) {
   return s;
 }
 
+// d p / d (v, omega) of a point p in a frame moved by the small motion p -> p + omega x p + v: [I, -[p]x]
+// (the pose-error columns of the bundle's error model and of the held-out test).
+inline Eigen::Matrix<double, 3, 6> SmallMotionJacobian(const Eigen::Vector3d& p) {
+  Eigen::Matrix<double, 3, 6> j;
+  j.leftCols<3>().setIdentity();
+  j.rightCols<3>() = -Skew<double>(p);
+  return j;
+}
+
 template <typename T>
 Mat3T<T> RotX(const T& angle) {
   using std::cos;
