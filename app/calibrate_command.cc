@@ -12,6 +12,7 @@
 #include "app/model_exports.h"
 #include "app/output_options.h"
 #include "app/report_command.h"
+#include "bundle/bundle_adjustment.h"
 #include "geometry/rigid3.h"
 #include "io/camera_file.h"
 #include "io/hand_eye_file.h"
@@ -165,7 +166,8 @@ Status WriteHandEye(const LoadedInput& loaded, const calibration::CalibrationRep
   result.source = "selfcal calibrate " + loaded.input.path;
   result.provenance = {{"software_version", SELFCAL_VERSION},
                        {"input_sha256", loaded.input.sha256},
-                       {"method", report.model->method_description}};
+                       {"method", report.model->method_description},
+                       {"verdict", calibration::VerdictName(report.verdict)}};
   const std::string path = (std::filesystem::path(out_dir) / "hand_eye.yaml").string();
   if (Status s = io::SaveHandEye(result, path); !s.ok()) return s;
   std::cout << "hand-eye result: " << path << "\n";
@@ -226,7 +228,8 @@ Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationRep
   model.source = "selfcal calibrate " + loaded.input.path;
   model.provenance = {{"software_version", SELFCAL_VERSION},
                       {"input_sha256", loaded.input.sha256},
-                      {"method", report.model->method_description}};
+                      {"method", report.model->method_description},
+                      {"verdict", calibration::VerdictName(report.verdict)}};
   const std::string model_path = (out / "calibrated_model.yaml").string();
   if (Status s = io::SaveCalibratedModel(model, model_path); !s.ok()) return s;
   std::cout << "calibrated model (" << calibration::MethodName(report.method) << "): " << model_path << "\n";
@@ -290,6 +293,13 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   if (from_session) {
     std::cout << "session " << request.input << ": " << loaded->observations.poses.size() << " accepted samples\n";
   }
+  // The parameter names against this model before any work: a wrong name writes nothing.
+  bundle::BundleOptions names;
+  names.held_parameters = request.fix;
+  names.free_parameters = request.free;
+  std::string unknown;
+  bundle::HeldParameterIndices(names, loaded->observations.robot.num_joints(), &unknown);
+  if (!unknown.empty()) return Fail(Status::Error(ErrorCode::kInvalidInput, "--fix/--free: " + unknown));
   const int identification = static_cast<int>(loaded->observations.PosesWithRole(PoseRole::kIdentification).size());
   if (request.folds_given && request.folds > 0 && identification < 2 * request.folds) {
     return Fail(Status::Error(ErrorCode::kInvalidInput,
@@ -324,7 +334,7 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   if (Status s = WriteCameraFiles(request, report); !s.ok()) return Fail(s);
   if (!report.accepted()) {
     std::cerr << "selfcal: " << ExitCodeName(code) << ": " << TerminalSafe(report.message)
-              << " (no calibrated model written)\n";
+              << (report.model ? " (the calibrated model is written, marked untested)\n" : " (no calibrated model written)\n");
   }
   if (from_session) PrintSummary(loaded->session->summary);
   if (run != nullptr) *run = {std::move(loaded).value().observations, std::move(report)};

@@ -36,6 +36,7 @@ ExitCode ExitCodeFor(calibration::Verdict verdict) {
     case calibration::Verdict::kUnconverged:
     case calibration::Verdict::kSolverFailure: return ExitCode::kSolverFailure;
     case calibration::Verdict::kRejected: return ExitCode::kModelRejected;
+    case calibration::Verdict::kUntested: return ExitCode::kUntested;
   }
   return ExitCode::kSolverFailure;
 }

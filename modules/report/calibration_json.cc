@@ -76,6 +76,8 @@ json CrossValidationJson(const calibration::CrossValidationReport& cv) {
   return {{"ran", cv.ran},           {"message", cv.message},       {"folds", cv.folds},
           {"seed", cv.seed},         {"num_residuals", cv.num_residuals}, {"rms_px", Finite(cv.rms_px)},
           {"mm_per_px", Finite(cv.mm_per_px)}, {"rms_mm", Finite(cv.rms_mm)}, {"folds_passed", cv.folds_passed},
+          {"folds_tested", cv.folds_tested},
+          {"pooled", cv.pooled.dof > 0 ? HeldOutFigureJson(cv.pooled) : json()},
           {"per_fold", folds}};
 }
 
