@@ -16,6 +16,7 @@
 #include "base/atomic_file.h"
 #include "detection/contact_sheet.h"
 #include "detection/detect_points.h"
+#include "detection/grid_orientation.h"
 #include "io/camera_file.h"
 #include "io/file_lists.h"
 #include "io/hand_eye_file.h"
@@ -31,7 +32,8 @@ namespace {
 
 struct DetectSettings {
   std::string images, poses, out, contact_sheet;
-  std::string detector = "dots", identity = "grid", grid;
+  std::string detector = "dots", identity = "grid", grid, polarity = "dark";
+  bool asymmetric = false;  // circles: OpenCV's asymmetric grid
   std::string dictionary, board;  // charuco: the markers' dictionary and the board's squares ROWSxCOLS
   std::string robot, hand_eye;
   double fx_px = 0, cx_px = NAN, cy_px = NAN, mu = 1.0, k1 = 0.0;
@@ -77,6 +79,13 @@ Result<detection::DetectionOptions> ToDetectionOptions(const DetectSettings& a) 
   if (a.grid.empty() && o.detector == detection::Detector::kChessboard) {
     return Usage("--detector chessboard needs --grid ROWSxCOLS (inner corners, e.g. 6x9)");
   }
+  if (a.grid.empty() && o.detector == detection::Detector::kCircles) {
+    return Usage("--detector circles needs --grid ROWSxCOLS (rows of dots x dots per row, e.g. 11x4 --asymmetric)");
+  }
+  Result<detection::Polarity> polarity = detection::ParsePolarity(a.polarity);
+  if (!polarity.ok()) return polarity.status();
+  o.polarity = *polarity;
+  o.asymmetric = a.asymmetric;
   const bool charuco = o.detector == detection::Detector::kCharuco;
   if (charuco != !a.board.empty() || charuco != !a.dictionary.empty() || (charuco && !a.grid.empty())) {
     return Usage("--detector charuco takes --dictionary NAME and --board XxY (squares, e.g. 5x7) instead of --grid; "
@@ -247,7 +256,8 @@ int DetectFromSettings(const DetectSettings& a) {
   }
   detection::DetectionOptions detect_options = *options;
   detect_options.progress = Progress();
-  const std::vector<detection::ImagePoints> points = detection::DetectAllImagePoints(pixels, detect_options);
+  std::vector<detection::ImagePoints> points = detection::DetectAllImagePoints(pixels, detect_options);
+  detection::OrientCircleGrids(detect_options, robot_poses, *setup, &points);
   PrintPerImage(*images, points);
   Result<ObservationSet> set = detection::BuildObservationSet(ids, points, robot_poses, *setup);
   if (!set.ok()) return Fail(set.status());
@@ -319,9 +329,12 @@ Command AddDetectCommand(CLI::App& app) {
                   "Also write every image with its points and ids as one PNG");
   cmd->add_option("--contact-sheet-tile-px", a->sheet_tile_px, "Largest thumbnail width on the contact sheet, px")
       ->check(CLI::Range(64, 8192));
-  cmd->add_option("--detector", a->detector, "dots, chessboard or charuco")
-      ->check(CLI::IsMember({"dots", "chessboard", "charuco"}));
-  cmd->add_option("--grid", a->grid, "ROWSxCOLS: the dot grid (default 10x10) or the chessboard's inner corners");
+  cmd->add_option("--detector", a->detector, "dots, circles (a circle grid without an origin dot), chessboard or charuco")
+      ->check(CLI::IsMember({"dots", "circles", "chessboard", "charuco"}));
+  cmd->add_option("--grid", a->grid, "ROWSxCOLS: the dot grid (default 10x10), the circle grid or the chessboard's inner corners");
+  cmd->add_flag("--asymmetric", a->asymmetric, "circles: OpenCV's asymmetric grid (every other row shifted by half a step)");
+  cmd->add_option("--polarity", a->polarity, "dots and circles: dark dots (default), light dots on a dark board, or auto")
+      ->check(CLI::IsMember({"dark", "light", "auto"}));
   cmd->add_option("--dictionary", a->dictionary, "charuco: the markers' OpenCV dictionary, e.g. DICT_6X6_250");
   cmd->add_option("--board", a->board, "charuco: the board's squares XxY (OpenCV's squaresX x squaresY), e.g. 5x7");
   cmd->add_option("--identity", a->identity, "How dots are named: grid (larger origin dot), apriltag, order")
