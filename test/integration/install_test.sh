@@ -137,4 +137,13 @@ if [[ $mode == prefix && -f $root/share/selfcal/plotly.min.js ]]; then
   grep -qF "searched $root/share/selfcal/plotly.min.js, /usr/share/python3-plotly/plotly.js" "$tmp/out.log" ||
     fail "the refusal does not name the places searched"
 fi
+# The build tree's own selfcal falls back to the source tree, except with SELFCAL_NO_SOURCE_FALLBACK=1.
+if [[ $mode == prefix ]]; then
+  if (cd "$tmp/work" && SELFCAL_NO_SOURCE_FALLBACK=1 "$build/app/selfcal" simulate --points --no-html --out nofallback \
+    >"$tmp/out.log" 2>&1); then
+    fail "SELFCAL_NO_SOURCE_FALLBACK=1: the build tree's selfcal still found the source tree's config/"
+  fi
+  grep -q "config/robots/puma560.yaml" "$tmp/out.log" || { cat "$tmp/out.log"; fail "the refusal names no robot file"; }
+  echo "SELFCAL_NO_SOURCE_FALLBACK=1: $(head -n 1 "$tmp/out.log")"
+fi
 echo "install test ($mode): passed"
