@@ -6,7 +6,8 @@
 # namespace where the source tree, the build tree and (when the install has its own plotly.min.js)
 # /usr/share/python3-plotly are hidden under empty mounts, from a working directory outside them and with
 # a bare environment: `selfcal simulate --points` (the shipped robot and trajectory, report.html) and
-# `selfcal calibrate` of its observations (report.html; an OpenCV camera file, through the private library).
+# `selfcal calibrate` of its observations (report.html; an OpenCV camera file, through the private library)
+# and `selfcal-robot-sim` on a shipped robot.
 # Exits 77 (skipped) when no mount namespace can be made (no unshare, or user namespaces disabled).
 set -euo pipefail
 
@@ -109,12 +110,14 @@ run() {
   sealed "$@" >"$tmp/out.log" 2>"$tmp/err.log" || rc=$?
   ((rc == 0)) || { cat "$tmp/out.log" "$tmp/err.log"; fail "$* exited $rc"; }
   if grep -q "warning" "$tmp/err.log"; then cat "$tmp/err.log"; fail "$* warned"; fi
-  tail -n 3 "$tmp/out.log" | sed 's/^/  /'
+  tail -n 2 "$tmp/out.log" | sed 's/^/  /'
 }
 run "$root/bin/selfcal" --version
 run "$root/bin/selfcal" simulate --points --seed 3 --out sim
 run "$root/bin/selfcal" calibrate sim/observations.yaml --out cal --write-camera-opencv cal/camera_opencv.yaml
-run "$root/bin/selfcal-robot-sim" --help
+# The simulated robot server with a shipped robot, stopped after a second (SIGTERM: a clean stop, exit 0).
+run timeout --preserve-status 1 "$root/bin/selfcal-robot-sim" --robot config/robots/ur5e.yaml --port 0
+grep -q "^listening on 127.0.0.1:" "$tmp/out.log" || fail "selfcal-robot-sim did not start"
 for file in sim/report.json sim/report.html sim/calibrated_model.yaml cal/report.json cal/report.html \
   cal/calibrated_model.yaml cal/camera_opencv.yaml; do
   [[ -s $tmp/work/$file ]] || fail "$file not written"
