@@ -20,8 +20,10 @@
 #include "io/report_json.h"
 #include "io/robot_config.h"
 #include "observations/joint_limits.h"
+#include "base/atomic_file.h"
 #include "base/terminal_text.h"
 #include "report/calibration_report.h"
+#include "report/image_residuals.h"
 #include "session/session_dir.h"
 #include "session/session_observations.h"
 #include "yaml/yaml_reader.h"
@@ -198,6 +200,12 @@ Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationRep
   if (Status s = io::WriteJsonFile(document, report_path); !s.ok()) return s;
   std::cout << "report: " << report_path << "\n";
   AddOutputFile("report", report_path);
+  const std::string residuals_path = (out / "image_residuals.csv").string();
+  if (Status s = WriteFileAtomically(residuals_path, report::ImageResidualsCsv(loaded.observations, report)); !s.ok()) {
+    return s;
+  }
+  std::cout << "per-image residuals: " << residuals_path << "\n";
+  AddOutputFile("image_residuals", residuals_path);
   RecordCalibrationFigures(document);
   const std::string html_path = (out / "report.html").string();
   if (request.html) {
@@ -272,7 +280,7 @@ void AddParameterMaskOptions(CLI::App* cmd, std::vector<std::string>* fix, std::
 }
 
 std::vector<std::string> CalibrationOutputFiles() {
-  return {"observations.yaml", "report.json",           "report.html",
+  return {"observations.yaml", "report.json",           "report.html",           "image_residuals.csv",
           "calibrated_model.yaml", "calibrated.urdf", "calibrated_robot.yaml", "camera_static_transform.yaml",
           "hand_eye.yaml"};
 }
