@@ -20,6 +20,7 @@
 #include "io/report_json.h"
 #include "io/robot_config.h"
 #include "observations/joint_limits.h"
+#include "observations/pool_recordings.h"
 #include "base/atomic_file.h"
 #include "base/terminal_text.h"
 #include "report/calibration_report.h"
@@ -83,6 +84,43 @@ Status ReplaceCamera(const CalibrateRequest& request, LoadedInput* loaded) {
   return Status::Ok();
 }
 
+// An observations file, its notes on stderr; *origin: the robot config it names (empty when none).
+Result<ObservationSet> LoadObservationsFile(const std::string& path, std::optional<io::RobotOrigin>* origin) {
+  Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(path);
+  if (!doc.ok()) return doc.status();
+  std::vector<std::string> notes;
+  Result<ObservationSet> obs = io::ParseObservations(*doc, &notes);
+  if (!obs.ok()) return obs.status();
+  for (const std::string& note : notes) std::cerr << "selfcal: note: " << TerminalSafe(note) << "\n";
+  Result<io::RobotOrigin> found = io::RobotOriginOfObservations(*doc);
+  *origin = found.ok() ? *found : io::RobotOrigin{};
+  return obs;
+}
+
+// `first` (the input) pooled with the --also files, each a scene named by its file name without extension.
+Result<ObservationSet> PoolWithRecordings(const CalibrateRequest& request, ObservationSet first) {
+  if (session::IsSessionDirectory(request.input)) {
+    return Status::Error(ErrorCode::kInvalidInput, "--also pools observations files; " + request.input +
+                                                       " is a session directory (calibrate it alone, or pool its "
+                                                       "observations.yaml from an earlier calibrate)");
+  }
+  std::vector<Recording> recordings{{std::filesystem::path(request.input).stem().string(), std::move(first)}};
+  for (const std::string& path : request.also) {
+    std::optional<io::RobotOrigin> ignored;
+    Result<ObservationSet> obs = LoadObservationsFile(path, &ignored);
+    if (!obs.ok()) return obs.status();
+    const std::string label = std::filesystem::path(path).stem().string();
+    for (const Recording& r : recordings) {
+      if (r.label == label) {
+        return Status::Error(ErrorCode::kInvalidInput, "--also " + path + ": another recording is named `" + label +
+                                                           "` already (each file's name names its scene)");
+      }
+    }
+    recordings.push_back({label, std::move(obs).value()});
+  }
+  return PoolRecordings(recordings);
+}
+
 Result<LoadedInput> LoadInput(const CalibrateRequest& request) {
   LoadedInput loaded;
   // The camera files asked for are written last: what writes them must be there before anything is solved.
@@ -103,16 +141,15 @@ Result<LoadedInput> LoadInput(const CalibrateRequest& request) {
     loaded.input = {"session", request.input, session->manifest_sha256};
     loaded.observations = std::move(session).value().observations;
   } else {
-    Result<yaml::YamlDocument> doc = yaml::LoadYamlFile(request.input);
-    if (!doc.ok()) return doc.status();
-    std::vector<std::string> notes;
-    Result<ObservationSet> obs = io::ParseObservations(*doc, &notes);
+    Result<ObservationSet> obs = LoadObservationsFile(request.input, &loaded.origin);
     if (!obs.ok()) return obs.status();
-    for (const std::string& note : notes) std::cerr << "selfcal: note: " << TerminalSafe(note) << "\n";
     loaded.observations = std::move(obs).value();
-    Result<io::RobotOrigin> origin = io::RobotOriginOfObservations(*doc);
-    loaded.origin = origin.ok() ? *origin : io::RobotOrigin{};
     loaded.input = {"observations", request.input, FileSha256(request.input)};
+  }
+  if (!request.also.empty()) {
+    Result<ObservationSet> pooled = PoolWithRecordings(request, std::move(loaded.observations));
+    if (!pooled.ok()) return pooled.status();
+    loaded.observations = std::move(pooled).value();
   }
   if (Status s = ReplaceCamera(request, &loaded); !s.ok()) return s;
   return loaded;
@@ -365,6 +402,11 @@ Command AddCalibrateCommand(CLI::App& app) {
   cmd->add_option("--seed", request->seed, "Seed of the RANSAC sampling (results are deterministic per seed)");
   AddMethodOption(cmd, method.get());
   AddParameterMaskOptions(cmd, &request->fix, &request->free);
+  cmd->add_option("--also", request->also,
+                  "Another observations file of the same arm, calibrated together with the first, its poses a scene "
+                  "of their own named by the file's name (a board that moved between recordings); repeatable")
+      ->check(CLI::ExistingFile);
+  AddInputPaths(cmd, [request] { return request->also; });
   cmd->add_option("--weak-tolerance-mm", request->weak_tolerance_mm,
                   "Hold a joint length the poses determine worse than this at the robot description's value, named "
                   "in the output (0: never)")

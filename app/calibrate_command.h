@@ -49,6 +49,9 @@ struct CalibrateRequest {
   // The robot config the data was recorded with, for the exports in its convention and names (simulate
   // sets it; empty: the input's own robot: a session's robot.yaml, an observations file's robot).
   std::string robot_config{};
+  // Further observations files of the same arm (--also), pooled with `input`, each recording a scene of its
+  // own named by its file name (observations/pool_recordings.h).
+  std::vector<std::string> also{};
 };
 
 // What a calibration read and returned, for callers that compare it with a truth (`simulate`).

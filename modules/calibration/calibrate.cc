@@ -241,6 +241,9 @@ CalibrationReport CalibrateSteps(const ObservationSet& observations, const Calib
     }
     report.verdict = VerdictFor(report.bundle->bundle.outcome);
     report.message = report.bundle->bundle.message;
+    if (report.bundle->bundle.outcome == bundle::Outcome::kConverged) {
+      report.scene_moves = SceneMovesOf(obs, report.bundle->bundle.dots_in_base);
+    }
     if (report.bundle->bundle.outcome == bundle::Outcome::kConverged &&
         obs.PosesWithRole(PoseRole::kVerification).empty()) {
       report.cross_validation =

@@ -30,6 +30,7 @@
 #include "bundle/pose_noise_bundle.h"
 #include "calibration/motion_check.h"
 #include "calibration/paper_pipeline.h"
+#include "calibration/scene_moves.h"
 #include "kinematics/robot_model.h"
 #include "observations/observation_set.h"
 
@@ -116,6 +117,8 @@ struct CalibrationReport {
   std::optional<BundleStageReport> bundle;  // when method == kBundle
   // The bundle converged and the set names no verification pose: its k-fold held-out figure.
   std::optional<CrossValidationReport> cross_validation;
+  // The bundle converged on a set of several scenes sharing point ids: where each lies against the first.
+  std::vector<SceneMove> scene_moves;
   std::optional<CalibratedModel> model;    // the chosen method's model, only when accepted or untested
   // The acceptance checks of the chosen method's converged model (empty when it did not converge).
   Acceptance acceptance;

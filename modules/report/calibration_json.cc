@@ -511,6 +511,18 @@ json CalibrationReportJson(const ObservationSet& obs, const calibration::Calibra
   j["predicted_3d_error"] = field("predicted_3d_error");
   j["heldout_reprojection"] = field("heldout_reprojection");
   j["cross_validation"] = report.cross_validation ? CrossValidationJson(*report.cross_validation) : json();
+  json moves = json::array();
+  for (const calibration::SceneMove& m : report.scene_moves) {
+    moves.push_back({{"scene", m.scene},
+                     {"relative_to", m.relative_to},
+                     {"shared_points", m.shared_points},
+                     {"displacement_rms_mm", m.displacement_rms_m * 1e3},
+                     {"displacement_max_mm", m.displacement_max_m * 1e3},
+                     {"rotation_deg", RadToDeg(m.rotation_rad)},
+                     {"rigid_fit_rms_mm", m.rigid_fit_rms_m * 1e3},
+                     {"moved", m.moved}});
+  }
+  j["scene_moves"] = moves;
   j["methods"] = methods;
   j["session"] = context.session ? SessionJson(context.input, *context.session) : json();
   if (report.hand_eye_start) j["hand_eye"] = HandEyeJson(report);

@@ -225,6 +225,14 @@ void PrintCalibrationSummary(const calibration::CalibrationReport& report, std::
     out << "\n";
     PrintBundleSummary(*report.bundle, report.hand_eye_start.has_value(), out);
     if (report.cross_validation) PrintCrossValidation(*report.cross_validation, out);
+    for (const calibration::SceneMove& m : report.scene_moves) {
+      out << "  scene `" << m.scene << "` against `" << m.relative_to << "`: its " << m.shared_points
+          << " points lie " << std::fixed << std::setprecision(2) << m.displacement_rms_m * 1e3 << " mm RMS from the first's (largest "
+          << m.displacement_max_m * 1e3 << " mm), a rigid move of " << RadToDeg(m.rotation_rad) << " deg (fit RMS "
+          << m.rigid_fit_rms_m * 1e3 << " mm): " << (m.moved ? "the scene moved" : "no move beyond the points' scatter")
+          << "\n";
+      out.unsetf(std::ios::floatfield);
+    }
   }
   if (!report.acceptance.checks.empty()) {
     out << "\nacceptance of the " << calibration::MethodName(report.method) << " model:\n";

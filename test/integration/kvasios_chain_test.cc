@@ -108,6 +108,44 @@ TEST(KvasiosChain, EverySessionCalibratesWithTheDefaultsNamingWhatTheDataCannotD
   }
 }
 
+// Sessions s1 and s3 (recorded the next day, the board moved by about 7 mm and 2 deg) pooled as they are:
+// each file a scene of its own, one arm calibrated from both, the move measured and named; s1 with s2 (the
+// same day, the board unmoved) shows no move beyond the points' scatter.
+TEST(KvasiosChain, RecordingsPooledEachAsItsSceneNameTheBoardThatMoved) {
+  const fs::path dir = FreshDir("kvasios", "pooled");
+  const std::string s1 = Detect("s1", dir / "s1"), s2 = Detect("s2", dir / "s2"), s3 = Detect("s3", dir / "s3");
+  // Each scene is named by its file's name: give the copies their sessions' names.
+  fs::copy_file(s1, dir / "s1.yaml");
+  fs::copy_file(s2, dir / "s2.yaml");
+  fs::copy_file(s3, dir / "s3.yaml");
+  std::string output;
+  int code = RunSelfcalInSource("calibrate " + (dir / "s1.yaml").string() + " --also " + (dir / "s3.yaml").string() +
+                                    " --out " + (dir / "cal13").string() + " --no-html",
+                                &output);
+  EXPECT_EQ(code, 0) << output;
+  std::ifstream in13(dir / "cal13" / "report.json");
+  const nlohmann::json moved = nlohmann::json::parse(in13).at("scene_moves");
+  ASSERT_EQ(moved.size(), 1u) << moved.dump();
+  EXPECT_EQ(moved[0].at("scene"), "s3");
+  EXPECT_EQ(moved[0].at("relative_to"), "s1");
+  EXPECT_EQ(moved[0].at("shared_points").get<int>(), 24);
+  EXPECT_TRUE(moved[0].at("moved").get<bool>()) << moved.dump();
+  EXPECT_GT(moved[0].at("displacement_rms_mm").get<double>(), 10 * moved[0].at("rigid_fit_rms_mm").get<double>()) << moved.dump();
+  EXPECT_LT(moved[0].at("displacement_rms_mm").get<double>(), 12.0) << moved.dump();
+  EXPECT_NEAR(moved[0].at("rotation_deg").get<double>(), 2.1, 0.6) << moved.dump();
+  EXPECT_NE(output.find("scene `s3` against `s1`"), std::string::npos) << output;
+  EXPECT_NE(output.find("the scene moved"), std::string::npos) << output;
+
+  code = RunSelfcalInSource("calibrate " + (dir / "s1.yaml").string() + " --also " + (dir / "s2.yaml").string() +
+                                " --out " + (dir / "cal12").string() + " --no-html",
+                            &output);
+  EXPECT_EQ(code, 0) << output;
+  std::ifstream in12(dir / "cal12" / "report.json");
+  const nlohmann::json still = nlohmann::json::parse(in12).at("scene_moves");
+  ASSERT_EQ(still.size(), 1u) << still.dump();
+  EXPECT_FALSE(still[0].at("moved").get<bool>()) << still.dump();
+}
+
 // Without verification poses and without the cross-validation nothing held images out: the model is
 // written, and the verdict, the exit code and the model's provenance say it is untested.
 TEST(KvasiosChain, AModelNoHeldOutTestCouldCheckIsWrittenAsUntested) {
