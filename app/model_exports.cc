@@ -6,8 +6,10 @@
 #include <sstream>
 
 #include "app/cli_output.h"
+#include "base/atomic_file.h"
 #include "io/dh_config_file.h"
 #include "io/static_transform_file.h"
+#include "io/ur_kinematics_file.h"
 #include "kinematics/dh_table.h"
 #include "urdf/urdf_writer.h"
 
@@ -43,6 +45,21 @@ Status WriteDhTable(const RobotModel& calibrated, const std::string& convention,
   return Status::Ok();
 }
 
+// ur_calibrated_kinematics.yaml for a Universal Robots arm (io/ur_kinematics_file.h), or why not.
+Status WriteUrKinematics(const RobotModel& calibrated, const std::filesystem::path& out) {
+  if (!io::IsUniversalRobotsArm(calibrated)) return Status::Ok();
+  const std::string path = (out / "ur_calibrated_kinematics.yaml").string();
+  Result<std::string> text = io::UrKinematicsYaml(calibrated);
+  if (!text.ok()) {
+    std::cout << "ur_description kinematics: not written, " << text.status().message() << "\n";
+    return Status::Ok();
+  }
+  if (Status s = WriteFileAtomically(path, *text); !s.ok()) return s;
+  std::cout << "ur_description kinematics (kinematics_params_file): " << path << "\n";
+  AddOutputFile("ur_kinematics", path);
+  return Status::Ok();
+}
+
 // The URDF's names when the robot came from one (and the joint count agrees), else the writer's defaults.
 urdf::UrdfNames NamesOf(const io::RobotOrigin& origin, int num_joints) {
   urdf::UrdfNames names;
@@ -72,6 +89,7 @@ Status WriteModelExports(const RobotModel& calibrated, const io::RobotOrigin& or
   std::cout << "calibrated URDF: " << urdf_path << "\n";
   AddOutputFile("calibrated_urdf", urdf_path);
   if (Status s = WriteDhTable(calibrated, origin.dh_convention, source, out); !s.ok()) return s;
+  if (Status s = WriteUrKinematics(calibrated, out); !s.ok()) return s;
   return WriteCameraStaticTransform(calibrated.flange_from_cam, origin, out_dir);
 }
 
