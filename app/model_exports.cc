@@ -11,6 +11,8 @@
 #include "io/static_transform_file.h"
 #include "io/ur_kinematics_file.h"
 #include "kinematics/dh_table.h"
+#include "base/terminal_text.h"
+#include "urdf/urdf_calibrated.h"
 #include "urdf/urdf_writer.h"
 
 namespace selfcal::app {
@@ -71,6 +73,26 @@ urdf::UrdfNames NamesOf(const io::RobotOrigin& origin, int num_joints) {
   return names;
 }
 
+// calibrated.urdf: the user's URDF with the calibrated joint origins when the robot came from a URDF file
+// that is still there and converts to this model (urdf/urdf_calibrated.h), else selfcal's own URDF of the
+// model with the input's names (urdf/urdf_writer.h).
+Status WriteCalibratedUrdf(const RobotModel& calibrated, const io::RobotOrigin& origin, const std::string& path) {
+  if (!origin.urdf_file.empty()) {
+    Result<std::string> text = urdf::CalibratedUserUrdfFile(
+        origin.urdf_file, {origin.base_link, origin.tip_link, origin.camera_link}, calibrated);
+    if (text.ok()) {
+      if (Status s = WriteFileAtomically(path, *text); !s.ok()) return s;
+      std::cout << "calibrated URDF (" << origin.urdf_file << " with the calibrated joint origins): " << path << "\n";
+      return Status::Ok();
+    }
+    std::cout << "calibrated URDF: " << origin.urdf_file << " cannot take the calibrated origins ("
+              << TerminalSafe(text.status().message()) << "); selfcal's URDF of the model with its names instead\n";
+  }
+  if (Status s = urdf::WriteUrdf(calibrated, NamesOf(origin, calibrated.num_joints()), path); !s.ok()) return s;
+  std::cout << "calibrated URDF: " << path << "\n";
+  return Status::Ok();
+}
+
 }  // namespace
 
 io::RobotOrigin OriginOfInput(const std::string& robot_config, const std::string& input, bool is_session) {
@@ -85,8 +107,7 @@ Status WriteModelExports(const RobotModel& calibrated, const io::RobotOrigin& or
                          const std::string& out_dir) {
   const std::filesystem::path out(out_dir);
   const std::string urdf_path = (out / "calibrated.urdf").string();  // docs/urdf.md
-  if (Status s = urdf::WriteUrdf(calibrated, NamesOf(origin, calibrated.num_joints()), urdf_path); !s.ok()) return s;
-  std::cout << "calibrated URDF: " << urdf_path << "\n";
+  if (Status s = WriteCalibratedUrdf(calibrated, origin, urdf_path); !s.ok()) return s;
   AddOutputFile("calibrated_urdf", urdf_path);
   if (Status s = WriteDhTable(calibrated, origin.dh_convention, source, out); !s.ok()) return s;
   if (Status s = WriteUrKinematics(calibrated, out); !s.ok()) return s;

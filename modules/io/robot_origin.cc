@@ -24,9 +24,10 @@ Result<RobotOrigin> OriginOfNode(const yaml::YamlNode& root, const std::string& 
   if (!urdf_file.empty()) {
     const urdf::UrdfChainSpec spec{ScalarOf(root, "base_link"), ScalarOf(root, "tip_link"), ScalarOf(root, "camera_link")};
     // The joint names need the URDF; flange_from_cam does not matter for them.
-    Result<urdf::UrdfRobot> robot = urdf::LoadUrdfRobot(ResolveBesideConfig(urdf_file, path), spec, Rigid3());
+    const std::string resolved = ResolveBesideConfig(urdf_file, path);
+    Result<urdf::UrdfRobot> robot = urdf::LoadUrdfRobot(resolved, spec, Rigid3());
     if (!robot.ok()) return robot.status();
-    return RobotOrigin{"", robot->joint_names, spec.base_link, spec.tip_link, spec.camera_link};
+    return RobotOrigin{"", robot->joint_names, spec.base_link, spec.tip_link, spec.camera_link, resolved};
   }
   Problems problems(path);
   MapReader map(root, "", &problems);

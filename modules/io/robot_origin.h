@@ -21,6 +21,9 @@ struct RobotOrigin {
   std::string dh_convention;             // "standard", "modified", "modified_hayati"; empty for a URDF / unknown
   std::vector<std::string> joint_names;  // the URDF's movable joints, base to tip; empty otherwise
   std::string base_link, tip_link, camera_link;  // the URDF's links; empty otherwise
+  // The URDF file itself (resolved beside the config) when read from a config naming it; empty otherwise
+  // (a session records the converted model and the names only).
+  std::string urdf_file;
 
   bool FromUrdf() const { return !joint_names.empty(); }
 };

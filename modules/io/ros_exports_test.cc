@@ -11,6 +11,7 @@
 #include "io/robot_config.h"
 #include "io/ur_kinematics_file.h"
 #include "support/perturbed_model.h"
+#include "support/ur_description_chain.h"
 
 namespace selfcal::io {
 namespace {
@@ -51,19 +52,6 @@ TEST(CameraInfoFile, HoldsTheCameraInCameraCalibrationParsersKeys) {
             (std::vector<double>{1001.25, 0, 641.5, 0, 0, fy, 478.25, 0, 0, 0, 1, 0}));
 }
 
-// base_link_inertia -> wrist_3_link as ur_description's xacro builds it from the file.
-Rigid3 XacroChain(const YAML::Node& kinematics, const Eigen::VectorXd& q) {
-  Rigid3 chain;
-  int i = 0;
-  for (const char* joint : {"shoulder", "upper_arm", "forearm", "wrist_1", "wrist_2", "wrist_3"}) {
-    const YAML::Node j = kinematics[joint];
-    const Eigen::Matrix3d r = RotZ(j["yaw"].as<double>()) * RotY(j["pitch"].as<double>()) * RotX(j["roll"].as<double>());
-    const Rigid3 origin(r, Eigen::Vector3d(j["x"].as<double>(), j["y"].as<double>(), j["z"].as<double>()));
-    chain = chain * origin * Rigid3::FromRotation(RotZ(q[i++]));
-  }
-  return chain;
-}
-
 TEST(UrKinematicsFile, ReproducesTheCalibratedModelThroughUrDescriptionsChain) {
   Result<RobotModel> nominal = LoadRobotModel(SourcePath("config/robots/ur5e.yaml"));
   ASSERT_TRUE(nominal.ok()) << nominal.status().message();
@@ -84,7 +72,7 @@ TEST(UrKinematicsFile, ReproducesTheCalibratedModelThroughUrDescriptionsChain) {
     for (int j = 0; j < 6; ++j) {
       q[j] = std::uniform_real_distribution<double>(calibrated.limits[j].min_rad, calibrated.limits[j].max_rad)(rng);
     }
-    const PoseDifference d = ComparePoses(XacroChain(doc["kinematics"], q), BaseFromFlange(calibrated, rho, q));
+    const PoseDifference d = ComparePoses(selfcal::testing::UrDescriptionChain(doc["kinematics"], q), BaseFromFlange(calibrated, rho, q));
     worst_m = std::max(worst_m, d.position_m);
     worst_rad = std::max(worst_rad, d.rotation_rad);
   }

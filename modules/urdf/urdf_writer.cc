@@ -13,7 +13,7 @@ namespace {
 constexpr double kNearGimbalLock = 0.7;
 
 std::string Num(double v) {
-  if (v == 0) return "0";
+  if (std::abs(v) < 1e-15) return "0";  // rounding residue (1e-19 m) of a composed transform: noise to a reader
   char buffer[40];
   std::snprintf(buffer, sizeof buffer, "%.17g", v);
   return buffer;
@@ -43,14 +43,21 @@ std::string Xml(const std::string& text) {
   return out;
 }
 
-std::string Origin(const Rigid3& t) {
+}  // namespace
+
+std::string OriginElement(const Rigid3& t) {
   const Eigen::Matrix3d& r = t.rotation;
-  const double roll = std::atan2(r(2, 1), r(2, 2));
-  const double pitch = std::atan2(-r(2, 0), std::hypot(r(2, 1), r(2, 2)));
-  const double yaw = std::atan2(r(1, 0), r(0, 0));
+  // R = Rz(yaw) Ry(pitch) Rx(roll); at gimbal lock (a right-angle pitch) yaw = 0 and roll takes the rest.
+  const double cos_pitch = std::hypot(r(2, 1), r(2, 2));
+  const double pitch = std::atan2(-r(2, 0), cos_pitch);
+  const bool locked = cos_pitch < 1e-12;
+  const double roll = locked ? std::atan2(-r(1, 2), r(1, 1)) : std::atan2(r(2, 1), r(2, 2));
+  const double yaw = locked ? 0.0 : std::atan2(r(1, 0), r(0, 0));
   return "<origin xyz=\"" + Num(t.translation.x()) + " " + Num(t.translation.y()) + " " + Num(t.translation.z()) +
          "\" rpy=\"" + Num(roll) + " " + Num(pitch) + " " + Num(yaw) + "\"/>";
 }
+
+namespace {
 
 class UrdfText {
  public:
@@ -77,10 +84,10 @@ class UrdfText {
   void Write(const std::string& name, const char* type, const std::string& parent, const std::string& child,
              const Rigid3& origin, const JointLimits* limits) {
     out_ << "  <joint name=\"" << Xml(name) << "\" type=\"" << type << "\">\n    <parent link=\"" << Xml(parent)
-         << "\"/>\n    <child link=\"" << Xml(child) << "\"/>\n    " << Origin(origin) << "\n";
+         << "\"/>\n    <child link=\"" << Xml(child) << "\"/>\n    " << OriginElement(origin) << "\n";
     if (limits) {
       out_ << "    <axis xyz=\"0 0 1\"/>\n    <limit lower=\"" << Num(limits->min_rad) << "\" upper=\""
-           << Num(limits->max_rad) << "\" effort=\"0\" velocity=\"0\"/>\n";
+           << Num(limits->max_rad) << "\" effort=\"0\" velocity=\"" << Num(kDefaultJointVelocityRadPerS) << "\"/>\n";
     }
     out_ << "  </joint>\n";
   }
