@@ -65,7 +65,14 @@ Status WriteUrKinematics(const RobotModel& calibrated, const std::filesystem::pa
 // The URDF's names when the robot came from one (and the joint count agrees), else the writer's defaults.
 urdf::UrdfNames NamesOf(const io::RobotOrigin& origin, int num_joints) {
   urdf::UrdfNames names;
-  if (!origin.FromUrdf() || static_cast<int>(origin.joint_names.size()) != num_joints) return names;
+  const auto joints_of = [num_joints](const auto& values) { return static_cast<int>(values.size()) == num_joints; };
+  if (joints_of(origin.max_velocity_rad_s)) names.velocities_rad_s = origin.max_velocity_rad_s;
+  if (!origin.FromUrdf()) {  // a DH config's own names, when it gives them
+    if (joints_of(origin.config_joint_names)) names.joints = origin.config_joint_names;
+    if (joints_of(origin.config_link_names)) names.links = origin.config_link_names;
+    return names;
+  }
+  if (!joints_of(origin.joint_names)) return names;
   names.joints = origin.joint_names;
   if (!origin.base_link.empty()) names.base_link = origin.base_link;
   if (!origin.tip_link.empty()) names.tip_link = origin.tip_link;

@@ -1,5 +1,7 @@
 #include "io/robot_origin.h"
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 
 #include "base/atomic_file.h"
@@ -17,6 +19,30 @@ std::string ScalarOf(const yaml::YamlNode& map, const std::string& key) {
   return node != nullptr && node->IsScalar() ? node->scalar : "";
 }
 
+// A DH config's per-joint `name`, `link` and `max_velocity_deg_s`, each kept only when every row gives it (the
+// robot config's own reader checks their values).
+void ReadJointExtras(const yaml::YamlNode& root, RobotOrigin* origin) {
+  const yaml::YamlNode* joints = root.Find("joints");
+  if (joints == nullptr || !joints->IsSequence() || joints->items.empty()) return;
+  std::vector<std::string> names, links;
+  std::vector<double> velocities;
+  for (const yaml::YamlNode& row : joints->items) {
+    if (!row.IsMap()) return;
+    names.push_back(ScalarOf(row, "name"));
+    links.push_back(ScalarOf(row, "link"));
+    char* end = nullptr;
+    const std::string v = ScalarOf(row, "max_velocity_deg_s");
+    const double deg_s = v.empty() ? 0 : std::strtod(v.c_str(), &end);
+    velocities.push_back(deg_s > 0 && end != nullptr && *end == '\0' ? DegToRad(deg_s) : 0);
+  }
+  auto all = [](const auto& values, const auto& unset) {
+    return std::none_of(values.begin(), values.end(), [&](const auto& v) { return v == unset; });
+  };
+  if (all(names, std::string())) origin->config_joint_names = names;
+  if (all(links, std::string())) origin->config_link_names = links;
+  if (all(velocities, 0.0)) origin->max_velocity_rad_s = velocities;
+}
+
 Result<RobotOrigin> OriginOfNode(const yaml::YamlNode& root, const std::string& path) {
   RobotOrigin origin;
   if (!root.IsMap()) return Status::Error(ErrorCode::kInvalidInput, path + ": not a robot config");
@@ -27,13 +53,20 @@ Result<RobotOrigin> OriginOfNode(const yaml::YamlNode& root, const std::string& 
     const std::string resolved = ResolveBesideConfig(urdf_file, path);
     Result<urdf::UrdfRobot> robot = urdf::LoadUrdfRobot(resolved, spec, Rigid3());
     if (!robot.ok()) return robot.status();
-    return RobotOrigin{"", robot->joint_names, spec.base_link, spec.tip_link, spec.camera_link, resolved};
+    RobotOrigin origin;
+    origin.joint_names = robot->joint_names;
+    origin.base_link = spec.base_link;
+    origin.tip_link = spec.tip_link;
+    origin.camera_link = spec.camera_link;
+    origin.urdf_file = resolved;
+    return origin;
   }
   Problems problems(path);
   MapReader map(root, "", &problems);
   map.Abandon();  // only entered_as is read here; the robot's own reader checks the rest
   if (!ReadEnteredAs(&map, &origin)) return problems.ToStatus("robot config");
   if (origin.dh_convention.empty() && !origin.FromUrdf()) origin.dh_convention = ScalarOf(root, "dh_convention");
+  if (!origin.FromUrdf()) ReadJointExtras(root, &origin);
   return origin;
 }
 

@@ -24,6 +24,10 @@ struct RobotOrigin {
   // The URDF file itself (resolved beside the config) when read from a config naming it; empty otherwise
   // (a session records the converted model and the names only).
   std::string urdf_file;
+  // A DH config's optional `name`, `link` and `max_velocity_deg_s` of every joint row (all rows or none):
+  // calibrated.urdf's joint and link names and <limit velocity> (rad/s); empty when not given.
+  std::vector<std::string> config_joint_names, config_link_names;
+  std::vector<double> max_velocity_rad_s;
 
   bool FromUrdf() const { return !joint_names.empty(); }
 };

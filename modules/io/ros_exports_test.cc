@@ -9,6 +9,7 @@
 #include "io/camera_info_file.h"
 #include "io/io_test_util.h"
 #include "io/robot_config.h"
+#include "io/robot_origin.h"
 #include "io/ur_kinematics_file.h"
 #include "support/perturbed_model.h"
 #include "support/ur_description_chain.h"
@@ -108,6 +109,32 @@ TEST(UrKinematicsFile, AFlangeOffTheLastAxisIsRefused) {
   RobotModel panda = model;
   panda.name = "panda";
   EXPECT_FALSE(IsUniversalRobotsArm(panda));
+}
+
+TEST(RobotOriginOfConfig, ADhConfigsJointNamesLinksAndSpeedsAreReadForTheExports) {
+  Result<RobotOrigin> ur = RobotOriginOfConfig(SourcePath("config/robots/ur5e.yaml"));
+  ASSERT_TRUE(ur.ok()) << ur.status().message();
+  EXPECT_FALSE(ur->FromUrdf());
+  EXPECT_EQ(ur->config_joint_names.front(), "shoulder_pan_joint");
+  EXPECT_EQ(ur->config_link_names.back(), "wrist_3_link");
+  EXPECT_EQ(ur->max_velocity_rad_s, std::vector<double>(6, kPi));
+  Result<RobotOrigin> puma = RobotOriginOfConfig(SourcePath("config/robots/puma560.yaml"));
+  ASSERT_TRUE(puma.ok()) << puma.status().message();
+  EXPECT_TRUE(puma->config_joint_names.empty() && puma->max_velocity_rad_s.empty());
+}
+
+TEST(RobotConfig, AJointOrLinkNameGivenTwiceIsRefusedAtItsRow) {
+  std::string text = ReadFile(SourcePath("config/robots/ur5e.yaml"));
+  const std::string second = "name: shoulder_lift_joint, link: upper_arm_link";
+  ASSERT_NE(text.find(second), std::string::npos);
+  text.replace(text.find(second), second.size(), "name: shoulder_lift_joint, link: tool0");
+  TempDir dir;
+  WriteFile(dir.File("robot.yaml"), text);
+  Result<RobotModel> loaded = LoadRobotModel(dir.File("robot.yaml"));
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_NE(loaded.status().message().find("link name `tool0` of joint 2 at " + dir.File("robot.yaml") + ":19"), std::string::npos)
+      << loaded.status().message();
+  EXPECT_NE(loaded.status().message().find("is already a link of the calibrated URDF"), std::string::npos);
 }
 
 }  // namespace

@@ -65,29 +65,29 @@ class UrdfText {
 
   // A joint from parent to child at `origin`; revolute about z within `limits` when given, else fixed.
   void Joint(const std::string& name, const std::string& parent, const std::string& child, const Rigid3& origin,
-             const JointLimits* limits) {
+             const JointLimits* limits, double velocity_rad_s = 0) {
     std::string from = parent;
     Rigid3 last = origin;
     if (std::abs(origin.rotation(2, 0)) > kNearGimbalLock) {
       const Rigid3 quarter = Rigid3::FromRotation(RotZ(kPi / 2));
       from = name + "_origin";
       Link(from);
-      Write(name + "_origin", "fixed", parent, from, origin * quarter, nullptr);
+      Write(name + "_origin", "fixed", parent, from, origin * quarter, nullptr, 0);
       last = quarter.Inverse();
     }
-    Write(name, limits ? "revolute" : "fixed", from, child, last, limits);
+    Write(name, limits ? "revolute" : "fixed", from, child, last, limits, velocity_rad_s);
   }
 
   std::string str() const { return out_.str(); }
 
  private:
   void Write(const std::string& name, const char* type, const std::string& parent, const std::string& child,
-             const Rigid3& origin, const JointLimits* limits) {
+             const Rigid3& origin, const JointLimits* limits, double velocity_rad_s) {
     out_ << "  <joint name=\"" << Xml(name) << "\" type=\"" << type << "\">\n    <parent link=\"" << Xml(parent)
          << "\"/>\n    <child link=\"" << Xml(child) << "\"/>\n    " << OriginElement(origin) << "\n";
     if (limits) {
       out_ << "    <axis xyz=\"0 0 1\"/>\n    <limit lower=\"" << Num(limits->min_rad) << "\" upper=\""
-           << Num(limits->max_rad) << "\" effort=\"0\" velocity=\"" << Num(kDefaultJointVelocityRadPerS) << "\"/>\n";
+           << Num(limits->max_rad) << "\" effort=\"0\" velocity=\"" << Num(velocity_rad_s) << "\"/>\n";
     }
     out_ << "  </joint>\n";
   }
@@ -99,9 +99,11 @@ class UrdfText {
 
 Result<std::string> UrdfOfModel(const RobotModel& model, const UrdfNames& names, const FkCheckOptions& check) {
   const int n = model.num_joints();
-  if (!names.joints.empty() && static_cast<int>(names.joints.size()) != n) {
-    return Status::Error(ErrorCode::kInternal,
-                         std::to_string(names.joints.size()) + " joint names for " + std::to_string(n) + " joints");
+  for (const size_t given : {names.joints.size(), names.links.size(), names.velocities_rad_s.size()}) {
+    if (given != 0 && static_cast<int>(given) != n) {
+      return Status::Error(ErrorCode::kInternal,
+                           std::to_string(given) + " joint names, links or velocities for " + std::to_string(n) + " joints");
+    }
   }
   UrdfText text;
   text.Link(names.base_link);
@@ -110,10 +112,11 @@ Result<std::string> UrdfOfModel(const RobotModel& model, const UrdfNames& names,
   std::string parent = "link0";
   for (int i = 0; i < n; ++i) {
     const LinkParameters& p = model.links[i];
-    const std::string link = "link" + std::to_string(i + 1);
+    const std::string link = names.links.empty() ? "link" + std::to_string(i + 1) : names.links[i];
     text.Link(link);
     text.Joint(names.joints.empty() ? "joint" + std::to_string(i + 1) : names.joints[i], parent, link,
-               LinkTransform<double>(p.alpha, p.a, p.beta, p.theta, p.d), &model.limits[i]);
+               LinkTransform<double>(p.alpha, p.a, p.beta, p.theta, p.d), &model.limits[i],
+               names.velocities_rad_s.empty() ? kDefaultJointVelocityRadPerS : names.velocities_rad_s[i]);
     parent = link;
   }
   text.Link(names.tip_link);

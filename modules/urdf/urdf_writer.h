@@ -24,6 +24,8 @@ inline constexpr double kDefaultJointVelocityRadPerS = 1.0;
 struct UrdfNames {
   std::string robot;                // empty: the model's name
   std::vector<std::string> joints;  // empty: joint1 .. jointN
+  std::vector<std::string> links;   // the child link of each joint; empty: link1 .. linkN (the model's frames)
+  std::vector<double> velocities_rad_s;  // each joint's <limit velocity>; empty: kDefaultJointVelocityRadPerS
   std::string base_link = "base_link";
   std::string tip_link = "tool0";
   std::string camera_link = "camera_optical_frame";

@@ -21,6 +21,7 @@
 #include "support/temp_files.h"
 #include "support/ur_description_chain.h"
 #include "urdf/urdf_robot.h"
+#include "urdf/urdf_writer.h"
 
 namespace selfcal {
 namespace {
@@ -166,6 +167,11 @@ TEST(ExportsChain, AStandardDhRobotWithACalibratedBetaGetsTheReasonInsteadOfATab
   EXPECT_NE(output.find("j3.beta = "), std::string::npos) << output;
   EXPECT_NE(output.find("(Hayati's parallel-axis parameter), which standard DH cannot hold"), std::string::npos);
   EXPECT_NE(output.find("dropping them would move the flange by up to"), std::string::npos) << output;
+  // No names or speeds in the config: joint1 .. joint6 and the documented placeholder velocity.
+  const ::urdf::ModelInterfaceSharedPtr parsed = ::urdf::parseURDF(testing::ReadFile((dir / "calibrated.urdf").string()));
+  ASSERT_TRUE(parsed);
+  ASSERT_TRUE(parsed->getJoint("joint3") && parsed->getJoint("joint3")->limits);
+  EXPECT_EQ(parsed->getJoint("joint3")->limits->velocity, urdf::kDefaultJointVelocityRadPerS);
   // The default names, tool0 -> camera_optical_frame.
   const YAML::Node tf = YAML::LoadFile((dir / "camera_static_transform.yaml").string());
   EXPECT_EQ(tf["header"]["frame_id"].as<std::string>(), "tool0");
@@ -258,17 +264,19 @@ TEST(ExportsChain, AUr5esKinematicsFileIsTheCalibratedModelAndItsUrdfHasVelociti
   EXPECT_LE(worst_rad, 1e-9);
   std::cout << "UR5e kinematics file against the calibrated model, 1000 random joints: worst " << worst_m << " m, "
             << worst_rad << " rad\n";
-  // A DH robot's calibrated.urdf: velocity limits MoveIt's time parameterization takes (not 0).
+  // A DH robot's calibrated.urdf: the config's joint and link names (ur_description's) and its velocity
+  // limits (180 deg/s), which MoveIt's time parameterization takes (not 0).
   const ::urdf::ModelInterfaceSharedPtr parsed = ::urdf::parseURDF(testing::ReadFile((dir / "calibrated.urdf").string()));
   ASSERT_TRUE(parsed);
-  int revolute = 0;
+  EXPECT_EQ(RevoluteJointsTo(*parsed, "tool0"),
+            (std::vector<std::string>{"shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint",
+                                      "wrist_2_joint", "wrist_3_joint"}));
   for (const auto& [name, joint] : parsed->joints_) {
     if (joint->type != ::urdf::Joint::REVOLUTE) continue;
-    ++revolute;
     ASSERT_TRUE(joint->limits) << name;
-    EXPECT_GT(joint->limits->velocity, 0) << name;
+    EXPECT_DOUBLE_EQ(joint->limits->velocity, kPi) << name;
   }
-  EXPECT_EQ(revolute, 6);
+  EXPECT_EQ(parsed->getJoint("elbow_joint")->child_link_name, "forearm_link");
   if (!HasFailure()) fs::remove_all(dir);
 }
 
