@@ -86,6 +86,7 @@ bool ReadEnteredAs(MapReader* root, RobotOrigin* origin) {
   ok &= map.OptionalString("base_link", &origin->base_link);
   ok &= map.OptionalString("tip_link", &origin->tip_link);
   ok &= map.OptionalString("camera_link", &origin->camera_link);
+  ok &= map.OptionalString("urdf_file", &origin->urdf_file);
   if (const yaml::YamlNode* names = map.Optional("joint_names")) {
     if (!names->IsSequence()) {
       root->problems()->Add("`" + map.Path("joint_names") + "` at " + root->problems()->At(names->line) +
@@ -109,7 +110,11 @@ std::string EnteredAsYaml(const RobotOrigin& origin) {
   std::string out = "entered_as: {base_link: " + YamlQuoted(origin.base_link) + ", tip_link: " +
                     YamlQuoted(origin.tip_link) + ", camera_link: " + YamlQuoted(origin.camera_link) + ", joint_names: [";
   for (size_t i = 0; i < origin.joint_names.size(); ++i) out += (i ? ", " : "") + YamlQuoted(origin.joint_names[i]);
-  return out + "]}  # the URDF's names (for the exports)\n";
+  out += "]";
+  if (!origin.urdf_file.empty()) {
+    out += ", urdf_file: " + YamlQuoted(std::filesystem::absolute(origin.urdf_file).lexically_normal().string());
+  }
+  return out + "}  # the URDF's names and file (for the exports)\n";
 }
 
 Result<RobotOrigin> RobotOriginOfConfigText(const std::string& text, const std::string& path) {

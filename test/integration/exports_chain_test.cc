@@ -232,6 +232,34 @@ TEST(ExportsChain, AUrdfRobotsCalibratedUrdfIsTheUsersUrdfWithOnlyJointOriginsCh
   if (!HasFailure()) fs::remove_all(dir);
 }
 
+// The same through a session: `run` records the converted model with the URDF's names and file
+// (entered_as), so `calibrate SESSION` writes the user's URDF too, not selfcal's.
+TEST(ExportsChain, ASessionOfAUrdfRobotIsCalibratedIntoTheUsersUrdf) {
+  const fs::path dir = testing::FreshDir("ExportsChain", "meshes-session");
+  std::string output;
+  ASSERT_EQ(testing::RunSelfcal("simulate --no-html --quiet --robot " + kSource +
+                                    "/test/data/urdf/ur5e_meshes_robot.yaml --trajectory " + kSource +
+                                    "/config/trajectories/initial_ur5e.yaml --out " + (dir / "sim").string(),
+                                &output),
+            0)
+      << output;
+  ASSERT_EQ(testing::RunSelfcal("calibrate --no-html " + (dir / "sim" / "session").string() + " --out " +
+                                    (dir / "cal").string(),
+                                &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("ur5e_meshes.urdf with the calibrated joint origins"), std::string::npos) << output;
+  const std::string input = testing::ReadFile(kSource + "/test/data/urdf/ur5e_meshes.urdf");
+  const std::string written = testing::ReadFile((dir / "cal" / "calibrated.urdf").string());
+  EXPECT_EQ(LinesWithoutOrigins(written), LinesWithoutOrigins(input));
+  Result<io::CalibratedModel> calibrated = io::LoadCalibratedModel((dir / "cal" / "calibrated_model.yaml").string());
+  ASSERT_TRUE(calibrated.ok()) << calibrated.status().message();
+  EXPECT_LE(WorstKdlDifference(written, "base_link_inertia", "camera_color_optical_frame", calibrated->model, true,
+                               Random1000(calibrated->model)),
+            1e-9);
+  if (!HasFailure()) fs::remove_all(dir);
+}
+
 // A UR5e's ur_description kinematics file, built into the chain the way ur_description's xacro builds it, is
 // the calibrated model; a DH robot's calibrated.urdf has the non-zero velocity limits MoveIt needs.
 TEST(ExportsChain, AUr5esKinematicsFileIsTheCalibratedModelAndItsUrdfHasVelocities) {
