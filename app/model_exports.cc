@@ -48,10 +48,18 @@ Status WriteDhTable(const RobotModel& calibrated, const std::string& convention,
 }
 
 // ur_calibrated_kinematics.yaml for a Universal Robots arm (io/ur_kinematics_file.h), or why not.
-Status WriteUrKinematics(const RobotModel& calibrated, const std::filesystem::path& out) {
+// The file's chain starts at ur_description's base_link_inertia (the controller's Base frame): the model's
+// base for a DH config, and for a URDF robot only when its base_link is that link (ur_description's own
+// base_link is turned 180 deg about z from it).
+Status WriteUrKinematics(const RobotModel& calibrated, const io::RobotOrigin& origin, const std::filesystem::path& out) {
   if (!io::IsUniversalRobotsArm(calibrated)) return Status::Ok();
   const std::string path = (out / "ur_calibrated_kinematics.yaml").string();
-  Result<std::string> text = io::UrKinematicsYaml(calibrated);
+  Result<std::string> text =
+      origin.FromUrdf() && origin.base_link != "base_link_inertia"
+          ? Result<std::string>(Status::Error(ErrorCode::kInvalidInput,
+                                              "the model's base is the URDF's `" + origin.base_link +
+                                                  "`, not ur_description's base_link_inertia, where the file's chain starts"))
+          : io::UrKinematicsYaml(calibrated);
   if (!text.ok()) {
     std::cout << "ur_description kinematics: not written, " << text.status().message() << "\n";
     return Status::Ok();
@@ -117,7 +125,7 @@ Status WriteModelExports(const RobotModel& calibrated, const io::RobotOrigin& or
   if (Status s = WriteCalibratedUrdf(calibrated, origin, urdf_path); !s.ok()) return s;
   AddOutputFile("calibrated_urdf", urdf_path);
   if (Status s = WriteDhTable(calibrated, origin.dh_convention, source, out); !s.ok()) return s;
-  if (Status s = WriteUrKinematics(calibrated, out); !s.ok()) return s;
+  if (Status s = WriteUrKinematics(calibrated, origin, out); !s.ok()) return s;
   return WriteCameraStaticTransform(calibrated.flange_from_cam, origin, out_dir);
 }
 
