@@ -7,15 +7,22 @@ image_height, camera_name, camera_matrix, distortion_model plumb_bob, distortion
 rectification_matrix identity, projection_matrix [K | 0]) and the calibrated camera of calibrated_model.yaml,
 and with camera_calibration_parsers itself (Debian's python3-camera-calibration-parsers, ROS 1's
 readCalibration over the C++ parser) when it is installed, which must return the same sensor_msgs/CameraInfo.
-The OpenCV file of --write-camera-opencv must stay refused by that parser (it is OpenCV's format).
+The OpenCV file of --write-camera-opencv must stay refused by that parser (it is OpenCV's format). The UR5e's
+ur_calibrated_kinematics.yaml is read the same way against ur_description's keys, and its chain, built as
+ur_description's xacro builds it, against the forward kinematics of calibrated_model.yaml computed here with
+numpy (not selfcal's code) at 1000 random joint vectors, to 1e-9.
 
   ros_outputs_test.py SELFCAL_BINARY SOURCE_DIR
 """
+import math
 import os
+import random
+import re
 import subprocess
 import sys
 import tempfile
 
+import numpy
 import yaml
 
 KEYS = ["image_width", "image_height", "camera_name", "camera_matrix", "distortion_model",
@@ -80,6 +87,74 @@ def check_with_ros_parser(path, opencv_path, k, d, failures):
         failures.append(f"{opencv_path}: camera_calibration_parsers took the OpenCV file (it lacks R and P)")
 
 
+def rot(axis, angle):
+    c, s = math.cos(angle), math.sin(angle)
+    m = {"x": [[1, 0, 0], [0, c, -s], [0, s, c]], "y": [[c, 0, s], [0, 1, 0], [-s, 0, c]],
+         "z": [[c, -s, 0], [s, c, 0], [0, 0, 1]]}[axis]
+    t = numpy.eye(4)
+    t[:3, :3] = m
+    return t
+
+
+def trans(x, y, z):
+    t = numpy.eye(4)
+    t[:3, 3] = [x, y, z]
+    return t
+
+
+def rpy(roll, pitch, yaw):  # URDF's and selfcal's configs': R = Rz(yaw) Ry(pitch) Rx(roll)
+    return rot("z", yaw) @ rot("y", pitch) @ rot("x", roll)
+
+
+def model_flange(model, q):
+    """base_from_flange of calibrated_model.yaml (mm, deg): base_from_link0 * prod Rx Tx Ry Rz(q + theta) Tz * tail."""
+    def transform(node):
+        x, y, z = (v / 1000 for v in node["xyz_mm"])
+        return trans(x, y, z) @ rpy(*(math.radians(v) for v in node["rpy_deg"]))
+    t = transform(model["base_from_link0"])
+    for joint, qi in zip(model["joints"], q):
+        t = t @ rot("x", math.radians(joint["alpha_deg"])) @ trans(joint["a_mm"] / 1000, 0, 0) @ \
+            rot("y", math.radians(joint.get("beta_deg", 0))) @ \
+            rot("z", qi + math.radians(joint.get("theta_offset_deg", 0))) @ trans(0, 0, joint["d_mm"] / 1000)
+    return t @ transform(model["link_n_from_flange"])
+
+
+def xacro_chain(kinematics, q):
+    """base_link_inertia -> wrist_3_link as ur_description's xacro builds it from the kinematics file."""
+    t = numpy.eye(4)
+    for name, qi in zip(("shoulder", "upper_arm", "forearm", "wrist_1", "wrist_2", "wrist_3"), q):
+        j = kinematics[name]
+        t = t @ trans(j["x"], j["y"], j["z"]) @ rpy(j["roll"], j["pitch"], j["yaw"]) @ rot("z", qi)
+    return t
+
+
+def check_ur_kinematics(path, model, failures):
+    """ur_calibrated_kinematics.yaml by python3-yaml against ur_description's keys, and its chain against the
+    calibrated model's forward kinematics computed here from calibrated_model.yaml, at 1000 random joints."""
+    with open(path) as f:
+        kinematics = yaml.safe_load(f)["kinematics"]
+    joints = ["shoulder", "upper_arm", "forearm", "wrist_1", "wrist_2", "wrist_3"]
+    if list(kinematics) != joints + ["hash"]:
+        failures.append(f"{path}: keys {list(kinematics)}")
+        return
+    for name in joints:
+        if sorted(kinematics[name]) != sorted(["x", "y", "z", "roll", "pitch", "yaw"]) or \
+                not all(isinstance(v, (int, float)) for v in kinematics[name].values()):
+            failures.append(f"{path}: {name}: {kinematics[name]}")
+            return
+    if not re.fullmatch(r"calib_[0-9]+", str(kinematics["hash"])):
+        failures.append(f"{path}: hash {kinematics['hash']!r}")
+    rng = random.Random(3)
+    worst = 0.0
+    for _ in range(1000):
+        q = [rng.uniform(math.radians(j["min_deg"]), math.radians(j["max_deg"])) for j in model["joints"]]
+        a, b = xacro_chain(kinematics, q), model_flange(model, q)
+        worst = max(worst, float(numpy.abs(a[:3, 3] - b[:3, 3]).max()), float(numpy.abs(a[:3, :3] - b[:3, :3]).max()))
+    print(f"{path}: ur_description's chain against calibrated_model.yaml at 1000 random joints: worst {worst:.3g}")
+    if worst > 1e-9:
+        failures.append(f"{path}: the xacro's chain differs from the calibrated model by {worst:.3g}")
+
+
 def main():
     binary, source = sys.argv[1], sys.argv[2]
     failures = []
@@ -94,8 +169,9 @@ def main():
             print(p.stdout + p.stderr)
             return 1
         with open(os.path.join(out, "calibrated_model.yaml")) as f:
-            camera = yaml.safe_load(f)["camera"]
-        k, d = check_camera_info(os.path.join(out, "camera_info.yaml"), camera, failures)
+            model = yaml.safe_load(f)
+        k, d = check_camera_info(os.path.join(out, "camera_info.yaml"), model["camera"], failures)
+        check_ur_kinematics(os.path.join(out, "ur_calibrated_kinematics.yaml"), model, failures)
         p = subprocess.run([binary, "calibrate", "--no-html", "--quiet", os.path.join(out, "observations.yaml"),
                             "--out", os.path.join(tmp, "again"), "--write-camera-opencv", opencv],
                            capture_output=True, text=True)
