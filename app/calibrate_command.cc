@@ -12,6 +12,7 @@
 #include "app/model_exports.h"
 #include "app/output_options.h"
 #include "app/report_command.h"
+#include "bundle/bundle_adjustment.h"
 #include "geometry/rigid3.h"
 #include "io/camera_file.h"
 #include "io/camera_info_file.h"
@@ -20,8 +21,10 @@
 #include "io/report_json.h"
 #include "io/robot_config.h"
 #include "observations/joint_limits.h"
+#include "base/atomic_file.h"
 #include "base/terminal_text.h"
 #include "report/calibration_report.h"
+#include "report/image_residuals.h"
 #include "session/session_dir.h"
 #include "session/session_observations.h"
 #include "yaml/yaml_reader.h"
@@ -176,7 +179,8 @@ Status WriteHandEye(const LoadedInput& loaded, const calibration::CalibrationRep
   result.source = "selfcal calibrate " + loaded.input.path;
   result.provenance = {{"software_version", SELFCAL_VERSION},
                        {"input_sha256", loaded.input.sha256},
-                       {"method", report.model->method_description}};
+                       {"method", report.model->method_description},
+                       {"verdict", calibration::VerdictName(report.verdict)}};
   const std::string path = (std::filesystem::path(out_dir) / "hand_eye.yaml").string();
   if (Status s = io::SaveHandEye(result, path); !s.ok()) return s;
   std::cout << "hand-eye result: " << path << "\n";
@@ -207,6 +211,12 @@ Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationRep
   if (Status s = io::WriteJsonFile(document, report_path); !s.ok()) return s;
   std::cout << "report: " << report_path << "\n";
   AddOutputFile("report", report_path);
+  const std::string residuals_path = (out / "image_residuals.csv").string();
+  if (Status s = WriteFileAtomically(residuals_path, report::ImageResidualsCsv(loaded.observations, report)); !s.ok()) {
+    return s;
+  }
+  std::cout << "per-image residuals: " << residuals_path << "\n";
+  AddOutputFile("image_residuals", residuals_path);
   RecordCalibrationFigures(document);
   const std::string html_path = (out / "report.html").string();
   if (request.html) {
@@ -239,7 +249,8 @@ Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationRep
   model.source = "selfcal calibrate " + loaded.input.path;
   model.provenance = {{"software_version", SELFCAL_VERSION},
                       {"input_sha256", loaded.input.sha256},
-                      {"method", report.model->method_description}};
+                      {"method", report.model->method_description},
+                      {"verdict", calibration::VerdictName(report.verdict)}};
   const std::string model_path = (out / "calibrated_model.yaml").string();
   if (Status s = io::SaveCalibratedModel(model, model_path); !s.ok()) return s;
   std::cout << "calibrated model (" << calibration::MethodName(report.method) << "): " << model_path << "\n";
@@ -282,7 +293,7 @@ void AddParameterMaskOptions(CLI::App* cmd, std::vector<std::string>* fix, std::
 }
 
 std::vector<std::string> CalibrationOutputFiles() {
-  return {"observations.yaml", "report.json",           "report.html",
+  return {"observations.yaml", "report.json",           "report.html",           "image_residuals.csv",
           "calibrated_model.yaml", "calibrated.urdf", "calibrated_robot.yaml", "camera_static_transform.yaml",
           "hand_eye.yaml", "camera_info.yaml", "ur_calibrated_kinematics.yaml"};
 }
@@ -303,6 +314,13 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   if (from_session) {
     std::cout << "session " << request.input << ": " << loaded->observations.poses.size() << " accepted samples\n";
   }
+  // The parameter names against this model before any work: a wrong name writes nothing.
+  bundle::BundleOptions names;
+  names.held_parameters = request.fix;
+  names.free_parameters = request.free;
+  std::string unknown;
+  bundle::HeldParameterIndices(names, loaded->observations.robot.num_joints(), &unknown);
+  if (!unknown.empty()) return Fail(Status::Error(ErrorCode::kInvalidInput, "--fix/--free: " + unknown));
   const int identification = static_cast<int>(loaded->observations.PosesWithRole(PoseRole::kIdentification).size());
   if (request.folds_given && request.folds > 0 && identification < 2 * request.folds) {
     return Fail(Status::Error(ErrorCode::kInvalidInput,
@@ -337,7 +355,7 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   if (Status s = WriteCameraFiles(request, report); !s.ok()) return Fail(s);
   if (!report.accepted()) {
     std::cerr << "selfcal: " << ExitCodeName(code) << ": " << TerminalSafe(report.message)
-              << " (no calibrated model written)\n";
+              << (report.model ? " (the calibrated model is written, marked untested)\n" : " (no calibrated model written)\n");
   }
   if (from_session) PrintSummary(loaded->session->summary);
   if (run != nullptr) *run = {std::move(loaded).value().observations, std::move(report)};

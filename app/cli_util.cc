@@ -8,18 +8,13 @@
 #include "io/robot_config.h"
 #include "io/trajectory_file.h"
 
+#include "base/install_layout.h"
 #include "base/sha256.h"
 #include "base/terminal_text.h"
 
 namespace selfcal::app {
 
-std::string ResolveDataPath(const std::string& path) {
-  namespace fs = std::filesystem;
-  std::error_code ec;  // a symlink loop or an unreadable folder: not found here, the reader says why
-  if (fs::exists(path, ec) || fs::path(path).is_absolute()) return path;
-  const fs::path in_source = fs::path(SELFCAL_SOURCE_DIR) / path;
-  return fs::exists(in_source, ec) ? in_source.string() : path;
-}
+std::string ResolveDataPath(const std::string& path) { return FindDataFile(path); }
 
 int Fail(const Status& status) {
   std::cerr << "selfcal: " << TerminalSafe(status.ToString()) << "\n";
@@ -36,6 +31,7 @@ ExitCode ExitCodeFor(calibration::Verdict verdict) {
     case calibration::Verdict::kUnconverged:
     case calibration::Verdict::kSolverFailure: return ExitCode::kSolverFailure;
     case calibration::Verdict::kRejected: return ExitCode::kModelRejected;
+    case calibration::Verdict::kUntested: return ExitCode::kUntested;
   }
   return ExitCode::kSolverFailure;
 }

@@ -15,8 +15,9 @@
 
 namespace selfcal::app {
 
-// `path` as given if it exists, else relative to the source tree's root (so that the shipped defaults
-// under config/ work from any directory of a build tree).
+// `path` as given if it exists, else in the data directories of the installed program (share/selfcal; for
+// a program run from its build tree also the source tree's root): base/install_layout.h's FindDataFile, so
+// that the shipped defaults under config/ work from any directory.
 std::string ResolveDataPath(const std::string& path);
 
 // Prints "selfcal: <code name>: message" to stderr and returns the exit code.

@@ -1,7 +1,8 @@
 // selfcal detect: a folder of images and the robot pose of each -> an observations file (docs/detect.md).
 // Parse -> io (image list, grey images, poses, robot, hand-eye) -> detection (points by id, the
-// ObservationSet, the contact sheet) -> io (the observations file; the sheet through base/atomic_file.h).
-// Nothing is written unless everything succeeded.
+// ObservationSet, the contact sheet) -> io (the observations file; the sheet through base/atomic_file.h;
+// with --skip-failed the list of the images left out). Nothing is written unless everything succeeded, but
+// for the contact sheet of a detection that failed (exit 3): it shows each image's reason.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -16,6 +17,7 @@
 #include "base/atomic_file.h"
 #include "detection/contact_sheet.h"
 #include "detection/detect_points.h"
+#include "detection/grid_orientation.h"
 #include "io/camera_file.h"
 #include "io/file_lists.h"
 #include "io/hand_eye_file.h"
@@ -23,6 +25,7 @@
 #include "io/observations_file.h"
 #include "io/pose_files.h"
 #include "io/robot_config.h"
+#include "io/skipped_images_file.h"
 #include "io/transform_yaml.h"
 
 namespace selfcal::app {
@@ -31,7 +34,8 @@ namespace {
 
 struct DetectSettings {
   std::string images, poses, out, contact_sheet;
-  std::string detector = "dots", identity = "grid", grid;
+  std::string detector = "dots", identity = "grid", grid, polarity = "dark";
+  bool asymmetric = false;  // circles: OpenCV's asymmetric grid
   std::string dictionary, board;  // charuco: the markers' dictionary and the board's squares ROWSxCOLS
   std::string robot, hand_eye;
   double fx_px = 0, cx_px = NAN, cy_px = NAN, mu = 1.0, k1 = 0.0;
@@ -45,6 +49,7 @@ struct DetectSettings {
   double tag_tolerance_px = 3.0;
   int sheet_tile_px = 640;
   bool skip_failed = false;
+  std::string skipped_out;                  // --skipped-out, default SkippedListPath(out) with --skip-failed
   io::JsonPoseKeys json;                    // --pose-*-key: the keys of JSON pose files
   std::string joints_unit = "rad", matrix_order = "row", quaternion_order = "xyzw";
   std::vector<double> flange_from_tool;     // --flange-from-tool-mm-deg X,Y,Z,ROLL,PITCH,YAW
@@ -77,6 +82,13 @@ Result<detection::DetectionOptions> ToDetectionOptions(const DetectSettings& a) 
   if (a.grid.empty() && o.detector == detection::Detector::kChessboard) {
     return Usage("--detector chessboard needs --grid ROWSxCOLS (inner corners, e.g. 6x9)");
   }
+  if (a.grid.empty() && o.detector == detection::Detector::kCircles) {
+    return Usage("--detector circles needs --grid ROWSxCOLS (rows of dots x dots per row, e.g. 11x4 --asymmetric)");
+  }
+  Result<detection::Polarity> polarity = detection::ParsePolarity(a.polarity);
+  if (!polarity.ok()) return polarity.status();
+  o.polarity = *polarity;
+  o.asymmetric = a.asymmetric;
   const bool charuco = o.detector == detection::Detector::kCharuco;
   if (charuco != !a.board.empty() || charuco != !a.dictionary.empty() || (charuco && !a.grid.empty())) {
     return Usage("--detector charuco takes --dictionary NAME and --board XxY (squares, e.g. 5x7) instead of --grid; "
@@ -180,10 +192,61 @@ void ReportRotationCorrections(const io::ImagesAndPoses& inputs) {
   }
 }
 
-void PrintPerImage(const std::vector<io::NamedImage>& images, const std::vector<detection::ImagePoints>& points) {
+// An image without points is FAILED, or SKIPPED when --skip-failed leaves it out of a set that was built.
+void PrintPerImage(const std::vector<io::NamedImage>& images, const std::vector<detection::ImagePoints>& points,
+                   const std::string& failed_label) {
   for (size_t i = 0; i < images.size(); ++i) {
-    std::cout << (points[i].ok ? "  " : "  FAILED ") << images[i].path << ": " << points[i].message << "\n";
+    std::cout << (points[i].ok ? "  " : "  " + failed_label + " ") << images[i].path << ": " << points[i].message << "\n";
   }
+}
+
+// Where --skip-failed lists the images it left out, unless --skipped-out: beside the observations file,
+// OBS.yaml -> OBS.skipped.yaml.
+std::string SkippedListPath(const DetectSettings& a) {
+  if (!a.skipped_out.empty() || !a.skip_failed || a.out.empty()) return a.skipped_out;
+  for (const std::string ext : {".yaml", ".yml"}) {
+    if (a.out.size() > ext.size() && a.out.compare(a.out.size() - ext.size(), ext.size(), ext) == 0) {
+      return a.out.substr(0, a.out.size() - ext.size()) + ".skipped.yaml";
+    }
+  }
+  return a.out + ".skipped.yaml";
+}
+
+// --contact-sheet: every image, its points, and the reason of each image without them.
+Status WriteContactSheet(const DetectSettings& a, const detection::DetectionOptions& options,
+                         const std::vector<std::string>& ids, const std::vector<const vpImage<unsigned char>*>& pixels,
+                         const std::vector<detection::ImagePoints>& points, const std::string& failed_label) {
+  std::vector<detection::SheetImage> sheet;
+  for (size_t i = 0; i < pixels.size(); ++i) sheet.push_back({ids[i], pixels[i], &points[i]});
+  detection::ContactSheetOptions so;
+  so.max_tile_width_px = a.sheet_tile_px;
+  so.failed_label = failed_label;
+  if (options.identity == detection::Identity::kGrid) {
+    // A ChArUco board of cols squares has cols - 1 corners a row.
+    so.grid_cols = options.detector == detection::Detector::kCharuco ? options.cols - 1 : options.cols;
+  }
+  Result<std::string> png = detection::ContactSheetPng(sheet, so);
+  if (!png.ok()) return png.status();
+  return WriteFileAtomically(a.contact_sheet, *png);
+}
+
+// --skip-failed: the images left out, on stdout and in the skipped list.
+Status WriteSkippedList(const DetectSettings& a, const std::vector<io::NamedImage>& images,
+                        const std::vector<std::string>& ids, const std::vector<detection::ImagePoints>& points,
+                        const ObservationSet& set) {
+  io::SkippedImages list;
+  list.observations = a.out;
+  list.images = static_cast<int>(images.size());
+  list.kept = static_cast<int>(set.poses.size());
+  for (size_t i = 0; i < images.size(); ++i) {
+    if (points[i].ok && !points[i].points_px.empty()) continue;
+    list.skipped.push_back({ids[i], images[i].path, points[i].message.empty() ? "no point found" : points[i].message});
+  }
+  const std::string path = SkippedListPath(a);
+  if (Status s = io::SaveSkippedImages(list, path); !s.ok()) return s;
+  std::printf("skipped %zu of %zu images, listed in %s\n", list.skipped.size(), images.size(), path.c_str());
+  AddOutputFile("skipped_images", path);
+  return Status::Ok();
 }
 
 // --json: images and points, per image and in all.
@@ -216,6 +279,9 @@ int DetectFromSettings(const DetectSettings& a) {
   if (a.camera_file.empty() && !a.camera_name.empty()) {
     return Fail(Usage("--camera-name " + a.camera_name + " selects a camera of a --camera-file; none was given"));
   }
+  if (!a.skipped_out.empty() && !a.skip_failed) {
+    return Fail(Usage("--skipped-out " + a.skipped_out + " lists the images --skip-failed leaves out; give --skip-failed"));
+  }
   if (a.camera_file.empty() && !(a.fx_px > 0)) {
     return Fail(Usage("--camera-fx-px (the camera's nominal focal length, px) or --camera-file is required"));
   }
@@ -247,29 +313,28 @@ int DetectFromSettings(const DetectSettings& a) {
   }
   detection::DetectionOptions detect_options = *options;
   detect_options.progress = Progress();
-  const std::vector<detection::ImagePoints> points = detection::DetectAllImagePoints(pixels, detect_options);
-  PrintPerImage(*images, points);
+  std::vector<detection::ImagePoints> points = detection::DetectAllImagePoints(pixels, detect_options);
+  detection::OrientCircleGrids(detect_options, robot_poses, *setup, &points);
   Result<ObservationSet> set = detection::BuildObservationSet(ids, points, robot_poses, *setup);
-  if (!set.ok()) return Fail(set.status());
-
-  std::string sheet_png;
+  // A detection that failed (kDegenerateData) still gets its contact sheet: each image's reason, for a person.
+  const bool detection_failed = !set.ok() && set.status().code() == ErrorCode::kDegenerateData;
+  PrintPerImage(*images, points, set.ok() ? "SKIPPED" : "FAILED");
+  if (!set.ok() && !detection_failed) return Fail(set.status());
   if (!a.contact_sheet.empty()) {
-    std::vector<detection::SheetImage> sheet;
-    for (size_t i = 0; i < images->size(); ++i) sheet.push_back({ids[i], pixels[i], &points[i]});
-    detection::ContactSheetOptions so;
-    so.max_tile_width_px = a.sheet_tile_px;
-    if (options->identity == detection::Identity::kGrid) {
-      // A ChArUco board of cols squares has cols - 1 corners a row.
-      so.grid_cols = options->detector == detection::Detector::kCharuco ? options->cols - 1 : options->cols;
+    if (Status s = WriteContactSheet(a, *options, ids, pixels, points, set.ok() ? "SKIPPED" : "FAILED"); !s.ok()) {
+      return Fail(s);
     }
-    Result<std::string> png = detection::ContactSheetPng(sheet, so);
-    if (!png.ok()) return Fail(png.status());
-    sheet_png = std::move(*png);
-    if (Status s = WriteFileAtomically(a.contact_sheet, sheet_png); !s.ok()) return Fail(s);
+    if (detection_failed) std::cerr << "selfcal: each image's outcome is on the contact sheet " << a.contact_sheet << "\n";
   }
-  if (Status s = io::SaveObservations(*set, a.out); !s.ok()) {
+  if (detection_failed) return Fail(set.status());
+  Status written = io::SaveObservations(*set, a.out);
+  if (written.ok() && a.skip_failed) {
+    written = WriteSkippedList(a, *images, ids, points, *set);
+    if (!written.ok()) std::remove(a.out.c_str());
+  }
+  if (!written.ok()) {
     if (!a.contact_sheet.empty()) std::remove(a.contact_sheet.c_str());  // nothing is left on an error
-    return Fail(s);
+    return Fail(written);
   }
   size_t fewest = SIZE_MAX, most = 0;
   for (const PoseObservation& p : set->poses) {
@@ -319,9 +384,12 @@ Command AddDetectCommand(CLI::App& app) {
                   "Also write every image with its points and ids as one PNG");
   cmd->add_option("--contact-sheet-tile-px", a->sheet_tile_px, "Largest thumbnail width on the contact sheet, px")
       ->check(CLI::Range(64, 8192));
-  cmd->add_option("--detector", a->detector, "dots, chessboard or charuco")
-      ->check(CLI::IsMember({"dots", "chessboard", "charuco"}));
-  cmd->add_option("--grid", a->grid, "ROWSxCOLS: the dot grid (default 10x10) or the chessboard's inner corners");
+  cmd->add_option("--detector", a->detector, "dots, circles (a circle grid without an origin dot), chessboard or charuco")
+      ->check(CLI::IsMember({"dots", "circles", "chessboard", "charuco"}));
+  cmd->add_option("--grid", a->grid, "ROWSxCOLS: the dot grid (default 10x10), the circle grid or the chessboard's inner corners");
+  cmd->add_flag("--asymmetric", a->asymmetric, "circles: OpenCV's asymmetric grid (every other row shifted by half a step)");
+  cmd->add_option("--polarity", a->polarity, "dots and circles: dark dots (default), light dots on a dark board, or auto")
+      ->check(CLI::IsMember({"dark", "light", "auto"}));
   cmd->add_option("--dictionary", a->dictionary, "charuco: the markers' OpenCV dictionary, e.g. DICT_6X6_250");
   cmd->add_option("--board", a->board, "charuco: the board's squares XxY (OpenCV's squaresX x squaresY), e.g. 5x7");
   cmd->add_option("--identity", a->identity, "How dots are named: grid (larger origin dot), apriltag, order")
@@ -355,7 +423,11 @@ Command AddDetectCommand(CLI::App& app) {
   cmd->add_option("--yardstick", a->yardstick, "A,B,LENGTH_MM: a known distance between points A and B")
       ->delimiter(',')
       ->expected(3);
-  cmd->add_flag("--skip-failed", a->skip_failed, "Leave images without points out instead of failing");
+  cmd->add_flag("--skip-failed", a->skip_failed,
+                "Leave images without points out instead of failing, and list them with their reasons (--skipped-out)");
+  AddOutputOption(cmd, "--skipped-out", &a->skipped_out, OutputKind::kFile,
+                  "With --skip-failed: the list of the images left out (default: beside --out, OBS.skipped.yaml)");
+  SetOutputPathWhenEmpty(cmd, "--skipped-out", [a]() { return SkippedListPath(*a); });
   return [a, values]() {
     for (const CLI::Option* option : values) a->camera_values_given = a->camera_values_given || option->count() > 0;
     return DetectFromSettings(*a);

@@ -14,6 +14,7 @@ enum class ExitCode : int {
   kSolverFailure = 5,   // the solver did not converge or failed
   kModelRejected = 6,   // converged, but the model fails its held-out checks (no model written)
   kOutsideLimits = 7,   // compensate: a target is reachable only outside the joint limits (nothing written)
+  kUntested = 8,        // converged and passed what could be checked, but no held-out test: model written, unverified
   kInternal = 70,       // a bug in selfcal (sysexits.h EX_SOFTWARE): please report it
   kInterrupted = 130,   // Ctrl-C: the robot was stopped, the session is resumable
 };
@@ -39,6 +40,7 @@ inline const char* ExitCodeName(ExitCode code) {
     case ExitCode::kHardware: return "hardware_fault";
     case ExitCode::kSolverFailure: return "solver_failure";
     case ExitCode::kModelRejected: return "model_rejected";
+    case ExitCode::kUntested: return "untested";
     case ExitCode::kOutsideLimits: return "outside_joint_limits";
     case ExitCode::kInternal: return "internal_error";
     case ExitCode::kInterrupted: return "interrupted";

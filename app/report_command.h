@@ -2,9 +2,11 @@
 // the same page beside report.json for `calibrate` (report/html_report.h draws it).
 //
 // plotly.js is inlined into the page; this side finds and reads it: --plotly-js PATH when given, else
-// the environment's SELFCAL_PLOTLY_JS, else the file CMake found at configure time (the cache variable
-// SELFCAL_PLOTLY_JS; Debian 12's python3-plotly ships /usr/share/python3-plotly/plotly.js). A missing file
-// is a kInvalidInput naming it and how to install it.
+// the environment's SELFCAL_PLOTLY_JS, else the first that exists of plotly.min.js in the data directories
+// of base/install_layout.h (share/selfcal installed with the program; for a program run from its build
+// tree also the build directory, where CMake minifies it), Debian 12's python3-plotly
+// (/usr/share/python3-plotly/plotly.js) and pip's package_data copy. A missing file is a kInvalidInput
+// naming every place searched and how to install it.
 #pragma once
 
 #include <string>

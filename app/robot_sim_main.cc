@@ -17,6 +17,7 @@
 
 #include "app/cli_numbers.h"
 #include "app/exit_codes.h"
+#include "base/install_layout.h"
 #include "base/status.h"
 #include "io/robot_config.h"
 #include "robot/clock.h"
@@ -45,13 +46,6 @@ struct Args {
   std::vector<int> stale_read, nan_read, short_read;
   double jog_deg = 0;  // 0: the default jog (0.02 rad on joint 1)
 };
-
-// `path` as given if it exists or is absolute, else relative to the source tree (the shipped configs).
-std::string ResolveConfigPath(const std::string& path) {
-  if (std::filesystem::exists(path) || std::filesystem::path(path).is_absolute()) return path;
-  const std::filesystem::path in_source = std::filesystem::path(SELFCAL_SOURCE_DIR) / path;
-  return std::filesystem::exists(in_source) ? in_source.string() : path;
-}
 
 int Fail(const selfcal::Status& status) {
   std::cerr << "selfcal-robot-sim: " << status.ToString() << "\n";
@@ -106,7 +100,7 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : static_cast<int>(selfcal::app::ExitCode::kUsage);
   }
 
-  const Result<RobotModel> model = io::LoadRobotModel(ResolveConfigPath(args.robot));
+  const Result<RobotModel> model = io::LoadRobotModel(FindDataFile(args.robot));
   if (!model.ok()) return Fail(model.status());
   const int n = model->num_joints();
 

@@ -288,7 +288,7 @@ int SimulateSession(const SimulateArgs& args) {
   OutputDocument()["comparison_with_truth"] = comparison;
   std::cout << "\nsimulated session " << run_s << " s, with the calibration " << total_s << " s; results in " << args.out
             << "/: " << std::filesystem::path(run.session).filename().string()
-            << "/ (the session), observations.yaml, report.json"
+            << "/ (the session), observations.yaml, report.json, image_residuals.csv"
             << (std::filesystem::exists(std::filesystem::path(args.out) / "report.html") ? ", report.html" : "")
             << (code == 0 ? ", calibrated_model.yaml, calibrated.urdf" : "")
             << ", truth.json, comparison_with_truth.json\n";

@@ -4,7 +4,12 @@
 //   heldout_test             the held-out reprojection test (heldout_reprojection.h) of the chosen model,
 //                            normalised with the stated pixel noise and, when the bundle estimated one,
 //                            each verification image's pose error (bundle/error_model.h), at kHeldOutTestLevel
-//   beats_nominal_heldout    its held-out reprojection RMS below the nominal model's
+//   cross_validation_test    without verification poses: the k-fold held-out test (cross_validation.h), every
+//                            fold's chi-square at the stated noise and its estimated pose error summed, at
+//                            kHeldOutTestLevel
+//   beats_nominal_heldout    its held-out reprojection RMS below the nominal model's, or not significantly
+//                            worse where the nominal model is already good: a one-sided paired t-test of the
+//                            poses' mean square errors at 95 % (three verification poses at least)
 //   beats_nominal_distances  the 3-D RMS error of the check distances below the nominal model's (only
 //                            when the set has check distances). It decides only for a model without a
 //                            covariance (the paper's method): for the bundle, whose held-out test carries
@@ -25,7 +30,9 @@
 //                            converged with link lengths of metres)
 //
 // A check that cannot be made (no verification pose, a model without a covariance, flange poses with a
-// stated noise the test does not model) is kNotAvailable and says why; it refuses nothing. The stated
+// stated noise the test does not model) is kNotAvailable and says why; it refuses nothing. A model that
+// passes and yet had no held-out test made (HeldOutTested false: neither held-out test nor the comparison
+// with the nominal model on held-out images) is "untested" (calibrate.h), not accepted. The stated
 // noise is the test's scale because a wrong model inflates the noise estimated from its own residuals
 // (measured: a 1 mm link error held fixed raised the estimate from 0.20 to 0.28 px, which hid the error
 // from a test normalised by it).
@@ -37,6 +44,7 @@
 #include <Eigen/Core>
 
 #include "bundle/error_model.h"
+#include "calibration/cross_validation.h"
 #include "calibration/heldout_reprojection.h"
 #include "calibration/paper_pipeline.h"
 
@@ -46,7 +54,7 @@ enum class CheckStatus { kPassed, kFailed, kNotAvailable };
 const char* CheckStatusName(CheckStatus status);  // "passed", "failed", "not_available"
 
 struct AcceptanceCheck {
-  std::string name;      // heldout_test, beats_nominal_heldout, beats_nominal_distances
+  std::string name;      // heldout_test, cross_validation_test, beats_nominal_heldout, ...
   CheckStatus status = CheckStatus::kNotAvailable;
   std::string sentence;  // the figures and what they mean, in words
   bool decisive = true;  // false: reported, refuses nothing
@@ -56,6 +64,9 @@ struct Acceptance {
   std::vector<AcceptanceCheck> checks;
   bool Passed() const;                   // no decisive check failed
   bool Verified() const;                 // at least one check was made
+  // A decisive held-out check passed: the held-out test, the cross-validation test, or the comparison with
+  // the nominal model on verification images.
+  bool HeldOutTested() const;
   std::vector<std::string> Reasons() const;  // the sentences of the failed decisive checks
 };
 
@@ -76,6 +87,9 @@ struct AcceptanceInputs {
   // empty for the paper's method.
   const RobotModel* robot = nullptr;
   Eigen::VectorXd corrections;
+  // The k-fold cross-validation (null or not run: none; it runs only without verification poses).
+  const CrossValidationReport* cross_validation = nullptr;
+  std::string no_cross_validation_reason = "not run";  // when cross_validation is null
   // The score test of the parameters held by request (bundle/error_model.h); null: none.
   const bundle::HeldValueTest* held_values = nullptr;
 };

@@ -178,6 +178,7 @@ BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineR
     report.calibrated_camera = WithIntrinsics(obs.camera, b.intrinsics);
     step = std::chrono::steady_clock::now();
     if (valid) VerifyHeldOutReprojection(obs, &report);
+    if (verification_poses.empty()) report.heldout.message = "the set names no verification pose";
     report.seconds_heldout = SecondsSince(step);
     step = std::chrono::steady_clock::now();
     report.fit_geometry = FitGeometryOf(obs, b);

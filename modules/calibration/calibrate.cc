@@ -21,6 +21,7 @@ const char* VerdictName(Verdict verdict) {
     case Verdict::kUnconverged: return "unconverged";
     case Verdict::kSolverFailure: return "solver_failure";
     case Verdict::kRejected: return "rejected";
+    case Verdict::kUntested: return "untested";
   }
   return "solver_failure";
 }
@@ -132,6 +133,10 @@ void CheckAcceptance(const ObservationSet& obs, const ObservationSet& original, 
       in.no_test_reason = "the flange poses have a stated noise, which the test does not model";
     }
     in.held_values = &stage.bundle.held_values;
+    if (report->cross_validation) in.cross_validation = &*report->cross_validation;
+    if (!obs.PosesWithRole(PoseRole::kVerification).empty()) {
+      in.no_cross_validation_reason = "not run: the set has verification poses";
+    }
     in.distances_calibrated = &stage.verification;
     in.distances_nominal = &stage.verification_nominal;
     in.distances_decisive = false;
@@ -150,6 +155,7 @@ void CheckAcceptance(const ObservationSet& obs, const ObservationSet& original, 
     in.nominal = &report->paper_heldout->nominal;
     in.no_test_reason = "the paper's method gives no parameter covariance to predict with (its model is compared "
                         "with the nominal one only)";
+    in.no_cross_validation_reason = "the paper's method is not cross-validated (the bundle method is)";
     in.distances_calibrated = &report->paper.verification_calibrated;
     in.distances_nominal = &report->paper.verification_nominal;
   }
@@ -165,6 +171,15 @@ void CheckAcceptance(const ObservationSet& obs, const ObservationSet& original, 
                        " dots is predicted by the calibrated model (no dot is placed by the identification images, or "
                        "every one lies behind the camera at the recorded joint angles): fix the pose's joint angles "
                        "(their unit?) or dots, or remove the pose";
+    return;
+  }
+  if (report->acceptance.Passed() && !report->acceptance.HeldOutTested()) {
+    report->verdict = Verdict::kUntested;
+    report->message = "the model passed every check that could be made, but none of them held images out";
+    for (const AcceptanceCheck& c : report->acceptance.checks) {
+      if (c.name == "heldout_test" || c.name == "cross_validation_test") report->message += "; " + c.sentence;
+    }
+    report->message += ": name verification poses, or record enough poses for the cross-validation's folds (two a fold)";
     return;
   }
   if (report->acceptance.Passed()) return;
@@ -226,7 +241,7 @@ CalibrationReport CalibrateSteps(const ObservationSet& observations, const Calib
     }
     report.verdict = VerdictFor(report.bundle->bundle.outcome);
     report.message = report.bundle->bundle.message;
-    if (report.bundle->bundle.outcome == bundle::Outcome::kConverged && options.cross_validation_folds > 0 &&
+    if (report.bundle->bundle.outcome == bundle::Outcome::kConverged &&
         obs.PosesWithRole(PoseRole::kVerification).empty()) {
       report.cross_validation =
           CrossValidate(obs, *report.bundle, stage_options, options.cross_validation_folds, options.paper.two_view.seed);
@@ -241,7 +256,7 @@ CalibrationReport CalibrateSteps(const ObservationSet& observations, const Calib
     report.seconds_acceptance = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
   progress.Advance();
-  if (!report.accepted()) return report;  // no model for a result that is not to be applied
+  if (!report.has_model_verdict()) return report;  // no model for a result that is not to be applied
   CalibratedModel model;
   if (report.bundle) {
     const bundle::BundleReport& b = report.bundle->bundle;

@@ -51,6 +51,9 @@ enum class Verdict {
   kUnconverged,      // the solver stopped without converging: the result is not to be applied
   kSolverFailure,    // the solver failed (non-finite start, internal failure)
   kRejected,         // converged, but refused by its acceptance checks (acceptance.h): not to be applied
+  // Converged and passed every check that could be made, but no held-out test could be made (no
+  // verification pose, no cross-validation): the model is written, and says it was not verified.
+  kUntested,
 };
 const char* VerdictName(Verdict verdict);  // "accepted", "invalid_input", ...
 
@@ -113,7 +116,7 @@ struct CalibrationReport {
   std::optional<BundleStageReport> bundle;  // when method == kBundle
   // The bundle converged and the set names no verification pose: its k-fold held-out figure.
   std::optional<CrossValidationReport> cross_validation;
-  std::optional<CalibratedModel> model;    // the chosen method's model, only when accepted
+  std::optional<CalibratedModel> model;    // the chosen method's model, only when accepted or untested
   // The acceptance checks of the chosen method's converged model (empty when it did not converge).
   Acceptance acceptance;
   // Method::kPaper on joint angles, converged: the held-out figures of its model and of the nominal one.
@@ -123,6 +126,8 @@ struct CalibrationReport {
   double seconds_acceptance = 0, seconds_total = 0;
 
   bool accepted() const { return verdict == Verdict::kAccepted; }
+  // A model is written: accepted, or converged and passing what could be checked without a held-out test.
+  bool has_model_verdict() const { return verdict == Verdict::kAccepted || verdict == Verdict::kUntested; }
   // The chosen method's held-out verification (3-D error of the check distances), before and after.
   const VerificationSummary& verification_calibrated() const;
   const VerificationSummary& verification_nominal() const;

@@ -84,6 +84,9 @@ CrossValidationReport CrossValidate(const ObservationSet& obs, const BundleStage
   }
   report.ran = true;
   double sum2 = 0;
+  HeldOutFigure& pooled = report.pooled;
+  pooled.chi_square = 0;
+  pooled.max_px = 0;
   for (int f = 0; f < folds; ++f) {
     std::vector<int> held_out;
     for (size_t k = f; k < poses.size(); k += folds) held_out.push_back(poses[k]);
@@ -94,9 +97,22 @@ CrossValidationReport CrossValidate(const ObservationSet& obs, const BundleStage
       report.num_residuals += figure.num_residuals;
       sum2 += figure.rms_px * figure.rms_px * figure.num_residuals;
       report.folds_passed += figure.test_passed ? 1 : 0;
+      ++report.folds_tested;
+      pooled.num_residuals += figure.num_residuals;
+      pooled.dof += figure.dof;
+      pooled.chi_square += figure.chi_square;
+      pooled.max_px = std::max(pooled.max_px, figure.max_px);
     }
   }
-  if (report.num_residuals > 0) report.rms_px = std::sqrt(sum2 / report.num_residuals);
+  if (report.num_residuals > 0) {
+    report.rms_px = std::sqrt(sum2 / report.num_residuals);
+    pooled.rms_px = report.rms_px;
+    pooled.chi_square_limit = ChiSquareQuantile(kHeldOutTestLevel, pooled.dof);
+    pooled.p_value = ChiSquareUpperTail(pooled.chi_square, pooled.dof);
+    pooled.test_passed = pooled.chi_square <= pooled.chi_square_limit;
+  } else {
+    pooled = HeldOutFigure();
+  }
   const double depth = MedianDepth(obs, full);
   if (std::isfinite(depth) && full.bundle.fx_px > 0) {
     report.mm_per_px = depth * 1e3 / full.bundle.fx_px;

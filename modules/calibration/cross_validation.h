@@ -4,7 +4,9 @@
 // joint angles (or flange poses) alone (heldout_reprojection.h). The prediction error of poses the fit never
 // saw, in px per coordinate and in mm at the scene (px times the median camera-to-dot distance over f_x).
 //
-// A figure, not yet a verdict: the held-out test at the stated pixel noise is reported per fold.
+// The held-out test at the stated pixel noise (with each fold's estimated pose error, bundle/error_model.h)
+// per fold, and pooled over the folds: the sum of the folds' chi-squares against the sum of their degrees of
+// freedom, the verdict's test when the set names no verification pose (acceptance.h).
 #pragma once
 
 #include <cstdint>
@@ -35,6 +37,8 @@ struct CrossValidationReport {
   double mm_per_px = NAN;        // at the scene: median camera-to-dot distance / f_x
   double rms_mm = NAN;           // rms_px * mm_per_px
   int folds_passed = 0;          // folds whose held-out test passed at the stated noise
+  int folds_tested = 0;          // folds with a figure (converged, and predicting at least one detection)
+  HeldOutFigure pooled;          // every fold's figure summed: chi-square, dof, its 95 % limit, p
 };
 
 // k-fold cross-validation of `full` (the bundle stage of the whole set, converged): fold f holds out every

@@ -115,6 +115,45 @@ TEST(HandEye, ImageMotionsAgreeWithTheFlangeAndCatchAWrongFlangePose) {
   EXPECT_GT(over, involving / 2) << bad.motion_check->message;
 }
 
+// Each image's own camera pose (the free-camera bundle's, aligned onto the model's frame) beside the model's
+// camera pose (the flange pose times the hand-eye transform): on exact flange poses they agree to the noise
+// (measured: at most 0.62 mm and well under 0.05 deg at 0.2 px; the camera centres' depth is what the
+// images see worst);
+// a flange pose logged 3 deg off is the one image whose camera disagrees with the model's, by about 3 deg.
+TEST(HandEye, ImageCameraPosesAgainstTheModelPointAtAWrongFlangePose) {
+  FlangeWorld w = MakeFlangeWorld(0.2);
+  const CalibrationReport good = Calibrate(w.observations, CalibrateOptions());
+  ASSERT_TRUE(good.motion_check.has_value() && good.motion_check->ok) << good.motion_check->message;
+  ASSERT_EQ(good.motion_check->cameras.size(), w.observations.poses.size());
+  const Rigid3& flange_from_cam = good.model->robot.flange_from_cam;
+  for (size_t i = 0; i < w.observations.poses.size(); ++i) {
+    const ImageCameraPose& c = good.motion_check->cameras[i];
+    EXPECT_EQ(c.pose_id, w.observations.poses[i].id);
+    const Rigid3 model = *w.observations.poses[i].base_from_flange * flange_from_cam;
+    EXPECT_LT((c.base_from_cam_model.translation - model.translation).norm(), 1e-12);
+    EXPECT_LT(AngleBetween(c.base_from_cam_model.rotation, model.rotation), 1e-12);
+    EXPECT_LT(c.rotation_error_rad, 0.05 * kPi / 180) << c.pose_id;
+    EXPECT_LT(c.translation_error_m, 1.5e-3) << c.pose_id;
+    EXPECT_NEAR(c.rotation_error_rad, AngleBetween(c.base_from_cam_images.rotation, model.rotation), 1e-12);
+    EXPECT_NEAR(c.translation_error_m, (c.base_from_cam_images.translation - model.translation).norm(), 1e-12);
+  }
+  const size_t bad_index = 4;
+  PoseObservation& bad_pose = w.observations.poses[bad_index];
+  bad_pose.base_from_flange->rotation =
+      bad_pose.base_from_flange->rotation * ExpSO3<double>(Eigen::Vector3d(0, 3.0 * kPi / 180, 0));
+  const CalibrationReport bad = Calibrate(w.observations, CalibrateOptions());
+  ASSERT_TRUE(bad.motion_check.has_value() && bad.motion_check->ok);
+  ASSERT_EQ(bad.motion_check->cameras.size(), w.observations.poses.size());
+  for (size_t i = 0; i < w.observations.poses.size(); ++i) {
+    const ImageCameraPose& c = bad.motion_check->cameras[i];
+    if (i == bad_index) {
+      EXPECT_NEAR(c.rotation_error_rad, 3.0 * kPi / 180, 0.5 * kPi / 180);
+    } else {
+      EXPECT_LT(c.rotation_error_rad, 1.0 * kPi / 180) << c.pose_id;
+    }
+  }
+}
+
 // A flat dot sheet: the two-view poses of a plane are two-fold ambiguous, the start keeps the pairs whose
 // rotation angle matches the flange's, and the bundle (all views share one plane) is at its own bound:
 // over 12 noise draws the errors of f_x and the hand-eye translation, divided by the bundle's sigmas,
@@ -158,7 +197,10 @@ TEST(HandEye, StatedFlangePoseNoiseIsModelled) {
   w.observations.flange_translation_sigma_m = 1e-3;
   w.observations.flange_rotation_sigma_rad = 8.7e-4;
   const CalibrationReport report = Calibrate(w.observations, CalibrateOptions());
-  ASSERT_TRUE(report.accepted()) << report.message;
+  // The held-out test does not model a stated flange pose noise, and the set names no hand-eye transform to
+  // compare with: nothing held images out, so the model is written as untested.
+  ASSERT_EQ(report.verdict, Verdict::kUntested) << report.message;
+  ASSERT_TRUE(report.model.has_value());
   ASSERT_TRUE(report.pose_noise.has_value() && report.pose_noise->ok) << report.pose_noise->message;
   EXPECT_LT(report.pose_noise->rms_reprojection_px, 1.5 * 0.2 * std::sqrt(2.0)) << report.pose_noise->message;
   const Rigid3& x = report.model->robot.flange_from_cam;
@@ -184,7 +226,8 @@ TEST(HandEye, FreedIntrinsicsAreEstimatedByEveryBundleOfAFlangePoseSet) {
   CalibrateOptions options;
   options.bundle.bundle.free_parameters = {"camera", "fx", "cx", "cy", "k1"};
   const CalibrationReport report = Calibrate(w.observations, options);
-  ASSERT_TRUE(report.accepted()) << report.message;
+  ASSERT_EQ(report.verdict, Verdict::kUntested) << report.message;  // as above: a stated flange pose noise
+  ASSERT_TRUE(report.model.has_value());
   const bundle::BundleReport& b = report.bundle->bundle;
   const IntrinsicsMask expected = {true, false, true, true, true, false, false, false, false};
   EXPECT_EQ(b.intrinsics_estimated, expected);

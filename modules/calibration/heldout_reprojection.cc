@@ -351,7 +351,9 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
     }
   }
   if (residuals.rows.empty()) {
-    report.message = "no verification image sees a dot that the identification images place";
+    report.message = obs.PosesWithRole(PoseRole::kVerification).empty()
+                         ? "the set names no verification pose"
+                         : "no verification image sees a dot that the identification images place";
     return report;
   }
   first_row_of_pose.push_back(static_cast<int>(residuals.rows.size()));

@@ -17,6 +17,31 @@ double Quantile(std::vector<double> values, double q) {
   return values[lo] + (at - static_cast<double>(lo)) * (values[hi] - values[lo]);
 }
 
+// The images' cameras moved onto the model's frame by one rigid transform (motion_check.h), and each one's
+// disagreement with the model's camera.
+std::vector<ImageCameraPose> CompareWithModel(const std::vector<std::string>& ids, const std::vector<Rigid3>& images,
+                                              const std::vector<Rigid3>& model) {
+  Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+  for (size_t k = 0; k < images.size(); ++k) sum += model[k].rotation * images[k].rotation.transpose();
+  Rigid3 model_from_images(NearestRotation(sum), Eigen::Vector3d::Zero());
+  Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+  for (size_t k = 0; k < images.size(); ++k) {
+    shift += model[k].translation - model_from_images.rotation * images[k].translation;
+  }
+  model_from_images.translation = shift / static_cast<double>(std::max<size_t>(images.size(), 1));
+  std::vector<ImageCameraPose> out;
+  for (size_t k = 0; k < images.size(); ++k) {
+    ImageCameraPose c;
+    c.pose_id = ids[k];
+    c.base_from_cam_images = model_from_images * images[k];
+    c.base_from_cam_model = model[k];
+    c.translation_error_m = (c.base_from_cam_images.translation - model[k].translation).norm();
+    c.rotation_error_rad = LogSO3(model[k].rotation.transpose() * c.base_from_cam_images.rotation).norm();
+    out.push_back(c);
+  }
+  return out;
+}
+
 }  // namespace
 
 MotionCheck CheckImageMotions(const ObservationSet& obs, const Rigid3& flange_from_cam,
@@ -51,6 +76,13 @@ MotionCheck CheckImageMotions(const ObservationSet& obs, const Rigid3& flange_fr
       check.pairs.push_back(pair);
     }
   }
+  std::vector<std::string> ids;
+  std::vector<Rigid3> model;
+  for (int i : poses) {
+    ids.push_back(obs.poses[i].id);
+    model.push_back(start[i]);
+  }
+  check.cameras = CompareWithModel(ids, check.images.base_from_cam, model);
   check.median_error_rad = Quantile(errors, 0.5);
   check.p90_error_rad = Quantile(errors, 0.9);
   check.max_error_rad = errors.empty() ? 0 : *std::max_element(errors.begin(), errors.end());

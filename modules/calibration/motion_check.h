@@ -25,11 +25,24 @@ struct MotionPair {
   double error_rad = 0;  // |camera - flange|
 };
 
+// One image's own camera pose beside the model's. base_from_cam_images is the free-camera bundle's, solved
+// from the images alone (its gauge: the first camera held at the model's, the distance of the first two
+// held), moved by the one rigid transform that best aligns all the images' cameras with the model's (the
+// chordal mean of R_model R_images^T, then the mean of the centres' differences), so that no single image
+// carries the gauge. base_from_cam_model is the model's: base_from_flange * flange_from_cam.
+struct ImageCameraPose {
+  std::string pose_id;
+  Rigid3 base_from_cam_images, base_from_cam_model;
+  double translation_error_m = 0;  // |centre (images) - centre (model)|, m
+  double rotation_error_rad = 0;   // angle of R_model^T R_images, rad
+};
+
 struct MotionCheck {
   bool ok = false;
   std::string message;
   bundle::FreeCameraReport images;  // the free-camera bundle
   std::vector<MotionPair> pairs;    // every pair of the poses it solved
+  std::vector<ImageCameraPose> cameras;  // every pose it solved, in the order of obs.poses
   double median_error_rad = 0, p90_error_rad = 0, max_error_rad = 0;
   int pairs_over_2deg = 0;
 };

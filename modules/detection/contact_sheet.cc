@@ -50,10 +50,49 @@ void DrawPoints(cv::Mat* tile, const ImagePoints& points, double s, int grid_col
   }
 }
 
-std::string Title(const SheetImage& image) {
+std::string Title(const SheetImage& image, const std::string& failed_label) {
   if (image.points == nullptr) return image.title;
-  if (!image.points->ok) return image.title + ": FAILED: " + image.points->message;
-  return image.title + ": " + std::to_string(image.points->points_px.size()) + " points";
+  if (!image.points->ok) return image.title + ": " + failed_label;
+  return image.title + ": ok, " + std::to_string(image.points->points_px.size()) + " points";
+}
+
+// The words of `text` in lines of at most `width` characters, at most `max_lines` of them (the last one
+// ending in "..." when the text is longer); a word longer than a line is cut.
+std::vector<std::string> Wrap(const std::string& text, size_t width, size_t max_lines) {
+  std::vector<std::string> lines(1);
+  size_t start = 0;
+  while (start < text.size()) {
+    size_t end = text.find_first_of(" \n", start);
+    if (end == std::string::npos) end = text.size();
+    std::string word = text.substr(start, end - start).substr(0, width);
+    start = end + 1;
+    if (word.empty()) continue;
+    if (!lines.back().empty() && lines.back().size() + 1 + word.size() > width) lines.emplace_back();
+    lines.back() += (lines.back().empty() ? "" : " ") + word;
+  }
+  if (lines.size() > max_lines) {
+    lines.resize(max_lines);
+    std::string& last = lines.back();
+    last = last.substr(0, std::min(last.size(), width > 3 ? width - 3 : 0)) + "...";
+  }
+  return lines;
+}
+
+// A failed image's outcome and reason on its tile, in red on a darkened band across the tile's top: the
+// title line above holds only a few words of a long reason.
+void DrawReason(cv::Mat* tile, const std::string& label, const std::string& reason) {
+  constexpr int kLinePx = 15;
+  const size_t width = static_cast<size_t>(std::max(8, (tile->cols - 8) / 9));
+  std::vector<std::string> lines = Wrap(reason.empty() ? "no point found" : reason, width, 5);
+  lines.insert(lines.begin(), label);
+  const int band = std::min(tile->rows, static_cast<int>(lines.size()) * kLinePx + 8);
+  cv::Mat top = (*tile)(cv::Rect(0, 0, tile->cols, band));
+  top *= 0.3;
+  for (size_t k = 0; k < lines.size(); ++k) {
+    const int baseline = 4 + kLinePx * static_cast<int>(k + 1) - 3;
+    if (baseline > band) break;
+    Text(tile, lines[k], cv::Point(4, baseline), 1.0, kRed);
+  }
 }
 
 }  // namespace
@@ -92,10 +131,11 @@ Result<std::string> ContactSheetPng(const std::vector<SheetImage>& images, const
     }
     cv::cvtColor(scaled, tile, cv::COLOR_GRAY2BGR);
     if (im.points != nullptr && im.points->ok) DrawPoints(&tile, *im.points, s, options.grid_cols);
+    if (im.points != nullptr && !im.points->ok) DrawReason(&tile, options.failed_label, im.points->message);
     const cv::Rect where(x0, y0 + kTitleHeightPx, std::min(tile.cols, tile_w), std::min(tile.rows, tile_h));
     tile(cv::Rect(0, 0, where.width, where.height)).copyTo(sheet(where));
     const bool failed = im.points != nullptr && !im.points->ok;
-    std::string title = Title(im);
+    std::string title = Title(im, options.failed_label);
     if (title.size() > static_cast<size_t>(tile_w / 8)) title = title.substr(0, static_cast<size_t>(tile_w / 8 - 3)) + "...";
     cv::putText(sheet, title, cv::Point(x0, y0 + 16), cv::FONT_HERSHEY_PLAIN, 1.0, failed ? kRed : kGreen, 1, cv::LINE_AA);
   }

@@ -2,6 +2,8 @@
 
 #include <sstream>
 
+#include "detection/circle_grid.h"
+
 namespace selfcal::detection {
 
 namespace {
@@ -56,12 +58,67 @@ ImagePoints AprilTagPoints(const vpImage<unsigned char>& image, const tracking::
   return out;
 }
 
-ImagePoints OrderPoints(const tracking::DetectionReport& det) {
+ImagePoints OrderPoints(const tracking::DetectionReport& all, const DetectionOptions& options) {
+  const FilteredDots f = FilterTexture(all, options.blob_filter);
+  const tracking::DetectionReport& det = f.report;
   ImagePoints out;
-  out.candidates = static_cast<int>(det.dots.size());
+  out.candidates = static_cast<int>(all.dots.size());
   for (size_t k = 0; k < det.dots.size(); ++k) out.points_px[static_cast<int>(k)] = det.dots[k].centroid_px;
   out.ok = !out.points_px.empty();
   out.message = out.ok ? std::to_string(det.dots.size()) + " dots in raster order" : "no dot detected";
+  if (f.texture_blobs > 0) out.message += " (" + std::to_string(f.texture_blobs) + " blobs unlike the others left out)";
+  return out;
+}
+
+ImagePoints CirclePoints(const tracking::DetectionReport& all, const DetectionOptions& options) {
+  const FilteredDots f = FilterTexture(all, options.blob_filter);
+  const CircleGridDetection c = FindCircleGrid(f.report.dots, CircleGridLayout{options.rows, options.cols, options.asymmetric});
+  ImagePoints out;
+  out.candidates = static_cast<int>(all.dots.size());
+  out.ok = c.found;
+  out.message = c.message;
+  if (f.texture_blobs > 0) out.message += " (" + std::to_string(f.texture_blobs) + " blobs unlike the others left out)";
+  for (size_t k = 0; k < c.centres_px.size(); ++k) out.points_px[static_cast<int>(k)] = c.centres_px[k];
+  return out;
+}
+
+// The points of the dots of one polarity, and how clearly they stand out (ContrastScore of the dots used).
+struct PolarPoints {
+  ImagePoints points;
+  double score = 0;
+};
+
+PolarPoints DotPointsOfPolarity(const vpImage<unsigned char>& image, const DetectionOptions& options, Polarity polarity) {
+  const tracking::DetectionReport det = DetectDotsOfPolarity(image, options.dots, polarity);
+  PolarPoints out;
+  const bool filtered = options.detector == Detector::kCircles || options.identity == Identity::kOrder;
+  out.score = ContrastScore(filtered ? FilterTexture(det, options.blob_filter).report.dots : det.dots);
+  if (options.detector == Detector::kCircles) {
+    out.points = CirclePoints(det, options);
+  } else if (options.identity == Identity::kGrid) {
+    out.points = GridPoints(det, options);
+  } else if (options.identity == Identity::kAprilTag) {
+    out.points = AprilTagPoints(image, det, options);  // the tags are read in the image as it is
+  } else {
+    out.points = OrderPoints(det, options);
+  }
+  out.points.polarity = polarity;
+  return out;
+}
+
+// kAuto: the polarity whose grid is found (dots + grid, circles), else the larger score.
+ImagePoints DotPoints(const vpImage<unsigned char>& image, const DetectionOptions& options) {
+  if (options.polarity != Polarity::kAuto) return DotPointsOfPolarity(image, options, options.polarity).points;
+  PolarPoints dark = DotPointsOfPolarity(image, options, Polarity::kDark);
+  PolarPoints light = DotPointsOfPolarity(image, options, Polarity::kLight);
+  const bool grid = options.detector == Detector::kCircles || options.identity == Identity::kGrid;
+  const bool take_light = (grid && dark.points.ok != light.points.ok) ? light.points.ok : light.score > dark.score;
+  ImagePoints out = std::move(take_light ? light.points : dark.points);
+  std::ostringstream m;
+  m.precision(0);
+  m << std::fixed << " (polarity " << PolarityName(out.polarity) << " by auto: contrast scores dark " << dark.score
+    << ", light " << light.score << ")";
+  out.message += m.str();
   return out;
 }
 
@@ -108,6 +165,7 @@ ImagePoints CharucoPoints(const vpImage<unsigned char>& image, const DetectionOp
 const char* DetectorName(Detector detector) {
   switch (detector) {
     case Detector::kDots: return "dots";
+    case Detector::kCircles: return "circles";
     case Detector::kChessboard: return "chessboard";
     case Detector::kCharuco: return "charuco";
   }
@@ -125,9 +183,10 @@ const char* IdentityName(Identity identity) {
 
 Result<Detector> ParseDetector(const std::string& name) {
   if (name == "dots") return Detector::kDots;
+  if (name == "circles") return Detector::kCircles;
   if (name == "chessboard") return Detector::kChessboard;
   if (name == "charuco") return Detector::kCharuco;
-  return Status::Error(ErrorCode::kInvalidInput, "unknown detector `" + name + "`: dots, chessboard or charuco");
+  return Status::Error(ErrorCode::kInvalidInput, "unknown detector `" + name + "`: dots, circles, chessboard or charuco");
 }
 
 Result<Identity> ParseIdentity(const std::string& name) {
@@ -139,6 +198,10 @@ Result<Identity> ParseIdentity(const std::string& name) {
 
 Status DetectionOptions::Validate() const {
   std::ostringstream s;
+  if (polarity != Polarity::kDark && detector != Detector::kDots && detector != Detector::kCircles) {
+    s << "the polarity applies to the dots and circles detectors only\n";
+  }
+  if (asymmetric && detector != Detector::kCircles) s << "an asymmetric grid applies to the circles detector only\n";
   if (detector != Detector::kDots && identity != Identity::kGrid) {
     s << "a " << DetectorName(detector) << " board's corners are named by the board; identity " << IdentityName(identity)
       << " applies to dots only\n";
@@ -155,7 +218,9 @@ Status DetectionOptions::Validate() const {
     if (Status v = co.Validate(); !v.ok()) s << v.message();
   } else {
     if (Status v = dots.Validate(); !v.ok()) s << v.message();
-    if (identity == Identity::kGrid) {
+    if (Status v = blob_filter.Validate(); !v.ok()) s << v.message();
+    if (detector == Detector::kCircles && (rows < 2 || cols < 2)) s << "circles: a grid of at least 2 x 2 dots\n";
+    if (detector == Detector::kDots && identity == Identity::kGrid) {
       tracking::GridIdentityOptions go = grid;
       go.rows = rows;
       go.cols = cols;
@@ -177,13 +242,7 @@ ImagePoints DetectImagePoints(const vpImage<unsigned char>& image, const Detecti
   SELFCAL_CHECK(valid.ok(), "invalid DetectionOptions:\n" << valid.message());
   if (options.detector == Detector::kChessboard) return ChessboardPoints(image, options, previous);
   if (options.detector == Detector::kCharuco) return CharucoPoints(image, options);
-  const tracking::DetectionReport det = tracking::DetectDots(image, options.dots);
-  switch (options.identity) {
-    case Identity::kGrid: return GridPoints(det, options);
-    case Identity::kAprilTag: return AprilTagPoints(image, det, options);
-    case Identity::kOrder: return OrderPoints(det);
-  }
-  return ImagePoints();
+  return DotPoints(image, options);
 }
 
 std::vector<ImagePoints> DetectAllImagePoints(const std::vector<const vpImage<unsigned char>*>& images,

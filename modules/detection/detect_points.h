@@ -14,10 +14,17 @@
 //   dots + order      tracking::DetectDots: id = the dot's index in the detector's raster order. The same
 //                     id names the same dot only when every image shows the dots in the same raster order
 //                     (a nearly still camera); for anything else use grid or apriltag;
+//   circles           a symmetric or asymmetric circle grid without an origin dot (detection/circle_grid.h):
+//                     cv::findCirclesGrid on the dots, id = row * cols + col, its rotation in each image
+//                     chosen from the robot poses afterwards (detection/grid_orientation.h);
 //   chessboard        inner corners, ordered consistently (detection/chessboard.h): id = row * cols + col;
 //   charuco           a ChArUco board's inner corners named by its ArUco markers (detection/charuco.h):
 //                     OpenCV's ChArUco corner ids, the same physical corner in every image however much of
 //                     the board is seen.
+// Dots of either polarity (detection/blob_candidates.h): dark, light, or auto, per image the polarity whose
+// grid (dots + grid, circles) is found, else (and when both are, or for apriltag and order) the one whose
+// dots have the larger ContrastScore. Texture blobs are left out by ConsistentBlobs for circles and order
+// (not for grid, whose origin dot is larger than the others by design, nor for apriltag).
 // Pixels as tracking/dot_detector.h.
 #pragma once
 
@@ -31,6 +38,7 @@
 
 #include "base/progress.h"
 #include "base/status.h"
+#include "detection/blob_candidates.h"
 #include "detection/charuco.h"
 #include "detection/chessboard.h"
 #include "geometry/rigid3.h"
@@ -41,20 +49,23 @@
 
 namespace selfcal::detection {
 
-enum class Detector { kDots, kChessboard, kCharuco };
+enum class Detector { kDots, kCircles, kChessboard, kCharuco };
 enum class Identity { kGrid, kAprilTag, kOrder };
 const char* DetectorName(Detector detector);
 const char* IdentityName(Identity identity);
-// "dots" / "chessboard" / "charuco", "grid" / "apriltag" / "order"; kInvalidInput otherwise.
+// "dots" / "circles" / "chessboard" / "charuco", "grid" / "apriltag" / "order"; kInvalidInput otherwise.
 Result<Detector> ParseDetector(const std::string& name);
 Result<Identity> ParseIdentity(const std::string& name);
 
 struct DetectionOptions {
   Detector detector = Detector::kDots;
   Identity identity = Identity::kGrid;  // dots only; a chessboard names its corners by the grid
-  int rows = 10;  // dots + grid: the dot grid; chessboard: inner corners; charuco: squares
+  int rows = 10;  // dots + grid, circles: the dot grid; chessboard: inner corners; charuco: squares
   int cols = 10;
+  bool asymmetric = false;  // circles: OpenCV's asymmetric grid (every other row shifted by half a step)
   tracking::DotDetectorOptions dots;
+  Polarity polarity = Polarity::kDark;  // dots and circles
+  BlobFilterOptions blob_filter;        // circles and dots + order
   tracking::GridIdentityOptions grid;  // rows and cols are taken from above
   tracking::AprilTagOptions apriltag;
   double tag_side_m = 0;                    // apriltag: the black border's outer side
@@ -73,6 +84,7 @@ struct ImagePoints {
   std::string message;                     // why not (ok false), or how the ids were chosen
   std::map<int, Eigen::Vector2d> points_px;  // id -> pixel
   int candidates = 0;                      // dots detected (dots), corners found (chessboard), markers (charuco)
+  Polarity polarity = Polarity::kDark;     // dots and circles: the polarity the points are of
 };
 
 // The points of one image. `previous` is the previous image's result (chessboard continuity), or nullptr.

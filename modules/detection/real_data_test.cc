@@ -132,5 +132,32 @@ TEST(RealData, FrankaChessboardEveryCornerOfEveryImage) {
   }
 }
 
+// ViSP's 6 x 6 circle grid (../shared/data, 5 images, dark dots, no origin dot): every dot of every image
+// on the grid (a wrong cell is ~20 px off), auto polarity choosing dark; the same images inverted (white
+// dots on black) give the same centres with light polarity.
+TEST(RealData, VispCircleGridInEitherPolarity) {
+  const std::string dir = kShared + "/visp-franka-eye-in-hand/circles-grid/";
+  if (!Exists(dir + "circles-01.jpg")) GTEST_SKIP() << dir << " is not there";
+  DetectionOptions o;
+  o.detector = Detector::kCircles;
+  o.rows = o.cols = 6;
+  o.polarity = Polarity::kAuto;
+  for (int i = 1; i <= 5; ++i) {
+    const vpImage<unsigned char> image = Read(dir + "circles-0" + std::to_string(i) + ".jpg");
+    vpImage<unsigned char> inverted = image;
+    for (unsigned k = 0; k < inverted.getSize(); ++k) inverted.bitmap[k] = static_cast<unsigned char>(255 - image.bitmap[k]);
+    const ImagePoints p = DetectImagePoints(image, o, nullptr);
+    ASSERT_TRUE(p.ok) << "image " << i << ": " << p.message;
+    EXPECT_EQ(p.polarity, Polarity::kDark);
+    EXPECT_EQ(p.points_px.size(), 36u);
+    EXPECT_LT(MaxHomographyResidual(p, 6), 1.5) << "image " << i;
+    DetectionOptions light = o;
+    light.polarity = Polarity::kLight;
+    const ImagePoints q = DetectImagePoints(inverted, light, nullptr);
+    ASSERT_TRUE(q.ok) << "inverted image " << i << ": " << q.message;
+    for (const auto& [id, px] : p.points_px) EXPECT_LT((q.points_px.at(id) - px).norm(), 1e-9) << "image " << i << " dot " << id;
+  }
+}
+
 }  // namespace
 }  // namespace selfcal::detection

@@ -6,8 +6,9 @@
 // vpXmlParserCamera writes the ViSP XML. `CameraFormats()` gives the backend, one of two ways, chosen by
 // the program that links selfcal::io (modules/io/CMakeLists.txt):
 // - linked (every program by default): the backend compiled in, OpenCV core and ViSP core linked;
-// - loaded (`selfcal`, whose commands must start fast): `libselfcal_camera_formats.so` beside the
-//   executable, opened with dlopen on the first camera file that needs it (about 20 ms of CPU and 20
+// - loaded (`selfcal`, whose commands must start fast): `libselfcal_camera_formats.so` from the
+//   program's private library directory (base/install_layout.h: <prefix>/lib/selfcal installed, beside
+//   the executable in a build tree), opened with dlopen on the first camera file that needs it (about 20 ms of CPU and 20
 //   shared libraries that a calibration without such a file never loads).
 #pragma once
 

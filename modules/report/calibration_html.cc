@@ -52,9 +52,11 @@ std::vector<std::string> Reasons(const json& reasons) {
 void VerdictSection(const json& r, Page* page) {
   const bool accepted = At(r, {"accepted"}) == true;
   const std::string verdict = Text(At(r, {"verdict"}));
-  std::string box = std::string("<div class=\"verdict ") + (accepted ? "ok" : "refused") + "\" id=\"verdict\">";
+  const bool untested = verdict == "untested";  // a model written, that no held-out test verified
+  std::string box = std::string("<div class=\"verdict ") + (accepted ? "ok" : untested ? "untested" : "refused") +
+                    "\" id=\"verdict\">";
   box += "<div class=\"word\">" +
-         html::EscapeHtml(accepted ? "Accepted" : "Not accepted (" + verdict + ")") + "</div>";
+         html::EscapeHtml(accepted ? "Accepted" : untested ? "Untested" : "Not accepted (" + verdict + ")") + "</div>";
   const std::string message = Text(At(r, {"message"}));
   const std::vector<std::string> reasons = Reasons(At(r, {"reasons"}));
   // A refusal's message is its reasons joined: the list says it once.
@@ -69,8 +71,9 @@ void VerdictSection(const json& r, Page* page) {
     box += "</ul>";
   }
   box += "<p>" + html::EscapeHtml("exit code " + Text(At(r, {"exit_code"})) + "; method " + Text(At(r, {"method"})) +
-                                  (accepted ? "; the calibrated model was written"
-                                            : "; no calibrated model was written")) +
+                                  (accepted   ? "; the calibrated model was written"
+                                   : untested ? "; the calibrated model was written, not verified by a held-out test"
+                                              : "; no calibrated model was written")) +
          "</p></div>\n";
   page->Markup(box);
   const json& checks = At(r, {"acceptance"});

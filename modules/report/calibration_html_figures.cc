@@ -99,7 +99,7 @@ void SceneFigure(const json& plot_data, const json& verification, Page* page) {
     Rigid3 base_from_cam;
   };
   std::vector<Camera> cameras;
-  for (const json& c : At(plot_data, {"camera_poses"})) {
+  for (const json& c : At(plot_data, {"camera_poses_from_model"})) {
     Eigen::Vector3d t, w;
     if (!Vector3(At(c, {"xyz_m"}), &t) || !Vector3(At(c, {"rotvec_rad"}), &w)) continue;
     cameras.push_back({Text(At(c, {"pose"})), Text(At(c, {"role"})), Rigid3(ExpSO3<double>(w), t)});

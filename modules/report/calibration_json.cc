@@ -76,6 +76,8 @@ json CrossValidationJson(const calibration::CrossValidationReport& cv) {
   return {{"ran", cv.ran},           {"message", cv.message},       {"folds", cv.folds},
           {"seed", cv.seed},         {"num_residuals", cv.num_residuals}, {"rms_px", Finite(cv.rms_px)},
           {"mm_per_px", Finite(cv.mm_per_px)}, {"rms_mm", Finite(cv.rms_mm)}, {"folds_passed", cv.folds_passed},
+          {"folds_tested", cv.folds_tested},
+          {"pooled", cv.pooled.dof > 0 ? HeldOutFigureJson(cv.pooled) : json()},
           {"per_fold", folds}};
 }
 
@@ -344,6 +346,13 @@ json SessionJson(const ReportInput& input, const SessionContext& session) {
 }
 
 // A flange-pose set's hand-eye start and, when accepted, the calibrated transform with its sigmas.
+constexpr const char* kImageMotionsDescription =
+    "the images' own camera poses: a bundle adjustment of the images alone, every camera free (no flange pose, no "
+    "hand-eye transform), its rotation angles between pairs of images against the flange motions' (pairs), and each "
+    "image's camera pose (camera_poses_from_images: base_from_cam, moved onto the model's base frame by the one rigid "
+    "transform that best aligns all of them with the model's camera poses) with its disagreement with the model's "
+    "camera pose (flange pose times the calibrated hand-eye transform, methods.bundle.plot_data.camera_poses_from_model)";
+
 json HandEyeJson(const calibration::CalibrationReport& report) {
   const calibration::HandEyeStartReport& start = *report.hand_eye_start;
   json j;
@@ -405,7 +414,18 @@ json HandEyeJson(const calibration::CalibrationReport& report) {
       pairs.push_back({{"pose_a", p.pose_a}, {"pose_b", p.pose_b}, {"flange_angle_rad", p.flange_angle_rad},
                        {"camera_angle_rad", p.camera_angle_rad}, {"error_rad", p.error_rad}});
     }
-    j["image_motions"] = {{"ok", m.ok},
+    json cameras = json::array();
+    for (const calibration::ImageCameraPose& c : m.cameras) {
+      const Eigen::Vector3d& t = c.base_from_cam_images.translation;
+      const Eigen::Vector3d w = LogSO3(c.base_from_cam_images.rotation);
+      cameras.push_back({{"pose", c.pose_id},
+                         {"xyz_m", {t.x(), t.y(), t.z()}},
+                         {"rotvec_rad", {w.x(), w.y(), w.z()}},
+                         {"model_translation_error_m", c.translation_error_m},
+                         {"model_rotation_error_rad", c.rotation_error_rad}});
+    }
+    j["image_motions"] = {{"description", kImageMotionsDescription},
+                          {"ok", m.ok},
                           {"message", m.message},
                           {"images_rms_reprojection_px", m.images.rms_reprojection_px},
                           {"images_fx_px", m.images.intrinsics[kFx]},
@@ -413,7 +433,8 @@ json HandEyeJson(const calibration::CalibrationReport& report) {
                           {"p90_error_rad", m.p90_error_rad},
                           {"max_error_rad", m.max_error_rad},
                           {"pairs_over_2deg", m.pairs_over_2deg},
-                          {"pairs", pairs}};
+                          {"pairs", pairs},
+                          {"camera_poses_from_images", cameras}};
   }
   j["pose_noise"] = json();
   if (report.pose_noise) {

@@ -55,12 +55,14 @@ json BundlePlotDataJson(const ObservationSet& obs, const calibration::BundleStag
   }
   json dots = json::array();
   for (const auto& [id, p] : stage.bundle.dots_in_base) dots.push_back({{"dot", id}, {"xyz_m", Vector(p)}});
-  return {{"description", "for report.html's figures: the calibrated model's base_from_cam at every pose (translation and "
-                          "rotation vector, in the base frame of the bundle's gauge), the bundle's dots in that frame, "
+  return {{"description", "for report.html's figures: camera_poses_from_model, the calibrated model's base_from_cam at every "
+                          "pose (the recorded joints or flange pose through the calibrated model and hand-eye transform, "
+                          "not the image's own camera pose; translation and rotation vector, in the base frame of the "
+                          "bundle's gauge), the bundle's dots in that frame, "
                           "every identification detection of the final fit and every held-out detection with its "
                           "residual (detection - prediction, px), and the correlations of the estimated entries"},
           {"image", {{"width_px", obs.camera.width_px}, {"height_px", obs.camera.height_px}}},
-          {"camera_poses", cameras},
+          {"camera_poses_from_model", cameras},
           {"dots_in_base", dots},
           {"identification_residuals", ResidualsJson(g.identification_residuals)},
           {"heldout_residuals", ResidualsJson(stage.heldout.residuals)},

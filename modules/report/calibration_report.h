@@ -1,4 +1,4 @@
-// report.json of a calibration (schema: docs/report-format.md, "selfcal-calibration-report" version 2)
+// report.json of a calibration (schema: docs/report-format.md, "selfcal-calibration-report" version 3)
 // and its on-screen summary. Every value in the JSON is SI with the unit in the key (_m, _rad, _px, _s);
 // the text prints mm and degrees. The top level carries the chosen method's verdict and figures; the
 // sections under "methods" have the same shape for every method that ran.
@@ -18,7 +18,7 @@
 namespace selfcal::report {
 
 inline constexpr const char* kCalibrationReportFormat = "selfcal-calibration-report";
-inline constexpr int kCalibrationReportVersion = 2;
+inline constexpr int kCalibrationReportVersion = 3;
 
 // What was read: the observations file, or a session directory (whose provenance is its manifest).
 struct ReportInput {

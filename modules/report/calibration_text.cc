@@ -205,7 +205,12 @@ void PrintCrossValidation(const calibration::CrossValidationReport& cv, std::ost
       out << " -";
     }
   }
-  out << " px; " << cv.folds_passed << " of " << cv.folds << " pass the held-out test at the stated noise\n";
+  out << " px; " << cv.folds_passed << " of " << cv.folds << " pass the held-out test at the stated noise";
+  if (cv.pooled.dof > 0) {
+    out << "; pooled chi-square " << std::setprecision(1) << cv.pooled.chi_square << " over " << cv.pooled.dof
+        << " (95 % limit " << cv.pooled.chi_square_limit << ")";
+  }
+  out << "\n";
   out.unsetf(std::ios::floatfield);
 }
 

@@ -1,5 +1,5 @@
 // report.html: the self-contained HTML page of a report.json document (format
-// "selfcal-calibration-report", version 2: docs/report-format.md) or of a study's JSON document (format
+// "selfcal-calibration-report", version 3: docs/report-format.md) or of a study's JSON document (format
 // "selfcal-study", version 1), its plots drawn by plotly.js, which the caller reads and hands in as text
 // (the report module touches no file). docs/report-format.md, section "report.html", says what the page
 // shows.

@@ -24,9 +24,11 @@ p.note, p.caption { color: #555; font-size: 0.9em; }
 .verdict { border: 2px solid; border-radius: 6px; padding: 0.6em 1em; margin: 1em 0; }
 .verdict.ok { border-color: #2e7d32; background: #e8f5e9; }
 .verdict.refused { border-color: #c62828; background: #ffebee; }
+.verdict.untested { border-color: #ef6c00; background: #fff3e0; }
 .verdict .word { font-size: 1.4em; font-weight: bold; }
 .verdict.ok .word { color: #2e7d32; }
 .verdict.refused .word { color: #c62828; }
+.verdict.untested .word { color: #ef6c00; }
 table { border-collapse: collapse; margin: 0.5em 0 1em 0; font-size: 0.88em; }
 th, td { border: 1px solid #ccc; padding: 0.2em 0.5em; text-align: left; vertical-align: top; }
 th { background: #f3f3f3; }

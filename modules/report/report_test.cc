@@ -48,7 +48,7 @@ TEST_F(CalibrationReportTest, TopLevelCarriesTheChosenMethodsFigures) {
   ASSERT_TRUE(report_->accepted()) << report_->message;
   const nlohmann::json j = CalibrationReportJson(world_->observations, *report_, {{"observations", "o.yaml", "ab", "", "", ""}, 0, {}});
   EXPECT_EQ(j["format"], kCalibrationReportFormat);
-  EXPECT_EQ(j["version"], 2);
+  EXPECT_EQ(j["version"], 3);
   EXPECT_EQ(j["method"], "bundle");
   EXPECT_EQ(j["verdict"], "accepted");
   EXPECT_EQ(j["accepted"], true);
@@ -184,13 +184,7 @@ TEST(CalibrationReport, AbsentFiguresAreNullNotZero) {
 // unresolved.
 TEST(CalibrationReport, PlanarViewsCarryTheirNormalMotionAndUnresolvedRival) {
   const sim::SimResult world = testing::PumaArcWorld(0.2, 3, 3, /*flat_sheet=*/true);
-  ObservationSet obs = world.observations;
-  obs.robot = FlangePoseModel(Rigid3());
-  obs.flange_from_cam_known = false;
-  for (PoseObservation& pose : obs.poses) {
-    pose.base_from_flange = BaseFromFlange(world.truth.nominal, world.truth.rho_true, pose.joints_rad);
-    pose.joints_rad.resize(0);
-  }
+  ObservationSet obs = testing::AsFlangePoseSet(world);
   const calibration::CalibrationReport report = calibration::Calibrate(obs, {});
   const nlohmann::json j = CalibrationReportJson(obs, report, {});
   const nlohmann::json& plane = j.at("hand_eye").at("start").at("plane");

@@ -133,4 +133,23 @@ BoardTexture ChessboardTexture(int rows, int cols, double square_m, double dark_
   };
 }
 
+BoardTexture CircleGridTexture(int rows, int cols, bool asymmetric, double spacing_m, double radius_m, double dot_grey,
+                               double board_grey, double margin_m, BoardTexture surround) {
+  const double width_m = (asymmetric ? 2 * cols - 1 : cols - 1) * spacing_m, height_m = (rows - 1) * spacing_m;
+  return [=](double x, double y) {
+    if (x < -margin_m || y < -margin_m || x > width_m + margin_m || y > height_m + margin_m) {
+      return surround ? surround(x, y) : board_grey;
+    }
+    // The nearest disc centre is on one of the three rows nearest y.
+    const long r0 = std::lround(y / spacing_m);
+    for (long r = std::max(0L, r0 - 1); r <= std::min(static_cast<long>(rows) - 1, r0 + 1); ++r) {
+      const double shift = asymmetric ? static_cast<double>(r % 2) : 0.0, step = asymmetric ? 2.0 : 1.0;
+      const long c = std::clamp(std::lround((x / spacing_m - shift) / step), 0L, static_cast<long>(cols) - 1);
+      const double dx = x - (step * static_cast<double>(c) + shift) * spacing_m, dy = y - static_cast<double>(r) * spacing_m;
+      if (dx * dx + dy * dy <= radius_m * radius_m) return dot_grey;
+    }
+    return board_grey;
+  };
+}
+
 }  // namespace selfcal::sim

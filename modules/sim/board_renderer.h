@@ -64,4 +64,11 @@ class BoardRenderer {
 // +x (columns) and +y (rows), square (0, 0) dark; outside the squares the paper (light_grey).
 BoardTexture ChessboardTexture(int rows, int cols, double square_m, double dark_grey, double light_grey);
 
+// A circle grid board (OpenCV's layouts, no origin dot): rows x cols discs of radius radius_m, disc (r, c)
+// centred at (c, r) * spacing_m, or at (2 c + r mod 2, r) * spacing_m when asymmetric; dot_grey on
+// board_grey (light dots on a dark board, or dark on light) within margin_m of the outermost discs' centres,
+// and outside the board `surround` (a table's texture), or board_grey where that is empty.
+BoardTexture CircleGridTexture(int rows, int cols, bool asymmetric, double spacing_m, double radius_m, double dot_grey,
+                               double board_grey, double margin_m, BoardTexture surround = nullptr);
+
 }  // namespace selfcal::sim

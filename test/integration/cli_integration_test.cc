@@ -37,8 +37,8 @@ TEST(Cli, SimulateEndToEndThenCalibrateTheSameFileIsDeterministic) {
   const fs::path dir = FreshDir("simulate");
   std::string output;
   ASSERT_EQ(RunSelfcal("simulate --points --out " + dir.string() + " --seed 3", &output), 0) << output;
-  for (const char* file : {"observations.yaml", "truth.json", "report.json", "calibrated_model.yaml",
-                           "comparison_with_truth.json"}) {
+  for (const char* file : {"observations.yaml", "truth.json", "report.json", "image_residuals.csv",
+                           "calibrated_model.yaml", "comparison_with_truth.json"}) {
     EXPECT_TRUE(fs::exists(dir / file)) << file << "\n" << output;
   }
   const nlohmann::json first = ReadJson(dir / "report.json");
@@ -47,7 +47,7 @@ TEST(Cli, SimulateEndToEndThenCalibrateTheSameFileIsDeterministic) {
   EXPECT_EQ(first["verdict"], "accepted");
   EXPECT_EQ(first["methods"]["bundle"]["outcome"], "converged");
   EXPECT_EQ(first["methods"]["paper"]["outcome"], "success");
-  EXPECT_EQ(first["version"], 2);
+  EXPECT_EQ(first["version"], 3);
   EXPECT_TRUE(first["accepted"].get<bool>());
   // The calibrated model is a robot config selfcal reads back.
   EXPECT_TRUE(io::LoadRobotModel((dir / "calibrated_model.yaml").string()).ok());
@@ -64,6 +64,8 @@ TEST(Cli, SimulateEndToEndThenCalibrateTheSameFileIsDeterministic) {
     j->erase("input");
   }
   EXPECT_EQ(a.dump(), b.dump());
+  EXPECT_EQ(testing::ReadFile((dir / "image_residuals.csv").string()),
+            testing::ReadFile((again / "image_residuals.csv").string()));
   fs::remove_all(dir);
 }
 

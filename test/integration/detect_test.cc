@@ -17,6 +17,7 @@
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <yaml-cpp/yaml.h>
 
 #include "io/observations_file.h"
 #include "support/cli.h"
@@ -213,7 +214,8 @@ fs::path SmallRosCopy(const std::string& name) {
   return dir;
 }
 
-// Runs detect on the copy; returns the exit code, *out the output. No output file may exist after an error.
+// Runs detect on the copy; returns the exit code, *out the output. No output file may exist after an error,
+// but for the contact sheet after a detection that failed (exit 3): it shows why.
 int DetectOnCopy(const fs::path& dir, std::string* out, const std::string& extra = "") {
   const int code = RunSelfcal("detect --images " + (dir / "images").string() + " --poses " + (dir / "poses").string() +
                                   " --camera-fx-px 542.3 --out " + (dir / "obs.yaml").string() + " --contact-sheet " +
@@ -221,9 +223,24 @@ int DetectOnCopy(const fs::path& dir, std::string* out, const std::string& extra
                               out);
   if (code != 0) {
     EXPECT_FALSE(fs::exists(dir / "obs.yaml")) << *out;
-    EXPECT_FALSE(fs::exists(dir / "sheet.png")) << *out;
+    EXPECT_FALSE(fs::exists(dir / "obs.skipped.yaml")) << *out;
+    EXPECT_EQ(fs::exists(dir / "sheet.png"), code == 3) << *out;
   }
   return code;
+}
+
+// Red text pixels (a failed image's outcome and reason) in the top 80 rows of the k-th of three 640 x 480
+// tiles of a contact sheet (two columns).
+int RedOnTile(const cv::Mat& sheet, int k) {
+  const int x0 = 6 + (k % 2) * 646, y0 = 22 + (k / 2) * (480 + 22 + 6) + 22;
+  int red = 0;
+  for (int v = y0; v < y0 + 80; ++v) {
+    for (int u = x0; u < x0 + 640; ++u) {
+      const cv::Vec3b p = sheet.at<cv::Vec3b>(v, u);
+      red += (p[2] > 200 && p[1] < 80 && p[0] < 80) ? 1 : 0;
+    }
+  }
+  return red;
 }
 
 void WriteText(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
@@ -257,18 +274,57 @@ TEST(DetectCli, BadInputsNameTheFileAndWriteNothing) {
   }
 }
 
-// An image where the grid is not found: exit code 3 naming it; with --skip-failed that image is left out.
+// An image where the grid is not found: exit code 3 naming it, and the contact sheet written all the same,
+// the failed image's reason on its tile; with --skip-failed that image is left out, named on stdout and in
+// the skipped list beside the observations, with its reason.
 TEST(DetectCli, AFailedDetectionIsDegenerateDataUnlessSkipped) {
   const fs::path dir = SmallRosCopy("failed");
   cv::imwrite((dir / "images" / "1.png").string(), cv::Mat(480, 640, CV_8UC1, cv::Scalar(200)));
   std::string out;
   EXPECT_EQ(DetectOnCopy(dir, &out), 3) << out;
   EXPECT_NE(out.find("1: grid not identified"), std::string::npos) << out;
-  ASSERT_EQ(DetectOnCopy(dir, &out, "--skip-failed"), 0) << out;
+  EXPECT_NE(out.find("contact sheet " + (dir / "sheet.png").string()), std::string::npos) << out;
+  const cv::Mat sheet = cv::imread((dir / "sheet.png").string(), cv::IMREAD_COLOR);
+  ASSERT_EQ(sheet.cols, 6 + 2 * 646);
+  EXPECT_GT(RedOnTile(sheet, 1), 200);
+  EXPECT_EQ(RedOnTile(sheet, 0), 0);
+  EXPECT_EQ(RedOnTile(sheet, 2), 0);
+  // The sheet of the failed run is an earlier result: replaced only with --force.
+  EXPECT_EQ(RunSelfcal("detect --images " + (dir / "images").string() + " --poses " + (dir / "poses").string() +
+                           " --camera-fx-px 542.3 --out " + (dir / "obs.yaml").string() + " --contact-sheet " +
+                           (dir / "sheet.png").string() + " --skip-failed", &out),
+            2)
+      << out;
+  ASSERT_EQ(DetectOnCopy(dir, &out, "--skip-failed --force"), 0) << out;
   const ObservationSet set = Load(dir / "obs.yaml");
   ASSERT_EQ(set.poses.size(), 2u);
   EXPECT_EQ(set.poses[1].id, "2");
   EXPECT_TRUE(fs::exists(dir / "sheet.png"));
+  EXPECT_NE(out.find("skipped 1 of 3 images, listed in " + (dir / "obs.skipped.yaml").string()), std::string::npos)
+      << out;
+  EXPECT_NE(out.find("  SKIPPED " + (dir / "images" / "1.png").string() + ": grid not identified"), std::string::npos)
+      << out;
+  const YAML::Node skipped = YAML::LoadFile((dir / "obs.skipped.yaml").string());
+  EXPECT_EQ(skipped["format"].as<std::string>(), "selfcal-skipped-images");
+  EXPECT_EQ(skipped["observations"].as<std::string>(), (dir / "obs.yaml").string());
+  EXPECT_EQ(skipped["images"].as<int>(), 3);
+  EXPECT_EQ(skipped["kept"].as<int>(), 2);
+  ASSERT_EQ(skipped["skipped"].size(), 1u);
+  EXPECT_EQ(skipped["skipped"][0]["pose"].as<std::string>(), "1");
+  EXPECT_EQ(skipped["skipped"][0]["image"].as<std::string>(), (dir / "images" / "1.png").string());
+  EXPECT_EQ(skipped["skipped"][0]["reason"].as<std::string>().rfind("grid not identified", 0), 0u);
+  // --skipped-out names the list; without --skip-failed it is refused.
+  ASSERT_EQ(DetectOnCopy(dir, &out, "--skip-failed --force --skipped-out " + (dir / "left-out.yaml").string()), 0)
+      << out;
+  EXPECT_EQ(YAML::LoadFile((dir / "left-out.yaml").string())["skipped"].size(), 1u);
+  fs::remove(dir / "obs.yaml");
+  EXPECT_EQ(RunSelfcal("detect --images " + (dir / "images").string() + " --poses " + (dir / "poses").string() +
+                           " --camera-fx-px 542.3 --out " + (dir / "obs.yaml").string() + " --skipped-out " +
+                           (dir / "x.yaml").string(), &out),
+            2)
+      << out;
+  EXPECT_NE(out.find("--skipped-out"), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(dir / "obs.yaml"));
 }
 
 // A selfcal-poses list of joint angles on a robot config, and the yardstick option.

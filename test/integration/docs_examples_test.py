@@ -70,11 +70,24 @@ def make_real_files():
         ["simulate", "--points", "--no-html", "--robot", os.path.join(SRC, "config", "robots", "ur5e.yaml"),
          "--trajectory", os.path.join(SRC, "config", "trajectories", "initial_ur5e.yaml"), "--out", "sim-ur5e"],
     ]
+    # detect --skip-failed on three ROS images, one replaced by a blank one: its skipped list.
+    ros = os.path.join(SRC, "test", "data", "ros-industrial-dotgrid-10x10")
+    for sub in ("images", "poses"):
+        os.makedirs(os.path.join(WORK, "detect", sub))
+    for i in range(3):
+        shutil.copy(os.path.join(ros, "poses", f"{i}.yaml"), os.path.join(WORK, "detect", "poses"))
+        if i != 1:
+            shutil.copy(os.path.join(ros, "images", f"{i}.png"), os.path.join(WORK, "detect", "images"))
+    with open(os.path.join(WORK, "detect", "images", "1.pgm"), "wb") as f:
+        f.write(b"P5\n640 480\n255\n" + bytes([200]) * (640 * 480))
+    steps.append(["detect", "--images", "detect/images", "--poses", "detect/poses", "--camera-fx-px", "542.3",
+                  "--out", "detect/obs.yaml", "--skip-failed"])
     for step in steps:
         result = run(step)
         if result.returncode != 0:
             problem(f"selfcal {' '.join(step)} exited {result.returncode}: {result.stderr[-2000:]}")
     return {
+        "skipped_images": os.path.join(WORK, "detect", "obs.skipped.yaml"),
         "plan": os.path.join(WORK, "plan.yaml"),
         "observations": os.path.join(WORK, "sim", "observations.yaml"),
         "calibrated_model": os.path.join(WORK, "cal", "calibrated_model.yaml"),
@@ -131,6 +144,8 @@ def kind_of(lang, text):
         return ("robot", "keys")
     if "urdf_file:" in text:
         return ("urdf_robot", "urdf_robot")
+    if "format: selfcal-skipped-images" in text:
+        return ("skipped_images", "keys")
     if "format: selfcal-targets" in text:
         return ("targets", "targets")
     if body.startswith("header:") and "child_frame_id:" in text:
@@ -233,7 +248,7 @@ def check_examples(real):
 def check_written_keys_documented(real):
     docs = {"plan": "trajectory-format.md", "observations": "observations-format.md",
             "calibrated_model": "calibrated-model-format.md", "session_json": "session-format.md",
-            "setup_json": "session-format.md"}
+            "setup_json": "session-format.md", "skipped_images": "detect.md"}
     for kind, doc in docs.items():
         if not os.path.exists(real[kind]):
             continue

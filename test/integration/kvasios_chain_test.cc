@@ -95,11 +95,36 @@ TEST(KvasiosChain, EverySessionCalibratesWithTheDefaultsNamingWhatTheDataCannotD
     EXPECT_EQ(cv.at("per_fold").size(), 4u);
     EXPECT_GT(cv.at("num_residuals").get<int>(), 12 * 24 - 12) << cv.dump();
     EXPECT_LT(cv.at("rms_px").get<double>(), 1.2) << cv.dump();
+    // The folds' pooled held-out test is the verdict's: made, and passed.
+    bool cv_test = false;
+    for (const nlohmann::json& check : report.at("acceptance")) {
+      cv_test = cv_test || (check.at("check") == "cross_validation_test" && check.at("status") == "passed");
+    }
+    EXPECT_TRUE(cv_test) << report.at("acceptance").dump();
     EXPECT_NE(output.find("cross-validation (4 folds"), std::string::npos) << output;
     // The camera's start came from the images, not from the shipped mount 44 deg away.
     EXPECT_NE(bundle.at("start_note").get<std::string>().find("camera correction from the images"), std::string::npos)
         << bundle.at("start_note");
   }
+}
+
+// Without verification poses and without the cross-validation nothing held images out: the model is
+// written, and the verdict, the exit code and the model's provenance say it is untested.
+TEST(KvasiosChain, AModelNoHeldOutTestCouldCheckIsWrittenAsUntested) {
+  const fs::path dir = FreshDir("kvasios", "untested");
+  const std::string obs = Detect("s1", dir);
+  std::string output;
+  const int code = RunSelfcalInSource("calibrate " + obs + " --folds 0 --out " + (dir / "cal").string() + " --no-html", &output);
+  EXPECT_EQ(code, 8) << output;
+  EXPECT_NE(output.find("untested: "), std::string::npos) << output;
+  std::ifstream in(dir / "cal" / "report.json");
+  const nlohmann::json report = nlohmann::json::parse(in);
+  EXPECT_EQ(report.at("verdict"), "untested");
+  EXPECT_EQ(report.at("accepted"), false);
+  EXPECT_EQ(report.at("exit_code"), 8);
+  std::ifstream model(dir / "cal" / "calibrated_model.yaml");
+  const std::string text((std::istreambuf_iterator<char>(model)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"verdict\": \"untested\""), std::string::npos) << text.substr(0, 2000);
 }
 
 // Calibrated on s1 without the targets 0, 4 and 8, the model predicts those targets in s2 (recorded the same

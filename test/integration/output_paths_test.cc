@@ -154,7 +154,7 @@ TEST_F(OutputPathsTest, TheListNamesTheKnownOutputOptionsOfEveryCommand) {
   std::vector<std::string> listed;
   for (const OutputOption& o : *options_) listed.push_back(o.command + " " + o.option);
   for (const char* known : {"calibrate --out", "calibrate --write-camera-opencv", "calibrate --write-camera-visp",
-                            "compensate --out", "detect --out", "detect --contact-sheet", "name-dots --out",
+                            "compensate --out", "detect --out", "detect --contact-sheet", "detect --skipped-out", "name-dots --out",
                             "name-dots --setup", "plan --out", "report --out", "simulate --out", "make-trajectory --out",
                             "study --out", "identify-tracker --report", "identify-tracker --out", "audit --json",
                             "run --session"}) {

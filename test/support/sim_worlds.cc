@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "kinematics/robot_model.h"
+#include "observations/observation_set.h"
 #include "sim/trajectory_generator.h"
 #include "support/test_robots.h"
 
@@ -23,6 +25,17 @@ sim::SimResult PumaArcWorld(const sim::SimOptions& options) {
   sim::SimResult world = sim::Simulate(puma, trajectory.joints, options);
   EXPECT_TRUE(world.ok) << world.message;
   return world;
+}
+
+ObservationSet AsFlangePoseSet(const sim::SimResult& world) {
+  ObservationSet obs = world.observations;
+  obs.robot = FlangePoseModel(Rigid3());
+  obs.flange_from_cam_known = false;
+  for (PoseObservation& pose : obs.poses) {
+    pose.base_from_flange = BaseFromFlange(world.truth.nominal, world.truth.rho_true, pose.joints_rad);
+    pose.joints_rad.resize(0);
+  }
+  return obs;
 }
 
 }  // namespace selfcal::testing

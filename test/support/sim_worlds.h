@@ -15,4 +15,8 @@ sim::SimResult PumaArcWorld(double noise_px, uint64_t world_seed = 1, uint64_t n
 // The same world with any SimOptions (e.g. the spacing rule of rendered sessions).
 sim::SimResult PumaArcWorld(const sim::SimOptions& options);
 
+// The world's observations recorded as flange poses of the true arm (no robot, no joints, no nominal hand-eye
+// transform): a flange-pose set whose truth is the world's.
+ObservationSet AsFlangePoseSet(const sim::SimResult& world);
+
 }  // namespace selfcal::testing

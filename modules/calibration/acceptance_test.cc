@@ -1,0 +1,82 @@
+#include "calibration/acceptance.h"
+
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace selfcal::calibration {
+namespace {
+
+// A held-out figure of verification poses with the given RMS per coordinate (10 dots each).
+HeldOutReprojection Figures(const std::vector<double>& rms_px) {
+  HeldOutReprojection h;
+  h.ok = true;
+  double sum2 = 0;
+  for (size_t p = 0; p < rms_px.size(); ++p) {
+    HeldOutFigure f;
+    f.pose_id = "v" + std::to_string(p);
+    f.num_residuals = 10;
+    f.dof = 20;
+    f.rms_px = rms_px[p];
+    h.poses.push_back(f);
+    sum2 += rms_px[p] * rms_px[p];
+  }
+  h.overall.num_residuals = 10 * static_cast<int>(rms_px.size());
+  h.overall.dof = 2 * h.overall.num_residuals;
+  h.overall.rms_px = std::sqrt(sum2 / rms_px.size());
+  return h;
+}
+
+const AcceptanceCheck& Check(const Acceptance& a, const std::string& name) {
+  for (const AcceptanceCheck& c : a.checks) {
+    if (c.name == name) return c;
+  }
+  static const AcceptanceCheck none;
+  ADD_FAILURE() << "no check " << name;
+  return none;
+}
+
+// A nominal model that is already good: the calibrated one slightly worse on average, but by less than the
+// spread between poses, is not significantly worse; consistently worse on every pose, it is refused.
+TEST(Acceptance, ACalibrationNotSignificantlyWorseThanAGoodNominalModelPasses) {
+  const HeldOutReprojection nominal = Figures({0.50, 0.80, 0.40, 0.90, 0.60, 0.70});
+  const HeldOutReprojection close = Figures({0.60, 0.70, 0.50, 0.85, 0.65, 0.72});
+  AcceptanceInputs in;
+  in.calibrated = &close;
+  in.nominal = &nominal;
+  const AcceptanceCheck& passed = Check(AcceptanceOf(in), "beats_nominal_heldout");
+  EXPECT_EQ(passed.status, CheckStatus::kPassed) << passed.sentence;
+  EXPECT_NE(passed.sentence.find("not significantly worse"), std::string::npos) << passed.sentence;
+
+  const HeldOutReprojection worse = Figures({0.60, 0.90, 0.50, 1.00, 0.70, 0.80});
+  in.calibrated = &worse;
+  const AcceptanceCheck& failed = Check(AcceptanceOf(in), "beats_nominal_heldout");
+  EXPECT_EQ(failed.status, CheckStatus::kFailed) << failed.sentence;
+  EXPECT_NE(failed.sentence.find("worse than the nominal model's"), std::string::npos) << failed.sentence;
+}
+
+// Two poses cannot tell a spread: a calibrated model not below the nominal one is refused, as before.
+TEST(Acceptance, TooFewVerificationPosesToTestAreRefusedWhenNotBetter) {
+  const HeldOutReprojection nominal = Figures({0.50, 0.80});
+  const HeldOutReprojection worse = Figures({0.55, 0.80});
+  AcceptanceInputs in;
+  in.calibrated = &worse;
+  in.nominal = &nominal;
+  const AcceptanceCheck& c = Check(AcceptanceOf(in), "beats_nominal_heldout");
+  EXPECT_EQ(c.status, CheckStatus::kFailed) << c.sentence;
+  EXPECT_NE(c.sentence.find("too few"), std::string::npos) << c.sentence;
+}
+
+// The held-out checks that make a model tested, and the ones that do not.
+TEST(Acceptance, OnlyAHeldOutCheckMakesAModelTested) {
+  Acceptance a;
+  a.checks = {{"plausible_corrections", CheckStatus::kPassed, ""}, {"heldout_test", CheckStatus::kNotAvailable, ""}};
+  EXPECT_TRUE(a.Passed());
+  EXPECT_FALSE(a.HeldOutTested());
+  a.checks.push_back({"cross_validation_test", CheckStatus::kPassed, ""});
+  EXPECT_TRUE(a.HeldOutTested());
+}
+
+}  // namespace
+}  // namespace selfcal::calibration
