@@ -15,6 +15,7 @@
 #include "bundle/bundle_adjustment.h"
 #include "geometry/rigid3.h"
 #include "io/camera_file.h"
+#include "io/camera_info_file.h"
 #include "io/hand_eye_file.h"
 #include "io/observations_file.h"
 #include "io/report_json.h"
@@ -192,6 +193,16 @@ Status WriteCameraFiles(const CalibrateRequest& request, const calibration::Cali
   return Status::Ok();
 }
 
+// camera_info.yaml in `out_dir`: the calibrated camera in the format ROS's camera_calibration_parsers reads
+// (io/camera_info_file.h; the OpenCV file is not that format), named `camera_name` (default "camera").
+Status WriteCameraInfo(const CameraIntrinsics& camera, const std::string& camera_name, const std::string& out_dir) {
+  const std::string path = (std::filesystem::path(out_dir) / "camera_info.yaml").string();
+  if (Status s = io::SaveCameraInfo(camera, camera_name.empty() ? "camera" : camera_name, path); !s.ok()) return s;
+  std::cout << "camera (ROS camera_info): " << path << "\n";
+  AddOutputFile("camera_info", path);
+  return Status::Ok();
+}
+
 // A flange-pose set's result: the hand-eye transform and f_x with their standard deviations.
 Status WriteHandEye(const LoadedInput& loaded, const calibration::CalibrationReport& report, const std::string& out_dir,
                     const io::RobotOrigin& origin) {
@@ -252,7 +263,8 @@ Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationRep
   // An earlier run's model files in this directory (there only with --force, output_options.h) would sit
   // beside a report of this run: gone before this run writes its own, or none.
   for (const char* name : {"calibrated_model.yaml", "calibrated.urdf", "calibrated_robot.yaml",
-                           "camera_static_transform.yaml", "hand_eye.yaml"}) {
+                           "camera_static_transform.yaml", "hand_eye.yaml", "camera_info.yaml",
+                           "ur_calibrated_kinematics.yaml"}) {
     std::error_code error;
     if (std::filesystem::remove(out / name, error)) {
       std::cout << "removed the earlier run's " << (out / name).string() << (report.model ? "" : " (this run wrote no model)")
@@ -260,6 +272,7 @@ Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationRep
     }
   }
   if (!report.model) return Status::Ok();
+  if (Status s = WriteCameraInfo(report.model->camera, request.camera_name, out_dir); !s.ok()) return s;
   const io::RobotOrigin origin = request.robot_config.empty() && loaded.origin
                                      ? *loaded.origin
                                      : OriginOfInput(request.robot_config, request.input, loaded.session.has_value());
@@ -319,7 +332,7 @@ void AddParameterMaskOptions(CLI::App* cmd, std::vector<std::string>* fix, std::
 std::vector<std::string> CalibrationOutputFiles() {
   return {"observations.yaml", "report.json",           "report.html",           "image_residuals.csv",
           "calibrated_model.yaml", "calibrated.urdf", "calibrated_robot.yaml", "camera_static_transform.yaml",
-          "hand_eye.yaml"};
+          "hand_eye.yaml", "camera_info.yaml", "ur_calibrated_kinematics.yaml"};
 }
 
 int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {

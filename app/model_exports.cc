@@ -6,9 +6,13 @@
 #include <sstream>
 
 #include "app/cli_output.h"
+#include "base/atomic_file.h"
 #include "io/dh_config_file.h"
 #include "io/static_transform_file.h"
+#include "io/ur_kinematics_file.h"
 #include "kinematics/dh_table.h"
+#include "base/terminal_text.h"
+#include "urdf/urdf_calibrated.h"
 #include "urdf/urdf_writer.h"
 
 namespace selfcal::app {
@@ -43,15 +47,65 @@ Status WriteDhTable(const RobotModel& calibrated, const std::string& convention,
   return Status::Ok();
 }
 
+// ur_calibrated_kinematics.yaml for a Universal Robots arm (io/ur_kinematics_file.h), or why not.
+// The file's chain starts at ur_description's base_link_inertia (the controller's Base frame): the model's
+// base for a DH config, and for a URDF robot only when its base_link is that link (ur_description's own
+// base_link is turned 180 deg about z from it).
+Status WriteUrKinematics(const RobotModel& calibrated, const io::RobotOrigin& origin, const std::filesystem::path& out) {
+  if (!io::IsUniversalRobotsArm(calibrated)) return Status::Ok();
+  const std::string path = (out / "ur_calibrated_kinematics.yaml").string();
+  Result<std::string> text =
+      origin.FromUrdf() && origin.base_link != "base_link_inertia"
+          ? Result<std::string>(Status::Error(ErrorCode::kInvalidInput,
+                                              "the model's base is the URDF's `" + origin.base_link +
+                                                  "`, not ur_description's base_link_inertia, where the file's chain starts"))
+          : io::UrKinematicsYaml(calibrated);
+  if (!text.ok()) {
+    std::cout << "ur_description kinematics: not written, " << text.status().message() << "\n";
+    return Status::Ok();
+  }
+  if (Status s = WriteFileAtomically(path, *text); !s.ok()) return s;
+  std::cout << "ur_description kinematics (kinematics_params_file): " << path << "\n";
+  AddOutputFile("ur_kinematics", path);
+  return Status::Ok();
+}
+
 // The URDF's names when the robot came from one (and the joint count agrees), else the writer's defaults.
 urdf::UrdfNames NamesOf(const io::RobotOrigin& origin, int num_joints) {
   urdf::UrdfNames names;
-  if (!origin.FromUrdf() || static_cast<int>(origin.joint_names.size()) != num_joints) return names;
+  const auto joints_of = [num_joints](const auto& values) { return static_cast<int>(values.size()) == num_joints; };
+  if (joints_of(origin.max_velocity_rad_s)) names.velocities_rad_s = origin.max_velocity_rad_s;
+  if (!origin.FromUrdf()) {  // a DH config's own names, when it gives them
+    if (joints_of(origin.config_joint_names)) names.joints = origin.config_joint_names;
+    if (joints_of(origin.config_link_names)) names.links = origin.config_link_names;
+    return names;
+  }
+  if (!joints_of(origin.joint_names)) return names;
   names.joints = origin.joint_names;
   if (!origin.base_link.empty()) names.base_link = origin.base_link;
   if (!origin.tip_link.empty()) names.tip_link = origin.tip_link;
   if (!origin.camera_link.empty()) names.camera_link = origin.camera_link;
   return names;
+}
+
+// calibrated.urdf: the user's URDF with the calibrated joint origins when the robot came from a URDF file
+// that is still there and converts to this model (urdf/urdf_calibrated.h), else selfcal's own URDF of the
+// model with the input's names (urdf/urdf_writer.h).
+Status WriteCalibratedUrdf(const RobotModel& calibrated, const io::RobotOrigin& origin, const std::string& path) {
+  if (!origin.urdf_file.empty()) {
+    Result<std::string> text = urdf::CalibratedUserUrdfFile(
+        origin.urdf_file, {origin.base_link, origin.tip_link, origin.camera_link}, calibrated);
+    if (text.ok()) {
+      if (Status s = WriteFileAtomically(path, *text); !s.ok()) return s;
+      std::cout << "calibrated URDF (" << origin.urdf_file << " with the calibrated joint origins): " << path << "\n";
+      return Status::Ok();
+    }
+    std::cout << "calibrated URDF: " << origin.urdf_file << " cannot take the calibrated origins ("
+              << TerminalSafe(text.status().message()) << "); selfcal's URDF of the model with its names instead\n";
+  }
+  if (Status s = urdf::WriteUrdf(calibrated, NamesOf(origin, calibrated.num_joints()), path); !s.ok()) return s;
+  std::cout << "calibrated URDF: " << path << "\n";
+  return Status::Ok();
 }
 
 }  // namespace
@@ -68,10 +122,10 @@ Status WriteModelExports(const RobotModel& calibrated, const io::RobotOrigin& or
                          const std::string& out_dir) {
   const std::filesystem::path out(out_dir);
   const std::string urdf_path = (out / "calibrated.urdf").string();  // docs/urdf.md
-  if (Status s = urdf::WriteUrdf(calibrated, NamesOf(origin, calibrated.num_joints()), urdf_path); !s.ok()) return s;
-  std::cout << "calibrated URDF: " << urdf_path << "\n";
+  if (Status s = WriteCalibratedUrdf(calibrated, origin, urdf_path); !s.ok()) return s;
   AddOutputFile("calibrated_urdf", urdf_path);
   if (Status s = WriteDhTable(calibrated, origin.dh_convention, source, out); !s.ok()) return s;
+  if (Status s = WriteUrKinematics(calibrated, origin, out); !s.ok()) return s;
   return WriteCameraStaticTransform(calibrated.flange_from_cam, origin, out_dir);
 }
 

@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <sstream>
+#include <tuple>
 
 #include "io/atomic_file.h"
 #include "io/observations_file.h"
@@ -38,6 +40,7 @@ Convention ReadConvention(MapReader* map) {
 struct JointRow {
   LinkParameters link;  // alpha, a, beta, theta, d as written (convention-specific meaning)
   JointLimits limits;
+  std::string joint_name, link_name;  // optional, for the exports
 };
 
 bool ReadJoint(const yaml::YamlNode& node, const std::string& name, Convention convention, Problems* problems,
@@ -56,6 +59,12 @@ bool ReadJoint(const yaml::YamlNode& node, const std::string& name, Convention c
   } else {
     ok &= map.Quantity("beta", Unit::kAngle, kLinkAngle, &l.beta, /*required=*/false);
   }
+  // For the exports only (io/robot_origin.h reads them): the joint's and its link's names in calibrated.urdf,
+  // the joint's rated speed as its <limit velocity>.
+  ok &= map.OptionalName("name", &row->joint_name);
+  ok &= map.OptionalName("link", &row->link_name);
+  double velocity_deg_s = 0;
+  ok &= map.OptionalDouble("max_velocity_deg_s", Range::Positive(1e5), &velocity_deg_s);
   const bool min_ok = map.Quantity("min", Unit::kAngle, kJointLimit, &row->limits.min_rad);
   const bool max_ok = map.Quantity("max", Unit::kAngle, kJointLimit, &row->limits.max_rad);
   if (min_ok && max_ok && !(row->limits.min_rad < row->limits.max_rad)) {
@@ -66,6 +75,27 @@ bool ReadJoint(const yaml::YamlNode& node, const std::string& name, Convention c
   }
   map.Finish();
   return ok && min_ok && max_ok;
+}
+
+// The joints' `name`s and `link`s become calibrated.urdf's: each used once, and no link named like the
+// URDF's other links (urdf/urdf_writer.h).
+bool CheckExportNames(const std::vector<JointRow>& rows, const std::vector<int>& row_lines, Problems* problems) {
+  std::map<std::string, size_t> joints, links = {{"base_link", 0}, {"link0", 0}, {"tool0", 0}, {"camera_optical_frame", 0}};
+  bool ok = true;
+  for (size_t i = 0; i < rows.size() && i < row_lines.size(); ++i) {
+    for (auto [name, seen, what] : {std::tuple{rows[i].joint_name, &joints, "joint name"},
+                                    std::tuple{rows[i].link_name, &links, "link name"}}) {
+      if (name.empty()) continue;
+      if (!seen->emplace(name, i + 1).second) {
+        const size_t other = seen->at(name);
+        problems->Add(std::string(what) + " `" + name + "` of joint " + std::to_string(i + 1) + " at " +
+                      problems->At(row_lines[i]) + " is already " +
+                      (other == 0 ? "a link of the calibrated URDF" : "that of joint " + std::to_string(other)));
+        ok = false;
+      }
+    }
+  }
+  return ok;
 }
 
 void ReadParameters(MapReader* root, int num_joints, Eigen::VectorXd* out) {
@@ -176,6 +206,7 @@ CalibratedModel Parse(const yaml::YamlNode& node, const std::string& name, Probl
     ok = false;
   }
 
+  ok &= CheckExportNames(rows, row_lines, problems);
   RobotOrigin origin;
   if (convention == Convention::kModifiedHayati) {
     ok &= ReadEnteredAs(&map, &origin);  // io/robot_origin.h: read for the exports, no part of the model

@@ -1,5 +1,7 @@
 #include "io/robot_origin.h"
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 
 #include "base/atomic_file.h"
@@ -17,6 +19,30 @@ std::string ScalarOf(const yaml::YamlNode& map, const std::string& key) {
   return node != nullptr && node->IsScalar() ? node->scalar : "";
 }
 
+// A DH config's per-joint `name`, `link` and `max_velocity_deg_s`, each kept only when every row gives it (the
+// robot config's own reader checks their values).
+void ReadJointExtras(const yaml::YamlNode& root, RobotOrigin* origin) {
+  const yaml::YamlNode* joints = root.Find("joints");
+  if (joints == nullptr || !joints->IsSequence() || joints->items.empty()) return;
+  std::vector<std::string> names, links;
+  std::vector<double> velocities;
+  for (const yaml::YamlNode& row : joints->items) {
+    if (!row.IsMap()) return;
+    names.push_back(ScalarOf(row, "name"));
+    links.push_back(ScalarOf(row, "link"));
+    char* end = nullptr;
+    const std::string v = ScalarOf(row, "max_velocity_deg_s");
+    const double deg_s = v.empty() ? 0 : std::strtod(v.c_str(), &end);
+    velocities.push_back(deg_s > 0 && end != nullptr && *end == '\0' ? DegToRad(deg_s) : 0);
+  }
+  auto all = [](const auto& values, const auto& unset) {
+    return std::none_of(values.begin(), values.end(), [&](const auto& v) { return v == unset; });
+  };
+  if (all(names, std::string())) origin->config_joint_names = names;
+  if (all(links, std::string())) origin->config_link_names = links;
+  if (all(velocities, 0.0)) origin->max_velocity_rad_s = velocities;
+}
+
 Result<RobotOrigin> OriginOfNode(const yaml::YamlNode& root, const std::string& path) {
   RobotOrigin origin;
   if (!root.IsMap()) return Status::Error(ErrorCode::kInvalidInput, path + ": not a robot config");
@@ -24,15 +50,23 @@ Result<RobotOrigin> OriginOfNode(const yaml::YamlNode& root, const std::string& 
   if (!urdf_file.empty()) {
     const urdf::UrdfChainSpec spec{ScalarOf(root, "base_link"), ScalarOf(root, "tip_link"), ScalarOf(root, "camera_link")};
     // The joint names need the URDF; flange_from_cam does not matter for them.
-    Result<urdf::UrdfRobot> robot = urdf::LoadUrdfRobot(ResolveBesideConfig(urdf_file, path), spec, Rigid3());
+    const std::string resolved = ResolveBesideConfig(urdf_file, path);
+    Result<urdf::UrdfRobot> robot = urdf::LoadUrdfRobot(resolved, spec, Rigid3());
     if (!robot.ok()) return robot.status();
-    return RobotOrigin{"", robot->joint_names, spec.base_link, spec.tip_link, spec.camera_link};
+    RobotOrigin origin;
+    origin.joint_names = robot->joint_names;
+    origin.base_link = spec.base_link;
+    origin.tip_link = spec.tip_link;
+    origin.camera_link = spec.camera_link;
+    origin.urdf_file = resolved;
+    return origin;
   }
   Problems problems(path);
   MapReader map(root, "", &problems);
   map.Abandon();  // only entered_as is read here; the robot's own reader checks the rest
   if (!ReadEnteredAs(&map, &origin)) return problems.ToStatus("robot config");
   if (origin.dh_convention.empty() && !origin.FromUrdf()) origin.dh_convention = ScalarOf(root, "dh_convention");
+  if (!origin.FromUrdf()) ReadJointExtras(root, &origin);
   return origin;
 }
 
@@ -52,6 +86,7 @@ bool ReadEnteredAs(MapReader* root, RobotOrigin* origin) {
   ok &= map.OptionalString("base_link", &origin->base_link);
   ok &= map.OptionalString("tip_link", &origin->tip_link);
   ok &= map.OptionalString("camera_link", &origin->camera_link);
+  ok &= map.OptionalString("urdf_file", &origin->urdf_file);
   if (const yaml::YamlNode* names = map.Optional("joint_names")) {
     if (!names->IsSequence()) {
       root->problems()->Add("`" + map.Path("joint_names") + "` at " + root->problems()->At(names->line) +
@@ -75,7 +110,11 @@ std::string EnteredAsYaml(const RobotOrigin& origin) {
   std::string out = "entered_as: {base_link: " + YamlQuoted(origin.base_link) + ", tip_link: " +
                     YamlQuoted(origin.tip_link) + ", camera_link: " + YamlQuoted(origin.camera_link) + ", joint_names: [";
   for (size_t i = 0; i < origin.joint_names.size(); ++i) out += (i ? ", " : "") + YamlQuoted(origin.joint_names[i]);
-  return out + "]}  # the URDF's names (for the exports)\n";
+  out += "]";
+  if (!origin.urdf_file.empty()) {
+    out += ", urdf_file: " + YamlQuoted(std::filesystem::absolute(origin.urdf_file).lexically_normal().string());
+  }
+  return out + "}  # the URDF's names and file (for the exports)\n";
 }
 
 Result<RobotOrigin> RobotOriginOfConfigText(const std::string& text, const std::string& path) {

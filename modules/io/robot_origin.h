@@ -4,7 +4,7 @@
 // from a session's recorded robot.yaml, where a URDF robot is recorded as its converted model with
 //
 //   entered_as: {base_link: "base_link", tip_link: "tool0", camera_link: "camera_optical_frame",
-//                joint_names: ["joint1", ...]}
+//                joint_names: ["joint1", ...], urdf_file: "/abs/path/robot.urdf"}
 //
 // (accepted in modified_hayati configs, the form selfcal writes; no part of the kinematics).
 #pragma once
@@ -21,6 +21,14 @@ struct RobotOrigin {
   std::string dh_convention;             // "standard", "modified", "modified_hayati"; empty for a URDF / unknown
   std::vector<std::string> joint_names;  // the URDF's movable joints, base to tip; empty otherwise
   std::string base_link, tip_link, camera_link;  // the URDF's links; empty otherwise
+  // The URDF file itself (resolved beside the config) when read from a config naming it, or as a session
+  // recorded it (absolute); empty otherwise. calibrated.urdf is this file with the calibrated origins when
+  // it is still there and still converts to the calibrated arm (urdf/urdf_calibrated.h).
+  std::string urdf_file;
+  // A DH config's optional `name`, `link` and `max_velocity_deg_s` of every joint row (all rows or none):
+  // calibrated.urdf's joint and link names and <limit velocity> (rad/s); empty when not given.
+  std::vector<std::string> config_joint_names, config_link_names;
+  std::vector<double> max_velocity_rad_s;
 
   bool FromUrdf() const { return !joint_names.empty(); }
 };

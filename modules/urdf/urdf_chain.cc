@@ -7,11 +7,6 @@
 namespace selfcal::urdf {
 namespace {
 
-Rigid3 RigidOf(const ::urdf::Pose& pose) {
-  const Eigen::Quaterniond q(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z);
-  return Rigid3(q.normalized().toRotationMatrix(), Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z));
-}
-
 const char* JointTypeName(int type) {
   switch (type) {
     case ::urdf::Joint::REVOLUTE:
@@ -31,7 +26,21 @@ const char* JointTypeName(int type) {
   }
 }
 
-// The joints from `top` down to `bottom` (top first); empty with an error message when bottom is not below top.
+Status MissingLink(const ::urdf::ModelInterface& model, const std::string& file, const char* key,
+                   const std::string& link) {
+  std::string names;
+  for (const auto& entry : model.links_) names += (names.empty() ? "" : ", ") + entry.first;
+  return Status::Error(ErrorCode::kInvalidInput, file + ": " + key + " `" + link + "` is not a link of robot `" +
+                                                     model.getName() + "` (links: " + names + ")");
+}
+
+}  // namespace
+
+Rigid3 RigidOf(const ::urdf::Pose& pose) {
+  const Eigen::Quaterniond q(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z);
+  return Rigid3(q.normalized().toRotationMatrix(), Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z));
+}
+
 std::vector<::urdf::JointConstSharedPtr> JointsBetween(const ::urdf::ModelInterface& model, const std::string& top,
                                                        const std::string& bottom, std::string* error) {
   std::vector<::urdf::JointConstSharedPtr> joints;
@@ -48,15 +57,6 @@ std::vector<::urdf::JointConstSharedPtr> JointsBetween(const ::urdf::ModelInterf
   return joints;
 }
 
-Status MissingLink(const ::urdf::ModelInterface& model, const std::string& file, const char* key,
-                   const std::string& link) {
-  std::string names;
-  for (const auto& entry : model.links_) names += (names.empty() ? "" : ", ") + entry.first;
-  return Status::Error(ErrorCode::kInvalidInput, file + ": " + key + " `" + link + "` is not a link of robot `" +
-                                                     model.getName() + "` (links: " + names + ")");
-}
-
-}  // namespace
 
 Result<UrdfChain> ExtractChain(const ::urdf::ModelInterface& model, const std::string& name,
                                const UrdfChainSpec& spec) {

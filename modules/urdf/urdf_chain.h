@@ -1,6 +1,7 @@
 // The chain of a URDF between two links at q = 0, in the base link's frame (internal to the module).
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,6 +15,8 @@
 
 namespace urdf {
 class ModelInterface;
+class Joint;
+class Pose;
 }
 
 namespace selfcal::urdf {
@@ -32,6 +35,14 @@ struct UrdfChain {
   Rigid3 base_from_tip;                   // at q = 0
   std::optional<Rigid3> tip_from_camera;  // when a camera link was named
 };
+
+// A urdfdom pose (a joint's origin) as a Rigid3.
+Rigid3 RigidOf(const ::urdf::Pose& pose);
+
+// The joints from link `top` down to link `bottom` (top first); empty with *error set when bottom is not below top.
+std::vector<std::shared_ptr<const ::urdf::Joint>> JointsBetween(const ::urdf::ModelInterface& model,
+                                                                const std::string& top, const std::string& bottom,
+                                                                std::string* error);
 
 // The chain base_link -> tip_link (and tip_link -> camera_link) of `model`; `name` is the file in messages.
 Result<UrdfChain> ExtractChain(const ::urdf::ModelInterface& model, const std::string& name, const UrdfChainSpec& spec);

@@ -13,7 +13,7 @@ namespace {
 constexpr double kNearGimbalLock = 0.7;
 
 std::string Num(double v) {
-  if (v == 0) return "0";
+  if (std::abs(v) < 1e-15) return "0";  // rounding residue (1e-19 m) of a composed transform: noise to a reader
   char buffer[40];
   std::snprintf(buffer, sizeof buffer, "%.17g", v);
   return buffer;
@@ -43,14 +43,21 @@ std::string Xml(const std::string& text) {
   return out;
 }
 
-std::string Origin(const Rigid3& t) {
+}  // namespace
+
+std::string OriginElement(const Rigid3& t) {
   const Eigen::Matrix3d& r = t.rotation;
-  const double roll = std::atan2(r(2, 1), r(2, 2));
-  const double pitch = std::atan2(-r(2, 0), std::hypot(r(2, 1), r(2, 2)));
-  const double yaw = std::atan2(r(1, 0), r(0, 0));
+  // R = Rz(yaw) Ry(pitch) Rx(roll); at gimbal lock (a right-angle pitch) yaw = 0 and roll takes the rest.
+  const double cos_pitch = std::hypot(r(2, 1), r(2, 2));
+  const double pitch = std::atan2(-r(2, 0), cos_pitch);
+  const bool locked = cos_pitch < 1e-12;
+  const double roll = locked ? std::atan2(-r(1, 2), r(1, 1)) : std::atan2(r(2, 1), r(2, 2));
+  const double yaw = locked ? 0.0 : std::atan2(r(1, 0), r(0, 0));
   return "<origin xyz=\"" + Num(t.translation.x()) + " " + Num(t.translation.y()) + " " + Num(t.translation.z()) +
          "\" rpy=\"" + Num(roll) + " " + Num(pitch) + " " + Num(yaw) + "\"/>";
 }
+
+namespace {
 
 class UrdfText {
  public:
@@ -58,29 +65,29 @@ class UrdfText {
 
   // A joint from parent to child at `origin`; revolute about z within `limits` when given, else fixed.
   void Joint(const std::string& name, const std::string& parent, const std::string& child, const Rigid3& origin,
-             const JointLimits* limits) {
+             const JointLimits* limits, double velocity_rad_s = 0) {
     std::string from = parent;
     Rigid3 last = origin;
     if (std::abs(origin.rotation(2, 0)) > kNearGimbalLock) {
       const Rigid3 quarter = Rigid3::FromRotation(RotZ(kPi / 2));
       from = name + "_origin";
       Link(from);
-      Write(name + "_origin", "fixed", parent, from, origin * quarter, nullptr);
+      Write(name + "_origin", "fixed", parent, from, origin * quarter, nullptr, 0);
       last = quarter.Inverse();
     }
-    Write(name, limits ? "revolute" : "fixed", from, child, last, limits);
+    Write(name, limits ? "revolute" : "fixed", from, child, last, limits, velocity_rad_s);
   }
 
   std::string str() const { return out_.str(); }
 
  private:
   void Write(const std::string& name, const char* type, const std::string& parent, const std::string& child,
-             const Rigid3& origin, const JointLimits* limits) {
+             const Rigid3& origin, const JointLimits* limits, double velocity_rad_s) {
     out_ << "  <joint name=\"" << Xml(name) << "\" type=\"" << type << "\">\n    <parent link=\"" << Xml(parent)
-         << "\"/>\n    <child link=\"" << Xml(child) << "\"/>\n    " << Origin(origin) << "\n";
+         << "\"/>\n    <child link=\"" << Xml(child) << "\"/>\n    " << OriginElement(origin) << "\n";
     if (limits) {
       out_ << "    <axis xyz=\"0 0 1\"/>\n    <limit lower=\"" << Num(limits->min_rad) << "\" upper=\""
-           << Num(limits->max_rad) << "\" effort=\"0\" velocity=\"0\"/>\n";
+           << Num(limits->max_rad) << "\" effort=\"0\" velocity=\"" << Num(velocity_rad_s) << "\"/>\n";
     }
     out_ << "  </joint>\n";
   }
@@ -92,9 +99,11 @@ class UrdfText {
 
 Result<std::string> UrdfOfModel(const RobotModel& model, const UrdfNames& names, const FkCheckOptions& check) {
   const int n = model.num_joints();
-  if (!names.joints.empty() && static_cast<int>(names.joints.size()) != n) {
-    return Status::Error(ErrorCode::kInternal,
-                         std::to_string(names.joints.size()) + " joint names for " + std::to_string(n) + " joints");
+  for (const size_t given : {names.joints.size(), names.links.size(), names.velocities_rad_s.size()}) {
+    if (given != 0 && static_cast<int>(given) != n) {
+      return Status::Error(ErrorCode::kInternal,
+                           std::to_string(given) + " joint names, links or velocities for " + std::to_string(n) + " joints");
+    }
   }
   UrdfText text;
   text.Link(names.base_link);
@@ -103,10 +112,11 @@ Result<std::string> UrdfOfModel(const RobotModel& model, const UrdfNames& names,
   std::string parent = "link0";
   for (int i = 0; i < n; ++i) {
     const LinkParameters& p = model.links[i];
-    const std::string link = "link" + std::to_string(i + 1);
+    const std::string link = names.links.empty() ? "link" + std::to_string(i + 1) : names.links[i];
     text.Link(link);
     text.Joint(names.joints.empty() ? "joint" + std::to_string(i + 1) : names.joints[i], parent, link,
-               LinkTransform<double>(p.alpha, p.a, p.beta, p.theta, p.d), &model.limits[i]);
+               LinkTransform<double>(p.alpha, p.a, p.beta, p.theta, p.d), &model.limits[i],
+               names.velocities_rad_s.empty() ? kDefaultJointVelocityRadPerS : names.velocities_rad_s[i]);
     parent = link;
   }
   text.Link(names.tip_link);

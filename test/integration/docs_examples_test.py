@@ -67,6 +67,8 @@ def make_real_files():
          os.path.join(SRC, "config", "trajectories", "initial_puma560.yaml")],
         ["calibrate", "sim/observations.yaml", "--out", "cal", "--write-camera-opencv", "cal/camera.yaml",
          "--write-camera-visp", "cal/camera.xml"],
+        ["simulate", "--points", "--no-html", "--robot", os.path.join(SRC, "config", "robots", "ur5e.yaml"),
+         "--trajectory", os.path.join(SRC, "config", "trajectories", "initial_ur5e.yaml"), "--out", "sim-ur5e"],
     ]
     # detect --skip-failed on three ROS images, one replaced by a blank one: its skipped list.
     ros = os.path.join(SRC, "test", "data", "ros-industrial-dotgrid-10x10")
@@ -93,6 +95,8 @@ def make_real_files():
         "session_json": os.path.join(WORK, "session", "session.json"),
         "setup_json": os.path.join(WORK, "session", "inputs", "setup.json"),
         "static_transform": os.path.join(WORK, "cal", "camera_static_transform.yaml"),
+        "camera_info": os.path.join(WORK, "cal", "camera_info.yaml"),
+        "ur_kinematics": os.path.join(WORK, "sim-ur5e", "ur_calibrated_kinematics.yaml"),
     }
 
 
@@ -146,6 +150,10 @@ def kind_of(lang, text):
         return ("targets", "targets")
     if body.startswith("header:") and "child_frame_id:" in text:
         return ("static_transform", "keys")
+    if body.startswith("image_width:") and "distortion_model:" in text:
+        return ("camera_info", "keys")
+    if body.startswith("kinematics:") and "hash:" in text:
+        return ("ur_kinematics", "keys")
     return ("unclassified", None)
 
 

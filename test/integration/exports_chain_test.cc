@@ -1,9 +1,14 @@
 // The calibrated model's exports end to end through the selfcal binary (docs/urdf.md,
 // docs/calibrated-model-format.md, docs/ros-static-transform.md), each re-read by what consumes it:
 // calibrated.urdf keeps a URDF robot's names (urdfdom) and equals the model (KDL); the flange-to-camera
-// static transform (yaml-cpp); the DH table in the entered convention, or why not.
+// static transform (yaml-cpp); the DH table in the entered convention, or why not; a URDF robot's
+// calibrated.urdf is the user's URDF with only joint origins changed; a UR5e's ur_description kinematics
+// file is the calibrated model (docs/calibrated-model-format.md).
 #include <filesystem>
 #include <fstream>
+#include <random>
+#include <regex>
+#include <set>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -14,7 +19,9 @@
 #include "io/robot_config.h"
 #include "support/cli.h"
 #include "support/temp_files.h"
+#include "support/ur_description_chain.h"
 #include "urdf/urdf_robot.h"
+#include "urdf/urdf_writer.h"
 
 namespace selfcal {
 namespace {
@@ -40,6 +47,23 @@ double WorstKdlDifference(const std::string& urdf, const std::string& base, cons
   }
   return worst;
 }
+
+Rigid3 RigidOf(const ::urdf::Pose& p) {
+  const Eigen::Quaterniond q(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z);
+  return Rigid3(q.toRotationMatrix(), Eigen::Vector3d(p.position.x, p.position.y, p.position.z));
+}
+
+// The lines of `text` with every <origin ...> tag removed, the lines left empty by that dropped.
+std::vector<std::string> LinesWithoutOrigins(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(std::regex_replace(text, std::regex("<origin[^>]*>(</origin>)?"), ""));
+  for (std::string line; std::getline(in, line);) {
+    if (line.find_first_not_of(" \t") != std::string::npos) out.push_back(line);
+  }
+  return out;
+}
+
+std::vector<Eigen::VectorXd> Random1000(const RobotModel& model) { return urdf::RandomJointsWithinLimits(model, 1000, 31); }
 
 // The movable joints, base to tip, by urdfdom: walked from the tip link up to the base.
 std::vector<std::string> RevoluteJointsTo(const ::urdf::ModelInterface& parsed, const std::string& tip) {
@@ -143,10 +167,144 @@ TEST(ExportsChain, AStandardDhRobotWithACalibratedBetaGetsTheReasonInsteadOfATab
   EXPECT_NE(output.find("j3.beta = "), std::string::npos) << output;
   EXPECT_NE(output.find("(Hayati's parallel-axis parameter), which standard DH cannot hold"), std::string::npos);
   EXPECT_NE(output.find("dropping them would move the flange by up to"), std::string::npos) << output;
+  // No names or speeds in the config: joint1 .. joint6 and the documented placeholder velocity.
+  const ::urdf::ModelInterfaceSharedPtr parsed = ::urdf::parseURDF(testing::ReadFile((dir / "calibrated.urdf").string()));
+  ASSERT_TRUE(parsed);
+  ASSERT_TRUE(parsed->getJoint("joint3") && parsed->getJoint("joint3")->limits);
+  EXPECT_EQ(parsed->getJoint("joint3")->limits->velocity, urdf::kDefaultJointVelocityRadPerS);
   // The default names, tool0 -> camera_optical_frame.
   const YAML::Node tf = YAML::LoadFile((dir / "camera_static_transform.yaml").string());
   EXPECT_EQ(tf["header"]["frame_id"].as<std::string>(), "tool0");
   EXPECT_EQ(tf["child_frame_id"].as<std::string>(), "camera_optical_frame");
+  if (!HasFailure()) fs::remove_all(dir);
+}
+
+// The exports ROS 2 and MoveIt load: a URDF robot's calibrated.urdf is the user's URDF with only joint origins
+// changed (read back by urdfdom, KDL's forward kinematics the calibrated model's, 1000 random joints).
+TEST(ExportsChain, AUrdfRobotsCalibratedUrdfIsTheUsersUrdfWithOnlyJointOriginsChanged) {
+  const fs::path dir = testing::FreshDir("ExportsChain", "meshes");
+  std::string output;
+  ASSERT_EQ(testing::RunSelfcal("simulate --points --no-html --quiet --robot " + kSource +
+                                    "/test/data/urdf/ur5e_meshes_robot.yaml --trajectory " + kSource +
+                                    "/config/trajectories/initial_ur5e.yaml --out " + dir.string(),
+                                &output),
+            0)
+      << output;
+  const std::string input = testing::ReadFile(kSource + "/test/data/urdf/ur5e_meshes.urdf");
+  const std::string written = testing::ReadFile((dir / "calibrated.urdf").string());
+  // The diff: nothing but <origin> tags.
+  EXPECT_EQ(LinesWithoutOrigins(written), LinesWithoutOrigins(input));
+  // Which origins: the movable joints' and the camera's, no link's (visual, collision, inertial) and no
+  // other joint's; every limit, velocity and effort as the user wrote it.
+  const ::urdf::ModelInterfaceSharedPtr a = ::urdf::parseURDF(input), b = ::urdf::parseURDF(written);
+  ASSERT_TRUE(a && b) << written;
+  const std::set<std::string> changed = {"shoulder_lift_joint", "elbow_joint",  "wrist_1_joint",
+                                         "wrist_2_joint",       "wrist_3_joint", "camera_optical_joint"};
+  for (const auto& [name, joint] : a->joints_) {
+    const ::urdf::JointSharedPtr other = b->joints_.at(name);
+    const PoseDifference d =
+        ComparePoses(RigidOf(joint->parent_to_joint_origin_transform), RigidOf(other->parent_to_joint_origin_transform));
+    if (changed.count(name)) {
+      EXPECT_GT(d.position_m + d.rotation_rad, 1e-6) << name;
+    } else if (name != "shoulder_pan_joint") {  // its origin (none given) holds the base correction, if any
+      EXPECT_EQ(d.position_m + d.rotation_rad, 0) << name;
+    }
+    if (joint->limits) {
+      ASSERT_TRUE(other->limits) << name;
+      EXPECT_EQ(other->limits->velocity, joint->limits->velocity) << name;
+      EXPECT_EQ(other->limits->effort, joint->limits->effort) << name;
+      EXPECT_EQ(other->limits->lower, joint->limits->lower) << name;
+    }
+  }
+  for (const auto& [name, link] : a->links_) {
+    const ::urdf::LinkSharedPtr other = b->links_.at(name);
+    ASSERT_EQ(link->visual_array.size(), other->visual_array.size()) << name;
+    for (size_t k = 0; k < link->visual_array.size(); ++k) {
+      EXPECT_EQ(ComparePoses(RigidOf(link->visual_array[k]->origin), RigidOf(other->visual_array[k]->origin)).position_m, 0);
+    }
+    ASSERT_EQ(link->collision_array.size(), other->collision_array.size()) << name;
+  }
+  Result<io::CalibratedModel> calibrated = io::LoadCalibratedModel((dir / "calibrated_model.yaml").string());
+  ASSERT_TRUE(calibrated.ok()) << calibrated.status().message();
+  EXPECT_LE(WorstKdlDifference(written, "base_link_inertia", "tool_flange", calibrated->model, false, Random1000(calibrated->model)), 1e-9);
+  EXPECT_LE(WorstKdlDifference(written, "base_link_inertia", "camera_color_optical_frame", calibrated->model, true,
+                               Random1000(calibrated->model)), 1e-9);
+  if (!HasFailure()) fs::remove_all(dir);
+}
+
+// The same through a session: `run` records the converted model with the URDF's names and file
+// (entered_as), so `calibrate SESSION` writes the user's URDF too, not selfcal's.
+TEST(ExportsChain, ASessionOfAUrdfRobotIsCalibratedIntoTheUsersUrdf) {
+  const fs::path dir = testing::FreshDir("ExportsChain", "meshes-session");
+  std::string output;
+  ASSERT_EQ(testing::RunSelfcal("simulate --no-html --quiet --robot " + kSource +
+                                    "/test/data/urdf/ur5e_meshes_robot.yaml --trajectory " + kSource +
+                                    "/config/trajectories/initial_ur5e.yaml --out " + (dir / "sim").string(),
+                                &output),
+            0)
+      << output;
+  ASSERT_EQ(testing::RunSelfcal("calibrate --no-html " + (dir / "sim" / "session").string() + " --out " +
+                                    (dir / "cal").string(),
+                                &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("ur5e_meshes.urdf with the calibrated joint origins"), std::string::npos) << output;
+  const std::string input = testing::ReadFile(kSource + "/test/data/urdf/ur5e_meshes.urdf");
+  const std::string written = testing::ReadFile((dir / "cal" / "calibrated.urdf").string());
+  EXPECT_EQ(LinesWithoutOrigins(written), LinesWithoutOrigins(input));
+  Result<io::CalibratedModel> calibrated = io::LoadCalibratedModel((dir / "cal" / "calibrated_model.yaml").string());
+  ASSERT_TRUE(calibrated.ok()) << calibrated.status().message();
+  EXPECT_LE(WorstKdlDifference(written, "base_link_inertia", "camera_color_optical_frame", calibrated->model, true,
+                               Random1000(calibrated->model)),
+            1e-9);
+  if (!HasFailure()) fs::remove_all(dir);
+}
+
+// A UR5e's ur_description kinematics file, built into the chain the way ur_description's xacro builds it, is
+// the calibrated model; a DH robot's calibrated.urdf has the non-zero velocity limits MoveIt needs.
+TEST(ExportsChain, AUr5esKinematicsFileIsTheCalibratedModelAndItsUrdfHasVelocities) {
+  const fs::path dir = testing::FreshDir("ExportsChain", "ur5e");
+  std::string output;
+  ASSERT_EQ(testing::RunSelfcalInSource("simulate --points --no-html --robot config/robots/ur5e.yaml --trajectory "
+                                        "config/trajectories/initial_ur5e.yaml --out " + dir.string(),
+                                        &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("ur_description kinematics (kinematics_params_file): "), std::string::npos) << output;
+  Result<io::CalibratedModel> calibrated = io::LoadCalibratedModel((dir / "calibrated_model.yaml").string());
+  ASSERT_TRUE(calibrated.ok()) << calibrated.status().message();
+  const RobotModel& model = calibrated->model;
+  const YAML::Node doc = YAML::LoadFile((dir / "ur_calibrated_kinematics.yaml").string());
+  EXPECT_EQ(doc["kinematics"]["hash"].as<std::string>().rfind("calib_", 0), 0u);
+  const Eigen::VectorXd rho = KinematicParameters::Nominal(model);
+  std::mt19937_64 rng(12);
+  double worst_m = 0, worst_rad = 0;
+  for (int s = 0; s < 1000; ++s) {
+    Eigen::VectorXd q(6);
+    for (int j = 0; j < 6; ++j) {
+      q[j] = std::uniform_real_distribution<double>(model.limits[j].min_rad, model.limits[j].max_rad)(rng);
+    }
+    const PoseDifference d = ComparePoses(testing::UrDescriptionChain(doc["kinematics"], q), BaseFromFlange(model, rho, q));
+    worst_m = std::max(worst_m, d.position_m);
+    worst_rad = std::max(worst_rad, d.rotation_rad);
+  }
+  EXPECT_LE(worst_m, 1e-9);
+  EXPECT_LE(worst_rad, 1e-9);
+  std::cout << "UR5e kinematics file against the calibrated model, 1000 random joints: worst " << worst_m << " m, "
+            << worst_rad << " rad\n";
+  // A DH robot's calibrated.urdf: the config's joint and link names (ur_description's) and its velocity
+  // limits (180 deg/s), which MoveIt's time parameterization takes (not 0).
+  const ::urdf::ModelInterfaceSharedPtr parsed = ::urdf::parseURDF(testing::ReadFile((dir / "calibrated.urdf").string()));
+  ASSERT_TRUE(parsed);
+  EXPECT_EQ(RevoluteJointsTo(*parsed, "tool0"),
+            (std::vector<std::string>{"shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint",
+                                      "wrist_2_joint", "wrist_3_joint"}));
+  for (const auto& [name, joint] : parsed->joints_) {
+    if (joint->type != ::urdf::Joint::REVOLUTE) continue;
+    ASSERT_TRUE(joint->limits) << name;
+    EXPECT_DOUBLE_EQ(joint->limits->velocity, kPi) << name;
+  }
+  EXPECT_EQ(parsed->getJoint("elbow_joint")->child_link_name, "forearm_link");
   if (!HasFailure()) fs::remove_all(dir);
 }
 
