@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "io/robot_origin.h"
 #include "rosbag/mcap_reader.h"
 #include "rosbag/ros_messages.h"
 
@@ -204,6 +205,15 @@ Result<BagImages> LoadBagImages(const std::string& bag, const BagOptions& option
                    "moving more than the tolerance within the window either side, docs/detect.md)");
   }
   return out;
+}
+
+Result<BagImages> LoadBagImagesForRobot(const std::string& bag, const BagOptions& options,
+                                        const std::string& robot_config, const RobotModel& robot) {
+  Result<io::RobotOrigin> origin = io::RobotOriginOfConfig(robot_config);
+  if (!origin.ok()) return origin.status();
+  std::vector<std::string> names = origin->joint_names;
+  if (static_cast<int>(names.size()) != robot.num_joints()) names.clear();  // not one name per joint: by order
+  return LoadBagImages(bag, options, robot.num_joints(), names);
 }
 
 }  // namespace selfcal::rosbag

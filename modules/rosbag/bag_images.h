@@ -22,6 +22,7 @@
 #include "base/status.h"
 #include "io/image_files.h"
 #include "io/pose_files.h"
+#include "kinematics/robot_model.h"
 
 namespace selfcal::rosbag {
 
@@ -58,5 +59,10 @@ struct BagImages {
 // from a joint state, images of different sizes, no still image.
 Result<BagImages> LoadBagImages(const std::string& bag, const BagOptions& options, int dof,
                                 const std::vector<std::string>& joint_names);
+
+// The same for the robot of the config at `robot_config` (already loaded as `robot`): its joint names when
+// the config names them (io/robot_origin.h: a URDF robot), else the message's order.
+Result<BagImages> LoadBagImagesForRobot(const std::string& bag, const BagOptions& options,
+                                        const std::string& robot_config, const RobotModel& robot);
 
 }  // namespace selfcal::rosbag
