@@ -23,8 +23,12 @@ TEST(RosMessages, JointStateReadBackWithItsAlignment) {
   EXPECT_EQ(m->name, (std::vector<std::string>{"shoulder", "elbow"}));
   EXPECT_EQ(m->position, (std::vector<double>{0.25, -1.5}));
   EXPECT_TRUE(m->velocity.empty());
-  // "shoulder" + NUL + "elbow" + NUL leave the doubles' count at an offset that needs 4 bytes of padding
-  // before the first double: one byte off and the positions would not read back.
+  // Names "a", "bc", "d" leave the doubles' count ending at offset 52 after the header: the first double
+  // is aligned to 8, at 56 (the 4-byte alignment of XCDR2 would read it at 52).
+  Result<JointStateMessage> padded =
+      DecodeJointState(testing::JointStateCdr(0, 0, {"a", "bc", "d"}, {0.5, 2.0, -3.0}), "w");
+  ASSERT_TRUE(padded.ok()) << padded.status().ToString();
+  EXPECT_EQ(padded->position, (std::vector<double>{0.5, 2.0, -3.0}));
 }
 
 TEST(RosMessages, EveryTruncationAndAWrongEncapsulationAreRefused) {
