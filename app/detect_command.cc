@@ -27,6 +27,7 @@
 #include "io/robot_config.h"
 #include "io/skipped_images_file.h"
 #include "io/transform_yaml.h"
+#include "rosbag/bag_images.h"
 
 namespace selfcal::app {
 
@@ -34,6 +35,8 @@ namespace {
 
 struct DetectSettings {
   std::string images, poses, out, contact_sheet;
+  std::string bag;             // --bag: a ROS 2 recording instead of --images and --poses
+  rosbag::BagOptions bag_options;
   std::string detector = "dots", identity = "grid", grid, polarity = "dark";
   bool asymmetric = false;  // circles: OpenCV's asymmetric grid
   std::string dictionary, board;  // charuco: the markers' dictionary and the board's squares ROWSxCOLS
@@ -268,6 +271,34 @@ void RecordDetectFigures(const std::vector<io::NamedImage>& images, const std::v
                                 {"per_image", per_image}};
 }
 
+// The images and their poses: a folder and its poses (io), or a ROS 2 bag's still images (rosbag).
+Status LoadInputs(const DetectSettings& a, const RobotModel* robot, io::ImagesAndPoses* inputs,
+                  std::vector<io::NamedImage>* images) {
+  if (a.bag.empty() == a.images.empty()) return Usage("give --images (a folder of images) or --bag (a ROS 2 recording)");
+  if (!a.bag.empty()) {
+    if (!a.poses.empty() || !a.json.empty()) return Usage("--bag " + a.bag + " gives the joint angles: leave out --poses and --pose-*-key");
+    if (robot == nullptr || a.bag_options.image_topic.empty()) return Usage("--bag needs --robot and --image-topic");
+    Result<rosbag::BagImages> bag = rosbag::LoadBagImagesForRobot(a.bag, a.bag_options, ResolveDataPath(a.robot), *robot);
+    if (!bag.ok()) return bag.status();
+    for (const std::string& note : bag->notes) std::cerr << "selfcal: note: " << note << "\n";
+    std::printf("%zu of %d images on %s taken while the arm was still (%d while moving left out)\n", bag->images.size(),
+                bag->image_messages, a.bag_options.image_topic.c_str(), bag->moving);
+    *inputs = std::move(bag->inputs);
+    *images = std::move(bag->images);
+    return Status::Ok();
+  }
+  Result<io::PoseReadOptions> pose_options = ToPoseReadOptions(a);
+  if (!pose_options.ok()) return pose_options.status();
+  Result<io::ImagesAndPoses> listed = io::LoadImagesAndPoses(a.images, a.poses, robot, *pose_options);
+  if (!listed.ok()) return listed.status();
+  ReportRotationCorrections(*listed);
+  Result<std::vector<io::NamedImage>> read = io::ReadGreyImages(listed->images);
+  if (!read.ok()) return read.status();
+  *inputs = std::move(*listed);
+  *images = std::move(*read);
+  return Status::Ok();
+}
+
 int DetectFromSettings(const DetectSettings& a) {
   const auto start = std::chrono::steady_clock::now();
   Result<detection::DetectionOptions> options = ToDetectionOptions(a);
@@ -291,14 +322,12 @@ int DetectFromSettings(const DetectSettings& a) {
     if (!loaded.ok()) return Fail(loaded.status());
     robot = std::make_unique<RobotModel>(*loaded);
   }
-  Result<io::PoseReadOptions> pose_options = ToPoseReadOptions(a);
-  if (!pose_options.ok()) return Fail(pose_options.status());
-  Result<io::ImagesAndPoses> inputs = io::LoadImagesAndPoses(a.images, a.poses, robot.get(), *pose_options);
-  if (!inputs.ok()) return Fail(inputs.status());
-  ReportRotationCorrections(*inputs);
+  io::ImagesAndPoses inputs_read;
+  std::vector<io::NamedImage> images_read;
+  if (Status s = LoadInputs(a, robot.get(), &inputs_read, &images_read); !s.ok()) return Fail(s);
+  const io::ImagesAndPoses* inputs = &inputs_read;
+  const std::vector<io::NamedImage>* images = &images_read;
   const std::vector<io::ImagePose>& matched = inputs->poses;
-  Result<std::vector<io::NamedImage>> images = io::ReadGreyImages(inputs->images);
-  if (!images.ok()) return Fail(images.status());
   Result<detection::ObservationSetup> setup = ToSetup(a, images->front().image, robot.get());
   if (!setup.ok()) return Fail(setup.status());
 
@@ -357,8 +386,12 @@ Command AddDetectCommand(CLI::App& app) {
   auto a = std::make_shared<DetectSettings>();
   CLI::App* cmd = app.add_subcommand(
       "detect", "Detect and name the points of a folder of images and write an observations file (docs/detect.md)");
-  cmd->add_option("--images", a->images, "Directory of images (png, jpg, pgm, ...) or a glob ('shots/img_*.png')")
-      ->required();
+  cmd->add_option("--images", a->images, "Directory of images (png, jpg, pgm, ...) or a glob ('shots/img_*.png')");
+  cmd->add_option("--bag", a->bag, "A ROS 2 recording (rosbag2 .mcap) instead of --images and --poses: the images "
+                  "taken while the arm was still, with the joint states nearest in time (needs --robot, --image-topic)");
+  cmd->add_option("--image-topic", a->bag_options.image_topic,
+                  "--bag: the topic of the images (sensor_msgs/msg/Image or CompressedImage)");
+  cmd->add_option("--joint-topic", a->bag_options.joint_topic, "--bag: the joint states' topic (default /joint_states)");
   cmd->add_option("--poses", a->poses,
                   "Robot poses: a directory or glob of per-image files (ROS x,y,z,qx..qw, ViSP vpPoseVector, or JSON "
                   "with --pose-*-key), or a selfcal-poses list; not needed when --images holds a folder per pose");
