@@ -239,10 +239,12 @@ std::string Page::Render(const std::string& plotly_js) const {
   out += "<meta http-equiv=\"Content-Security-Policy\" content=\"" + std::string(kContentSecurityPolicy) + "\">\n";
   out += "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n";
   out += "<title>" + EscapeHtml(title_) + "</title>\n<style>" + kStyle + "</style>\n";
-  out += "<script>\n" + library + "\n</script>\n</head>\n<body>\n";
+  out += "</head>\n<body>\n";
   out += body_;
   out += "<footer>Plots: " + EscapeHtml(PlotlyVersion(plotly_js)) +
          ", inlined: this file opens offline and loads nothing.</footer>\n";
+  // The library at the end of the body: the page (the verdict first) is drawn before its megabytes parse.
+  out += "<script>\n" + library + "\n</script>\n";
   out += "<script type=\"application/json\" id=\"selfcal-figures\">" + ScriptJson(figures_) + "</script>\n";
   out += "<script>" + std::string(kInitScript) + "</script>\n</body>\n</html>\n";
   return out;
