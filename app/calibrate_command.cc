@@ -395,8 +395,14 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
               << (report.model ? " (the calibrated model is written, marked untested)\n" : " (no calibrated model written)\n");
   }
   if (from_session) PrintSummary(loaded->session->summary);
-  if (run != nullptr) *run = {std::move(loaded).value().observations, std::move(report)};
+  if (run != nullptr) *run = {std::move(loaded).value().observations, std::move(report), true};
   return static_cast<int>(code);
+}
+
+std::string CalibrationFinalLine(const CalibrationRun& run, int exit_code) {
+  if (run.solved) return report::VerdictHeadline(run.report);
+  return std::string(ExitCodeName(static_cast<ExitCode>(exit_code))) + " (exit " + std::to_string(exit_code) +
+         ", the reason above on stderr)";
 }
 
 Command AddCalibrateCommand(CLI::App& app) {
@@ -456,7 +462,10 @@ Command AddCalibrateCommand(CLI::App& app) {
     request->folds_given = folds->count() > 0;
     request->method = MethodFromName(*method);
     request->html = !*no_html;
-    return CalibrateAndWrite(*request);
+    CalibrationRun run;
+    const int code = CalibrateAndWrite(*request, &run);
+    PrintFinalLine(CalibrationFinalLine(run, code));
+    return code;
   };
 }
 

@@ -58,7 +58,12 @@ struct CalibrateRequest {
 struct CalibrationRun {
   ObservationSet observations;
   calibration::CalibrationReport report;
+  bool solved = false;  // the calibration ran and its report was written (report holds its verdict)
 };
+
+// The last line of `calibrate` (docs/cli-output.md): the verdict, the held-out figure it rests on and the
+// files written; for a command that stopped before a verdict, the exit code's name.
+std::string CalibrationFinalLine(const CalibrationRun& run, int exit_code);
 
 // The names calibrate (and simulate, through it) may write into its output directory: one that holds any
 // of them is refused without --force (output_options.h).

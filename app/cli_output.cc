@@ -4,10 +4,14 @@
 #include <sys/ioctl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
+#include <vector>
 
 #include "report/terminal_progress.h"
 
@@ -19,6 +23,7 @@ struct OutputState {
   bool json = false;
   bool quiet = false;
   nlohmann::json document = nlohmann::json::object();
+  std::vector<std::string> files;  // the paths of AddOutputFile in the order written
   std::unique_ptr<report::TerminalProgress> progress;
 };
 
@@ -95,7 +100,50 @@ void ClearProgressLine() {
 
 nlohmann::json& OutputDocument() { return State().document; }
 
-void AddOutputFile(const std::string& role, const std::string& path) { State().document["files"][role] = path; }
+void AddOutputFile(const std::string& role, const std::string& path) {
+  State().document["files"][role] = path;
+  std::vector<std::string>& files = State().files;
+  if (std::find(files.begin(), files.end(), path) == files.end()) files.push_back(path);
+}
+
+std::string WrittenFilesText() {
+  const std::vector<std::string>& files = State().files;
+  if (files.empty()) return "nothing written";
+  std::map<std::string, int> per_directory;
+  for (const std::string& path : files) ++per_directory[std::filesystem::path(path).parent_path().string()];
+  std::string directory = per_directory.begin()->first;
+  for (const auto& [name, n] : per_directory) {
+    if (n > per_directory[directory]) directory = name;
+  }
+  // Names in the order written; a name beside one of the same stem is shortened to its extension
+  // ("report.json/html").
+  std::vector<std::string> names;
+  std::string others;
+  for (const std::string& path : files) {
+    const std::filesystem::path p(path);
+    if (p.parent_path().string() != directory) {
+      others += ", " + path;
+      continue;
+    }
+    const std::string stem = p.stem().string() + ".";
+    auto same_stem = std::find_if(names.begin(), names.end(), [&](const std::string& name) {
+      return name.compare(0, stem.size(), stem) == 0;
+    });
+    if (same_stem != names.end() && p.has_extension()) {
+      *same_stem += "/" + p.extension().string().substr(1);
+    } else {
+      names.push_back(p.filename().string() + (std::filesystem::is_directory(p) ? "/" : ""));
+    }
+  }
+  std::string listed;
+  for (const std::string& name : names) listed += (listed.empty() ? "" : ", ") + name;
+  return "wrote " + (directory.empty() ? std::string() : directory + "/: ") + listed + others;
+}
+
+void PrintFinalLine(const std::string& headline) {
+  ClearProgressLine();
+  std::cout << headline << "; " << WrittenFilesText() << "\n" << std::flush;
+}
 
 void SetOutcome(const std::string& outcome) { State().document["outcome"] = outcome; }
 
@@ -107,6 +155,7 @@ void RecordError(const std::string& message) {
 int RunWithOutputMode(const std::string& name, const std::function<int()>& command) {
   OutputState& state = State();
   state.document = EmptyDocument(name);
+  state.files.clear();
   report::TerminalProgressOptions options;
   options.enabled = report::IsTerminal(STDERR_FILENO) && !state.quiet && !state.json;
   options.width = TerminalColumns(STDERR_FILENO);

@@ -37,6 +37,14 @@ nlohmann::json& OutputDocument();
 // A file the command wrote, under `role` (e.g. "report", "calibrated_model").
 void AddOutputFile(const std::string& role, const std::string& path);
 
+// The files this command wrote, short: "wrote DIR/: a, b, c" for the directory holding most of them and
+// the others by their path; "nothing written" when none.
+std::string WrittenFilesText();
+
+// The last line of a command's stdout (docs/cli-output.md): `headline` (the verdict or outcome word and
+// the figure it rests on) and WrittenFilesText(), separated by "; ".
+void PrintFinalLine(const std::string& headline);
+
 // The outcome's name when more precise than the exit code's (a verdict, a run outcome).
 void SetOutcome(const std::string& outcome);
 

@@ -286,12 +286,8 @@ int SimulateSession(const SimulateArgs& args) {
   if (Status s = io::WriteJsonFile(comparison, comparison_path); !s.ok()) return Fail(s);
   AddOutputFile("comparison_with_truth", comparison_path);
   OutputDocument()["comparison_with_truth"] = comparison;
-  std::cout << "\nsimulated session " << run_s << " s, with the calibration " << total_s << " s; results in " << args.out
-            << "/: " << std::filesystem::path(run.session).filename().string()
-            << "/ (the session), observations.yaml, report.json, image_residuals.csv"
-            << (std::filesystem::exists(std::filesystem::path(args.out) / "report.html") ? ", report.html" : "")
-            << (code == 0 ? ", calibrated_model.yaml, calibrated.urdf" : "")
-            << ", truth.json, comparison_with_truth.json\n";
+  std::cout << "\nsimulated session " << run_s << " s, with the calibration " << total_s << " s\n";
+  PrintFinalLine(CalibrationFinalLine(calibrated, code));
   return code;
 }
 
@@ -391,10 +387,7 @@ Command AddSimulateCommand(CLI::App& app) {
       AddOutputFile("comparison_with_truth", (out / "comparison_with_truth.json").string());
       OutputDocument()["comparison_with_truth"] = comparison;
     }
-    std::cout << "results in " << args->out << "/: observations.yaml, truth.json, report.json"
-              << (std::filesystem::exists(out / "report.html") ? ", report.html" : "")
-              << (code == 0 ? ", calibrated_model.yaml, calibrated.urdf" : "") << (comparison.empty() ? "" : ", comparison_with_truth.json")
-              << "\n";
+    PrintFinalLine(CalibrationFinalLine(calibrated, code));
     return code;
   };
 }

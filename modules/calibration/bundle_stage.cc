@@ -183,6 +183,11 @@ BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineR
     step = std::chrono::steady_clock::now();
     report.fit_geometry = FitGeometryOf(obs, b);
     report.seconds_fit_geometry = SecondsSince(step);
+    const double depth_m = MedianCameraToDotDistance(obs, report.fit_geometry, b.dots_in_base);
+    if (report.heldout.ok && std::isfinite(depth_m)) {
+      report.heldout.mm_per_px = depth_m * 1e3 / b.fx_px;
+      report.heldout.rms_mm = report.heldout.overall.rms_px * report.heldout.mm_per_px;
+    }
     if (verify) {
       ObservationSet calibrated = obs;
       calibrated.camera = report.calibrated_camera;

@@ -16,25 +16,6 @@ std::vector<int> ShuffledPoses(const ObservationSet& obs, std::uint64_t seed) {
   return poses;
 }
 
-// The median distance from the identification cameras of `full` to the dots they see (fit_geometry's
-// camera_poses are every pose of `obs`, in file order).
-double MedianDepth(const ObservationSet& obs, const BundleStageReport& full) {
-  std::vector<double> depths;
-  const std::vector<CameraPose>& cameras = full.fit_geometry.camera_poses;
-  for (size_t p = 0; p < cameras.size() && p < obs.poses.size(); ++p) {
-    if (cameras[p].role != PoseRole::kIdentification) continue;
-    for (const auto& entry : obs.poses[p].dots_px) {
-      auto dot = full.bundle.dots_in_base.find(entry.first);
-      if (dot != full.bundle.dots_in_base.end()) {
-        depths.push_back((dot->second - cameras[p].base_from_cam.translation).norm());
-      }
-    }
-  }
-  if (depths.empty()) return NAN;
-  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
-  return depths[depths.size() / 2];
-}
-
 // One fold: the bundle without `held_out`, started from the whole solve, and its prediction of them.
 CrossValidationFold RunFold(const ObservationSet& obs, const BundleStageReport& full, const BundleStageOptions& options,
                             const std::vector<int>& held_out) {
@@ -113,7 +94,7 @@ CrossValidationReport CrossValidate(const ObservationSet& obs, const BundleStage
   } else {
     pooled = HeldOutFigure();
   }
-  const double depth = MedianDepth(obs, full);
+  const double depth = MedianCameraToDotDistance(obs, full.fit_geometry, full.bundle.dots_in_base);
   if (std::isfinite(depth) && full.bundle.fx_px > 0) {
     report.mm_per_px = depth * 1e3 / full.bundle.fx_px;
     report.rms_mm = report.rms_px * report.mm_per_px;

@@ -1,5 +1,6 @@
 #include "calibration/fit_geometry.h"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <utility>
@@ -33,6 +34,22 @@ FitGeometry FitGeometryOf(const ObservationSet& obs, const bundle::BundleReport&
     }
   }
   return geometry;
+}
+
+double MedianCameraToDotDistance(const ObservationSet& obs, const FitGeometry& geometry,
+                                 const std::map<int, Eigen::Vector3d>& dots_in_base) {
+  std::vector<double> depths;
+  const std::vector<CameraPose>& cameras = geometry.camera_poses;
+  for (size_t p = 0; p < cameras.size() && p < obs.poses.size(); ++p) {
+    if (cameras[p].role != PoseRole::kIdentification) continue;
+    for (const auto& entry : obs.poses[p].dots_px) {
+      auto dot = dots_in_base.find(entry.first);
+      if (dot != dots_in_base.end()) depths.push_back((dot->second - cameras[p].base_from_cam.translation).norm());
+    }
+  }
+  if (depths.empty()) return NAN;
+  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  return depths[depths.size() / 2];
 }
 
 }  // namespace selfcal::calibration

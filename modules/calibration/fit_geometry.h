@@ -11,6 +11,7 @@
 // Works on an ObservationSet only: no files, no hardware, no truth.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -35,5 +36,11 @@ struct FitGeometry {
 // Empty when the bundle did not solve (no dots: it stopped before, e.g. kDegenerate, and its rho is its
 // start), or gave no full rho or no positive f_x. An unconverged solve has its geometry (where it stopped).
 FitGeometry FitGeometryOf(const ObservationSet& observations, const bundle::BundleReport& bundle);
+
+// The median distance (m) from the identification cameras of `geometry` (FitGeometryOf of the same
+// observations) to the dots of `dots_in_base` they see: the scene's depth, which turns an image error
+// into one at the scene (depth / f_x per px). NaN without such a camera and dot.
+double MedianCameraToDotDistance(const ObservationSet& observations, const FitGeometry& geometry,
+                                 const std::map<int, Eigen::Vector3d>& dots_in_base);
 
 }  // namespace selfcal::calibration

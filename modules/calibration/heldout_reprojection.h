@@ -103,6 +103,9 @@ struct HeldOutReprojection {
   // behind the camera at this pose): poses that cannot be used, in file order.
   std::vector<std::string> unused_poses;
   HeldOutFigure overall;
+  // overall.rms_px at the scene: mm_per_px is the median camera-to-dot distance over f_x
+  // (fit_geometry.h), rms_mm = overall.rms_px * mm_per_px; NaN when the stage did not give the depth.
+  double mm_per_px = NAN, rms_mm = NAN;
   std::vector<ObservedResidual> residuals;  // every predicted detection, pose by pose (those in `overall`)
   // Gross detection errors left out of the figures: a detection whose residual lies beyond
   // kGrossErrorChiSquare of its own predicted 2 x 2 covariance (4.4 sigma), when such are at most

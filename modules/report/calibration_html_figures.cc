@@ -369,12 +369,16 @@ void HeldOutFigure(const json& heldout, Page* page) {
                "The identification images' dots projected into each verification image; dashed: the pixel noise of "
                "the normalisation (" + Format(noise) + " px). A correct model's RMS sits near it, beside the prediction's "
                "own uncertainty.");
-  json ratio_layout = {{"title", {{"text", "Held-out test per verification pose (calibrated model)"}}},
+  json ratio_layout = {{"title", {{"text", "Held-out chi-square per verification pose at the estimated noise (a figure, not "
+                                           "the verdict's test)"}}},
                        {"height", 360}, {"xaxis", {{"title", {{"text", "verification pose"}}}, {"type", "category"}}},
                        {"yaxis", Axis("chi-square / 95 % limit")},
                        {"shapes", json::array({{{"type", "line"}, {"xref", "paper"}, {"x0", 0}, {"x1", 1}, {"y0", 1},
                                                 {"y1", 1}, {"line", {{"color", "#c62828"}, {"dash", "dash"}}}}})}};
-  page->Figure(json::array({ratio}), ratio_layout, "Above the dashed line at 1: that pose fails its own test at 95 %.");
+  page->Figure(json::array({ratio}), ratio_layout,
+               "Each pose's chi-square over its own 95 % limit, normalised with the bundle's noise estimate ("
+               + Format(noise) + " px): at 95 % one pose in twenty of a correct model lies above the dashed line at 1. "
+               "The verdict's test is the table's.");
 }
 
 void CheckDistanceFigure(const json& verification, const json& predicted, Page* page) {

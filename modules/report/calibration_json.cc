@@ -173,6 +173,8 @@ json HeldOutJson(const ObservationSet& obs, const calibration::BundleStageReport
   if (!c.ok && c.overall.num_residuals == 0 && c.poses.empty() && c.message.empty()) return nullptr;
   json calibrated = HeldOutModelJson(c);
   calibrated["overall_at_stated_noise"] = c.ok ? HeldOutFigureJson(stage.heldout_at_stated_noise) : json();
+  calibrated["m_per_px"] = Finite(c.mm_per_px * 1e-3);  // SI keys (the cross-validation's mm keys predate the rule)
+  calibrated["rms_m"] = Finite(c.rms_mm * 1e-3);
   const bool compare = c.ok && n.ok;
   return {{"description", "the dots placed from the identification images (the bundle's, or triangulated with the nominal "
                           "model) projected into every verification image with the same model and compared with the "

@@ -47,7 +47,19 @@ struct ReportContext {
 nlohmann::json CalibrationReportJson(const ObservationSet& observations, const calibration::CalibrationReport& report,
                                      const ReportContext& context);
 
-// The text summary: the paper pipeline, then the bundle adjustment when it ran.
+// The text summary: the paper pipeline, then the bundle adjustment when it ran. Lines longer than
+// kSummaryLineWidth characters are wrapped at spaces, the rest indented under the line's own indent.
 void PrintCalibrationSummary(const calibration::CalibrationReport& report, std::ostream& out);
+inline constexpr int kSummaryLineWidth = 120;
+
+// The verdict and the held-out figure it rests on, for the last line of `selfcal calibrate`
+// (docs/cli-output.md): "accepted: held-out 0.053 px (0.031 mm at the scene) on 10 verification poses".
+// The figure is the verification poses' held-out RMS per coordinate, or without verification poses the
+// cross-validation's pooled one; "no held-out figure" when there is neither.
+std::string VerdictHeadline(const calibration::CalibrationReport& report);
+
+// `text` with every line longer than `width` broken at spaces; the continuation lines take the line's
+// own indent plus two spaces. A word longer than the width stays whole.
+std::string WrapLines(const std::string& text, int width);
 
 }  // namespace selfcal::report

@@ -1,6 +1,8 @@
 #include "report/html_report.h"
 
+#include <iomanip>
 #include <regex>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -124,6 +126,30 @@ TEST_F(HtmlReportTest, VerdictFirstAndFiguresCarryTheReportsData) {
             (*document_)["heldout_reprojection"]["calibrated_model"]["overall"]["num_residuals"].get<size_t>());
   // Corrections: one point per free parameter, lengths and angles apart.
   EXPECT_EQ(figures[4]["data"][0]["x"].size() + figures[4]["data"][1]["x"].size(), bundle["free"].size());
+}
+
+// The verdict is drawn before plotly.js parses (the library after the body's text), and the page holds one
+// held-out chi-square test: the verdict's, at the stated noise; the estimated-noise one is not in the table.
+TEST_F(HtmlReportTest, VerdictBeforeTheLibraryAndOneHeldOutTest) {
+  const std::string html = *ReportHtml(*document_, kFakePlotly);
+  const size_t verdict = html.find("id=\"verdict\"");
+  const size_t library = html.find("window.Plotly = {}");
+  ASSERT_NE(verdict, std::string::npos);
+  ASSERT_NE(library, std::string::npos);
+  EXPECT_LT(verdict, library);
+  EXPECT_GT(library, html.find("<body>"));
+  const json& calibrated = (*document_)["heldout_reprojection"]["calibrated_model"];
+  const json& stated = calibrated["overall_at_stated_noise"];
+  const json& estimated = calibrated["overall"];
+  ASSERT_TRUE(stated.is_object());
+  ASSERT_NE(stated["chi_square"].get<double>(), estimated["chi_square"].get<double>());
+  // Table cells print 5 significant digits.
+  std::ostringstream stated_text, estimated_text;
+  stated_text << "<td>" << std::setprecision(5) << stated["chi_square_limit"].get<double>() << "</td>";
+  estimated_text << "<td>" << std::setprecision(5) << estimated["chi_square_limit"].get<double>() << "</td>";
+  EXPECT_NE(html.find(stated_text.str()), std::string::npos) << stated_text.str();
+  EXPECT_EQ(html.find(estimated_text.str()), std::string::npos) << estimated_text.str();
+  EXPECT_NE(html.find("calibrated (the verdict&#39;s test)"), std::string::npos);
 }
 
 TEST_F(HtmlReportTest, RefusesOtherDocumentsNamingTheKey) {

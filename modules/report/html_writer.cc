@@ -39,15 +39,20 @@ tr.fixed td { color: #777; }
 footer { color: #777; font-size: 0.8em; margin-top: 3em; border-top: 1px solid #ccc; padding-top: 0.5em; }
 )css";
 
-// Renders every figure once plotly.js has loaded, then marks the body with the number rendered (the
-// browser test waits for it). Any failure goes to the console, where the test looks for errors.
+// Runs plotly.js (inlined as text) once the page has been drawn, so that the verdict shows while its
+// megabytes parse, then renders every figure and marks the body with the number rendered (the browser
+// test waits for it). Any failure goes to the console, where the test looks for errors.
 constexpr const char* kInitScript = R"js(
 (function () {
-  var figures = JSON.parse(document.getElementById('selfcal-figures').textContent);
-  var config = {displaylogo: false, responsive: true};
-  Promise.all(figures.map(function (f) { return Plotly.newPlot(f.div, f.data, f.layout, config); }))
-    .then(function () { document.body.setAttribute('data-plots-rendered', String(figures.length)); },
-          function (e) { console.error('selfcal report: a figure failed: ' + e); });
+  function plots() {
+    (0, eval)(document.getElementById('selfcal-plotly').textContent);
+    var figures = JSON.parse(document.getElementById('selfcal-figures').textContent);
+    var config = {displaylogo: false, responsive: true};
+    Promise.all(figures.map(function (f) { return Plotly.newPlot(f.div, f.data, f.layout, config); }))
+      .then(function () { document.body.setAttribute('data-plots-rendered', String(figures.length)); },
+            function (e) { console.error('selfcal report: a figure failed: ' + e); });
+  }
+  requestAnimationFrame(function () { setTimeout(plots, 0); });
 })();
 )js";
 
@@ -239,10 +244,12 @@ std::string Page::Render(const std::string& plotly_js) const {
   out += "<meta http-equiv=\"Content-Security-Policy\" content=\"" + std::string(kContentSecurityPolicy) + "\">\n";
   out += "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n";
   out += "<title>" + EscapeHtml(title_) + "</title>\n<style>" + kStyle + "</style>\n";
-  out += "<script>\n" + library + "\n</script>\n</head>\n<body>\n";
+  out += "</head>\n<body>\n";
   out += body_;
   out += "<footer>Plots: " + EscapeHtml(PlotlyVersion(plotly_js)) +
          ", inlined: this file opens offline and loads nothing.</footer>\n";
+  // The library as text, run by the init script after the first paint: the verdict shows first.
+  out += "<script type=\"text/plain\" id=\"selfcal-plotly\">\n" + library + "\n</script>\n";
   out += "<script type=\"application/json\" id=\"selfcal-figures\">" + ScriptJson(figures_) + "</script>\n";
   out += "<script>" + std::string(kInitScript) + "</script>\n</body>\n</html>\n";
   return out;

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <sstream>
 #include <string>
 
@@ -96,6 +97,54 @@ TEST(CliJson, SimulatePointsAndCalibrateMatchTheirReports) {
   EXPECT_GT(c.at("heldout_reprojection").at("calibrated_model").at("overall").at("rms_px").get<double>(), 0);
   EXPECT_TRUE(c.at("heldout_reprojection").at("test_passed").get<bool>());
   EXPECT_EQ(sim.err.find("report: "), std::string::npos);  // human text is not moved to stderr either
+}
+
+// The last line of stdout without --json.
+std::string LastLine(const std::string& out) {
+  if (out.empty() || out.back() != '\n') return "(stdout does not end with a line)";
+  const size_t start = out.rfind('\n', out.size() - 2);
+  return out.substr(start == std::string::npos ? 0 : start + 1, out.size() - 1 - (start == std::string::npos ? 0 : start + 1));
+}
+
+// calibrate's last stdout line: the verdict word, the held-out figure in px and mm at the scene, the files
+// written; for an accepted run and a refused one (the same images with a pixel noise stated 20 times too
+// small). No line of the accepted run reads like a failed test.
+TEST(CliFinalLine, CalibrateEndsWithTheVerdictTheFigureAndTheFiles) {
+  const fs::path dir = FreshDir("cli_final_line", "calibrate");
+  const Output sim = RunSplit("simulate --points --seed 3 --quiet --out " + (dir / "sim").string(), dir);
+  ASSERT_EQ(sim.code, 0) << sim.err;
+  EXPECT_EQ(LastLine(sim.out).rfind("accepted: held-out ", 0), 0u) << sim.out;
+  const std::string observations = (dir / "sim" / "observations.yaml").string();
+  const Output ok = RunSplit("calibrate " + observations + " --quiet --out " + (dir / "ok").string(), dir);
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  const json report = json::parse(ReadFile((dir / "ok" / "report.json").string()));
+  const json& heldout = report.at("heldout_reprojection").at("calibrated_model");
+  std::ostringstream figure;
+  figure << std::fixed << std::setprecision(3) << "accepted: held-out " << heldout.at("overall").at("rms_px").get<double>()
+         << " px (" << heldout.at("rms_m").get<double>() * 1e3 << " mm at the scene) on "
+         << heldout.at("poses").size() << " verification poses; wrote " << (dir / "ok").string() << "/: ";
+  const std::string last = LastLine(ok.out);
+  EXPECT_EQ(last.rfind(figure.str(), 0), 0u) << last << "\nexpected to start with\n" << figure.str();
+  for (const char* name : {"report.json/html", "image_residuals.csv", "calibrated_model.yaml", "calibrated.urdf"}) {
+    EXPECT_NE(last.find(name), std::string::npos) << name << " in " << last;
+  }
+  EXPECT_EQ(ok.out.find(" > "), std::string::npos) << ok.out;  // no "chi-square 201.6 > 191.9"
+  EXPECT_EQ(ok.out.find("failed"), std::string::npos) << ok.out;
+
+  std::string small = ReadFile(observations);
+  const size_t noise = small.find("pixel_noise_px: 0.2\n");
+  ASSERT_NE(noise, std::string::npos);
+  small.replace(noise, std::string("pixel_noise_px: 0.2").size(), "pixel_noise_px: 0.01");
+  WriteFile((dir / "small_noise.yaml").string(), small);
+  const Output refused =
+      RunSplit("calibrate " + (dir / "small_noise.yaml").string() + " --quiet --out " + (dir / "refused").string(), dir);
+  ASSERT_EQ(refused.code, 6) << refused.err;
+  const std::string refused_last = LastLine(refused.out);
+  EXPECT_EQ(refused_last.rfind("rejected: held-out ", 0), 0u) << refused_last;
+  EXPECT_NE(refused_last.find(" px ("), std::string::npos) << refused_last;
+  EXPECT_NE(refused_last.find("wrote " + (dir / "refused").string() + "/: report.json/html"), std::string::npos)
+      << refused_last;
+  EXPECT_EQ(refused_last.find("calibrated_model.yaml"), std::string::npos) << refused_last;
 }
 
 TEST(CliJson, AnErrorStillPrintsTheDocumentWithTheMessage) {
