@@ -19,7 +19,7 @@ import sys
 ROS_SET = "test/data/ros-industrial-dotgrid-10x10"
 FRANKA_SET = "test/data/visp-franka-eye-in-hand"
 URDF_YAML = {"panda.urdf": "panda_robot.yaml", "puma560.urdf": "puma560_robot.yaml", "ur5e.urdf": "ur5e_robot.yaml",
-             "ur5e_named.urdf": "ur5e_named_robot.yaml"}
+             "ur5e_named.urdf": "ur5e_named_robot.yaml", "ur5e_meshes.urdf": "ur5e_meshes_robot.yaml"}
 TARGET_JOINTS_DEG = [[10, 40, -160, 5, 40, 10], [20, 30, -170, 10, 50, -20], [0, 45, -150, -10, 35, 30]]
 
 
@@ -81,7 +81,7 @@ def _robot_of_trajectory(path):
 def _robot_of_config(path):
     base = os.path.basename(path)
     return {"panda_robot.yaml": "panda", "puma560_robot.yaml": "puma560", "ur5e_robot.yaml": "ur5e",
-            "ur5e_named_robot.yaml": "ur5e"}.get(base, os.path.splitext(base)[0])
+            "ur5e_named_robot.yaml": "ur5e", "ur5e_meshes_robot.yaml": "ur5e"}.get(base, os.path.splitext(base)[0])
 
 
 def _link(src, dst):
