@@ -71,8 +71,8 @@ struct PlanResult {
   int num_identification_poses = 0;
   std::vector<int> free_columns;       // identifiable rho indices (J's columns)
   std::vector<std::string> free_names;
-  // A start that breaks a constraint is repaired first: each offending pose after the reference is replaced by
-  // the nearest (joint space) feasible candidate of the seeded pool. The "start" figures are of the repaired
+  // A start that breaks a constraint is repaired first: each offending pose, the reference (pose 0) included,
+  // is replaced by the nearest (joint space) feasible candidate of the seeded pool. The "start" figures are of the repaired
   // start; check_start is of the start as given.
   int repaired_poses = 0;
   int pool_size = 0;                   // candidates generated for the exchange designs
@@ -90,9 +90,8 @@ struct PlanResult {
   double seconds = 0;
 };
 
-// Plans from `start` (its size is m). The start's reference pose (pose 0) must satisfy the single-pose
-// constraints and every pose must have the robot's joint count; other violations are repaired (above) or
-// the result says why not.
+// Plans from `start` (its size is m). Every pose must have the robot's joint count and finite values; other
+// violations, the reference pose's (pose 0) included, are repaired (above) or the result says why not.
 PlanResult PlanMeasurements(const PlanningProblem& problem, const std::vector<Eigen::VectorXd>& start,
                             const PlannerOptions& options);
 
