@@ -53,6 +53,16 @@ std::string Format(const char* format, double a, double b = 0, double c = 0, dou
   return buffer;
 }
 
+// The held-out chi-square against its limit, in words: "a chi-square of X over N degrees of freedom, within
+// its 95 % limit of L (p = P)", or above it with `failure` and the usual causes.
+std::string ChiSquareClause(const HeldOutFigure& f, const char* failure) {
+  const std::string head = Format("a chi-square of %.6g over %.0f degrees of freedom, ", f.chi_square, f.dof);
+  if (f.test_passed) return head + Format("within its 95 %% limit of %.6g (p = %.2g)", f.chi_square_limit, f.p_value);
+  return head + Format("above its 95 %% limit of %.6g (p = %.2g): ", f.chi_square_limit, f.p_value) + failure +
+         " (a parameter held at a wrong value, a wrong f_x or lens, a wrong joint sign, or a pixel noise stated too "
+         "small)";
+}
+
 AcceptanceCheck HeldOutTest(const AcceptanceInputs& in) {
   AcceptanceCheck check{"heldout_test", CheckStatus::kNotAvailable, ""};
   if (in.calibrated == nullptr || !in.calibrated->ok) {
@@ -67,17 +77,11 @@ AcceptanceCheck HeldOutTest(const AcceptanceInputs& in) {
     return check;
   }
   const HeldOutFigure& f = *in.test_at_stated_noise;
-  const bool passed = f.test_passed;
-  check.status = passed ? CheckStatus::kPassed : CheckStatus::kFailed;
-  check.sentence =
-      Format("the calibrated model predicts the dots of the verification images at %.3g px RMS; with the stated pixel "
-             "noise of %.3g px that is a chi-square of %.6g over %.0f degrees of freedom, ",
-             f.rms_px, in.stated_noise_px, f.chi_square, f.dof) +
-      Format(passed ? "within its 95 %% limit of %.6g (p = %.2g)"
-                    : "above its 95 %% limit of %.6g (p = %.2g): the model does not explain images it was not fitted "
-                      "to (a parameter held at a wrong value, a wrong f_x or lens, a wrong joint sign, or a pixel noise "
-                      "stated too small)",
-             f.chi_square_limit, f.p_value);
+  check.status = f.test_passed ? CheckStatus::kPassed : CheckStatus::kFailed;
+  check.sentence = Format("the calibrated model predicts the dots of the verification images at %.3g px RMS; with the "
+                          "stated pixel noise of %.3g px that is ",
+                          f.rms_px, in.stated_noise_px) +
+                   ChiSquareClause(f, "the model does not explain images it was not fitted to");
   return check;
 }
 
@@ -100,13 +104,9 @@ AcceptanceCheck CrossValidationTest(const AcceptanceInputs& in) {
   check.sentence =
       Format("with each of %.0f folds of the identification poses left out in turn, the model fitted to the others "
              "predicts them at %.3g px RMS; with the stated pixel noise of %.3g px and the estimated pose error that "
-             "is a chi-square of %.6g over %.0f degrees of freedom, ",
-             cv->folds_tested, f.rms_px, in.stated_noise_px, f.chi_square, f.dof) +
-      Format(f.test_passed ? "within its 95 %% limit of %.6g (p = %.2g)"
-                           : "above its 95 %% limit of %.6g (p = %.2g): the model does not predict poses it was not "
-                             "fitted to (a parameter held at a wrong value, a wrong f_x or lens, a wrong joint sign, or "
-                             "a pixel noise stated too small)",
-             f.chi_square_limit, f.p_value);
+             "is ",
+             cv->folds_tested, f.rms_px, in.stated_noise_px) +
+      ChiSquareClause(f, "the model does not predict poses it was not fitted to");
   if (cv->folds_tested < cv->folds) {
     check.sentence += Format(" (%.0f of the %.0f folds did not converge or predicted nothing)",
                              cv->folds - cv->folds_tested, cv->folds);

@@ -75,7 +75,6 @@ CrossValidationReport CrossValidate(const ObservationSet& obs, const BundleStage
     report.per_fold.push_back(RunFold(obs, full, options, held_out));
     const HeldOutFigure& figure = report.per_fold.back().figure;
     if (figure.num_residuals > 0) {
-      report.num_residuals += figure.num_residuals;
       sum2 += figure.rms_px * figure.rms_px * figure.num_residuals;
       report.folds_passed += figure.test_passed ? 1 : 0;
       ++report.folds_tested;
@@ -85,9 +84,8 @@ CrossValidationReport CrossValidate(const ObservationSet& obs, const BundleStage
       pooled.max_px = std::max(pooled.max_px, figure.max_px);
     }
   }
-  if (report.num_residuals > 0) {
-    report.rms_px = std::sqrt(sum2 / report.num_residuals);
-    pooled.rms_px = report.rms_px;
+  if (pooled.num_residuals > 0) {
+    pooled.rms_px = std::sqrt(sum2 / pooled.num_residuals);
     pooled.chi_square_limit = ChiSquareQuantile(kHeldOutTestLevel, pooled.dof);
     pooled.p_value = ChiSquareUpperTail(pooled.chi_square, pooled.dof);
     pooled.test_passed = pooled.chi_square <= pooled.chi_square_limit;
@@ -97,7 +95,7 @@ CrossValidationReport CrossValidate(const ObservationSet& obs, const BundleStage
   const double depth = MedianCameraToDotDistance(obs, full.fit_geometry, full.bundle.dots_in_base);
   if (std::isfinite(depth) && full.bundle.fx_px > 0) {
     report.mm_per_px = depth * 1e3 / full.bundle.fx_px;
-    report.rms_mm = report.rms_px * report.mm_per_px;
+    report.rms_mm = pooled.rms_px * report.mm_per_px;
   }
   report.message = "held-out RMS over " + std::to_string(folds) + " folds";
   return report;

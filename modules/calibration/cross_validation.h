@@ -32,13 +32,12 @@ struct CrossValidationReport {
   int folds = 0;
   std::uint64_t seed = 0;
   std::vector<CrossValidationFold> per_fold;
-  int num_residuals = 0;         // predicted detections over every fold
-  double rms_px = NAN;           // per coordinate, pooled over every fold
   double mm_per_px = NAN;        // at the scene: median camera-to-dot distance / f_x
-  double rms_mm = NAN;           // rms_px * mm_per_px
+  double rms_mm = NAN;           // pooled.rms_px * mm_per_px
   int folds_passed = 0;          // folds whose held-out test passed at the stated noise
   int folds_tested = 0;          // folds with a figure (converged, and predicting at least one detection)
-  HeldOutFigure pooled;          // every fold's figure summed: chi-square, dof, its 95 % limit, p
+  // Every fold's figure summed: predicted detections, RMS per coordinate, chi-square, dof, its 95 % limit, p.
+  HeldOutFigure pooled;
 };
 
 // k-fold cross-validation of `full` (the bundle stage of the whole set, converged): fold f holds out every

@@ -34,11 +34,11 @@ TEST(CrossValidation, ACorrectModelPredictsHeldOutFoldsAtThePixelNoise) {
   }
   EXPECT_EQ(count, obs.poses.size());
   EXPECT_EQ(held.size(), obs.poses.size());
-  EXPECT_GT(cv.rms_px, 0.2 * 0.8);
-  EXPECT_LT(cv.rms_px, 0.2 * 1.3);
+  EXPECT_GT(cv.pooled.rms_px, 0.2 * 0.8);
+  EXPECT_LT(cv.pooled.rms_px, 0.2 * 1.3);
   EXPECT_GE(cv.folds_passed, 3);
   EXPECT_GT(cv.mm_per_px, 0);
-  EXPECT_NEAR(cv.rms_mm, cv.rms_px * cv.mm_per_px, 1e-12);
+  EXPECT_NEAR(cv.rms_mm, cv.pooled.rms_px * cv.mm_per_px, 1e-12);
   // The verdict's test: the folds' chi-squares summed over their degrees of freedom, passed, and the model
   // accepted on it (no verification pose to test with).
   int dof = 0;

@@ -1,6 +1,5 @@
 #include "calibration/scene_moves.h"
 
-#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Geometry>
@@ -8,10 +7,7 @@
 namespace selfcal::calibration {
 
 std::vector<SceneMove> SceneMovesOf(const ObservationSet& obs, const std::map<int, Eigen::Vector3d>& dots_in_base) {
-  std::vector<std::string> names;
-  for (const PoseObservation& pose : obs.poses) {
-    if (std::find(names.begin(), names.end(), pose.scene) == names.end()) names.push_back(pose.scene);
-  }
+  const std::vector<std::string> names = SceneNames(obs);
   std::vector<SceneMove> moves;
   for (size_t k = 1; k < names.size(); ++k) {
     std::vector<Eigen::Vector3d> first, here;

@@ -104,11 +104,16 @@ Matches MatchById(const PoseObservation& a, const PoseObservation& b) {
   return m;
 }
 
-ObservationSet SeparateScenes(const ObservationSet& observations, std::vector<std::string>* scenes) {
+std::vector<std::string> SceneNames(const ObservationSet& observations) {
   std::vector<std::string> names;
   for (const PoseObservation& pose : observations.poses) {
     if (std::find(names.begin(), names.end(), pose.scene) == names.end()) names.push_back(pose.scene);
   }
+  return names;
+}
+
+ObservationSet SeparateScenes(const ObservationSet& observations, std::vector<std::string>* scenes) {
+  const std::vector<std::string> names = SceneNames(observations);
   if (scenes != nullptr) *scenes = names;
   if (names.size() <= 1) return observations;
   ObservationSet out = observations;

@@ -89,6 +89,10 @@ Matches MatchById(const PoseObservation& a, const PoseObservation& b);
 // ids): k * kSceneDotStride + id.
 inline constexpr int kSceneDotStride = 1000000;
 
+// The scene names of the poses in the order they first appear (scene k of SeparateScenes is the k-th); one
+// empty name for a set whose poses name none.
+std::vector<std::string> SceneNames(const ObservationSet& observations);
+
 // A set whose poses name more than one scene, with the dots of each scene made separate points: scene k's dot
 // ids moved by k * kSceneDotStride, and every yardstick and check distance repeated for every scene. A set of
 // one scene is returned as it is. *scenes (optional): the scene names in that order.

@@ -74,7 +74,7 @@ json CrossValidationJson(const calibration::CrossValidationReport& cv) {
                      {"figure", f.figure.num_residuals > 0 ? HeldOutFigureJson(f.figure) : json()}});
   }
   return {{"ran", cv.ran},           {"message", cv.message},       {"folds", cv.folds},
-          {"seed", cv.seed},         {"num_residuals", cv.num_residuals}, {"rms_px", Finite(cv.rms_px)},
+          {"seed", cv.seed},         {"num_residuals", cv.pooled.num_residuals}, {"rms_px", Finite(cv.pooled.rms_px)},
           {"mm_per_px", Finite(cv.mm_per_px)}, {"rms_mm", Finite(cv.rms_mm)}, {"folds_passed", cv.folds_passed},
           {"folds_tested", cv.folds_tested},
           {"pooled", cv.pooled.dof > 0 ? HeldOutFigureJson(cv.pooled) : json()},

@@ -231,11 +231,11 @@ void PrintHandEye(const calibration::CalibrationReport& report, std::ostream& ou
 // The k-fold held-out figure of a set without verification poses.
 void PrintCrossValidation(const calibration::CrossValidationReport& cv, std::ostream& out) {
   out << "  cross-validation (" << cv.folds << " folds over the identification poses, seed " << cv.seed << "): ";
-  if (!cv.ran || cv.num_residuals == 0) {
+  if (!cv.ran || cv.pooled.num_residuals == 0) {
     out << cv.message << "\n";
     return;
   }
-  out << "held-out RMS " << std::fixed << std::setprecision(3) << cv.rms_px << " px per coordinate";
+  out << "held-out RMS " << std::fixed << std::setprecision(3) << cv.pooled.rms_px << " px per coordinate";
   if (std::isfinite(cv.rms_mm)) out << " (" << cv.rms_mm << " mm at the scene)";
   out << "; folds";
   for (const calibration::CrossValidationFold& f : cv.per_fold) {
@@ -315,14 +315,14 @@ std::string VerdictHeadline(const calibration::CalibrationReport& report) {
     heldout = &report.paper_heldout->calibrated;
   }
   const calibration::CrossValidationReport* cv =
-      report.cross_validation && report.cross_validation->ran && report.cross_validation->num_residuals > 0
+      report.cross_validation && report.cross_validation->ran && report.cross_validation->pooled.num_residuals > 0
           ? &*report.cross_validation
           : nullptr;
   if (heldout != nullptr) {
     line += ": held-out " + PxAndMm(heldout->overall.rms_px, heldout->rms_mm) + " on " +
             std::to_string(heldout->poses.size()) + " verification poses";
   } else if (cv != nullptr) {
-    line += ": cross-validated " + PxAndMm(cv->rms_px, cv->rms_mm) + ", " + std::to_string(cv->folds) + " folds";
+    line += ": cross-validated " + PxAndMm(cv->pooled.rms_px, cv->rms_mm) + ", " + std::to_string(cv->folds) + " folds";
   } else {
     line += ": no held-out figure";
   }
