@@ -375,7 +375,9 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   options.bundle.bundle.weak_length_tolerance_m = request.weak_tolerance_mm * 1e-3;
   options.bundle.bundle.estimate_pose_error = !request.pixel_noise_only;
   options.bundle.bundle.weak_angle_tolerance_rad = DegToRad(request.weak_tolerance_deg);
-  options.flange_scale_from_yardsticks = request.scale_from == "yardstick";
+  options.flange_scale = request.scale_from == "yardstick" ? calibration::FlangeScale::kYardstick
+                         : request.scale_from == "flange" ? calibration::FlangeScale::kFlange
+                                                          : calibration::FlangeScale::kAuto;
   options.progress = Progress();
   calibration::CalibrationReport report = calibration::Calibrate(loaded->observations, options);
   report::PrintCalibrationSummary(report, std::cout);
@@ -443,8 +445,10 @@ Command AddCalibrateCommand(CLI::App& app) {
                            ->check(CLI::Range(0, 1000));
   cmd->add_option("--scale-from", request->scale_from,
                   "Flange poses: what fixes the metric scale. flange: the flange translations (yardsticks are checks); "
-                  "yardstick: the yardsticks as length constraints beside them")
-      ->check(CLI::IsMember({"flange", "yardstick"}));
+                  "yardstick: the yardsticks as length constraints beside them, under the flange pose noise stated "
+                  "or estimated; auto (default): yardstick when the set has one and a pose noise is stated or "
+                  "estimated, else flange")
+      ->check(CLI::IsMember({"auto", "flange", "yardstick"}));
   cmd->add_option("--camera-file", request->camera_file,
                   "Camera intrinsics file (OpenCV FileStorage YAML/XML or ViSP XML, docs/camera-files.md) replacing the "
                   "observations' camera; same image size");

@@ -31,7 +31,7 @@ struct CalibrateRequest {
   uint64_t seed = 1;  // RANSAC sampling of the two-view step
   calibration::Method method = calibration::Method::kBundle;
   std::vector<std::string> fix{}, free{};  // parameter names and groups (bundle::BundleOptions::held_parameters)
-  std::string scale_from = "flange";   // flange-pose sets: "flange" or "yardstick" (CalibrateOptions)
+  std::string scale_from = "auto";     // flange-pose sets: "auto", "flange" or "yardstick" (CalibrateOptions)
   // Weak directions: the manufacturing tolerances above which a poorly determined joint parameter is held at
   // the robot description's value (bundle::BundleOptions::weak_length_tolerance_m; 0: never held).
   double weak_tolerance_mm = 5.0, weak_tolerance_deg = 0.5;

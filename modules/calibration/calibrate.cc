@@ -87,9 +87,29 @@ ObservationSet PrepareFlangePoseSet(const ObservationSet& observations, const Ca
   return prepared;
 }
 
+// The flange pose noise the pose-noise bundle models: the set's stated one, else the bundle's error model's
+// camera pose error per image when it found one (a component it found absent is held nearly exact); none
+// when neither is there (exact flange poses).
+bool FlangePoseNoiseOf(const ObservationSet& observations, const bundle::BundleReport& b, double* translation_m,
+                       double* rotation_rad, bool* estimated) {
+  *estimated = !(observations.flange_translation_sigma_m > 0);
+  if (!*estimated) {
+    *translation_m = observations.flange_translation_sigma_m;
+    *rotation_rad = observations.flange_rotation_sigma_rad;
+    return true;
+  }
+  const bundle::ErrorModel& e = b.error_model;
+  if (!e.estimated || !(e.pose_translation_m > 0 || e.pose_rotation_rad > 0)) return false;
+  constexpr double kAbsent = 1e-6;  // 1 um, 1 urad: a component the residuals show none of
+  *translation_m = e.pose_translation_m > 0 ? e.pose_translation_m : kAbsent;
+  *rotation_rad = e.pose_rotation_rad > 0 ? e.pose_rotation_rad : kAbsent;
+  return true;
+}
+
 // A flange-pose set after its bundle: the images' own camera motions against the flange motions, and with a
-// stated flange pose noise the pose-noise bundle; both start from the bundle's hand-eye transform, dots and
-// calibrated camera, and estimate the intrinsics the bundle estimated.
+// flange pose noise (stated, or estimated from the residuals) the pose-noise bundle; both start from the
+// bundle's hand-eye transform, dots and calibrated camera, and estimate the intrinsics the bundle estimated.
+// The yardsticks constrain the scale there as options.flange_scale says.
 void CheckFlangePoses(const ObservationSet& observations, const ObservationSet& prepared, const CalibrateOptions& options,
                       CalibrationReport* report) {
   const BundleStageReport& stage = *report->bundle;
@@ -100,17 +120,20 @@ void CheckFlangePoses(const ObservationSet& observations, const ObservationSet& 
   bundle::FreeCameraOptions check_options = options.motion_check;
   check_options.intrinsics = b.intrinsics_estimated;
   report->motion_check = CheckImageMotions(calibrated, stage.calibrated_robot.flange_from_cam, b.dots_in_base, check_options);
-  if (!(observations.flange_translation_sigma_m > 0)) return;
   bundle::PoseNoiseOptions noise;
-  noise.translation_sigma_m = observations.flange_translation_sigma_m;
-  noise.rotation_sigma_rad = observations.flange_rotation_sigma_rad;
+  if (!FlangePoseNoiseOf(observations, b, &noise.translation_sigma_m, &noise.rotation_sigma_rad,
+                         &report->pose_noise_estimated)) {
+    return;
+  }
   noise.intrinsics = b.intrinsics_estimated;
   noise.yardstick_sigma_m = options.bundle.bundle.yardstick_sigma_m;
-  if (options.flange_scale_from_yardsticks) {
+  if (options.flange_scale != FlangeScale::kFlange) {
     calibrated.yardsticks = observations.yardsticks;
     calibrated.check_distances = observations.check_distances;
   }
   report->pose_noise = bundle::RunPoseNoiseBundle(calibrated, stage.calibrated_robot.flange_from_cam, b.dots_in_base, noise);
+  report->pose_noise_translation_m = noise.translation_sigma_m;
+  report->pose_noise_rotation_rad = noise.rotation_sigma_rad;
   report->flange_scale_yardsticks = static_cast<int>(report->pose_noise->yardstick_lengths_m.size());
 }
 
@@ -206,13 +229,9 @@ CalibrationReport CalibrateSteps(const ObservationSet& observations, const Calib
   if (flange_poses) {
     prepared = PrepareFlangePoseSet(observations, options, &report);
     progress.Advance();
-    if (options.flange_scale_from_yardsticks &&
-        (observations.yardsticks.empty() || !(observations.flange_translation_sigma_m > 0))) {
+    if (options.flange_scale == FlangeScale::kYardstick && observations.yardsticks.empty()) {
       report.verdict = Verdict::kInvalidInput;
-      report.message = observations.yardsticks.empty()
-                           ? "the scale from yardsticks needs a yardstick in the observations"
-                           : "the scale from yardsticks needs a stated flange pose noise (flange_pose_noise): exact flange "
-                             "poses fix the scale themselves";
+      report.message = "the scale from yardsticks needs a yardstick in the observations";
       return report;
     }
     if (!observations.flange_from_cam_known && !report.hand_eye_start->ok) {
@@ -252,6 +271,14 @@ CalibrationReport CalibrateSteps(const ObservationSet& observations, const Calib
     progress.Advance();
   }
   if (flange_poses && report.bundle) CheckFlangePoses(observations, obs, options, &report);
+  if (flange_poses && options.flange_scale == FlangeScale::kYardstick && report.bundle &&
+      report.bundle->bundle.outcome == bundle::Outcome::kConverged && !report.pose_noise) {
+    report.verdict = Verdict::kInvalidInput;
+    report.message = "the scale from yardsticks needs a flange pose noise, and none was stated (detect "
+                     "--flange-pose-noise-mm/-deg) or found in the residuals: exact flange poses fix the scale "
+                     "themselves";
+    return report;
+  }
   if (flange_poses) progress.Advance();
   if (report.accepted()) {
     const auto start = std::chrono::steady_clock::now();
@@ -286,7 +313,8 @@ CalibrationReport CalibrateSteps(const ObservationSet& observations, const Calib
     model.camera = WithIntrinsics(model.camera, report.pose_noise->intrinsics);
     model.flange_from_cam_stddev = report.pose_noise->stddev;
     model.intrinsics_stddev = report.pose_noise->intrinsics_stddev;
-    model.method_description += ", flange poses with their stated noise";
+    model.method_description += report.pose_noise_estimated ? ", flange poses with their noise estimated from the residuals"
+                                                            : ", flange poses with their stated noise";
   }
   report.model = std::move(model);
   return report;

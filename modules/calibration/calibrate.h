@@ -58,6 +58,8 @@ enum class Verdict {
 };
 const char* VerdictName(Verdict verdict);  // "accepted", "invalid_input", ...
 
+enum class FlangeScale { kAuto, kFlange, kYardstick };
+
 struct CalibrateOptions {
   Method method = Method::kBundle;
   PaperPipelineOptions paper;  // paper.two_view.seed seeds the RANSAC sampling
@@ -67,11 +69,13 @@ struct CalibrateOptions {
   int cross_validation_folds = 4;
   HandEyeStartOptions hand_eye;  // flange-pose sets (its two-view seed is paper.two_view.seed)
   bundle::FreeCameraOptions motion_check;  // flange-pose sets: the images' own camera motions
-  // Flange-pose sets: false, the flange translations alone give the metric scale and the yardsticks are
-  // checks; true, the yardsticks are length constraints (the paper's scale) beside the flange translations
-  // in the pose-noise bundle (a stated flange pose noise is required: exact poses fix the scale
-  // themselves), for controllers whose reported translations are less consistent than a known length.
-  bool flange_scale_from_yardsticks = false;
+  // Flange-pose sets: what fixes the metric scale. kFlange: the flange translations alone, the yardsticks
+  // are checks; kYardstick: the yardsticks are length constraints (the paper's scale) beside the flange
+  // translations in the pose-noise bundle, which needs a flange pose noise, stated or estimated from the
+  // residuals (exact poses fix the scale themselves); kAuto: kYardstick when the set has a yardstick and a
+  // pose noise was stated or estimated, else kFlange. A controller's translations carry its own scale
+  // error; a measured length is the one the images are scaled to.
+  FlangeScale flange_scale = FlangeScale::kAuto;
   // Told the stages (the start, the chosen method, the checks) and, inside the paper's pipeline, its
   // two-view pairs, for a person watching; null: nothing reported.
   ProgressSink* progress = nullptr;
@@ -107,10 +111,13 @@ struct CalibrationReport {
   std::optional<HandEyeStartReport> hand_eye_start;
   // A flange-pose set whose bundle converged: the images' own camera motions against the flange motions.
   std::optional<MotionCheck> motion_check;
-  // A flange-pose set with a stated pose noise: the hand-eye bundle with a corrected flange pose per
-  // image (bundle/pose_noise_bundle.h), started from the exact-pose bundle; its hand-eye transform and
-  // f_x are the model's when it converged.
+  // A flange-pose set with a pose noise, stated in the set or else estimated by the bundle's error model
+  // (its camera pose per image): the hand-eye bundle with a corrected flange pose per image
+  // (bundle/pose_noise_bundle.h), started from the exact-pose bundle; its hand-eye transform and f_x are
+  // the model's when it converged.
   std::optional<bundle::PoseNoiseReport> pose_noise;
+  bool pose_noise_estimated = false;  // the noise of pose_noise is the error model's, not the set's
+  double pose_noise_translation_m = 0, pose_noise_rotation_rad = 0;  // the noise it modelled, per axis
   // A flange-pose set: how many yardsticks constrained the scale beside the flange translations (0: the
   // flange translations alone; the yardsticks were checks).
   int flange_scale_yardsticks = 0;

@@ -443,6 +443,12 @@ json HandEyeJson(const calibration::CalibrationReport& report) {
     const bundle::PoseNoiseReport& n = *report.pose_noise;
     j["pose_noise"] = {{"ok", n.ok},
                        {"message", n.message},
+                       {"noise_source", report.pose_noise_estimated ? "estimated" : "stated"},
+                       {"translation_sigma_m", report.pose_noise_translation_m},
+                       {"rotation_sigma_rad", report.pose_noise_rotation_rad},
+                       {"intrinsics", report.bundle ? IntrinsicsJson(n.intrinsics, report.bundle->bundle.intrinsics_estimated,
+                                                                     n.intrinsics_stddev)
+                                                    : json()},
                        {"rms_reprojection_px", n.rms_reprojection_px},
                        {"pose_ids", n.pose_ids},
                        {"correction_translation_m", n.correction_translation_m},

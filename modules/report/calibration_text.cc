@@ -219,7 +219,9 @@ void PrintHandEye(const calibration::CalibrationReport& report, std::ostream& ou
   out << "\n";
   out.unsetf(std::ios::floatfield);
   if (report.pose_noise) {
-    out << "with the stated flange pose noise: " << (report.pose_noise->ok ? "" : "not solved: ")
+    out << "with the flange pose noise " << (report.pose_noise_estimated ? "estimated from the residuals" : "stated")
+        << " (" << report.pose_noise_translation_m * kMm << " mm / " << RadToDeg(report.pose_noise_rotation_rad)
+        << " deg per axis): " << (report.pose_noise->ok ? "" : "not solved: ")
         << report.pose_noise->message << "\n";
   }
   if (report.motion_check) {

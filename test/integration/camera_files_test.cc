@@ -35,7 +35,7 @@ nlohmann::json ReadJson(const fs::path& path) {
   return nlohmann::json::parse(in);
 }
 
-// Every intrinsic of `camera` against the report's methods.bundle.intrinsics, to `relative` (0: exact).
+// Every intrinsic of `camera` against a report's intrinsics object, to `relative` (0: exact).
 void ExpectReportCamera(const nlohmann::json& intrinsics, const CameraIntrinsics& camera, double relative,
                         const std::string& what) {
   const IntrinsicsVector values = IntrinsicsOf(camera);
@@ -86,11 +86,16 @@ TEST(CameraFilesCli, FrankaCameraFileInCalibratedCameraOutInBothFormats) {
   Result<io::HandEyeResult> hand_eye = io::LoadHandEye((out / "hand_eye.yaml").string());
   ASSERT_TRUE(hand_eye.ok()) << hand_eye.status().ToString();
   ASSERT_TRUE(hand_eye->camera.has_value());
-  // The model's camera is the bundle's here (no stated flange pose noise): all three equal the report.
-  ExpectReportCamera(intrinsics, *written_opencv, 1e-15, "OpenCV file");  // mu: f_y / f_x rounded once
-  ExpectReportCamera(intrinsics, *written_visp, 1e-12, "ViSP file");
-  ExpectReportCamera(intrinsics, *hand_eye->camera, 0.0, "hand_eye.yaml");
-  EXPECT_EQ(hand_eye->intrinsics_stddev[kK1], intrinsics.at("k1").at("stddev").get<double>());
+  // The model's camera is the pose-noise solve's here (the residuals show a pose error, which it models):
+  // all three equal the report's hand_eye.pose_noise.intrinsics.
+  const nlohmann::json& noise = report.at("hand_eye").at("pose_noise");
+  ASSERT_EQ(noise.at("noise_source"), "estimated") << noise.dump();
+  const nlohmann::json& model = noise.at("intrinsics");
+  EXPECT_TRUE(model.at("k1").at("estimated").get<bool>());
+  ExpectReportCamera(model, *written_opencv, 1e-15, "OpenCV file");  // mu: f_y / f_x rounded once
+  ExpectReportCamera(model, *written_visp, 1e-12, "ViSP file");
+  ExpectReportCamera(model, *hand_eye->camera, 0.0, "hand_eye.yaml");
+  EXPECT_EQ(hand_eye->intrinsics_stddev[kK1], model.at("k1").at("stddev").get<double>());
   EXPECT_TRUE(std::isnan(hand_eye->intrinsics_stddev[kCx]));
 
   const fs::path refused = dir / "refused";
@@ -114,7 +119,8 @@ TEST(CameraFilesCli, FrankaCameraFileInCalibratedCameraOutInBothFormats) {
       << output;
   Result<CameraIntrinsics> lens = io::LoadCameraFile(opencv2);
   ASSERT_TRUE(lens.ok()) << lens.status().ToString();
-  ExpectReportCamera(ReadJson(refused / "report.json").at("methods").at("bundle").at("intrinsics"), *lens, 1e-15, "lens");
+  ExpectReportCamera(ReadJson(refused / "report.json").at("hand_eye").at("pose_noise").at("intrinsics"), *lens, 1e-15,
+                     "lens");
   EXPECT_NE(lens->p1, 0.0);
 }
 

@@ -60,20 +60,39 @@ TEST(RealDataChain, FrankaChessboardImageMotionsAgreeWithTheFlangeAtLeastAsWellA
 // (a joint least-squares fit of the hand-eye translation and one scale on the PnP motions: 4.1 mm RMS
 // residual at scale 1, 1.6 mm at 1.13), and the transform's z moves by 0.33 mm per 0.1 % of scale, so
 // without a known length no method lands on ViSP's z. One yardstick (the board's diagonal, 8 x 5
-// squares of 23.6 mm: 222.64 mm) with a stated flange pose noise fixes it: within 2 mm on every axis.
-TEST(RealDataChain, FrankaHandEyeWithOneYardstickMatchesViSP) {
+// squares of 23.6 mm: 222.64 mm) fixes it, with the defaults: the flange pose noise is estimated from the
+// residuals and the yardstick is a length constraint beside the flange translations; within 2 mm on every
+// axis. Told to scale by the flanges alone, z lands tens of mm away.
+TEST(RealDataChain, FrankaHandEyeWithOneYardstickMatchesViSPWithTheDefaults) {
   const auto dir = FreshDir("chain", "franka-yardstick");
   const std::string obs = (dir / "franka.yaml").string();
   ASSERT_TRUE(RunCli(kFrankaDetect + "--yardstick 0,53,222.64 --out " + obs));
-  std::string output;
-  const auto exact = dir / "exact";
-  // Exact flange poses fix the scale themselves: a yardstick cannot be imposed on them.
-  EXPECT_EQ(RunSelfcalInSource("calibrate " + obs + " --free camera,fx,k1 --scale-from yardstick --out " + exact.string(),
-                               &output),
-            2)
-      << output;
-  EXPECT_NE(output.find("needs a stated flange pose noise"), std::string::npos) << output;
-  // The pose noise stated to detect, which writes it into the observations file.
+  const double visp_mm[3] = {57.7, -33.9, -42.3};
+  const auto out = dir / "calibration";
+  ASSERT_TRUE(RunCli("calibrate " + obs + " --out " + out.string()));
+  const nlohmann::json report = ReadReport(out);
+  EXPECT_EQ(report.at("hand_eye").at("scale_yardsticks").get<int>(), 1);
+  const nlohmann::json& noise = report.at("hand_eye").at("pose_noise");
+  EXPECT_EQ(noise.at("noise_source"), "estimated") << noise.dump();
+  EXPECT_GT(noise.at("translation_sigma_m").get<double>(), 1e-4) << noise.dump();  // the Franka's poses are not exact
+  const nlohmann::json& x = report.at("hand_eye").at("flange_from_cam");
+  for (int k = 0; k < 3; ++k) {
+    const double mm = x.at("xyz_m").at(k).get<double>() * 1e3;
+    EXPECT_NEAR(mm, visp_mm[k], 2.0) << k;
+    EXPECT_GT(x.at("stddev").at("xyz_m").at(k).get<double>(), 0.0) << k;
+  }
+  const auto flange = dir / "flange-scale";
+  ASSERT_TRUE(RunCli("calibrate " + obs + " --scale-from flange --out " + flange.string()));
+  const nlohmann::json by_flange = ReadReport(flange);
+  EXPECT_EQ(by_flange.at("hand_eye").at("scale_yardsticks").get<int>(), 0);
+  const double z_mm = by_flange.at("hand_eye").at("flange_from_cam").at("xyz_m").at(2).get<double>() * 1e3;
+  EXPECT_GT(std::abs(z_mm - visp_mm[2]), 20.0) << z_mm;
+}
+
+// The pose noise stated to detect, which writes it into the observations file, is the one modelled; a
+// yardstick asked for where the set has none is refused, nothing written.
+TEST(RealDataChain, FrankaHandEyeWithAStatedPoseNoiseMatchesViSP) {
+  const auto dir = FreshDir("chain", "franka-stated-noise");
   const std::string noisy = (dir / "franka-noise.yaml").string();
   ASSERT_TRUE(RunCli(kFrankaDetect + "--yardstick 0,53,222.64 --flange-pose-noise-mm 2 --flange-pose-noise-deg 0.1 "
                      "--out " + noisy));
@@ -84,12 +103,22 @@ TEST(RealDataChain, FrankaHandEyeWithOneYardstickMatchesViSP) {
   ASSERT_TRUE(RunCli("calibrate " + noisy + " --free camera,fx,k1 --scale-from yardstick --out " + out.string()));
   const nlohmann::json report = ReadReport(out);
   EXPECT_EQ(report.at("hand_eye").at("scale_yardsticks").get<int>(), 1);
+  EXPECT_EQ(report.at("hand_eye").at("pose_noise").at("noise_source"), "stated");
+  EXPECT_DOUBLE_EQ(report.at("hand_eye").at("pose_noise").at("translation_sigma_m").get<double>(), 0.002);
   const nlohmann::json& plane = report.at("hand_eye").at("start").at("plane");
   EXPECT_TRUE(plane.at("ok").get<bool>()) << plane.dump();
   EXPECT_EQ(plane.at("views_resolved").get<int>(), 7) << plane.dump();
   const nlohmann::json& xyz = report.at("hand_eye").at("flange_from_cam").at("xyz_m");
   const double visp_mm[3] = {57.7, -33.9, -42.3};
-  for (int k = 0; k < 3; ++k) EXPECT_NEAR(xyz.at(k).get<double>() * 1e3, visp_mm[k], 2.0) << k << " " << output;
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(xyz.at(k).get<double>() * 1e3, visp_mm[k], 2.0) << k;
+  const std::string plain = (dir / "franka.yaml").string();
+  ASSERT_TRUE(RunCli(kFrankaDetect + "--out " + plain));
+  std::string output;
+  const auto refused = dir / "refused";
+  EXPECT_EQ(RunSelfcalInSource("calibrate " + plain + " --scale-from yardstick --out " + refused.string(), &output), 2)
+      << output;
+  EXPECT_NE(output.find("needs a yardstick in the observations"), std::string::npos) << output;
+  EXPECT_FALSE(std::filesystem::exists(refused / "hand_eye.yaml"));
 }
 
 // The ROS-Industrial dot grid with the data's own calibrated intrinsics (rct_camera_intr_calibrated.yaml:
