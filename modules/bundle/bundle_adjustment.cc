@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <map>
 #include <memory>
@@ -191,27 +192,27 @@ bool AnalyzeStartGauge(const BundleData& data, const BundleState& state, const B
   return true;
 }
 
-// Weak directions: the joint parameters these poses determine worse than their manufacturing tolerance are
-// held at the robot description's value (the start moved back there) and named, with the joints that barely
-// move. False when the nominal model cannot be evaluated (a dot behind a camera).
-bool HoldWeakParameters(const BundleData& data, const BundleOptions& options, internal::Gauge* gauge,
-                        BundleState* state, BundleReport* report) {
-  if (data.base_from_flange.empty()) report->barely_moving = BarelyMovingJoints(data.joints);
-  if (options.weak_length_tolerance_m <= 0 && options.weak_angle_tolerance_rad <= 0) return true;
-  BundleState nominal = *state;
+// The weak joint parameters of the free set, judged at the nominal model (the start's dots and intrinsics):
+// at the stated pixel noise, or under `model`. False when the nominal model cannot be evaluated.
+bool FindWeakAtNominal(const BundleData& data, const BundleOptions& options, const internal::Gauge& gauge,
+                       const BundleState& state, std::vector<identification::WeakColumn>* weak) {
+  BundleState nominal = state;
+  nominal.rho = KinematicParameters::Nominal(data.robot);
+  return internal::FindWeakParameters(data, nominal, gauge, options.intrinsics, options.weak_length_tolerance_m,
+                                      options.weak_angle_tolerance_rad, weak);
+}
+
+// Holds `weak` at the robot description's values (the state moved there) and names them in the report.
+void HoldAtNominal(const std::vector<identification::WeakColumn>& weak, bool under_error_model, const BundleData& data,
+                   internal::Gauge* gauge, BundleState* state, BundleReport* report) {
   const Eigen::VectorXd nominal_rho = KinematicParameters::Nominal(data.robot);
-  nominal.rho = nominal_rho;
-  std::vector<identification::WeakColumn> weak;
-  if (!internal::FindWeakParameters(data, nominal, *gauge, options.intrinsics, options.weak_length_tolerance_m,
-                                    options.weak_angle_tolerance_rad, &weak)) {
-    return false;
-  }
   const KinematicParameters params(data.robot.num_joints());
   for (const identification::WeakColumn& w : weak) {
     report->weak.push_back({params.name(w.column), params.kind(w.column) == ParameterKind::kLength,
-                            w.conditional_std, w.tolerance, w.combination});
+                            w.conditional_std, w.tolerance, w.combination, under_error_model});
     report->fixed_names.push_back(params.name(w.column));
     state->rho[w.column] = nominal_rho[w.column];
+    if (w.column < report->stddev.size()) report->stddev[w.column] = NAN;
     auto it = std::find(gauge->free_kinematic.begin(), gauge->free_kinematic.end(), w.column);
     if (it != gauge->free_kinematic.end()) gauge->free_kinematic.erase(it);
   }
@@ -219,6 +220,65 @@ bool HoldWeakParameters(const BundleData& data, const BundleOptions& options, in
   for (int i : gauge->free_kinematic) gauge->free_names.push_back(params.name(i));
   report->free_indices = gauge->free_kinematic;
   report->free_names = gauge->free_names;
+}
+
+// Weak directions: the joint parameters these poses determine worse than their manufacturing tolerance are
+// held at the robot description's value (the start moved back there) and named, with the joints that barely
+// move. False when the nominal model cannot be evaluated (a dot behind a camera).
+bool HoldWeakParameters(const BundleData& data, const BundleOptions& options, internal::Gauge* gauge,
+                        BundleState* state, BundleReport* report) {
+  if (data.base_from_flange.empty()) report->barely_moving = BarelyMovingJoints(data.joints);
+  if (options.weak_length_tolerance_m <= 0 && options.weak_angle_tolerance_rad <= 0) return true;
+  std::vector<identification::WeakColumn> weak;
+  if (!FindWeakAtNominal(data, options, *gauge, *state, &weak)) return false;
+  HoldAtNominal(weak, false, data, gauge, state, report);
+  return true;
+}
+
+// Weak directions under the cell's error model, once the fit has estimated it: the first judgement
+// (HoldWeakParameters, each parameter given the ones before it, at the stated pixel noise) misses what each
+// image's pose error (joint reading noise, what the model does not hold) leaves poorly determined. The free
+// joint parameter whose standard deviation under the model exceeds its tolerance by the most is held at the
+// description's value and named with the free parameters it is most correlated with; true when one was
+// (the caller refits and asks again).
+bool HoldWeakestUnderErrorModel(const BundleData& data, const BundleOptions& options, internal::Gauge* gauge,
+                                BundleState* state, BundleReport* report) {
+  const ErrorModel& model = report->error_model;
+  if (!report->covariance_available || !model.estimated || !(model.pose_translation_m > 0 || model.pose_rotation_rad > 0)) {
+    return false;
+  }
+  const KinematicParameters params(data.robot.num_joints());
+  const std::vector<int>& free = gauge->free_kinematic;
+  int worst = -1;
+  double worst_ratio = 1.0;
+  for (size_t k = 0; k < free.size(); ++k) {
+    const int c = free[k];
+    if (c < KinematicParameters::JointOffset(0) || c >= params.CamOffset()) continue;
+    const double tolerance =
+        params.kind(c) == ParameterKind::kLength ? options.weak_length_tolerance_m : options.weak_angle_tolerance_rad;
+    if (!(tolerance > 0) || !(report->stddev[c] > tolerance * worst_ratio)) continue;
+    worst = static_cast<int>(k);
+    worst_ratio = report->stddev[c] / tolerance;
+  }
+  if (worst < 0) return false;
+  identification::WeakColumn w;
+  w.column = free[worst];
+  w.conditional_std = report->stddev[w.column];
+  w.tolerance = w.conditional_std / worst_ratio;
+  std::vector<std::pair<double, int>> partners;
+  for (size_t k = 0; k < free.size(); ++k) {
+    if (static_cast<int>(k) != worst) partners.push_back({report->correlation_free(worst, k), free[k]});
+  }
+  std::sort(partners.begin(), partners.end(),
+            [](const auto& x, const auto& y) { return std::abs(x.first) > std::abs(y.first); });
+  std::ostringstream combination;
+  combination << "correlated with";
+  for (size_t k = 0; k < std::min<size_t>(2, partners.size()); ++k) {
+    combination << (k ? ", " : " ") << params.name(partners[k].second) << " (" << std::setprecision(2)
+                << partners[k].first << ")";
+  }
+  w.combination = combination.str();
+  HoldAtNominal({w}, true, data, gauge, state, report);
   return true;
 }
 
@@ -328,6 +388,19 @@ ScreenedFit SolveScreened(const std::vector<int>& free, const BundleOptions& opt
     if (!in_solve[d]) report->dropped_dots.push_back(full.dot_ids[d]);
   }
   return fit;
+}
+
+// The solution of a fit and its figures, into the report.
+void RecordSolution(const BundleData& data, const BundleState& state, BundleReport* report) {
+  report->rho = state.rho;
+  report->intrinsics = state.intrinsics;
+  report->fx_px = state.intrinsics[kFx];
+  report->dots_in_base.clear();
+  for (size_t d = 0; d < data.dot_ids.size(); ++d) report->dots_in_base[data.dot_ids[d]] = state.dots[d];
+  report->num_observations = static_cast<int>(data.observations.size());
+  double sum2 = 0;
+  for (double e : ReprojectionErrors(data, state)) sum2 += e * e;
+  report->rms_reprojection_px = report->num_observations > 0 ? std::sqrt(sum2 / report->num_observations) : 0.0;
 }
 
 // Covariance of the free globals at the solution, dots as nuisance (K8), scaled by the residual
@@ -504,24 +577,26 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
                                                  " observations, among them the yardstick's views (the solve before it "
                                                  "had not found the images' geometry: a poor start)");
   }
-  const internal::LmSummary& summary = fit.summary;
-  const bool converged = summary.termination == internal::LmSummary::Termination::kConvergence;
-  report.final_cost = summary.final_cost;
-  report.termination = std::string(internal::TerminationName(summary.termination)) + ": " + summary.message;
-  if (summary.termination == internal::LmSummary::Termination::kFailure) {
-    return finish(Outcome::kFailure, "solver failed: " + report.termination);
-  }
-  report.rho = state.rho;
-  report.intrinsics = state.intrinsics;
-  report.fx_px = state.intrinsics[kFx];
-  for (size_t d = 0; d < data.dot_ids.size(); ++d) report.dots_in_base[data.dot_ids[d]] = state.dots[d];
-  report.num_observations = static_cast<int>(data.observations.size());
-  {
-    double sum2 = 0;
-    for (double e : ReprojectionErrors(data, state)) sum2 += e * e;
-    report.rms_reprojection_px = report.num_observations > 0 ? std::sqrt(sum2 / report.num_observations) : 0.0;
-  }
+  internal::LmSummary summary = fit.summary;
+  const auto failed = [&report](const internal::LmSummary& fit_summary) {
+    report.final_cost = fit_summary.final_cost;
+    report.termination = std::string(internal::TerminationName(fit_summary.termination)) + ": " + fit_summary.message;
+    return fit_summary.termination == internal::LmSummary::Termination::kFailure;
+  };
+  if (failed(summary)) return finish(Outcome::kFailure, "solver failed: " + report.termination);
+  RecordSolution(data, state, &report);
   EstimateCovariance(data, state, gauge.free_kinematic, options, summary.final_cost, &report);
+  // At most one round per free parameter; each holds one.
+  for (size_t round = 0; round < report.free_indices.size() &&
+                         HoldWeakestUnderErrorModel(data, options, &gauge, &state, &report);
+       ++round) {
+    summary = Solve(data, gauge.free_kinematic, options, false, &state);
+    report.iterations += summary.iterations;
+    if (failed(summary)) return finish(Outcome::kFailure, "solver failed: " + report.termination);
+    RecordSolution(data, state, &report);
+    EstimateCovariance(data, state, gauge.free_kinematic, options, summary.final_cost, &report);
+  }
+  const bool converged = summary.termination == internal::LmSummary::Termination::kConvergence;
   TestHeldParameters(data, state, gauge.free_kinematic, options, held, requested.intrinsics, &report);
 
   std::ostringstream msg;

@@ -132,9 +132,12 @@ struct RemovedObservation {
 struct WeakParameter {
   std::string name;            // "j4.d"
   bool length = true;          // m, else rad
-  double conditional_std = 0;  // given the parameters kept before it, at the stated pixel noise
+  double conditional_std = 0;  // given the parameters kept before it, at the stated pixel noise (or the error model's)
   double tolerance = 0;
   std::string combination;     // "0.71 j2.d - 0.71 j4.d": what it trades off with
+  // Found after the fit, under its estimated error model (pixel noise and each image's pose error), rather
+  // than at the stated pixel noise before it.
+  bool under_error_model = false;
 };
 
 struct BundleReport {
