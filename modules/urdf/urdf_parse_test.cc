@@ -60,6 +60,18 @@ TEST(UrdfParse, SyntaxErrorsNameTheLine) {
   EXPECT_EQ(Refusal(twice), "arm.urdf:3: not well-formed XML (tinyxml: Error parsing Element.)");
 }
 
+// Issue 36's campaign: a URDF with bytes that are not UTF-8 (in a comment, between elements) was taken;
+// XML without another declared encoding is UTF-8, and a URDF declares none.
+TEST(UrdfParse, InvalidUtf8IsRefusedByLine) {
+  for (const std::string& bad : {std::string("\xc0\xaf"), std::string("\xf8\x88\x80\x80\x80")}) {
+    std::string text = Ur5e();
+    const size_t at = text.find("<link");
+    ASSERT_NE(at, std::string::npos);
+    text.insert(at, bad);
+    EXPECT_EQ(Refusal(text), "arm.urdf:" + std::to_string(LineOf(text, bad)) + ": invalid UTF-8 (a URDF must be UTF-8)");
+  }
+}
+
 // urdfdom's own refusals (a model error, not a syntax error): its reason, and the line of the element whose
 // name it quotes, instead of "urdfdom could not parse the URDF".
 TEST(UrdfParse, UrdfdomModelErrorsNameTheElementAndItsLine) {
