@@ -103,10 +103,11 @@ TEST(UrdfParse, ValuesUrdfdomTakesSilentlyAreRefusedByLine) {
       {"<axis xyz=\"0 0 1\"/>", "<axis xyz=\"99999999999999999999999 0 1\"/>"},
       {"<origin xyz=\"0 0 0.1625\"", "<origin xyz=\"0 0 1e308\""},
       {"rpy=\"1.5707963267948966 0 0\"", "rpy=\"1e308 0 0\""},
-      {"upper=\"6.283185307179586\"", "upepr=\"6.283185307179586\""}};
+      {"upper=\"6.283185307179586\"", "upepr=\"6.283185307179586\""},
+      {"<axis xyz=\"0 0 1\"/>", "<axis xyz=\"0 0 1\"/><axis xyz=\"1 0 0\"/>"}};  // the campaign's urdf-00559
   const std::vector<std::string> expected = {"<aixs> is not an element of a joint", "1e+23 is beyond the limit",
                                              "1e+308 m is beyond the limit", "1e+308 rad is beyond the limit",
-                                             "a revolute joint needs `upper=`"};
+                                             "a revolute joint needs `upper=`", "<axis> is given twice in a joint"};
   for (size_t k = 0; k < cases.size(); ++k) {
     std::string text = Ur5e();
     const size_t line_at = text.find(joint2);
