@@ -323,11 +323,13 @@ def _document_rule(kind, old, new):
         return ("a %s document of the seed's format and version: `report` renders what it is given (a key it "
                 "lacks leaves its figure or row out, every text is escaped: report/html_report.h) and computes "
                 "nothing from it" % ("report" if kind.name == "report_json" else "study"))
-    if kind.fmt == "journal" and not new["torn_tail"] and not old["torn_tail"] and \
-            _journal_kept(new["records"]) == _journal_kept(old["records"]):
+    kept_old = _journal_kept(old["records"]) if kind.fmt == "journal" else None
+    if kind.fmt == "journal" and not old["torn_tail"] and \
+            (_journal_kept(new["records"]) == kept_old if not new["torn_tail"] else
+             _journal_kept(new["records"]) == kept_old[:len(_journal_kept(new["records"]))]):
         return ("only records of the motion's progress (move_started, move_done, settled) removed, repeated or "
                 "reordered, or a sample, frame or plan record repeated exactly: the records a reader uses are the "
-                "same, in the same order")
+                "same, in the same order%s" % (" up to a torn tail (ignored, session-format.md)" if new["torn_tail"] else ""))
     if kind.name == "urdf" and _urdf_as_sets(old) == _urdf_as_sets(new):
         return "a URDF's links or joints reordered: they are sets, their order is not data"
     return ""
@@ -380,14 +382,18 @@ def explain(kind, ctx, original, mutant, ops):
     ctx = dict(ctx, new_doc=new, seed_text=original)
     reasons = set()
     differing = (set(fa) ^ set(fb)) | {q for q in fa if q in fb and fa[q] != fb[q]}
-    for p in fa:
-        if len(p) >= 2 and p[-1] == "[]" and p[-2] in RECORD_LISTS:
-            prefix = p[:-1]
-            if all(q[:len(prefix)] == prefix for q in differing) and _record_list_change(old, new, prefix):
-                return True, "records of `%s` removed, repeated or reordered: a list of any length (%s)" % (p[-2], ", ".join(names))
+    covered = [p[:-1] for p in fa if len(p) >= 2 and p[-1] == "[]" and p[-2] in RECORD_LISTS and
+               any(q[:len(p) - 1] == p[:-1] for q in differing) and _record_list_change(old, new, p[:-1])]
+    for prefix in covered:
+        reasons.add("records of `%s` removed, repeated or reordered: a list of any length (%s)" % (prefix[-1], ", ".join(names)))
     for path in sorted(set(fa) | set(fb), key=str):
         a, b = fa.get(path, None), fb.get(path, None)
         if path in fa and path in fb and a == b:
+            continue
+        if any(path[:len(prefix)] == prefix for prefix in covered):
+            continue
+        if kind.name == "urdf" and path and path[0] in ("<transmission>", "<gazebo>"):
+            reasons.add("inside <transmission> or <gazebo> (ros_control's and Gazebo's: selfcal reads neither)")
             continue
         keys = _keys_of(path)
         if path not in fb:
