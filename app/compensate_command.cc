@@ -75,7 +75,7 @@ int RunCompensate(const CompensateArgs& args) {
   Result<io::TargetsFile> targets = io::LoadTargetsFile(args.targets, model.num_joints());
   if (!targets.ok()) return Fail(targets.status());
   if (!targets->robot.empty() && targets->robot != model.name) {
-    return Fail(Status::Error(ErrorCode::kInvalidInput, args.targets + ": `robot` = `" + targets->robot +
+    return Fail(Status::Error(ErrorCode::kInvalidInput, args.targets + ":" + std::to_string(targets->robot_line) + ": `robot` = `" + targets->robot +
                                                             "`, but the calibrated model is `" + model.name + "`"));
   }
   std::vector<compensation::Target> list;

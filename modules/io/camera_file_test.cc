@@ -282,6 +282,22 @@ TEST_F(BadCameraFiles, Visp) {
   EXPECT_TRUE(Refused("nosize.xml", nosize, "missing element <image_width> in <camera>"));
 }
 
+// Issue 36's campaign: lines of a ViSP file's comments swapped or repeated left `--` inside a comment and
+// a comment's text between elements, and a misspelt XML declaration; ViSP's files have none of them.
+TEST_F(BadCameraFiles, VispTextThatIsNotWellFormedXmlIsRefusedByLine) {
+  const std::string model = "      <type>perspectiveProjWithoutDistortion</type>\n      <px>600</px>\n      <py>601</py>\n"
+                            "      <u0>320</u0>\n      <v0>240</v0>\n";
+  std::string dashes = Visp(model);
+  dashes.replace(dashes.find("  <camera>"), 0, "  <!--a comment\n  <!--repeated-->\n");
+  EXPECT_TRUE(Refused("dashes.xml", dashes, dir_.File("dashes.xml") + ":3: `--` inside a comment"));
+  std::string stray = Visp(model);
+  stray.replace(stray.find("    <image_width>"), 0, "   the vpXmlParserCamera class.-->\n");
+  EXPECT_TRUE(Refused("stray.xml", stray, dir_.File("stray.xml") + ":5: text `the vpXmlParserCamera class.-->` between the elements of <camera>"));
+  std::string declaration = Visp(model);
+  declaration.replace(declaration.find("version"), 7, "versino");
+  EXPECT_TRUE(Refused("declaration.xml", declaration, dir_.File("declaration.xml") + ":1: the XML declaration must begin `<?xml version=`"));
+}
+
 std::string Nested(const std::string& open, const std::string& close, int depth) {
   std::string text;
   for (int i = 0; i < depth; ++i) text += open;

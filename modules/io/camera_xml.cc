@@ -18,6 +18,7 @@ struct XmlElement {
   std::string name;
   std::string text;  // character data directly inside, entities decoded, trimmed
   int line = 0;
+  int text_line = 0;  // of its first character data that is not white space (0: none)
   std::vector<XmlElement> children;
 };
 
@@ -47,6 +48,23 @@ std::string Decode(const std::string& s) {
   return out;
 }
 
+// Why the comment or declaration at s[i] is not well-formed XML, or "": `--` inside a comment (XML 1.0
+// allows none; a comment's lines moved or repeated leave one), an XML declaration without `version=`.
+std::string MarkupProblem(const std::string& s, size_t i) {
+  if (s.compare(i, 4, "<!--") == 0) {
+    const size_t end = s.find("-->", i + 4);
+    return s.find("--", i + 4) < end ? "`--` inside a comment (XML allows none: were a comment's lines moved?)" : "";
+  }
+  if (s.compare(i, 5, "<?xml") != 0 || i + 5 >= s.size() || s.find_first_of(" \t\r\n", i + 5) != i + 5) return "";
+  const size_t name = s.find_first_not_of(" \t\r\n", i + 5);
+  const size_t equals = name == std::string::npos ? name : s.find_first_not_of(" \t\r\n", name + 7);
+  if (s.compare(name == std::string::npos ? s.size() : name, 7, "version") == 0 && equals != std::string::npos &&
+      s[equals] == '=') {
+    return "";
+  }
+  return "the XML declaration must begin `<?xml version=`";
+}
+
 // Parses `s` into the single top-level element. Returns an error message, its line in *error_line, or "".
 std::string ParseXml(const std::string& s, XmlElement* top, int* error_line) {
   const auto fail = [error_line](int at, const std::string& why) {
@@ -65,6 +83,10 @@ std::string ParseXml(const std::string& s, XmlElement* top, int* error_line) {
       if (stack.empty()) {
         if (!Trim(text).empty()) return fail(line, "text outside the root element");
       } else {
+        const size_t first = text.find_first_not_of(" \t\r\n");
+        if (first != std::string::npos && stack.back().text_line == 0) {
+          stack.back().text_line = line + static_cast<int>(std::count(text.begin(), text.begin() + first, '\n'));
+        }
         stack.back().text += text;
       }
       advance(i, next);
@@ -78,6 +100,7 @@ std::string ParseXml(const std::string& s, XmlElement* top, int* error_line) {
       i = close + end.size();
       return true;
     };
+    if (const std::string problem = MarkupProblem(s, i); !problem.empty()) return fail(line, problem);
     if (s.compare(i, 4, "<!--") == 0) {
       if (!skip_to("-->")) return fail(line, "unterminated comment");
       continue;
@@ -102,6 +125,11 @@ std::string ParseXml(const std::string& s, XmlElement* top, int* error_line) {
       XmlElement done = std::move(stack.back());
       stack.pop_back();
       done.text = Decode(Trim(done.text));
+      const bool container = done.name == "root" || done.name == "camera" || done.name == "model";  // hold elements only
+      if (container && !done.text.empty()) {  // a value element holding one is refused by CheckLeaves
+        return fail(done.text_line, "text `" + done.text.substr(0, std::min(done.text.find('\n'), size_t{60})) +
+                                        "` between the elements of <" + done.name + ">");
+      }
       (stack.empty() ? tops : stack.back().children).push_back(std::move(done));
       continue;
     }

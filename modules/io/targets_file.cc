@@ -44,6 +44,7 @@ Result<TargetsFile> LoadTargetsFile(const std::string& path, int num_joints) {
   }
   TargetsFile file;
   root.OptionalName("robot", &file.robot);
+  file.robot_line = root.KeyLine("robot");
   std::string frame;
   if (root.String("frame", &frame)) {
     if (frame == "camera" || frame == "flange") {

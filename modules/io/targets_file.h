@@ -32,6 +32,7 @@ struct PoseTarget {
 
 struct TargetsFile {
   std::string robot;
+  int robot_line = 0;  // of `robot` in the file read (0: not read from a file)
   bool camera_frame = true;  // false: flange
   std::vector<PoseTarget> targets;
 };

@@ -51,8 +51,15 @@ void ParseUrdfRobotConfig(MapReader* map, Problems* problems, CalibratedModel* o
   map->Finish();
   if (!ok || problems->size() != before) return;
   Result<urdf::UrdfRobot> robot = urdf::LoadUrdfRobot(ResolveBesideConfig(file, problems->file()), spec, flange_from_cam);
-  if (!robot.ok()) {
-    problems->Add("urdf_file `" + file + "` of " + problems->file() + ": " + robot.status().message());
+  if (!robot.ok()) {  // at the config's line of the key the refusal is about (a missing one: the map's line)
+    const std::string& message = robot.status().message();
+    int line = map->KeyLine("urdf_file");
+    for (const std::string key : {"base_link", "tip_link", "camera_link"}) {
+      if (message.find(key + " `") != std::string::npos || message.find("give " + key) != std::string::npos) {
+        line = map->KeyLine(key);
+      }
+    }
+    problems->Add("urdf_file `" + file + "` of " + problems->At(line) + ": " + message);
     return;
   }
   out->model = robot->model;

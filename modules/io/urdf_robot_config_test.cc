@@ -82,6 +82,9 @@ TEST(UrdfRobotConfig, RefusesContradictionsAndNamesTheUrdfProblem) {
   std::string bad_tip =
       Refusal("urdf_file: " + urdf + "\nbase_link: base_link\ntip_link: nowhere\ncamera_link: tool0\n");
   EXPECT_NE(bad_tip.find("tip_link `nowhere` is not a link"), std::string::npos) << bad_tip;
+  // Issue 36's campaign: the robot config's line of the key the URDF refusal is about, not only its name.
+  EXPECT_NE(bad_tip.find("robot.yaml:3: "), std::string::npos) << bad_tip;
+  EXPECT_NE(no_cam.find("robot.yaml:1: "), std::string::npos) << no_cam;
   std::string missing = Refusal("urdf_file: absent.urdf\nbase_link: a\ntip_link: b\ncamera_link: c\n");
   EXPECT_NE(missing.find("absent.urdf"), std::string::npos) << missing;
 }

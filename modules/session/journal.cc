@@ -224,6 +224,12 @@ Status ParseJournal(const std::string& data, const std::string& path, const Jour
                                                  ": the journal is damaged, not torn by a crash; refusing to drop "
                                                  "records (nothing was changed)");
     }
+    if (data.find("\rJ1 ", pos) != std::string::npos) {  // a crash never writes one there: CR line ends
+      return Status::Error(ErrorCode::kInvalidInput,
+                           where + " is corrupt (" + record.reason + ") and records separated by a carriage return "
+                                   "follow it: the journal's line ends were converted (CR: an editor); it is "
+                                   "damaged, refusing it (nothing was changed)");
+    }
     // One interrupted append leaves one line at most (a prefix of a record, or a record whose bytes did not
     // all reach the disk); several lines of text after the last valid record are not a tail torn by a
     // crash but a damaged or replaced journal, which a resume would otherwise cut to its valid part.

@@ -159,6 +159,26 @@ TEST(JournalTest, ConvertedLineEndsAreRefusedAsDamage) {
   }
 }
 
+// Issue 36's campaign: CR line ends and a first record whose length no longer ends at a carriage return
+// (its header damaged too) left no newline in the file: the whole journal was taken as one torn record,
+// and the session as empty.
+TEST(JournalTest, RecordsSeparatedByCarriageReturnsAreNotATornTail) {
+  TempDir dir;
+  const std::string path = dir.File(kJournalFileName);
+  const std::string lf = WriteJournal(dir.File("lf.log"), 3);
+  std::string text;
+  for (char c : lf) text += c == '\n' ? '\r' : c;
+  text[3] = text[3] == 'f' ? 'e' : 'f';  // the first record's length: its end is no longer the carriage return
+  WriteFile(path, text);
+  Result<Journal> journal = Journal::Open(path);
+  ASSERT_FALSE(journal.ok()) << journal->records().size() << " records";
+  EXPECT_EQ(journal.status().code(), ErrorCode::kInvalidInput);
+  EXPECT_TRUE(Contains(journal.status().message(), "journal " + path + ": record 1 at byte offset 0 is corrupt"))
+      << journal.status().message();
+  EXPECT_TRUE(Contains(journal.status().message(), "carriage return")) << journal.status().message();
+  EXPECT_EQ(FileSize(path), text.size());
+}
+
 TEST(JournalTest, CorruptLastRecordIsATornTail) {
   TempDir dir;
   const std::string path = dir.File(kJournalFileName);

@@ -35,6 +35,7 @@ void ParseNaming(const json& j, JsonFields* fields, SetupNaming* naming) {
       fields->Add(at, "`" + at.name + "` must be an object {id, u_px, v_px, area_px2}");
       continue;
     }
+    fields->CheckKnown(d, at, {"id", "u_px", "v_px", "area_px2"});
     ReferenceDot r;
     if (!(fields->GetInt(d, at, "id", &r.id) & fields->GetDouble(d, at, "u_px", &r.u_px) &
           fields->GetDouble(d, at, "v_px", &r.v_px) & fields->GetDouble(d, at, "area_px2", &r.area_px2))) {
@@ -58,6 +59,7 @@ void ParseCamera(const json& j, JsonFields* fields, CameraIntrinsics* camera) {
     fields->Add(at, "`camera` must be an object (found " + JsonTypeName(*c) + ")");
     return;
   }
+  fields->CheckKnown(*c, at, {"width_px", "height_px", "fx_px", "mu", "cx_px", "cy_px", "k1"});
   for (const auto& [key, out] : {std::pair{"width_px", &camera->width_px}, std::pair{"height_px", &camera->height_px}}) {
     if (fields->GetInt(*c, at, key, out) && *out <= 0) fields->Add(at.Member(key), "`camera." + std::string(key) + "` must be positive");
   }
@@ -81,6 +83,7 @@ void ParseDistances(const json& j, const std::string& key, JsonFields* fields, s
       fields->Add(at, "`" + at.name + "` must be an object {dot_a, dot_b, length_m}");
       continue;
     }
+    fields->CheckKnown(d, at, {"dot_a", "dot_b", "length_m"});
     KnownDistance distance;
     if (fields->GetInt(d, at, "dot_a", &distance.dot_a) & fields->GetInt(d, at, "dot_b", &distance.dot_b) &
         fields->GetDouble(d, at, "length_m", &distance.length_m)) {
@@ -126,6 +129,8 @@ Status ParseSetupFile(const std::string& text, const std::string& name, Observat
                std::string("format must be ") + kSetupFormatName + " version " + std::to_string(kSetupFormatVersion));
     return fields.ToStatus();
   }
+  fields.CheckKnown(j, {}, {"format", "version", "camera", "pixel_noise_px", "yardsticks", "check_distances",
+                           "reference_dots", "reference_image"});
   ParseCamera(j, &fields, &set->camera);
   if (fields.GetDouble(j, {}, "pixel_noise_px", &set->pixel_noise_px) && !(set->pixel_noise_px > 0)) {
     fields.Add(JsonPath{}.Member("pixel_noise_px"), "`pixel_noise_px` must be positive");

@@ -88,6 +88,11 @@ TEST(SetupFile, EveryRefusalNamesTheFileAndTheLineOfItsKey) {
       {[](auto& j) { j["camera"]["width_px"] = 0; }, "width_px", "", 0, "`camera.width_px` must be positive"},
       {[](auto& j) { j["version"] = 2; }, "version", "", 0, "format must be selfcal-session-setup version 1"},
       {[](auto& j) { j["camera"] = 5; }, "camera", "", 0, "`camera` must be an object (found number)"},
+      // Issue 36: a key no version of the format has (a typo, a unit swapped) was ignored.
+      {[](auto& j) { j["pixel_noise_pxs"] = 0.5; }, "pixel_noise_pxs", "", 0, "unknown key `pixel_noise_pxs`"},
+      {[](auto& j) { j["camera"]["k2"] = 0.1; }, "k2", "", 0, "unknown key `k2` in `camera`"},
+      {[](auto& j) { j["yardsticks"][0]["length_mm"] = 200; }, "length_mm", "", 0,
+       "unknown key `length_mm` in `yardsticks[0]`"},
   };
   for (const Case& c : cases) {
     nlohmann::json j = nlohmann::json::parse(SetupFileText(ASetup()));

@@ -1,5 +1,8 @@
 #include "simulation/session_audit.h"
 
+#include <nlohmann/json.hpp>
+
+#include "base/json_lines.h"
 #include "base/terminal_text.h"
 #include "io/robot_config.h"
 #include "session/samples.h"
@@ -30,6 +33,44 @@ Result<SimCellOptions> SimulatedRunOptions(const session::SessionSnapshot& snaps
   return SimCellOptionsFor(*text, name);
 }
 
+// A JSON value as a refusal quotes it: terminal-safe, at most 60 characters.
+std::string Quoted(const nlohmann::json& value) {
+  std::string text = value.dump();
+  if (text.size() > 60) text = text.substr(0, 57) + "...";
+  return TerminalSafe(text);
+}
+
+// The recorded setup.json against the rebuilt world's: read as every reader of it does (a syntax error, a
+// repeated key, a missing or mistyped one refused by line), then compared as data, so that the same setup
+// written otherwise is the same setup; the first value that differs is refused naming its line and key.
+Status CompareSetup(const std::string& rebuilt, const std::string& recorded, const std::string& path) {
+  const std::string name = path + "/inputs/" + session::kSetupFileName;
+  ObservationSet parsed;
+  session::SetupNaming naming;
+  if (Status s = session::ParseSetupFile(recorded, name, &parsed, &naming); !s.ok()) return s;
+  const nlohmann::json expected = nlohmann::json::parse(rebuilt);
+  const nlohmann::json found = nlohmann::json::parse(recorded);
+  const nlohmann::json patch = nlohmann::json::diff(found, expected);  // what turns the recorded into the rebuilt
+  if (patch.empty()) return Status::Ok();
+  const nlohmann::json& first = patch.front();
+  const std::string pointer = first.at("path").get<std::string>();
+  const std::string op = first.at("op").get<std::string>();
+  const std::string key = "`" + TerminalSafe(JsonPointerName(pointer)) + "`";
+  const std::string world = "the simulated world rebuilt from robot.yaml, the journal's plan and run.json";
+  std::string what;
+  if (op == "replace") {
+    what = key + " is " + Quoted(found.at(nlohmann::json::json_pointer(pointer))) + " where " + world + " has " +
+           Quoted(first.at("value"));
+  } else if (op == "remove") {
+    what = key + " is not in the setup of " + world;
+  } else {
+    what = "missing " + key + ", which " + world + " has (" + Quoted(first.value("value", nlohmann::json())) + ")";
+  }
+  return Refuse(name + ":" + std::to_string(JsonLines(recorded).Line(pointer)) + ": " + what +
+                ": the world does not reproduce the recorded setup (recorded by another version?); its identities "
+                "cannot be scored");
+}
+
 // The world `selfcal run` built for this session, rebuilt from its inputs and checked against setup.json.
 Result<SimCell> RebuildWorld(const session::SessionSnapshot& snapshot, const session::SessionLog& log,
                              const SimCellOptions& options, const std::string& path) {
@@ -45,11 +86,7 @@ Result<SimCell> RebuildWorld(const session::SessionSnapshot& snapshot, const ses
   if (!cell.ok()) return cell.status();
   Result<std::string> setup = snapshot.Input(session::kSetupFileName);
   if (!setup.ok()) return setup.status();
-  if (session::SetupFileText(SimSetup(*cell)) != *setup) {
-    return Refuse("session " + path + ": the simulated world rebuilt from robot.yaml, the journal's plan and run.json "
-                  "does not reproduce the recorded " + path + "/inputs/setup.json (recorded by another version?); "
-                  "its identities cannot be scored");
-  }
+  if (Status s = CompareSetup(session::SetupFileText(SimSetup(*cell)), *setup, path); !s.ok()) return s;
   return cell;
 }
 

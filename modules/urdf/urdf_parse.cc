@@ -88,6 +88,7 @@ Result<std::shared_ptr<::urdf::ModelInterface>> ParseUrdfText(const std::string&
   XmlScanLimits limits;
   limits.kind = "a URDF";
   limits.max_bytes = kMaxUrdfBytes;
+  limits.require_utf8 = true;  // XML that declares no other encoding is UTF-8; tinyxml would take any bytes
   if (Status s = ScanXml(text, name, limits); !s.ok()) return s;
   TiXmlDocument xml;
   xml.Parse(text.c_str());

@@ -60,6 +60,18 @@ TEST(UrdfParse, SyntaxErrorsNameTheLine) {
   EXPECT_EQ(Refusal(twice), "arm.urdf:3: not well-formed XML (tinyxml: Error parsing Element.)");
 }
 
+// Issue 36's campaign: a URDF with bytes that are not UTF-8 (in a comment, between elements) was taken;
+// XML without another declared encoding is UTF-8, and a URDF declares none.
+TEST(UrdfParse, InvalidUtf8IsRefusedByLine) {
+  for (const std::string& bad : {std::string("\xc0\xaf"), std::string("\xf8\x88\x80\x80\x80")}) {
+    std::string text = Ur5e();
+    const size_t at = text.find("<link");
+    ASSERT_NE(at, std::string::npos);
+    text.insert(at, bad);
+    EXPECT_EQ(Refusal(text), "arm.urdf:" + std::to_string(LineOf(text, bad)) + ": invalid UTF-8 (a URDF must be UTF-8)");
+  }
+}
+
 // urdfdom's own refusals (a model error, not a syntax error): its reason, and the line of the element whose
 // name it quotes, instead of "urdfdom could not parse the URDF".
 TEST(UrdfParse, UrdfdomModelErrorsNameTheElementAndItsLine) {
@@ -91,10 +103,11 @@ TEST(UrdfParse, ValuesUrdfdomTakesSilentlyAreRefusedByLine) {
       {"<axis xyz=\"0 0 1\"/>", "<axis xyz=\"99999999999999999999999 0 1\"/>"},
       {"<origin xyz=\"0 0 0.1625\"", "<origin xyz=\"0 0 1e308\""},
       {"rpy=\"1.5707963267948966 0 0\"", "rpy=\"1e308 0 0\""},
-      {"upper=\"6.283185307179586\"", "upepr=\"6.283185307179586\""}};
+      {"upper=\"6.283185307179586\"", "upepr=\"6.283185307179586\""},
+      {"<axis xyz=\"0 0 1\"/>", "<axis xyz=\"0 0 1\"/><axis xyz=\"1 0 0\"/>"}};  // the campaign's urdf-00559
   const std::vector<std::string> expected = {"<aixs> is not an element of a joint", "1e+23 is beyond the limit",
                                              "1e+308 m is beyond the limit", "1e+308 rad is beyond the limit",
-                                             "a revolute joint needs `upper=`"};
+                                             "a revolute joint needs `upper=`", "<axis> is given twice in a joint"};
   for (size_t k = 0; k < cases.size(); ++k) {
     std::string text = Ur5e();
     const size_t line_at = text.find(joint2);

@@ -37,10 +37,14 @@ class Checker {
     what_ = "the <joint> named `" + TerminalSafe(joint_name ? joint_name : "") + "`";
     static const std::set<std::string> kKnown = {"origin", "parent",  "child", "axis", "calibration",
                                                  "dynamics", "limit", "mimic", "safety_controller"};
+    std::set<std::string> seen;
     for (const TiXmlElement* e = joint.FirstChildElement(); e; e = e->NextSiblingElement()) {
       if (kKnown.count(e->ValueStr()) == 0) {
         Add(*e, "<" + TerminalSafe(e->ValueStr()) + "> is not an element of a joint (a joint's elements: <origin>, "
                 "<parent>, <child>, <axis>, <limit>, <dynamics>, <calibration>, <mimic>, <safety_controller>)");
+      } else if (!seen.insert(e->ValueStr()).second) {
+        Add(*e, "<" + e->ValueStr() + "> is given twice in a joint (urdfdom would take the first without a word); "
+                "keep one");
       }
     }
     if (const TiXmlElement* axis = joint.FirstChildElement("axis")) Values(*axis, "xyz", kMaxUrdfAxisComponent, "");

@@ -6,8 +6,10 @@ JSON without duplicate keys or NaN, XML, the journal's framing and CRC, CSV numb
      mark, the spelling of a number, key order);
   2. otherwise every difference must fall under a stated rule: free text, an optional key removed, a list
      of records shortened, repeated or reordered, a joint inside the robot config's limits, a finite
-     measured value within 10x of the seed's magnitude, a number of a report (only rendered), a torn
-     journal tail (documented as ignored);
+     measured value within 10x of the seed's magnitude, a report or study document of its format and
+     version (`report` only renders it), a torn journal tail (documented as ignored), records of the
+     journal's motion progress removed, repeated or reordered (no reader uses them beyond their fields),
+     a URDF's links and joints reordered (sets, not lists), a URDF's effort and velocity limits (not read);
   3. anything else, including a mutant the strict reader refuses, is unexplained.
 """
 import json
@@ -19,7 +21,7 @@ import zlib
 
 import yaml
 
-FREE_TEXT = {"description", "source", "planner", "comment", "note", "notes", "software_version", "title"}
+FREE_TEXT = {"description", "source", "planner", "comment", "note", "notes", "software_version", "title", "provenance"}
 OPTIONAL = {
     "trajectory": {"robot", "description", "planner"},
     "targets": {"robot", "seed_deg", "seed_rad"},
@@ -29,7 +31,10 @@ OPTIONAL = {
              "<calibration>", "<material>", "<mass>", "<inertia>", "<geometry>", "@name"},
 }
 RECORD_LISTS = {"poses_deg", "poses_rad", "targets", "samples", "observations", "poses", "rows", "images", "joints",
-                "dots"}
+                "dots", "scene_dots_mm"}
+# The journal's records of the motion's progress: ReadSessionLog checks their fields only (samples.cc), and
+# a resume or a revisit writes them again for a pose, so any number of them in any order is a journal.
+PROGRESS_RECORDS = {"move_started", "move_done", "settled"}
 MEASURED = re.compile(r"(_mm|_m|_deg|_rad|_px|^u$|^v$|^uv|^xyz|^rpy|^quat|^rotvec|^joints|^data|^x$|^y$|^z$|"
                       r"^q[xyzw]$|^fx|^fy|^cx|^cy|^k\d|^p\d|^mu$|^rotation|^[abd]$|^alpha|^theta)")
 
@@ -186,17 +191,35 @@ def _rule_for_value(kind, ctx, path, old, new):
     last = keys[-1] if keys else ""
     if any(k in FREE_TEXT for k in keys):
         return "free text key `%s`" % last
+    if kind.name == "urdf" and "<limit>" in keys and last in ("@effort", "@velocity"):
+        return "a URDF joint's effort or velocity limit (selfcal reads neither)"
+    if kind.name == "tracker" and isinstance(path[-1], int) and _is_number(new) and math.isfinite(new):
+        if 9 <= path[-1] <= 14:
+            return "an unused column of a tracker row (10-15: read and ignored, io/fanuc_tracker_csv.h)"
+        if 15 <= path[-1] <= 20 and -720 <= new <= 720:
+            return "a joint reading inside the reader's range [-720, 720] deg"
+    if kind.name == "visp_pose" and "data" in keys and _is_number(new) and math.isfinite(new) and \
+            abs(new) <= 10 * max(abs(old), 1.0):
+        return "a component of a pose vector (t in m, theta-u in rad), finite, of either sign, within 10x of the seed's"
     if isinstance(old, str) and isinstance(new, str) and last.startswith("@") or last == "#text":
         a, b = old.split(), new.split()
         try:
             pairs = [(float(x), float(y)) for x, y in zip(a, b)]
         except ValueError:
-            return None
-        if len(a) != len(b) or not all(_plausible(x, y) for x, y in pairs):
-            return None
-        return "a finite geometric or camera value within 10x of the seed's (`%s`)" % "/".join(keys[-2:])
+            pairs = None
+        if pairs is not None:
+            if len(a) != len(b) or not all(_plausible(x, y) for x, y in pairs):
+                return None
+            return "a finite geometric or camera value within 10x of the seed's (`%s`)" % "/".join(keys[-2:])
     if kind.name == "observations" and last == "id" and isinstance(new, str) and new.strip():
         return "a pose's id is a label: any non-empty one"
+    if kind.name == "urdf" and "<joint>" in keys and last == "@name" and isinstance(new, str) and new and \
+            ctx.get("seed_text", b"").count(('"%s"' % old).encode()) == 1:
+        return "the name of a URDF joint no element names (a label)"
+    if kind.name == "calibrated_model" and "intrinsics_stddev" in keys and _is_number(new) and 0 <= new <= 1e6:
+        return "an intrinsics standard deviation in its documented range [0, 1e6] (reported, not used by compensate)"
+    if kind.name == "calibrated_model" and "parameters" in keys and _is_number(new) and abs(new) < 1e-12:
+        return "a kinematic parameter set to zero (below 1e-12 of its unit): a valid parameter"
     if kind.name == "camera_visp" and "<name>" in keys and ctx.get("seed_name") == "cam_visp.xml":
         return "the name of the only camera of a file read without --camera-name"
     if kind.name == "ros_pose" and last in ("qx", "qy", "qz", "qw") and _is_number(new) and isinstance(ctx.get("new_doc"), dict):
@@ -213,6 +236,8 @@ def _rule_for_value(kind, ctx, path, old, new):
         return None
     if kind.name in ("report_json", "study_json"):
         return "a finite number of a report: report only renders it"
+    if kind.name == "trajectory" and "scene_dots_mm" in keys and _plausible(old, new):
+        return "a scene dot's coordinate, finite and within 10x of the seed's (any such dot is a valid scene)"
     if kind.name == "trajectory" and last in ("poses_deg", "poses_rad"):
         limits = _joint_limits(ctx, kind, path)
         if limits:
@@ -248,6 +273,67 @@ def _normal(data):
     data = data[3:] if data.startswith(b"\xef\xbb\xbf") else data
     return b"\n".join(line.rstrip(b" \t\r") for line in data.split(b"\n"))
 
+UNIT_PAIRS = {"_mm": ("_m", 1e-3), "_m": ("_mm", 1e3), "_deg": ("_rad", math.pi / 180), "_rad": ("_deg", 180 / math.pi)}
+
+
+def _same_in_other_unit(path, value, here, there):
+    """The key at `path` of document `here` is absent from `there`, which gives the same quantity under the
+    key's other unit (`a_mm` / `a_m`, `_deg` / `_rad`) with the same value converted (a reader takes both)."""
+    if not path or not isinstance(path[-1], str) or not _is_number(value):
+        return False
+    for suffix, (other, factor) in UNIT_PAIRS.items():
+        if path[-1].endswith(suffix):
+            twin = path[:-1] + (path[-1][:-len(suffix)] + other,)
+            v = there.get(twin)
+            if twin not in here and _is_number(v) and math.isclose(v, value * factor, rel_tol=1e-9, abs_tol=1e-12):
+                return True
+    return False
+
+
+def _journal_kept(records):
+    """The records a reader uses, in order, an exact repeat of one dropped (a repeated sample_accepted,
+    frame_written or pose_planned must agree with the first and the first counts: samples.h)."""
+    kept, seen = [], set()
+    for r in records:
+        if isinstance(r, dict) and r.get("type") in PROGRESS_RECORDS:
+            continue
+        key = json.dumps(r, sort_keys=True)
+        if key in seen and isinstance(r, dict) and r.get("type") in ("sample_accepted", "frame_written", "pose_planned"):
+            continue
+        seen.add(key)
+        kept.append(r)
+    return kept
+
+
+def _urdf_as_sets(doc):
+    """A URDF's tree with <robot>'s <link> and <joint> lists sorted by name: their order is not data."""
+    if not isinstance(doc, dict):
+        return doc
+    out = dict(doc)
+    for tag in ("<link>", "<joint>"):
+        if isinstance(out.get(tag), list):
+            out[tag] = sorted(out[tag], key=lambda e: json.dumps(e, sort_keys=True))
+    return out
+
+
+def _document_rule(kind, old, new):
+    """A rule about the whole document, or "": see the module's docstring."""
+    if kind.name in ("report_json", "study_json") and isinstance(old, dict) and isinstance(new, dict) and \
+            all(new.get(k) == old.get(k) for k in ("format", "version")):
+        return ("a %s document of the seed's format and version: `report` renders what it is given (a key it "
+                "lacks leaves its figure or row out, every text is escaped: report/html_report.h) and computes "
+                "nothing from it" % ("report" if kind.name == "report_json" else "study"))
+    kept_old = _journal_kept(old["records"]) if kind.fmt == "journal" else None
+    if kind.fmt == "journal" and not old["torn_tail"] and \
+            (_journal_kept(new["records"]) == kept_old if not new["torn_tail"] else
+             _journal_kept(new["records"]) == kept_old[:len(_journal_kept(new["records"]))]):
+        return ("only records of the motion's progress (move_started, move_done, settled) removed, repeated or "
+                "reordered, or a sample, frame or plan record repeated exactly: the records a reader uses are the "
+                "same, in the same order%s" % (" up to a torn tail (ignored, session-format.md)" if new["torn_tail"] else ""))
+    if kind.name == "urdf" and _urdf_as_sets(old) == _urdf_as_sets(new):
+        return "a URDF's links or joints reordered: they are sets, their order is not data"
+    return ""
+
 
 def explain(kind, ctx, original, mutant, ops):
     names = [o["desc"].split(" ")[0] for o in ops]
@@ -263,11 +349,27 @@ def explain(kind, ctx, original, mutant, ops):
         line = huge[0].get("line", b"x") if huge else b"x"
         if huge and len(ops) == 1 and (not line.strip() or line.strip().startswith((b"#", b"<!--"))):
             return True, "semantics-preserving (huge): a comment or blank line repeated"
+        if True:  # a comment's line inside it, a progress record or a report's list item repeated
+            try:
+                same = _document_rule(kind, old, parse(kind.fmt, mutant)) or \
+                    ("the same data after parsing" if parse(kind.fmt, mutant) == old else "")
+            except Exception:  # noqa: BLE001
+                same = ""
+            if same:
+                return True, "%s (a file of %.1f MiB: %s)" % (same, len(mutant) / 2.0 ** 20, ", ".join(names))
         return False, "a file of %.1f MiB accepted (%s)" % (len(mutant) / 2.0 ** 20, ", ".join(names))
     try:
-        new = parse(kind.fmt, mutant)
+        try:
+            new = parse(kind.fmt, mutant)
+        except Exception:  # noqa: BLE001
+            if "trailing_space" not in {o["op"] for o in ops} or kind.fmt == "journal":
+                raise
+            new = parse(kind.fmt, _normal(mutant))  # PyYAML refuses a tab at a flow line's end; it is not data
     except Exception as e:  # noqa: BLE001
         return False, "not a valid %s file for a strict reader: %s" % (kind.fmt, str(e).splitlines()[0][:160] if str(e) else type(e).__name__)
+    document_rule = _document_rule(kind, old, new)
+    if document_rule:
+        return True, document_rule
     if kind.fmt == "journal" and new["torn_tail"] and new["records"] == old["records"][:len(new["records"])]:
         return True, "torn journal tail: the records before it unchanged (a torn tail is ignored, session-format.md)"
     if old == new:
@@ -277,20 +379,30 @@ def explain(kind, ctx, original, mutant, ops):
             return True, "semantics-preserving (%s): the same data" % ", ".join(sorted(ops_set))
         return True, "the same data after parsing (%s)" % ", ".join(sorted(ops_set))
     fa, fb = flatten(old), flatten(new)
-    ctx = dict(ctx, new_doc=new)
+    ctx = dict(ctx, new_doc=new, seed_text=original)
     reasons = set()
     differing = (set(fa) ^ set(fb)) | {q for q in fa if q in fb and fa[q] != fb[q]}
-    for p in fa:
-        if len(p) >= 2 and p[-1] == "[]" and p[-2] in RECORD_LISTS:
-            prefix = p[:-1]
-            if all(q[:len(prefix)] == prefix for q in differing) and _record_list_change(old, new, prefix):
-                return True, "records of `%s` removed, repeated or reordered: a list of any length (%s)" % (p[-2], ", ".join(names))
+    covered = [p[:-1] for p in fa if len(p) >= 2 and p[-1] == "[]" and p[-2] in RECORD_LISTS and
+               any(q[:len(p) - 1] == p[:-1] for q in differing) and _record_list_change(old, new, p[:-1])]
+    for prefix in covered:
+        reasons.add("records of `%s` removed, repeated or reordered: a list of any length (%s)" % (prefix[-1], ", ".join(names)))
     for path in sorted(set(fa) | set(fb), key=str):
         a, b = fa.get(path, None), fb.get(path, None)
         if path in fa and path in fb and a == b:
             continue
+        if any(path[:len(prefix)] == prefix for prefix in covered):
+            continue
+        if kind.name == "urdf" and path and path[0] in ("<transmission>", "<gazebo>"):
+            reasons.add("inside <transmission> or <gazebo> (ros_control's and Gazebo's: selfcal reads neither)")
+            continue
         keys = _keys_of(path)
         if path not in fb:
+            if kind.name == "camera_visp" and "<name>" in keys and ctx.get("seed_name") == "cam_visp.xml":
+                reasons.add("the name of the only camera of a file read without --camera-name removed")
+                continue
+            if _same_in_other_unit(path, a, fa, fb):
+                reasons.add("`%s` given in the other unit of its quantity, the same value" % keys[-1])
+                continue
             if keys and (keys[-1] in OPTIONAL.get(kind.name, ()) or keys[-1] in FREE_TEXT or
                          any(k in OPTIONAL.get(kind.name, ()) for k in keys)):
                 reasons.add("optional key `%s` removed" % keys[-1])
@@ -301,7 +413,7 @@ def explain(kind, ctx, original, mutant, ops):
                 continue
             return False, "key %s removed and the reader did not ask for it" % "/".join(map(str, path))
         if path not in fa:
-            if path[-1] == "{}":
+            if path[-1] == "{}" or _same_in_other_unit(path, b, fb, fa):
                 continue
             if kind.name == "urdf" and len(path) >= 2 and path[0].startswith("<") and \
                     path[0] not in ("<link>", "<joint>", "<material>") and not any("deeper" in str(p) for p in path):

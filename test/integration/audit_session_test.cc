@@ -144,8 +144,40 @@ TEST_F(AuditSessionTest, RefusesASessionWhoseSetupTheRebuiltWorldDoesNotReproduc
                          &output),
             2)
       << output;
+  const fs::path setup_json = *root_ / "other_setup" / "inputs" / "setup.json";
+  const std::string line = LineOf(setup_json, "\"pixel_noise_px\"");
+  EXPECT_TRUE(Contains(output, setup_json.string() + ":" + line + ": `pixel_noise_px` is 0.5 where the simulated world"))
+      << output;
   EXPECT_TRUE(Contains(output, "does not reproduce")) << output;
-  EXPECT_TRUE(Contains(output, "setup.json")) << output;
+}
+
+// A key of the recorded setup the rebuilt world does not have, and a key given twice: named by line.
+TEST_F(AuditSessionTest, RefusesAnUnknownOrRepeatedSetupKeyNamingItsLine) {
+  std::string output;
+  EXPECT_EQ(AuditChanged("extra_setup", "setup.json", [](nlohmann::json* setup) { (*setup)["camera"]["k9"] = 1; },
+                         &output),
+            2)
+      << output;
+  const fs::path extra = *root_ / "extra_setup" / "inputs" / "setup.json";
+  EXPECT_TRUE(Contains(output, extra.string() + ":" + LineOf(extra, "\"k9\"") + ": ")) << output;
+  EXPECT_TRUE(Contains(output, "k9")) << output;
+
+  const fs::path session = Copy("twice_setup");
+  std::string text = ReadFile((session / "inputs" / "setup.json").string());
+  text.replace(text.find("\"pixel_noise_px\""), 0, "\"pixel_noise_px\": 0.5,\n  ");
+  RewriteInput(session, "setup.json", text);
+  EXPECT_EQ(RunSelfcal("audit " + session.string(), &output), 2) << output;
+  EXPECT_TRUE(Contains(output, (session / "inputs" / "setup.json").string() + ":")) << output;
+  EXPECT_TRUE(Contains(output, "`pixel_noise_px` is given twice")) << output;
+}
+
+// The same setup data written otherwise (indentation, key order) is the same setup: audited, exit 0.
+TEST_F(AuditSessionTest, AuditsASetupOfTheSameDataWrittenOtherwise) {
+  const fs::path session = Copy("reformatted_setup");
+  const nlohmann::json setup = nlohmann::json::parse(ReadFile((session / "inputs" / "setup.json").string()));
+  RewriteInput(session, "setup.json", setup.dump(4) + "\n");
+  std::string output;
+  EXPECT_EQ(RunSelfcal("audit " + session.string(), &output), 0) << output;
 }
 
 TEST_F(AuditSessionTest, RefusesToWriteItsJsonIntoTheSession) {

@@ -2,6 +2,7 @@
 // error at held-out targets when the nominal model's joints are commanded and when the compensated ones are,
 // both on the true arm of truth.json. Also: recorded joints outside the config's limits (calibrate warns and
 // names the poses, run refuses to command them) and identify-tracker's model.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -157,6 +158,18 @@ TEST(CompensateChain, ATargetOutsideTheLimitsExitsSevenAndWritesNothing) {
       << output;
   EXPECT_NE(output.find("joint 5 at "), std::string::npos) << output;
   EXPECT_NE(output.find("outside its limits [-100, 100] deg"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(dir / "joints.yaml"));
+  // Another robot's targets: refused at the line of `robot` (issue 36's campaign: it named only the key).
+  targets.robot = "irb140";
+  ASSERT_TRUE(io::SaveTargetsFile(targets, (dir / "targets.yaml").string()).ok());
+  const std::string text = testing::ReadFile((dir / "targets.yaml").string());
+  const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(text.find("robot:")), '\n'));
+  EXPECT_EQ(testing::RunSelfcal("compensate " + (dir / "calibrated_model.yaml").string() + " --targets " +
+                                    (dir / "targets.yaml").string() + " --out " + (dir / "joints.yaml").string(),
+                                &output),
+            2)
+      << output;
+  EXPECT_NE(output.find("targets.yaml:" + std::to_string(line) + ": `robot` = `irb140`"), std::string::npos) << output;
   EXPECT_FALSE(fs::exists(dir / "joints.yaml"));
   if (!HasFailure()) fs::remove_all(dir);
 }
