@@ -47,6 +47,30 @@ Status UrRobotOptions::Validate() const {
   return Status::Error(ErrorCode::kInvalidInput, "UR robot options:" + problems.str());
 }
 
+Result<UrRobotOptions> UrRunOptions(const std::string& host, const std::vector<int>& ports, JointLimits position_limits) {
+  const size_t colon = host.find(':');
+  const bool host_port = colon != std::string::npos && host.find(':', colon + 1) == std::string::npos;
+  if (host.empty() || host_port) {
+    return Status::Error(ErrorCode::kInvalidInput, "--address \"" + host + "\": --robot ur takes the controller's HOST "
+                                                   "alone (its ports are UR's; --ur-ports for the loopback fake)");
+  }
+  if (!ports.empty() && ports.size() != 3) {
+    return Status::Error(ErrorCode::kInvalidInput, "--ur-ports takes three ports: RTDE, secondary, Dashboard");
+  }
+  UrRobotOptions options;
+  if (ports.size() == 3) {
+    options.rtde_port = ports[0];
+    options.secondary_port = ports[1];
+    options.dashboard_port = ports[2];
+  }
+  position_limits.max_velocity_rad_s = Eigen::VectorXd::Constant(position_limits.lower_rad.size(), kUrJointSpeedLimit_rad_s);
+  options.limits = std::move(position_limits);
+  if (Status valid = options.Validate(); !valid.ok()) {
+    return Status::Error(ErrorCode::kInvalidInput, valid.message() + " (the robot config must describe a six-joint UR arm)");
+  }
+  return options;
+}
+
 UrRobot::UrRobot(std::string host, UrRobotOptions options)
     : host_(std::move(host)), options_(std::move(options)), name_("UR robot " + host_) {
   const Status valid = options_.Validate();

@@ -18,6 +18,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "base/status.h"
 #include "robot/clock.h"
@@ -47,6 +48,16 @@ struct UrRobotOptions {
   std::function<void(const std::string&)> log;     // what Connect() found (the factory calibration); may be empty
   Status Validate() const;
 };
+
+// The joint speed limit assumed for every joint of a UR arm: 120 deg/s, the slowest joint of UR's
+// datasheets (the base and shoulder of the larger arms); the velocity scaling is a fraction of it.
+inline constexpr double kUrJointSpeedLimit_rad_s = 2.0943951023931953;
+
+// The options of `selfcal run --robot ur`: `host` a host name or address (empty, or HOST:PORT, refused:
+// the ports are UR's), `ports` none (a controller's) or the RTDE, secondary and Dashboard ports (the
+// loopback fake's), the robot config's position limits with kUrJointSpeedLimit_rad_s. kInvalidInput
+// naming the option.
+Result<UrRobotOptions> UrRunOptions(const std::string& host, const std::vector<int>& ports, JointLimits position_limits);
 
 class UrRobot : public Robot {
  public:
