@@ -314,10 +314,14 @@ Status UrRobot::Connect() {
     std::ostringstream said;
     said.precision(12);
     said << name_ << ": " << identity_.model << " serial " << identity_.serial << ", factory calibration "
-         << identity_.calibration_id << " (status " << kinematics_->calibration_status << "): DH d [m]";
-    for (double d : kinematics_->dh_d) said << " " << d;
-    said << ", a [m]";
-    for (double a : kinematics_->dh_a) said << " " << a;
+         << identity_.calibration_id << " (status " << kinematics_->calibration_status
+         << "); its standard DH table in a robot config's keys:";
+    constexpr double kDegPerRad = 57.29577951308232;
+    for (int j = 0; j < 6; ++j) {
+      said << "\n  - {a_mm: " << kinematics_->dh_a[j] * 1e3 << ", alpha_deg: " << kinematics_->dh_alpha[j] * kDegPerRad
+           << ", d_mm: " << kinematics_->dh_d[j] * 1e3 << ", theta_offset_deg: " << kinematics_->dh_theta[j] * kDegPerRad
+           << "}";
+    }
     options_.log(said.str());
   }
   return Status::Ok();

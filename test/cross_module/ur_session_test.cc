@@ -125,6 +125,21 @@ TEST(UrSession, EachFaultDuringTheFirstMoveHaltsTheRunAndNoMoveFollows) {
     EXPECT_EQ(report.error, ErrorCode::kHardware) << c.name;
     EXPECT_EQ(report.halt_reason, c.halt_reason) << c.name << ": " << report.message;
     EXPECT_TRUE(report.stop_sent) << c.name;  // stopj; after a drop on a fresh connection
+    // The session records the controller's identity, the factory calibration's checksums included, and
+    // no move after its halt.
+    ASSERT_TRUE(cell.created.has_value()) << c.name;
+    const std::vector<nlohmann::json>& records = cell.created->journal().records();
+    ASSERT_FALSE(records.empty());
+    EXPECT_EQ(records.front()["type"], "session_started");
+    EXPECT_EQ(records.front()["robot_backend"], "ur");
+    EXPECT_EQ(records.front()["robot_model"], "UR5e");
+    EXPECT_EQ(records.front()["robot_serial"], "20235500001");
+    EXPECT_EQ(records.front()["robot_calibration"],
+              "ur-kinematics-00001001-00001002-00001003-00001004-00001005-00001006");
+    int moves = 0;
+    for (const nlohmann::json& r : records) moves += r["type"] == "move_started" ? 1 : 0;
+    EXPECT_EQ(moves, 1) << c.name;
+    EXPECT_EQ(records.back()["type"], "halted") << records.back().dump();
     cell.StopFake();
     EXPECT_EQ(cell.fake.motion_commands(), 1) << c.name << ": only the first move, none after the halt";
     EXPECT_GE(cell.fake.stop_commands(), 1) << c.name;

@@ -99,6 +99,10 @@ TEST(UrFakeBinary, AControllerIsIdentifiedAndNothingMovesWithoutACamera) {
     EXPECT_TRUE(Has(output, "UR5e serial 20235500001, factory calibration "
                             "ur-kinematics-00001001-00001002-00001003-00001004-00001005-00001006"))
         << output;
+    // The factory DH table in a robot config's keys, to start a nominal model from.
+    EXPECT_TRUE(Has(output, "  - {a_mm: 0, alpha_deg: 90, d_mm: 162.5, theta_offset_deg: 0}\n"
+                            "  - {a_mm: -425, alpha_deg: 0, d_mm: 0, theta_offset_deg: 0}"))
+        << output;
     EXPECT_TRUE(Has(output, "opening the camera")) << output;
     EXPECT_TRUE(Has(output, "HALTED before any motion command: nothing was sent to the arm")) << output;
     EXPECT_FALSE(fs::exists(dir / "s"));
