@@ -79,7 +79,47 @@ UrRobot::UrRobot(std::string host, UrRobotOptions options)
 
 UrRobot::~UrRobot() { CloseAll(); }
 
+void UrRobot::StartReader() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    latest_.reset();
+    reader_failure_ = Status::Ok();
+  }
+  stop_reader_ = false;
+  reader_ = std::thread([this] { ReadStreams(); });
+}
+
+void UrRobot::ReadStreams() {
+  while (!stop_reader_.load()) {
+    Status failure;
+    Result<ur::RtdePackage> package = ReadRtdePackage(0.02);
+    if (package.ok() && package->type == ur::kRtdeDataPackage) {
+      Result<ur::UrState> state = ur::DecodeStateData(package->payload, recipe_id_);
+      if (state.ok()) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        latest_ = *state;
+        latest_s_ = clock_.Now();
+        ++packages_read_;
+      } else {
+        failure = RobotFailure(RobotError::kProtocol, "RTDE: " + state.status().message());
+      }
+    } else if (!package.ok() && RobotErrorOf(package.status()) != RobotError::kTimeout) {
+      failure = package.status();
+    }
+    if (LineIoResult io; failure.ok() && !(io = secondary_.DiscardInput()).ok()) {
+      failure = RobotFailure(RobotError::kDisconnected, "secondary interface lost: " + io.error);
+    }
+    if (!failure.ok()) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      reader_failure_ = failure;
+      return;
+    }
+  }
+}
+
 void UrRobot::CloseAll() {
+  stop_reader_ = true;
+  if (reader_.joinable()) reader_.join();
   rtde_.Close();
   secondary_.Close();
   dashboard_.Close();
@@ -181,10 +221,10 @@ Result<ur::RtdePackage> UrRobot::ReadRtdePackage(double timeout_s) {
   LineIoResult io = rtde_.ReadBytes(&header, 3, timeout_s);
   if (io.outcome == LineIo::kTimeout) return RobotFailure(RobotError::kTimeout, "no RTDE package");
   Result<uint16_t> size = io.ok() ? ur::RtdePackageSize(header) : Result<uint16_t>(uint16_t{3});
-  if (!size.ok()) return Broken(RobotError::kProtocol, "RTDE: " + size.status().message());
+  if (!size.ok()) return RobotFailure(RobotError::kProtocol, "RTDE: " + size.status().message());
   if (io.ok()) io = rtde_.ReadBytes(&payload, *size - 3, options_.reply_timeout_s);
   if (!io.ok()) {
-    return Broken(ErrorOfIo(io.outcome), "RTDE (port " + std::to_string(options_.rtde_port) + "): " + io.error);
+    return RobotFailure(ErrorOfIo(io.outcome), "RTDE (port " + std::to_string(options_.rtde_port) + "): " + io.error);
   }
   return ur::RtdePackage{static_cast<uint8_t>(header[2]), payload};
 }
@@ -200,7 +240,7 @@ Status UrRobot::StartRtde() {
       if (!reply.ok() && RobotErrorOf(reply.status()) == RobotError::kTimeout) {
         return Broken(RobotError::kTimeout, "RTDE: no answer to request '" + std::string(1, char(type)) + "'");
       }
-      if (!reply.ok()) return reply.status();
+      if (!reply.ok()) return Broken(RobotErrorOf(reply.status()), reply.status().message());
       if (reply->type == type) return reply->payload;
       if (reply->type != ur::kRtdeTextMessage) {
         return Broken(RobotError::kProtocol, "RTDE: package type " + std::to_string(reply->type) +
@@ -233,20 +273,26 @@ Status UrRobot::StartRtde() {
   return Status::Ok();
 }
 
-Result<ur::UrState> UrRobot::LatestState() {
-  bool got = false;
+Result<ur::UrState> UrRobot::LatestState(double* arrival_s) {
+  const double deadline_s = clock_.Now() + options_.reply_timeout_s;
   while (true) {
-    Result<ur::RtdePackage> package = ReadRtdePackage(got ? 0.0 : options_.reply_timeout_s);
-    if (!package.ok() && RobotErrorOf(package.status()) == RobotError::kTimeout) {
-      if (got) return last_state_;
-      return Broken(RobotError::kTimeout, "RTDE: no data package within " + std::to_string(options_.reply_timeout_s) + " s");
+    Status failure;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      failure = reader_failure_;
+      if (failure.ok() && latest_ && clock_.Now() - latest_s_ <= options_.reply_timeout_s) {
+        last_state_ = *latest_;
+        if (arrival_s != nullptr) *arrival_s = latest_s_;
+        return last_state_;
+      }
     }
-    if (!package.ok()) return package.status();
-    if (package->type != ur::kRtdeDataPackage) continue;
-    Result<ur::UrState> state = ur::DecodeStateData(package->payload, recipe_id_);
-    if (!state.ok()) return Broken(RobotError::kProtocol, "RTDE: " + state.status().message());
-    last_state_ = *state;
-    got = true;
+    if (!failure.ok()) return Broken(RobotErrorOf(failure), failure.message());
+    if (clock_.Now() > deadline_s) {
+      std::ostringstream message;
+      message << "RTDE: no data package within " << options_.reply_timeout_s << " s";
+      return Broken(RobotError::kTimeout, message.str());
+    }
+    clock_.SleepFor(0.002);
   }
 }
 
@@ -282,7 +328,9 @@ Status UrRobot::ConnectUnchecked() {
                                                    said(identity_) + "); refusing it");
   }
   if (Status s = open(&rtde_, options_.rtde_port); !s.ok()) return s;
-  return StartRtde();
+  if (Status s = StartRtde(); !s.ok()) return s;
+  StartReader();  // from here on both streams are read as they come, whatever the caller does
+  return Status::Ok();
 }
 
 Status UrRobot::Connect() {
@@ -344,12 +392,13 @@ Result<JointLimits> UrRobot::Limits() {
 
 Result<JointReading> UrRobot::ReadJoints() {
   if (Status link = LinkStatus("ReadJoints"); !link.ok()) return link;
-  Result<ur::UrState> state = LatestState();
+  double arrival_s = 0;
+  Result<ur::UrState> state = LatestState(&arrival_s);
   if (!state.ok()) return state.status();
   JointReading reading;
   reading.position_rad = state->q_rad;
   reading.velocity_rad_s = state->qd_rad_s;
-  reading.time_s = clock_.Now();
+  reading.time_s = arrival_s;
   return reading;
 }
 
@@ -363,9 +412,6 @@ Status UrRobot::StartMove(const Eigen::VectorXd& target_rad, double velocity_sca
   if (const RobotStatus now = ur::StatusOfState(*state); now.state != MotionState::kIdle) {
     return RobotFailure(RobotError::kRejected, name_ + ": move refused before sending: " + now.message);
   }
-  if (LineIoResult io = secondary_.DiscardInput(); !io.ok()) {
-    return Broken(RobotError::kDisconnected, "secondary interface lost: " + io.error);
-  }
   const double velocity = velocity_scaling * options_.limits.max_velocity_rad_s.minCoeff();
   const std::string script = ur::MovejScript(target_rad, options_.acceleration_per_velocity * velocity, velocity);
   if (LineIoResult io = secondary_.WriteLine(script, options_.reply_timeout_s); !io.ok()) {
@@ -377,9 +423,6 @@ Status UrRobot::StartMove(const Eigen::VectorXd& target_rad, double velocity_sca
 
 Result<RobotStatus> UrRobot::GetStatus() {
   if (Status link = LinkStatus("GetStatus"); !link.ok()) return link;
-  if (LineIoResult io = secondary_.DiscardInput(); !io.ok()) {
-    return Broken(RobotError::kDisconnected, "secondary interface lost: " + io.error);
-  }
   Result<ur::UrState> state = LatestState();
   if (!state.ok()) return state.status();
   RobotStatus status = ur::StatusOfState(*state);

@@ -1,8 +1,9 @@
 // The Universal Robots backend (`selfcal run --robot ur --address HOST`, docs/universal-robots.md): a
 // `Robot` that speaks a UR controller's own interfaces (ur_protocol.h), no program on the robot's side:
 //   - RTDE (30004): the joints, joint speeds, runtime state, safety and robot status bits, streamed at
-//     rtde_frequency_hz; every reading is the newest package, stamped on this process's CLOCK_MONOTONIC
-//     when it is read (as network_robot.h's readings, for the camera's freshness checks);
+//     rtde_frequency_hz and read as it comes by a thread of this object; every reading is the newest
+//     package, stamped on this process's CLOCK_MONOTONIC when it arrived (as network_robot.h's readings,
+//     for the camera's freshness checks);
 //   - the secondary interface (30002): `movej` to move, `stopj` to stop; its robot state stream read at
 //     connect for the kinematics info (the factory calibration: DH values and checksums), then drained;
 //   - the Dashboard server (29999): at connect, what a person must clear before anything moves (remote
@@ -15,9 +16,13 @@
 // on every later call until Connect() succeeds again (R10), and a reconnect refuses another arm (R13).
 #pragma once
 
+#include <atomic>
+#include <cstdint>
 #include <functional>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "base/status.h"
@@ -81,15 +86,28 @@ class UrRobot : public Robot {
   // The factory calibration read at connect (the kinematics info), nullopt before.
   const std::optional<ur::KinematicsInfo>& factory_kinematics() const { return kinematics_; }
   const std::string& name() const { return name_; }
+  // RTDE data packages read since the object was made (the reader thread's progress).
+  uint64_t packages_read() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return packages_read_;
+  }
 
  private:
   Status ConnectUnchecked();
   Status CheckDashboard();
   Status ReadKinematics();
   Status StartRtde();
+  // One package from the RTDE socket (no change of the link state): kTimeout when none began in time.
   Result<ur::RtdePackage> ReadRtdePackage(double timeout_s);
-  // The newest state package (all buffered ones read, waiting up to reply_timeout_s for one when none is).
-  Result<ur::UrState> LatestState();
+  // The reader thread: from the end of Connect() until CloseAll(), the RTDE packages and the secondary
+  // interface's stream are read as they arrive (a stream left unread while the operator reads the preview
+  // would fill the socket, and a controller may drop such a client); the newest state kept with its
+  // arrival time; the first failure kept for the caller.
+  void StartReader();
+  void ReadStreams();
+  // The newest state package, no older than reply_timeout_s (waiting that long for one), and when it
+  // arrived; the reader's failure breaks the link.
+  Result<ur::UrState> LatestState(double* arrival_s = nullptr);
   Result<std::string> Dashboard(const std::string& command);
   Status LinkStatus(const char* call) const;
   Status Broken(RobotError error, const std::string& reason);
@@ -108,6 +126,13 @@ class UrRobot : public Robot {
   std::optional<ur::KinematicsInfo> kinematics_;
   std::optional<Eigen::VectorXd> target_;  // the move in progress
   ur::UrState last_state_;
+  std::thread reader_;
+  std::atomic<bool> stop_reader_{true};
+  std::mutex mutex_;  // guards the four below, written by the reader thread
+  std::optional<ur::UrState> latest_;
+  double latest_s_ = 0;
+  Status reader_failure_;
+  uint64_t packages_read_ = 0;
 };
 
 }  // namespace selfcal::robot

@@ -101,6 +101,20 @@ TEST(UrRobotTest, ConnectsReadsIdentityAndCalibrationAndMovesToASettledEnd) {
   EXPECT_EQ(served.fake().motion_commands(), 1);
 }
 
+// Both streams are read while nobody calls (the operator reading the preview before typing the serial):
+// the RTDE packages keep being consumed at the stream's rate, and the arm answers at once afterwards.
+TEST(UrRobotTest, TheStreamsAreReadWhileTheCallerWaits) {
+  ServedFake served({});
+  UrRobot arm("127.0.0.1", served.ClientOptions());
+  ASSERT_TRUE(arm.Connect().ok());
+  const uint64_t before = arm.packages_read();
+  std::this_thread::sleep_for(std::chrono::milliseconds(800));
+  EXPECT_GE(arm.packages_read() - before, 50u);  // 125 Hz: 100 in 0.8 s
+  const Result<JointReading> now = arm.ReadJoints();
+  ASSERT_TRUE(now.ok()) << now.status().message();
+  EXPECT_LT(MonotonicClock().Now() - now->time_s, 0.05);  // a fresh package, stamped when it arrived
+}
+
 // Each refusal at connect: the message says what a person must do, and no script reached the controller.
 TEST(UrRobotTest, RefusalsAtConnectSendNoMotionCommand) {
   struct Case {
