@@ -276,7 +276,10 @@ std::optional<Eigen::VectorXd> ParseMovej(const std::string& line, double* veloc
   char end = 0;
   const int read = std::sscanf(line.c_str(), "movej([%lf, %lf, %lf, %lf, %lf, %lf], a=%lf, v=%lf%c", &q[0], &q[1],
                                &q[2], &q[3], &q[4], &q[5], &a, &v, &end);
-  if (read != 9 || end != ')' || !(v > 0) || !(a > 0)) return std::nullopt;
+  if (read != 9 || end != ')' || !(v > 0) || !(a > 0) || !std::isfinite(v) || !std::isfinite(a)) return std::nullopt;
+  for (double qj : q) {
+    if (!std::isfinite(qj)) return std::nullopt;
+  }
   if (velocity_rad_s != nullptr) *velocity_rad_s = v;
   return Eigen::Map<const Eigen::VectorXd>(q, 6).eval();
 }

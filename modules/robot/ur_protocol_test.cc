@@ -115,6 +115,7 @@ TEST(UrProtocolTest, UrScriptLinesRoundTrip) {
   EXPECT_TRUE(back->isApprox(q, 1e-12));
   EXPECT_DOUBLE_EQ(v, 0.3);
   EXPECT_FALSE(ParseMovej("movej([0, 0, 0], a=1, v=1)", &v).has_value());
+  EXPECT_FALSE(ParseMovej("movej([nan, 0, 0, 0, 0, 0], a=1, v=1)", &v).has_value());
   EXPECT_EQ(StopjScript(3.0), "stopj(3.000000)");
   EXPECT_EQ(DashboardValue("Safetystatus: PROTECTIVE_STOP", "Safetystatus:"), "PROTECTIVE_STOP");
   EXPECT_EQ(DashboardValue("nonsense", "Robotmode:"), "");
