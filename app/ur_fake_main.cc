@@ -53,6 +53,7 @@ int main(int argc, char** argv) {
   app.add_flag("--remote-control-off", options.remote_control_off,
                "The Dashboard says remote control is off (and scripts are ignored)");
   app.add_flag("--protective-stop-at-start", options.protective_stop_at_start, "Start in a protective stop");
+  app.add_flag("--program-running", options.program_running, "A program runs on the controller (runtime_state 2)");
   selfcal::app::CheckNumbersStrictly(app);
   try {
     app.parse(argc, argv);

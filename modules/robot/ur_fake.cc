@@ -45,6 +45,7 @@ ur::KinematicsInfo Ur5eNominalKinematics() {
 UrFakeController::UrFakeController(const UrFakeOptions& options) : options_(options) {
   state_.q_rad = options_.start_rad;
   if (options_.protective_stop_at_start) state_.safety_status_bits = ur::kSafetyProtectiveStopped;
+  if (options_.program_running) state_.runtime_state = 2;
 }
 
 Result<UrFakeController> UrFakeController::Listen(const UrFakeOptions& options) {
@@ -69,7 +70,7 @@ void UrFakeController::DropAll(const Log& log) {
 void UrFakeController::Step(double dt_s, const Log& log) {
   if (!moving_) {
     state_.qd_rad_s.setZero();
-    state_.runtime_state = 1;
+    if (!options_.program_running) state_.runtime_state = 1;
     return;
   }
   move_time_s_ += dt_s;

@@ -38,6 +38,7 @@ struct UrFakeOptions {
   bool wrong_recipe = false;      // the recipe setup answered with NOT_FOUND for safety_status_bits
   bool remote_control_off = false;
   bool protective_stop_at_start = false;
+  bool program_running = false;   // runtime_state "playing": someone's program runs on the controller
 };
 
 class UrFakeController {

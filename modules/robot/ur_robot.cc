@@ -357,6 +357,13 @@ Status UrRobot::Connect() {
                                                                    : RobotError::kRejected,
                         name_ + ": RTDE reports " + now.message + ": a person must clear it at the teach pendant");
   }
+  if (last_state_.runtime_state != 1) {  // RTDE guide: 1 stopped; a script sent now would replace a program
+    CloseAll();
+    link_ = Link::kClosed;
+    return RobotFailure(RobotError::kRejected, name_ + ": a program is running on the controller (RTDE runtime_state " +
+                                                   std::to_string(last_state_.runtime_state) +
+                                                   ", not 1 stopped): stop it at the teach pendant");
+  }
   if (!first_identity_) first_identity_ = identity_;
   if (options_.log) {
     std::ostringstream said;

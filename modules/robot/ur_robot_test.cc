@@ -122,7 +122,8 @@ TEST(UrRobotTest, RefusalsAtConnectSendNoMotionCommand) {
     RobotError error;
     const char* says;
   };
-  UrFakeOptions remote_off, stopped, wrong_recipe, outside;
+  UrFakeOptions remote_off, stopped, wrong_recipe, outside, running;
+  running.program_running = true;
   remote_off.remote_control_off = true;
   stopped.protective_stop_at_start = true;
   wrong_recipe.wrong_recipe = true;
@@ -130,7 +131,8 @@ TEST(UrRobotTest, RefusalsAtConnectSendNoMotionCommand) {
   for (const Case& c : {Case{remote_off, RobotError::kRejected, "remote control is off"},
                         Case{stopped, RobotError::kProtectiveStop, "PROTECTIVE_STOP"},
                         Case{wrong_recipe, RobotError::kProtocol, "NOT_FOUND"},
-                        Case{outside, RobotError::kBadReading, "outside its limits"}}) {
+                        Case{outside, RobotError::kBadReading, "outside its limits"},
+                        Case{running, RobotError::kRejected, "a program is running on the controller"}}) {
     ServedFake served(c.options);
     UrRobot arm("127.0.0.1", served.ClientOptions());
     const Status s = arm.Connect();

@@ -1,7 +1,7 @@
 // `selfcal run --robot ur` against the selfcal-ur-fake binary on loopback (docs/universal-robots.md), as a
 // user meets it: a controller that connects is identified (model, serial, the factory calibration's
 // checksums) and, without a camera here, the run halts before any motion command; each state a person must
-// clear at the controller (remote control off, a protective stop) and a wrong answer to the RTDE recipe
+// clear at the controller (remote control off, a protective stop, a program running) and a wrong answer to the RTDE recipe
 // refuses the run at connect with the hardware exit code, a message saying what to do, no session, and no
 // motion command at the fake. Bad --address values are usage errors before anything is connected.
 // (The session loop's halts during a move: test/cross_module/ur_session_test.cc.)
@@ -121,7 +121,8 @@ TEST(UrFakeBinary, WhatAPersonMustClearRefusesTheRunAtConnectAndNothingIsSent) {
   };
   for (const Case& c : {Case{"--remote-control-off", "switch the teach pendant to Remote Control"},
                         Case{"--protective-stop-at-start", "PROTECTIVE_STOP: a person must clear it"},
-                        Case{"--wrong-recipe", "NOT_FOUND"}}) {
+                        Case{"--wrong-recipe", "NOT_FOUND"},
+                        Case{"--program-running", "a program is running on the controller"}}) {
     UrFake fake({c.fault}, dir / (std::string(c.fault).substr(2) + ".log"));  // a log each
     ASSERT_FALSE(fake.ports().empty());
     std::string output;
