@@ -20,13 +20,13 @@ void Say(const Log& log, const std::string& line) {
   if (log) log(line);
 }
 
-// A client waiting on `listener`: taken when `client` is free, else accepted and closed (one client).
-void AcceptOne(TcpListener* listener, LineSocket* client, const std::string& greeting) {
+// A client waiting on `listener` becomes `client`, replacing (closing) the one before; true when it did.
+bool AcceptNewest(TcpListener* listener, LineSocket* client, const std::string& greeting) {
   std::optional<LineSocket> waiting = listener->Accept(0, 4096);
-  if (!waiting) return;
-  if (client->is_open()) return;  // `waiting` closes when it goes out of scope
+  if (!waiting) return false;
   *client = std::move(*waiting);
   if (!greeting.empty()) client->WriteLine(greeting, 0.5);
+  return true;
 }
 
 }  // namespace
@@ -214,11 +214,9 @@ void UrFakeController::Serve(const std::atomic<bool>& stop, const Log& log) {
   MonotonicClock clock;
   double next_s = clock.Now();
   while (!stop.load()) {
-    AcceptOne(&dashboard_, &dashboard_client_, "Connected: Universal Robots Dashboard Server");
-    AcceptOne(&secondary_, &secondary_client_, "");
-    const bool rtde_was_open = rtde_client_.is_open();
-    AcceptOne(&rtde_, &rtde_client_, "");
-    if (!rtde_was_open) streaming_ = false;
+    AcceptNewest(&dashboard_, &dashboard_client_, "Connected: Universal Robots Dashboard Server");
+    AcceptNewest(&secondary_, &secondary_client_, "");
+    if (AcceptNewest(&rtde_, &rtde_client_, "")) streaming_ = false;
     ServeDashboard(log);
     ServeSecondary(log);
     ServeRtde(log);

@@ -6,7 +6,8 @@
 // target, all arriving together, the leading joint at movej's v. Faults on request: the connections
 // dropped during a move, a protective stop during a move, a move that stops short and never finishes,
 // a wrong answer to the recipe setup, remote control off. It counts the motion commands (movej) it
-// received, and every line it receives is passed to `log`. One client per port; not a real controller.
+// received, and every line it receives is passed to `log`. It serves the newest client of each port (a new
+// connection replaces the one before); not a real controller.
 #pragma once
 
 #include <atomic>

@@ -196,3 +196,65 @@ TEST(UrRobotTest, ADroppedConnectionIsStickyAndTheStopGoesOutOnAFreshConnection)
 
 }  // namespace
 }  // namespace selfcal::robot
+
+namespace selfcal::robot {
+namespace {
+
+// R10, R13: a reconnect re-reads the identity and refuses another arm; R12: an expected identity is
+// checked at connect. Both refusals come before anything is sent.
+TEST(UrRobotTest, AReconnectRefusesAnotherArmAndTheExpectedIdentityIsChecked) {
+  auto first = std::make_unique<ServedFake>(UrFakeOptions{});
+  const UrRobotOptions options = first->ClientOptions();
+  UrRobot arm("127.0.0.1", options);
+  ASSERT_TRUE(arm.Connect().ok());
+  arm.Disconnect();
+  ASSERT_TRUE(arm.Connect().ok());  // the same controller again
+  arm.Disconnect();
+  first.reset();
+  UrFakeOptions other;
+  other.serial = "20235599999";
+  other.rtde_port = options.rtde_port;  // another controller where the first one was
+  other.secondary_port = options.secondary_port;
+  other.dashboard_port = options.dashboard_port;
+  ServedFake second(other);
+  const Status again = arm.Connect();
+  EXPECT_EQ(RobotErrorOf(again), RobotError::kProtocol) << again.message();
+  EXPECT_NE(again.message().find("not the one first connected"), std::string::npos) << again.message();
+  UrRobotOptions expecting = options;
+  expecting.expected_identity = RobotIdentity{"", "UR5e", "20235500001", "", true};
+  UrRobot expected("127.0.0.1", expecting);
+  const Status refused = expected.Connect();
+  EXPECT_EQ(RobotErrorOf(refused), RobotError::kProtocol) << refused.message();
+  EXPECT_NE(refused.message().find("not the expected robot"), std::string::npos) << refused.message();
+  second.Shutdown();
+  EXPECT_EQ(second.fake().motion_commands(), 0);
+  EXPECT_EQ(second.fake().stop_commands(), 0);
+}
+
+// The controller's text reaches messages and the identity escaped (no terminal control from a controller).
+TEST(UrRobotTest, ControllerTextIsSanitised) {
+  UrFakeOptions options;
+  options.model = "UR5e\x1b[2J\a";
+  ServedFake served(options);
+  UrRobot arm("127.0.0.1", served.ClientOptions());
+  ASSERT_TRUE(arm.Connect().ok());
+  EXPECT_EQ(arm.Identity()->model, "UR5e\\x1b[2J\\x07");
+}
+
+// A controller that accepts the connection and never answers: a timeout at connect, not a hang.
+TEST(UrRobotTest, ASilentControllerTimesOutAtConnect) {
+  Result<TcpListener> silent = TcpListener::Listen("127.0.0.1", 0);
+  ASSERT_TRUE(silent.ok());
+  UrRobotOptions options = ServedFake(UrFakeOptions{}).ClientOptions();
+  options.dashboard_port = silent->port();
+  options.reply_timeout_s = 0.2;
+  UrRobot arm("127.0.0.1", options);
+  const auto start = std::chrono::steady_clock::now();
+  const Status s = arm.Connect();
+  EXPECT_EQ(RobotErrorOf(s), RobotError::kTimeout) << s.message();
+  EXPECT_NE(s.message().find("greeting"), std::string::npos) << s.message();
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0);
+}
+
+}  // namespace
+}  // namespace selfcal::robot
