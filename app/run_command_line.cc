@@ -37,8 +37,16 @@ Command AddRunCommand(CLI::App& app) {
   cmd->add_option("--setup", a->setup,
                   "Camera, yardstick and checks (docs/session-format.md); refused with --robot sim, whose cell makes "
                   "its own");
-  cmd->add_option("--robot", a->robot_backend, "Robot backend")->check(CLI::IsMember({"sim", "network", "manual"}));
-  cmd->add_option("--address", a->address, "network backend: HOST:PORT (docs/robot-protocol.md)");
+  cmd->add_option("--robot", a->robot_backend, "Robot backend")->check(CLI::IsMember({"sim", "network", "manual", "ur"}));
+  cmd->add_option("--address", a->address,
+                  "network backend: HOST:PORT (docs/robot-protocol.md); ur: the controller's HOST "
+                  "(docs/universal-robots.md)");
+  cmd->add_option("--ur-ports", a->ur_ports,
+                  "ur: the RTDE, secondary interface and Dashboard ports (default 30004,30002,29999; another set for "
+                  "selfcal-ur-fake)")
+      ->delimiter(',')
+      ->expected(3)
+      ->check(CLI::Range(1, 65535));
   cmd->add_option("--camera", a->camera_backend, "Camera backend")->check(CLI::IsMember({"sim", "v4l2"}));
   cmd->add_option("--device", a->device, "v4l2 camera device");
   cmd->add_option("--velocity-scaling", a->velocity_scaling,

@@ -33,6 +33,7 @@
 #include "simulation/sim_session.h"
 #include "robot/manual_robot.h"
 #include "robot/network_robot.h"
+#include "robot/ur_robot.h"
 #include "session/samples.h"
 #include "session/session_cleanup.h"
 #include "session/session_dir.h"
@@ -351,22 +352,31 @@ Status MakeBackends(const RunSettings& a, RunPlan* run, Backends* b) {
   }
   b->owned_clock = std::make_unique<robot::MonotonicClock>();
   b->clock = b->owned_clock.get();
+  const auto log = [](const std::string& line) {
+    ClearProgressLine();
+    std::cout << TerminalSafe(line) << "\n";
+  };
   if (a.robot_backend == "network") {
     const size_t colon = a.address.rfind(':');
     const int port = colon == std::string::npos ? -1 : PortNumber(a.address.substr(colon + 1));
     if (port < 0) return Status::Error(ErrorCode::kInvalidInput, "--address must be HOST:PORT, not \"" + a.address + "\"");
     robot::NetworkRobotOptions options;  // everything checked at connect against the robot config
     options.config_limits = ManualJointLimits(run->nominal);
-    options.log = [](const std::string& line) {
-      ClearProgressLine();
-      std::cout << TerminalSafe(line) << "\n";
-    };
+    options.log = log;
     b->owned_robot = std::make_unique<robot::NetworkRobot>(a.address.substr(0, colon), port, options);
+  } else if (a.robot_backend == "ur") {
+    if (a.address == RunSettings().address) {
+      return Status::Error(ErrorCode::kInvalidInput, "--robot ur needs --address HOST, the controller's (docs/universal-robots.md)");
+    }
+    Result<robot::UrRobotOptions> ur = robot::UrRunOptions(a.address, a.ur_ports, ManualJointLimits(run->nominal));
+    if (!ur.ok()) return ur.status();
+    ur.value().log = log;
+    b->owned_robot = std::make_unique<robot::UrRobot>(a.address, *ur);
   } else if (a.robot_backend == "manual") {
     b->owned_robot = std::make_unique<robot::ManualRobot>(std::cin, JsonMode() ? std::cerr : std::cout,
                                                           ManualJointLimits(run->nominal), *b->clock);
   } else {
-    return Status::Error(ErrorCode::kInvalidInput, "--robot must be sim, network or manual");
+    return Status::Error(ErrorCode::kInvalidInput, "--robot must be sim, network, manual or ur");
   }
   b->arm = b->owned_robot.get();
   capture::V4l2Options options;

@@ -27,6 +27,7 @@ struct RunSettings {
   std::string setup;  // required unless --camera sim
   std::string robot_backend = "sim";
   std::string address = "127.0.0.1:5700";
+  std::vector<int> ur_ports;  // --robot ur: RTDE, secondary, Dashboard ports; empty: a controller's
   std::string camera_backend = "sim";
   std::string device = "/dev/video0";
   double velocity_scaling = -1;  // default: 1.0 simulated, 0.1 otherwise (R1)

@@ -131,8 +131,11 @@ Result<LineSocket> LineSocket::Connect(const std::string& host, int port, double
 }
 
 LineIoResult LineSocket::WriteLine(const std::string& line, double timeout_s) {
+  return WriteBytes(line + "\n", timeout_s);
+}
+
+LineIoResult LineSocket::WriteBytes(const std::string& data, double timeout_s) {
   if (fd_ < 0) return {LineIo::kClosed, "not connected"};
-  const std::string data = line + "\n";
   const double deadline_s = MonotonicClock().Now() + timeout_s;
   size_t sent = 0;
   while (sent < data.size()) {
@@ -171,8 +174,16 @@ LineIoResult LineSocket::ReadLine(std::string* line, double timeout_s) {
     if (buffer_.size() > max_line_bytes_) {
       return {LineIo::kTooLong, "more than " + std::to_string(max_line_bytes_) + " bytes without a line end"};
     }
+    const LineIoResult filled = Fill(deadline_s);
+    if (filled.outcome == LineIo::kTimeout) return {LineIo::kTimeout, "no complete line within the timeout"};
+    if (!filled.ok()) return filled;
+  }
+}
+
+LineIoResult LineSocket::Fill(double deadline_s) {
+  while (true) {
     const int ready = WaitFor(fd_, POLLIN, deadline_s);
-    if (ready == 0) return {LineIo::kTimeout, "no complete line within the timeout"};
+    if (ready == 0) return {LineIo::kTimeout, "nothing within the timeout"};
     if (ready < 0) return {LineIo::kFailed, "poll: " + ErrnoText(errno)};
     char chunk[4096];
     const ssize_t n = ::recv(fd_, chunk, sizeof(chunk), 0);
@@ -184,7 +195,29 @@ LineIoResult LineSocket::ReadLine(std::string* line, double timeout_s) {
       return {LineIo::kFailed, "recv: " + ErrnoText(error)};
     }
     buffer_.append(chunk, static_cast<size_t>(n));
+    return {};
   }
+}
+
+LineIoResult LineSocket::ReadBytes(std::string* data, size_t count, double timeout_s) {
+  if (fd_ < 0) return {LineIo::kClosed, "not connected"};
+  const double deadline_s = MonotonicClock().Now() + timeout_s;
+  while (buffer_.size() < count) {
+    const LineIoResult filled = Fill(deadline_s);
+    if (!filled.ok()) return filled;
+  }
+  data->assign(buffer_, 0, count);
+  buffer_.erase(0, count);
+  return {};
+}
+
+LineIoResult LineSocket::DiscardInput() {
+  if (fd_ < 0) return {LineIo::kClosed, "not connected"};
+  const double now_s = MonotonicClock().Now();
+  LineIoResult filled;
+  while ((filled = Fill(now_s)).ok()) buffer_.clear();
+  buffer_.clear();
+  return filled.outcome == LineIo::kTimeout ? LineIoResult{} : filled;
 }
 
 TcpListener::~TcpListener() { Close(); }

@@ -54,7 +54,19 @@ class LineSocket {
   // Bytes received beyond the lines read so far.
   bool has_buffered_input() const { return !buffer_.empty(); }
 
+  // Binary use (the UR backend's RTDE and primary interfaces, ur_protocol.h): sends `data` as it is.
+  LineIoResult WriteBytes(const std::string& data, double timeout_s);
+  // Exactly `count` bytes, waiting at most `timeout_s` (0: only what has already arrived); on a timeout
+  // the bytes received so far stay buffered for the next call.
+  LineIoResult ReadBytes(std::string* data, size_t count, double timeout_s);
+  // Reads and drops whatever has arrived (a stream nobody reads must not fill the socket); kClosed when
+  // the peer closed or reset the connection.
+  LineIoResult DiscardInput();
+
  private:
+  // One poll() until `deadline_s` and one recv() into the buffer.
+  LineIoResult Fill(double deadline_s);
+
   int fd_ = -1;
   size_t max_line_bytes_ = 0;
   std::string buffer_;

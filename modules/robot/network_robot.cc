@@ -39,13 +39,6 @@ Status SanitisedStatus(const Status& status) {
   return RobotFailure(RobotErrorOf(status), Sanitised(status.message()));
 }
 
-std::string Numbers(const Eigen::VectorXd& v) {
-  std::ostringstream out;
-  out.precision(6);
-  for (Eigen::Index i = 0; i < v.size(); ++i) out << (i ? " " : "") << v[i];
-  return out.str();
-}
-
 }  // namespace
 
 Status NetworkRobotOptions::Validate() const {
@@ -206,8 +199,10 @@ Status NetworkRobot::CheckAgainstConfig(const protocol::HelloInfo& hello, JointL
       return RobotFailure(RobotError::kProtocol, name_ + ": LIMITS: " + what.str() + " do not overlap");
     }
     if ((lower != limits->lower_rad[j] || upper != limits->upper_rad[j]) && options_.log) {
-      options_.log(name_ + ": " + what.str() + ": the narrower [" + Numbers(Eigen::Vector2d(lower, upper)) +
-                   "] rad is used");
+      std::ostringstream narrower;
+      narrower.precision(6);
+      narrower << ": the narrower [" << lower << " " << upper << "] rad is used";
+      options_.log(name_ + ": " + what.str() + narrower.str());
     }
     limits->lower_rad[j] = lower;
     limits->upper_rad[j] = upper;
@@ -217,43 +212,8 @@ Status NetworkRobot::CheckAgainstConfig(const protocol::HelloInfo& hello, JointL
 
 Status NetworkRobot::CheckStartReading() {
   if (!options_.config_limits) return Status::Ok();
-  JointReading readings[2];
-  for (int k = 0; k < 2; ++k) {
-    if (k == 1) clock_.SleepFor(options_.rest_interval_s);
-    Result<JointReading> r = ReadJoints();
-    if (!r.ok()) return r.status();
-    const JointReading& q = *r;
-    const std::string which = name_ + ": the start reading " + (k == 0 ? "" : "(again) ");
-    if (q.position_rad.size() != limits_.lower_rad.size() || q.velocity_rad_s.size() != q.position_rad.size()) {
-      return RobotFailure(RobotError::kBadReading, which + "has " + std::to_string(q.position_rad.size()) +
-                                                       " joints, the robot config has " +
-                                                       std::to_string(limits_.lower_rad.size()));
-    }
-    if (!q.position_rad.allFinite() || !q.velocity_rad_s.allFinite()) {
-      return RobotFailure(RobotError::kBadReading, which + "is not finite: " + Numbers(q.position_rad) + " rad, " +
-                                                       Numbers(q.velocity_rad_s) + " rad/s");
-    }
-    for (Eigen::Index j = 0; j < q.position_rad.size(); ++j) {
-      if (q.position_rad[j] < limits_.lower_rad[j] - 1e-9 || q.position_rad[j] > limits_.upper_rad[j] + 1e-9) {
-        std::ostringstream what;
-        what << which << "has joint " << j + 1 << " at " << q.position_rad[j] << " rad, outside its limits ["
-             << limits_.lower_rad[j] << ", " << limits_.upper_rad[j] << "] rad";
-        return RobotFailure(RobotError::kBadReading, what.str());
-      }
-    }
-    readings[k] = q;
-  }
-  const double moved = (readings[1].position_rad - readings[0].position_rad).cwiseAbs().maxCoeff();
-  const double speed = std::max(readings[0].velocity_rad_s.cwiseAbs().maxCoeff(),
-                                readings[1].velocity_rad_s.cwiseAbs().maxCoeff());
-  if (moved > options_.rest_tolerance_rad || speed > options_.rest_velocity_rad_s) {
-    std::ostringstream what;
-    what << name_ << ": the arm is not at rest at connect: two readings " << options_.rest_interval_s
-         << " s apart differ by up to " << moved << " rad, joint speeds up to " << speed << " rad/s (at rest: "
-         << options_.rest_tolerance_rad << " rad, " << options_.rest_velocity_rad_s << " rad/s)";
-    return RobotFailure(RobotError::kBadReading, what.str());
-  }
-  return Status::Ok();
+  return CheckStartAtRest([this] { return ReadJoints(); }, [this](double s) { clock_.SleepFor(s); }, limits_,
+                          {options_.rest_interval_s, options_.rest_tolerance_rad, options_.rest_velocity_rad_s}, name_);
 }
 
 Status NetworkRobot::Connect() {

@@ -2,9 +2,20 @@
 
 #include <cmath>
 #include <cstring>
+#include <algorithm>
 #include <sstream>
 
 namespace selfcal::robot {
+namespace {
+
+std::string Numbers(const Eigen::VectorXd& v) {
+  std::ostringstream out;
+  out.precision(6);
+  for (Eigen::Index i = 0; i < v.size(); ++i) out << (i ? " " : "") << v[i];
+  return out.str();
+}
+
+}  // namespace
 
 const char* RobotErrorName(RobotError error) {
   switch (error) {
@@ -120,6 +131,47 @@ std::string CheckMoveTarget(const JointLimits& limits, const Eigen::VectorXd& ta
     }
   }
   return "";
+}
+
+Status CheckStartAtRest(const std::function<Result<JointReading>()>& read, const std::function<void(double)>& sleep,
+                        const JointLimits& limits, const RestCheck& rest, const std::string& name) {
+  JointReading readings[2];
+  for (int k = 0; k < 2; ++k) {
+    if (k == 1) sleep(rest.interval_s);
+    Result<JointReading> r = read();
+    if (!r.ok()) return r.status();
+    const JointReading& q = *r;
+    const std::string which = name + ": the start reading " + (k == 0 ? "" : "(again) ");
+    if (q.position_rad.size() != limits.lower_rad.size() || q.velocity_rad_s.size() != q.position_rad.size()) {
+      return RobotFailure(RobotError::kBadReading, which + "has " + std::to_string(q.position_rad.size()) +
+                                                       " joints, the robot config has " +
+                                                       std::to_string(limits.lower_rad.size()));
+    }
+    if (!q.position_rad.allFinite() || !q.velocity_rad_s.allFinite()) {
+      return RobotFailure(RobotError::kBadReading, which + "is not finite: " + Numbers(q.position_rad) + " rad, " +
+                                                       Numbers(q.velocity_rad_s) + " rad/s");
+    }
+    for (Eigen::Index j = 0; j < q.position_rad.size(); ++j) {
+      if (q.position_rad[j] < limits.lower_rad[j] - 1e-9 || q.position_rad[j] > limits.upper_rad[j] + 1e-9) {
+        std::ostringstream what;
+        what << which << "has joint " << j + 1 << " at " << q.position_rad[j] << " rad, outside its limits ["
+             << limits.lower_rad[j] << ", " << limits.upper_rad[j] << "] rad";
+        return RobotFailure(RobotError::kBadReading, what.str());
+      }
+    }
+    readings[k] = q;
+  }
+  const double moved = (readings[1].position_rad - readings[0].position_rad).cwiseAbs().maxCoeff();
+  const double speed = std::max(readings[0].velocity_rad_s.cwiseAbs().maxCoeff(),
+                                readings[1].velocity_rad_s.cwiseAbs().maxCoeff());
+  if (moved > rest.tolerance_rad || speed > rest.velocity_rad_s) {
+    std::ostringstream what;
+    what << name << ": the arm is not at rest at connect: two readings " << rest.interval_s
+         << " s apart differ by up to " << moved << " rad, joint speeds up to " << speed << " rad/s (at rest: "
+         << rest.tolerance_rad << " rad, " << rest.velocity_rad_s << " rad/s)";
+    return RobotFailure(RobotError::kBadReading, what.str());
+  }
+  return Status::Ok();
 }
 
 }  // namespace selfcal::robot

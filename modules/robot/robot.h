@@ -15,6 +15,7 @@
 // carries a RobotError; RobotErrorOf() reads it back. Messages name the backend and the pose or joint.
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include <Eigen/Core>
@@ -96,6 +97,18 @@ double QuinticMoveDuration(const Eigen::VectorXd& from_rad, const Eigen::VectorX
 // not in (0, 1]. Names the joint (1-based), the value and the limit, in rad. For the backends that check
 // targets themselves before anything moves (R3, C6).
 std::string CheckMoveTarget(const JointLimits& limits, const Eigen::VectorXd& target_rad, double velocity_scaling);
+
+// What a backend checks of the arm before anything moves (R8, R4): two readings of `read` taken
+// interval_s apart, each of the limits' length, finite and within them, agreeing within tolerance_rad with
+// joint speeds within velocity_rad_s (at rest). `sleep` waits the interval; `name` prefixes the messages.
+// kBadReading naming the joint and values, or the error of `read`.
+struct RestCheck {
+  double interval_s = 0.05;
+  double tolerance_rad = 1e-3;
+  double velocity_rad_s = 1e-2;
+};
+Status CheckStartAtRest(const std::function<Result<JointReading>()>& read, const std::function<void(double)>& sleep,
+                        const JointLimits& limits, const RestCheck& rest, const std::string& name);
 
 struct RobotStatus {
   MotionState state = MotionState::kIdle;

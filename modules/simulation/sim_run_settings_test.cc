@@ -178,6 +178,10 @@ TEST(SimRunSettings, OnlyTheSimulatedRobotAndCameraAreASimulatedRun) {
   ASSERT_TRUE(backends.ok());
   EXPECT_EQ(backends->robot, "network");
   EXPECT_FALSE(backends->simulated());
+  run["robot"] = "ur";  // a session of the Universal Robots backend is read, and is not simulated
+  backends = ReadRunBackends(Text(run));
+  ASSERT_TRUE(backends.ok()) << backends.status().message();
+  EXPECT_FALSE(backends->simulated());
   run["robot"] = "sim";
   run["camera"] = "v4l2";
   backends = ReadRunBackends(Text(run));
