@@ -1,6 +1,6 @@
 // --camera sim with another robot (FollowReportedJoints): every frame shows the cell's world at the joints
 // that robot reports when the frame is delivered, one reading per frame, and a bad reading leaves the
-// camera where the last good one put it.
+// camera where the last good one put it. And a dry run (RunOptions::dry_run) opens no camera.
 #include <gtest/gtest.h>
 
 #include "simulation/sim_session.h"
@@ -78,6 +78,39 @@ TEST(FollowReportedJoints, EachFrameShowsTheJointsTheRobotReports) {
   EXPECT_LT(OffsetFrom(h.cell, first), 1e-9);
   EXPECT_EQ(arm.readings, 4);
   EXPECT_NE(h.cell.camera->Describe().find("real time"), std::string::npos);  // the monotonic clock of live backends
+}
+
+// A camera that is not there: Open fails, and counts.
+class AbsentCamera : public capture::FrameSource {
+ public:
+  std::string Describe() const override { return "absent camera"; }
+  Status Open() override {
+    ++opens;
+    return Status::Error(ErrorCode::kHardware, "no such device");
+  }
+  Result<capture::Frame> Grab(double, double) override { return Status::Error(ErrorCode::kHardware, "closed"); }
+  void Close() override {}
+  int opens = 0;
+};
+
+TEST(FollowReportedJoints, ADryRunNeedsNoCameraAndIsNeverArmed) {
+  Harness h(5);
+  AbsentCamera absent;
+  acquisition::RunContext c = h.Context();
+  c.camera = &absent;
+  h.options.dry_run = true;
+  std::string shown;
+  c.confirm = [&](const std::string& preview, const robot::RobotIdentity&) {
+    shown = preview;
+    return true;  // even a yes does not arm a dry run
+  };
+  const acquisition::RunReport report = acquisition::RunSession(h.plan, c, h.options);
+  EXPECT_EQ(report.outcome, acquisition::RunOutcome::kRefused) << report.message;
+  EXPECT_EQ(absent.opens, 0);
+  EXPECT_NE(shown.find("5 moves"), std::string::npos) << shown;
+  EXPECT_EQ(h.cell.robot->counts().start_move, 0);
+  EXPECT_EQ(h.cell.robot->counts().stop, 0);
+  EXPECT_TRUE(h.session->journal().records().empty());
 }
 
 }  // namespace
