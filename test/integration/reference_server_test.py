@@ -7,14 +7,15 @@ Modes (each a ctest of its own):
   protocol    raw requests: JOINTS before HELLO refused, a second client refused while the first goes on,
               bad MOVEs refused, and a connection reset (RST) by the client mid-move: the arm at rest within
               one control cycle (from the server's log), and still there for the next client.
-  session     selfcal run --robot network --camera sim: the default plan (25 poses) recorded, calibrate
-              accepts it.
+  session     selfcal run --robot network --camera sim: the default plan (25 poses) recorded while a second
+              client is refused mid-session, calibrate accepts it.
   kill        selfcal SIGKILLed mid-move: the arm at rest within one control cycle of the server noticing,
               measured from the kill.
   exception   the arm's joint read raises mid-move: the server stops the arm (within a cycle) and drops the
               client; selfcal halts (exit 4) and sends no motion command after it.
   protective  a protective stop mid-move: selfcal halts (exit 4), no MOVE after it; refused again until a
               person acknowledges (SIGUSR1), then `run --resume` completes the session.
+  emergency   an emergency stop mid-move: selfcal halts (exit 4), no MOVE after it.
   terminate   the server ended (SIGTERM) mid-move: the arm at rest within a cycle, selfcal halts (exit 4).
 """
 import os
@@ -162,7 +163,14 @@ def run_selfcal(selfcal, src, server, session, extra=(), background=False):
 def session(selfcal, src, tmp, failures):
     server = Server(src)
     s = os.path.join(tmp, "s")
-    code, out = run_selfcal(selfcal, src, server, s)
+    proc = run_selfcal(selfcal, src, server, s, background=True)
+    server.wait_for(r"move #5 started")
+    intruder = Client(server.port)  # a second client mid-session: refused, the session goes on
+    refused = intruder.reader.readline().rstrip("\n")
+    if refused != "ERR fault busy: another client is connected" or intruder.reader.readline() != "":
+        failures.append("a second client during the session: %r, not refused and closed" % refused)
+    out, _ = proc.communicate(timeout=300)
+    code = proc.returncode
     print(out[-800:])
     if code != 0 or "run: completed: session complete: 25 samples accepted" not in out:
         failures.append("run against the reference server: exit %d\n%s\n%s" % (code, out[-3000:], server.log()[-3000:]))
@@ -200,6 +208,11 @@ def mid_move(selfcal, src, tmp, move, act):
     acted_s = time.monotonic()
     act(server, proc)
     return server, proc, acted_s
+
+
+def emergency(selfcal, src, tmp, failures):
+    server, _, _ = halted_run(selfcal, src, tmp, failures, ["--emergency-stop-move", "2"], "emergency_stop")
+    server.stop()
 
 
 def kill(selfcal, src, tmp, failures):
@@ -254,7 +267,7 @@ def main():
     with tempfile.TemporaryDirectory(prefix="refserver-") as tmp:
         try:
             {"protocol": protocol, "session": session, "kill": kill, "exception": exception,
-             "protective": protective, "terminate": terminate}[mode](selfcal, src, tmp, failures)
+             "protective": protective, "emergency": emergency, "terminate": terminate}[mode](selfcal, src, tmp, failures)
         except AssertionError as e:
             failures.append(str(e))
     for f in failures:
