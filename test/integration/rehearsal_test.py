@@ -8,7 +8,8 @@ dry-run: with selfcal-robot-sim on a free port, `run --robot network --dry-run` 
   camera), and with `--camera sim` (the simulated camera following the network robot) likewise; nothing is
   created and no MOVE reaches the server.
 session: selfcal-robot-sim (started at the default plan's first pose) plus `run --robot network --camera
-  sim` records the whole default plan (25 poses), `calibrate` accepts it, and its figures equal those of
+  sim` records the whole default plan (25 poses), `audit` finds its identities right against the cell
+  rebuilt from its inputs (the world that rendered it), `calibrate` accepts it, and its figures equal those of
   the same plan and seed on `--robot sim` within the statistics: every free parameter and f_x within 4
   combined standard deviations (sqrt(s1^2 + s2^2): the two sessions' images carry different pixel noise,
   their frames being numbered differently), the same free set, and both check-distance RMS below 0.5 mm.
@@ -106,6 +107,20 @@ def whole_session(selfcal, robot_sim, src, tmp, failures):
         recorded = json.load(f)
     if (recorded["robot"], recorded["camera"], recorded["seed"]) != ("network", "sim", 1):
         failures.append("run.json does not record the network robot, the simulated camera and seed 1: %s" % recorded)
+    # Which world rendered the images: `audit` rebuilds the cell from the session's inputs (robot.yaml,
+    # plan, run.json's seed; setup.json must match) and scores every recorded identity against its truth.
+    audit_json = os.path.join(tmp, "audit.json")
+    code, out = run(selfcal, ["audit", network, "--json", audit_json], src)
+    if code != 0:
+        failures.append("audit of the network session: exit %d\n%s" % (code, out[-2000:]))
+    else:
+        with open(audit_json) as f:
+            audit = json.load(f)["identities"]
+        print("audit: %d samples, %d wrong identities, named %.0f of %.0f dots in view per sample, worst %.3f px" %
+              (audit["samples_accepted"], audit["wrong_total"], audit["named_per_sample"]["mean"],
+               audit["in_view_per_sample"]["mean"], audit["max_right_error_px"]))
+        if audit["wrong_total"] != 0 or audit["samples_accepted"] != 25 or not audit["max_right_error_px"] < 0.5:
+            failures.append("audit of the network session: %s" % json.dumps(audit)[:2000])
     simulated = os.path.join(tmp, "simulated")
     code, out = run(selfcal, ["run", "--robot", "sim", "--camera", "sim", "--seed", "1", "--live-view", "off",
                               "--session", simulated], src)
