@@ -35,6 +35,9 @@ PLAN = "config/trajectories/initial_puma560.yaml"
 CYCLE_S = 0.008
 
 
+STARTED = []  # every server a test started: stopped at the end whatever happened
+
+
 class Server:
     """The reference server on a free port; its stderr collected line by line with the arrival time."""
 
@@ -44,6 +47,7 @@ class Server:
         args = [sys.executable, os.path.join(src, "scripts", "reference-robot-server"), "--port", "0",
                 "--cycle-s", str(CYCLE_S), "--initial-joints-rad", ",".join(repr(q) for q in first)] + list(extra)
         self.proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        STARTED.append(self.proc)
         line = self.proc.stdout.readline()
         if not line.startswith("listening on 127.0.0.1:"):
             raise RuntimeError("reference-robot-server did not start: " + line + self.proc.stderr.read())
@@ -270,6 +274,11 @@ def main():
              "protective": protective, "emergency": emergency, "terminate": terminate}[mode](selfcal, src, tmp, failures)
         except AssertionError as e:
             failures.append(str(e))
+        finally:
+            for proc in STARTED:
+                if proc.poll() is None:
+                    proc.kill()
+                    proc.wait()
     for f in failures:
         print("FAILED: " + f)
     return 1 if failures else 0

@@ -26,12 +26,16 @@ import tempfile
 PLAN = "config/trajectories/initial_puma560.yaml"
 
 
+STARTED = []  # every server a test started: stopped at the end whatever happened
+
+
 class Server:
     """selfcal-robot-sim on 127.0.0.1, any free port (it prints the one it got)."""
 
     def __init__(self, binary, cwd, extra):
         self.proc = subprocess.Popen([binary, "--port", "0", "--serial", "REHEARSAL-1"] + extra, cwd=cwd,
                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        STARTED.append(self.proc)
         line = self.proc.stdout.readline()
         if not line.startswith("listening on 127.0.0.1:"):
             raise RuntimeError("selfcal-robot-sim did not start: " + line + self.proc.stderr.read())
@@ -168,7 +172,13 @@ def main():
     mode, selfcal, robot_sim, src = sys.argv[1:5]
     failures = []
     with tempfile.TemporaryDirectory(prefix="rehearsal-") as tmp:
-        {"dry-run": dry_run, "session": whole_session}[mode](selfcal, robot_sim, src, tmp, failures)
+        try:
+            {"dry-run": dry_run, "session": whole_session}[mode](selfcal, robot_sim, src, tmp, failures)
+        finally:
+            for proc in STARTED:
+                if proc.poll() is None:
+                    proc.kill()
+                    proc.wait()
     for f in failures:
         print("FAILED: " + f)
     return 1 if failures else 0
