@@ -20,6 +20,7 @@
 #include "base/install_layout.h"
 #include "base/status.h"
 #include "io/robot_config.h"
+#include "io/trajectory_file.h"
 #include "robot/clock.h"
 #include "robot/robot_server.h"
 #include "robot/simulated_robot.h"
@@ -37,6 +38,7 @@ struct Args {
   int port = 0;
   double max_velocity_deg_s = 60;
   std::vector<double> initial_joints_deg;
+  std::string start_at_plan;  // the first pose of this trajectory file
   std::string serial;
   std::string calibration_id;
   uint64_t seed = 0;
@@ -72,6 +74,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1e-3, 1e4));
   app.add_option("--initial-joints-deg", args.initial_joints_deg, "Start joints (deg; default 0, or mid-range)")
       ->delimiter(',');
+  app.add_option("--start-at-plan", args.start_at_plan,
+                 "Start at the first pose of this trajectory file (the plan a rehearsal runs: `selfcal run "
+                 "--robot network --camera sim`)")
+      ->excludes("--initial-joints-deg");
   app.add_option("--serial", args.serial, "Serial reported in HELLO (default sim-<seed>)");
   app.add_option("--calibration-id", args.calibration_id, "Calibration id reported in HELLO");
   app.add_option("--seed", args.seed, "Seed of the encoder noise");
@@ -124,6 +130,15 @@ int main(int argc, char** argv) {
                                                       " values for " + std::to_string(n) + " joints"));
     }
     for (int j = 0; j < n; ++j) options.initial_joints_rad[j] = args.initial_joints_deg[j] * kRadPerDeg;
+  }
+  if (!args.start_at_plan.empty()) {
+    const Result<io::TrajectoryFile> plan =
+        io::LoadTrajectoryFileForRobot(FindDataFile(args.start_at_plan), *model, args.robot);
+    if (!plan.ok()) return Fail(plan.status());
+    if (plan->poses.empty()) {
+      return Fail(Status::Error(ErrorCode::kInvalidInput, "--start-at-plan " + args.start_at_plan + ": no poses"));
+    }
+    options.initial_joints_rad = plan->poses.front();
   }
   options.latency_s = args.latency_s;
   options.encoder_noise_rad = args.encoder_noise_deg * kRadPerDeg;

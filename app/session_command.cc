@@ -184,17 +184,17 @@ Status OpenRunLiveView(const RunSettings& a, Backends* b) {
 // Refuses backend combinations that cannot work and fills in the default velocity scaling.
 Status CheckRunSettings(RunSettings* a) {
   const bool sim_robot = a->robot_backend == "sim";
-  if ((a->camera_backend == "sim") != sim_robot) {
+  const bool sim_camera = a->camera_backend == "sim";  // with any robot: it renders the joints the robot reports
+  if (sim_robot && !sim_camera) {
     return Status::Error(ErrorCode::kInvalidInput,
-                         "--camera sim renders what the simulated arm sees: it needs --robot sim, and --robot sim "
-                         "needs --camera sim");
+                         "--robot sim needs --camera sim: the simulated arm moves only in the simulated cell");
   }
-  if (sim_robot && !a->setup.empty()) {
+  if (sim_camera && !a->setup.empty()) {
     return Status::Error(ErrorCode::kInvalidInput,
-                         "--setup " + a->setup + " does not apply to --robot sim: the simulated cell makes its own "
-                         "setup (camera, yardstick, checks); leave --setup out, or run a real robot and camera");
+                         "--setup " + a->setup + " does not apply to --camera sim (nor --robot sim): the simulated "
+                         "cell makes its own setup (camera, yardstick, checks); leave --setup out, or use a real camera");
   }
-  if (!sim_robot && a->setup.empty()) {
+  if (!sim_camera && a->setup.empty()) {
     return Status::Error(ErrorCode::kInvalidInput,
                          "--setup FILE (camera, yardstick; docs/session-format.md) is required with a real camera");
   }
@@ -227,8 +227,9 @@ Status LoadRunPlan(const RunSettings& a, RunPlan* run) {
     return Status::Error(ErrorCode::kDegenerateData, acquisition::PreflightRefusal(acquisition::PreflightProblems(check)));
   }
   run->inputs = {robot_input, *plan_input, {"run.json", RunJsonText(a)}};
-  // The simulated cell is built before the session so that its setup can be recorded.
-  if (a.robot_backend == "sim") {
+  // The simulated cell (--camera sim, with any robot) is built before the session so that its setup can be
+  // recorded.
+  if (a.camera_backend == "sim") {
     run->cell = simulation::MakeSimCell(run->nominal, run->plan, SimCellOptionsFor(a), run->plan.front().joints_rad, 0);
     if (!run->cell.ok()) return run->cell.status();
     const ObservationSet setup = simulation::SimSetup(*run->cell);
@@ -379,11 +380,19 @@ Status MakeBackends(const RunSettings& a, RunPlan* run, Backends* b) {
     return Status::Error(ErrorCode::kInvalidInput, "--robot must be sim, network, manual or ur");
   }
   b->arm = b->owned_robot.get();
+  if (b->owned_identifier) b->identifier = b->owned_identifier.get();
+  if (a.camera_backend == "sim") {  // the simulated cell's camera at the joints this robot reports
+    simulation::FollowReportedJoints(&run->cell.value(), SimCellOptionsFor(a), b->arm, run->plan.front().joints_rad);
+    b->camera = run->cell->camera.get();
+    std::cout << "camera sim: the simulated cell of seed " << a.seed << " (run.json), rendered at the joints the "
+              << a.robot_backend << " robot reports\n";
+    if (!b->owned_identifier) b->identifier = run->cell->identifier.get();
+    return Status::Ok();
+  }
   capture::V4l2Options options;
   options.device = a.device;
   b->owned_camera = std::make_unique<capture::V4l2Camera>(options);
   b->camera = b->owned_camera.get();
-  if (b->owned_identifier) b->identifier = b->owned_identifier.get();
   return Status::Ok();
 }
 
@@ -473,6 +482,7 @@ int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, co
   options.journal_sim_clock = sim_robot;
   options.mode = sim_robot ? "simulated" : a.robot_backend;
   options.revisit_skipped = a.revisit_skipped;
+  options.dry_run = a.dry_run;  // no camera opened
   if (sim_robot) options.settle.min_dwell_s = 0.6;  // > the simulated ring-down cutoff (resume determinism)
   acquisition::RunContext context;
   context.robot = b.arm;

@@ -263,8 +263,9 @@ Route Runner::PlanRoute(const session::SessionLog& log, const std::vector<int>& 
 }
 
 bool Runner::Arm(const Route& route, const RobotAtStart& robot) {
-  // V1: the camera must work before anything moves (its Open grabs a test frame where it can).
-  if (Status s = c_.camera->Open(); !s.ok()) {
+  // V1: the camera must work before anything moves (its Open grabs a test frame where it can). A dry run
+  // moves nothing and needs no camera.
+  if (Status s = o_.dry_run ? Status::Ok() : c_.camera->Open(); !s.ok()) {
     report_.outcome = RunOutcome::kHalted;
     report_.error = ErrorCode::kHardware;
     report_.message = "opening the camera " + c_.camera->Describe() + ": " + s.message();
@@ -281,8 +282,9 @@ bool Runner::Arm(const Route& route, const RobotAtStart& robot) {
     report_.message = PreflightRefusal(preflight.problems);
     return false;
   }
-  // A dry run of a resume is never armed, whatever the callback answers: it holds no session to write.
-  if (!c_.confirm(report_.preview, identity) || c_.dry_run_of != nullptr) {
+  // A dry run (and a dry run of a resume, which holds no session to write) is never armed, whatever the
+  // callback answers.
+  if (!c_.confirm(report_.preview, identity) || c_.dry_run_of != nullptr || o_.dry_run) {
     report_.message = "not confirmed: nothing was sent to the arm";
     return false;
   }

@@ -133,6 +133,9 @@ struct RunOptions {
   std::uint64_t frame_bytes_estimate = 400 * 1024;  // P5: free space needed per frame
   bool journal_sim_clock = false;   // simulated sessions: journal the clock with each sample (resume)
   std::string mode = "simulated";   // session_started.mode
+  // A dry run: the robot is read and the preview made, and the run is never armed, whatever confirm
+  // answers; the camera is not opened (a dry run needs none).
+  bool dry_run = false;
   int revisit_skipped = 1;          // resume: further attempts per pose skipped for a revisitable reason
   // A session whose every pose is visited with fewer accepted identification samples than this ends in
   // kTooFewSamples, not kCompleted: the default calibration (the bundle adjustment,

@@ -17,18 +17,18 @@ namespace {
 
 Status Refuse(const std::string& message) { return Status::Error(ErrorCode::kInvalidInput, message); }
 
-// The recorded session's run settings, refused unless they are the simulated robot's and camera's.
+// The recorded session's run settings, refused unless its images are the simulated camera's (any robot).
 Result<SimCellOptions> SimulatedRunOptions(const session::SessionSnapshot& snapshot, const std::string& path) {
   Result<std::string> text = snapshot.Input("run.json");
   if (!text.ok()) return text.status();
   const std::string name = path + "/inputs/run.json";
   Result<RunBackends> backends = ReadRunBackends(*text, name);
   if (!backends.ok()) return backends.status();
-  if (!backends->simulated()) {
+  if (!backends->rendered()) {  // the simulated camera with any robot: the joints it rendered are recorded
     return Refuse("session " + path + " was recorded with robot \"" + TerminalSafe(backends->robot) +
                   "\" and camera \"" + TerminalSafe(backends->camera) + "\" (" + backends->robot_at +
-                  "): only a session recorded with the simulated robot and camera (run --robot sim --camera sim) "
-                  "has a hidden truth to audit against");
+                  "): only a session recorded with the simulated camera (run --camera sim, with the simulated "
+                  "robot or any other) has a hidden truth to audit against");
   }
   return SimCellOptionsFor(*text, name);
 }

@@ -1,4 +1,4 @@
-// `selfcal audit SESSION`: the dot identities of a session recorded with the simulated robot and camera,
+// `selfcal audit SESSION`: the dot identities of a session recorded with the simulated camera (any robot),
 // scored against the simulator's hidden truth (identity_audit.h). Read-only: the session is read through
 // session::ReadSession (no lock, nothing written). The hidden world is not stored in the session; it is
 // rebuilt from the recorded inputs exactly as `selfcal run` built it (robot.yaml, the journal's plan,
@@ -24,7 +24,7 @@ struct SessionAudit {
 };
 
 // The audit of the session at `session_path`. kInvalidInput naming the session and file when it cannot
-// be read, was not recorded with the simulated robot and camera (run.json), or its world cannot be
+// be read, was not recorded with the simulated camera (run.json), or its world cannot be
 // rebuilt identically; kDegenerateData when the world cannot be simulated at all.
 Result<SessionAudit> AuditSession(const std::string& session_path,
                                   const IdentityAuditOptions& options = IdentityAuditOptions());

@@ -31,8 +31,11 @@ struct RunBackends {
   std::string camera;
   std::string robot_at;
 
-  // The simulated robot and camera ("robot": "sim", "camera": "sim"): a session with a hidden truth.
+  // The simulated robot and camera ("robot": "sim", "camera": "sim").
   bool simulated() const { return robot == "sim" && camera == "sim"; }
+  // Images of the simulated cell ("camera": "sim", any robot: the camera renders the joints the robot
+  // reports): a session with a hidden truth.
+  bool rendered() const { return camera == "sim"; }
 };
 Result<RunBackends> ReadRunBackends(const std::string& run_json_text, const std::string& name = "run.json");
 

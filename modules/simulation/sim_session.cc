@@ -1,6 +1,7 @@
 #include "simulation/sim_session.h"
 
 #include <limits>
+#include <memory>
 
 #include "sim/image_renderer.h"
 
@@ -30,6 +31,20 @@ std::vector<tracking::PreviousDot> TruthIdentifier::FindMarked(const capture::Fr
                                                                const std::vector<int>& missing_ids) {
   return Name(detections, missing_ids);
 }
+
+namespace {
+
+// The dots a real scene would mark (the yardsticks' ends): TruthIdentifier::FindMarked names them anywhere.
+std::vector<int> MarkedDots(const sim::SimResult& world) {
+  std::vector<int> marked;
+  for (const KnownDistance& y : world.observations.yardsticks) {
+    marked.push_back(y.dot_a);
+    marked.push_back(y.dot_b);
+  }
+  return marked;
+}
+
+}  // namespace
 
 Result<SimCell> MakeSimCell(const RobotModel& nominal, const std::vector<acquisition::PlannedPose>& plan,
                             const SimCellOptions& options, const Eigen::VectorXd& start_joints_rad,
@@ -83,12 +98,29 @@ void RestartSimCell(SimCell* cell, const SimCellOptions& options, const Eigen::V
   const robot::SimulatedRobot* arm = cell->robot.get();
   cell->camera->SetPoseFunction(
       [truth, arm](double t) { return BaseFromCam(truth->nominal, truth->rho_true, arm->JointsAt(t)); });
-  std::vector<int> marked;
-  for (const KnownDistance& y : cell->world->observations.yardsticks) {
-    marked.push_back(y.dot_a);
-    marked.push_back(y.dot_b);
-  }
-  cell->identifier = std::make_unique<TruthIdentifier>(cell->camera.get(), marked);
+  cell->identifier = std::make_unique<TruthIdentifier>(cell->camera.get(), MarkedDots(*cell->world));
+}
+
+void FollowReportedJoints(SimCell* cell, const SimCellOptions& options, robot::Robot* robot,
+                          const Eigen::VectorXd& start_joints_rad) {
+  cell->identifier.reset();  // refers to the camera
+  cell->camera.reset();
+  cell->robot.reset();
+  sim::SimulatedCameraOptions camera_options = options.camera;
+  camera_options.render.noise_seed = options.world.noise_seed;
+  camera_options.real_time = true;
+  cell->camera = std::make_unique<sim::SimulatedCamera>(
+      cell->world->truth.camera_true, sim::MakeDotScene(cell->world->truth), camera_options);
+  const sim::SimTruth* truth = &cell->world->truth;
+  auto joints = std::make_shared<Eigen::VectorXd>(start_joints_rad);
+  cell->camera->SetPoseFunction([truth, robot, joints](double /*exposure_s*/) {
+    Result<robot::JointReading> reading = robot->ReadJoints();
+    if (reading.ok() && reading->position_rad.size() == joints->size() && reading->position_rad.allFinite()) {
+      *joints = reading->position_rad;
+    }
+    return BaseFromCam(truth->nominal, truth->rho_true, *joints);
+  });
+  cell->identifier = std::make_unique<TruthIdentifier>(cell->camera.get(), MarkedDots(*cell->world));
 }
 
 ObservationSet SimSetup(const SimCell& cell) {

@@ -3,6 +3,10 @@
 // through the true kinematics at the arm's true joints at every exposure, so that RunSession runs on it
 // exactly as on hardware (issue 6; `selfcal simulate` and `selfcal run --robot sim --camera sim`).
 //
+// With any other robot (`selfcal run --robot network|manual|... --camera sim`, a rehearsal without a
+// camera), FollowReportedJoints makes the same cell's camera follow that robot instead: each frame renders
+// the cell's world at the joints the robot reports when the frame is delivered, in real time.
+//
 // The first frame's dots are named by TruthIdentifier (the renderer knows which disc is which), standing
 // in for a pattern or AprilTags; every later identity comes from tracking alone.
 //
@@ -74,6 +78,16 @@ Result<SimCell> MakeSimCell(const RobotModel& nominal, const std::vector<acquisi
 // rest at `start_joints_rad`, the clock at `start_time_s` (the restart model of the header comment).
 void RestartSimCell(SimCell* cell, const SimCellOptions& options, const Eigen::VectorXd& start_joints_rad,
                     double start_time_s);
+
+// --camera sim with a robot other than the cell's own: the cell's camera (same world, scene, true arm and
+// rendering) is rebuilt in real time on the monotonic clock (the clock every live backend stamps its
+// readings with), and each frame is rendered at the true arm's camera pose at the joints `robot` reports
+// when the frame is delivered: one Robot::ReadJoints per frame (those readings count among the robot's).
+// A reading that fails, is short or is not finite leaves the camera where the last good one put it (the
+// session finds the bad reading itself at its next call); before any good reading, at `start_joints_rad`.
+// The cell's own SimulatedRobot is removed (nothing may drive it). `robot` must outlive the camera.
+void FollowReportedJoints(SimCell* cell, const SimCellOptions& options, robot::Robot* robot,
+                          const Eigen::VectorXd& start_joints_rad);
 
 // The setup of a simulated session: the world's observation header (camera with the nominal f_x,
 // yardstick, check distances), no poses.

@@ -123,7 +123,7 @@ TEST_F(AuditSessionTest, RefusesASessionNotRecordedWithTheSimulatedRobot) {
             2)
       << output;
   EXPECT_TRUE(Contains(output, "recorded with robot \"manual\"")) << output;
-  EXPECT_TRUE(Contains(output, "simulated robot")) << output;
+  EXPECT_TRUE(Contains(output, "simulated camera")) << output;
   const std::string line = LineOf(*root_ / "manual" / "inputs" / "run.json", "\"robot\"");
   EXPECT_TRUE(Contains(output, "inputs/run.json:" + line + "): only a session recorded")) << output;
 }

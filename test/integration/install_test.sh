@@ -77,7 +77,7 @@ echo "installed files (under $root):"
   END { print "  share/doc/selfcal/docs/: " docs " files" }')
 for file in bin/selfcal bin/selfcal-full bin/selfcal-robot-sim share/selfcal/config/robots/puma560.yaml \
   share/selfcal/config/trajectories/initial_puma560.yaml share/doc/selfcal/README.md \
-  share/doc/selfcal/docs/troubleshooting.md; do
+  share/doc/selfcal/docs/troubleshooting.md share/doc/selfcal/examples/reference-robot-server; do
   [[ -f $root/$file ]] || fail "$file not installed"
 done
 [[ -n $(find "$root" -path '*/selfcal/libselfcal_camera_formats.so') ]] ||

@@ -153,7 +153,7 @@ TEST(RunSafety, OptionsThatCannotApplyAreRefusedBeforeAnythingHappens) {
   EXPECT_EQ(RunSelfcal("run --session " + session.string() + " --setup " + (dir / "setup.json").string(), &output), 2)
       << output;
   EXPECT_TRUE(Has(StderrOf("run --session " + session.string() + " --setup " + (dir / "setup.json").string()),
-                  "does not apply to --robot sim"));
+                  "does not apply to --camera sim"));
   EXPECT_FALSE(fs::exists(session));
   for (const char* bad : {"nan", "inf", "0", "-0.5", "1.5", "abc"}) {
     const std::string command = "run --session " + session.string() + " --velocity-scaling " + bad;
