@@ -22,7 +22,9 @@
 //      VIDIOC_S_FMT returning EBUSY; messages name the node, errno and its name. TESTED without hardware:
 //      missing node, regular file, directory, a character device that is not V4L2 (/dev/null).
 //      UNTESTED (needs hardware or an unprivileged user): busy, permission denied, metadata-only node.
-//   V2 (format) - code: VIDIOC_S_FMT then VIDIOC_G_FMT on our own descriptor before ViSP opens, and
+//   V2 (format) - code: the device's modes enumerated (VIDIOC_ENUM_FMT / ENUM_FRAMESIZES /
+//      ENUM_FRAMEINTERVALS, v4l2_modes.h) and the requested format, size and frame period refused with the
+//      list when it is not among them (TESTED on the check, without hardware); VIDIOC_S_FMT then VIDIOC_G_FMT on our own descriptor before ViSP opens, and
 //      VIDIOC_G_FMT again after (ViSP silently falls back to other pixel formats); any difference in
 //      width, height, pixel format or a padded row (ViSP copies rows without stride) is kFormatMismatch.
 //      UNTESTED without hardware.
@@ -36,7 +38,8 @@
 //      Open. UNTESTED without hardware (the same rule is tested on the recorded and simulated sources).
 //   V6 (bad frames) - code: CheckFrame on every returned frame (kBadFrame); duplicates cannot occur (each
 //      frame is returned once). Truncated buffers (bytesused) are not visible through vpV4l2Grabber: NOT
-//      COVERED. The checks themselves are tested in frame_checks.
+//      COVERED for the uncompressed formats; an MJPEG frame that is truncated, corrupt or flagged
+//      V4L2_BUF_FLAG_ERROR is kBadFrame (the decoding TESTED on recorded frames, the stream UNTESTED). The checks themselves are tested in frame_checks.
 //   V7 (exposure / focus) - code: V4L2_CID_EXPOSURE_AUTO = manual, V4L2_CID_EXPOSURE_AUTO_PRIORITY = 0,
 //      V4L2_CID_AUTOGAIN = 0, V4L2_CID_FOCUS_AUTO = 0 (optionally absolute values), each read back with
 //      VIDIOC_G_CTRL and reported in controls() and Describe(); an absent or refused control is reported,
@@ -55,9 +58,14 @@
 
 namespace selfcal::capture {
 
-// The pixel formats vpV4l2Grabber converts to grey.
-enum class V4l2PixelFormat { kGrey, kYuyv, kRgb24, kBgr24, kRgb32 };
-const char* V4l2PixelFormatName(V4l2PixelFormat format);  // "GREY", "YUYV", "RGB3", "BGR3", "RGB4" (fourcc)
+// The pixel formats read: the uncompressed ones through vpV4l2Grabber, which converts them to grey; MJPEG
+// (most USB cameras at 1280x720 and above) through capture's own memory-mapped stream (v4l2_stream.h) and
+// libjpeg-turbo (mjpeg_decode.h), the luminance plane alone.
+enum class V4l2PixelFormat { kGrey, kYuyv, kRgb24, kBgr24, kRgb32, kMjpeg };
+// "GREY", "YUYV", "RGB3", "BGR3", "RGB4", "MJPG" (fourcc)
+const char* V4l2PixelFormatName(V4l2PixelFormat format);
+// The format of a fourcc name (case-sensitive, as above); false when none.
+bool V4l2PixelFormatFromName(const std::string& name, V4l2PixelFormat* format);
 
 struct V4l2Options {
   std::string device = "/dev/video0";
