@@ -3,6 +3,7 @@
 #include <memory>
 #include <string>
 
+#include "app/camera_options.h"
 #include "app/commands.h"
 #include "app/identify_options.h"
 #include "app/output_options.h"
@@ -39,7 +40,7 @@ Command AddRunCommand(CLI::App& app) {
                   "its own");
   cmd->add_option("--robot", a->robot_backend, "Robot backend")->check(CLI::IsMember({"sim", "network", "manual"}));
   cmd->add_option("--address", a->address, "network backend: HOST:PORT (docs/robot-protocol.md)");
-  cmd->add_option("--camera", a->camera_backend, "Camera backend")->check(CLI::IsMember({"sim", "v4l2"}));
+  AddCameraOptions(cmd, &a->camera_backend, &a->camera_mode, {"sim", "v4l2", "aravis"});
   cmd->add_option("--device", a->device, "v4l2 camera device");
   cmd->add_option("--velocity-scaling", a->velocity_scaling,
                   "Fraction of the joint velocity limits (default 1 simulated, 0.1 real)")
