@@ -97,7 +97,10 @@ Result<std::unique_ptr<capture::FrameSource>> MakeLiveCamera(const std::string& 
     options.width_px = mode.width_px;
     options.height_px = mode.height_px;
   }
-  if (mode.fps > 0) options.frame_period_s = 1.0 / mode.fps;
+  if (mode.fps > 0) {
+    options.frame_period_s = 1.0 / mode.fps;
+    options.exact_frame_period = true;  // a rate the user chose is checked; the default 30 fps only asked for
+  }
   capture::V4l2PixelFormatFromName(mode.format, &options.pixel_format);  // checked by --camera-format
   if (mode.exposure_ms >= 0) options.exposure_absolute_100us = static_cast<int>(std::lround(10 * mode.exposure_ms));
   return std::unique_ptr<capture::FrameSource>(std::make_unique<capture::V4l2Camera>(options));

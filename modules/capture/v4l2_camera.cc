@@ -128,7 +128,7 @@ Status V4l2Camera::Impl::Configure() {
   }
   modes = EnumerateV4l2Modes(control_fd.get());
   if (Status s = CheckV4l2ModeOffered(modes, options.device, Fourcc(options.pixel_format), options.width_px,
-                                      options.height_px, options.frame_period_s);
+                                      options.height_px, options.exact_frame_period ? options.frame_period_s : 0);
       !s.ok()) {
     return s;
   }
@@ -160,7 +160,8 @@ Status V4l2Camera::Impl::Configure() {
     period_settable = Ioctl(control_fd.get(), VIDIOC_S_PARM, &parm) == 0;
   }
   ReadFormat(control_fd.get(), &info);
-  if (period_settable && std::abs(info.frame_period_s - options.frame_period_s) > 0.01 * options.frame_period_s) {
+  if (options.exact_frame_period && period_settable &&
+      std::abs(info.frame_period_s - options.frame_period_s) > 0.01 * options.frame_period_s) {
     std::ostringstream why;
     why << who << "asked for " << 1.0 / options.frame_period_s << " fps, the driver set " << 1.0 / info.frame_period_s
         << " fps; it offers:\n"

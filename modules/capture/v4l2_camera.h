@@ -74,6 +74,9 @@ struct V4l2Options {
   V4l2PixelFormat pixel_format = V4l2PixelFormat::kYuyv;  // what UVC webcams deliver natively
   int num_buffers = 1;                // ViSP's advice for non-real-time use; the reader thread drains anyway
   double frame_period_s = 1.0 / 30;   // requested with VIDIOC_S_PARM when supported; read back
+  // Refuse a frame period the device does not list, or that the driver does not set (a rate the user
+  // chose); otherwise whatever period the driver sets is taken.
+  bool exact_frame_period = false;
   double open_timeout_s = 3.0;        // the test frame of Open must arrive within this
   bool lock_exposure = true;          // manual exposure, no auto gain, no frame-rate priority (V7)
   int exposure_absolute_100us = -1;   // with lock_exposure: V4L2_CID_EXPOSURE_ABSOLUTE; -1 keeps the current value

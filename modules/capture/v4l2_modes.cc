@@ -56,7 +56,7 @@ bool V4l2Mode::HasSize(int width_px, int height_px) const {
 }
 
 bool V4l2Mode::HasPeriod(double period_s) const {
-  if (periods_s.empty() && min_period_s <= 0) return true;  // the driver lists none
+  if (period_s <= 0 || (periods_s.empty() && min_period_s <= 0)) return true;  // any, or the driver lists none
   for (double p : periods_s) {
     if (std::abs(p - period_s) <= 0.01 * p) return true;
   }
@@ -130,7 +130,9 @@ Status CheckV4l2ModeOffered(const std::vector<V4l2Mode>& modes, const std::strin
   }
   std::ostringstream why;
   why << "camera " << device << " does not offer " << FourccToString(fourcc) << " " << width_px << "x"
-      << height_px << " at " << FpsText(period_s) << " fps ("
+      << height_px;
+  if (period_s > 0) why << " at " << FpsText(period_s) << " fps";
+  why << " ("
       << (!format_listed ? "no such pixel format" : !size_listed ? "not at that size" : "not at that frame rate")
       << "); it offers:\n"
       << V4l2ModesText(modes) << "choose one of these with --camera-format, --camera-width-px, --camera-height-px "

@@ -34,7 +34,8 @@ std::vector<V4l2Mode> EnumerateV4l2Modes(int fd);
 // "MJPG 1280x720 @ 30, 15 fps; YUYV 640x480 @ 30 fps; ...", one mode per line for messages.
 std::string V4l2ModesText(const std::vector<V4l2Mode>& modes);
 
-// OK when `modes` offers the format at that size and period (or lists no periods for it). Otherwise a
+// OK when `modes` offers the format at that size and period (or lists no periods for it; period_s <= 0:
+// any period). Otherwise a
 // kFormatMismatch naming `device` and listing what it offers. An empty list (a driver that enumerates
 // nothing) is accepted: the format read back after VIDIOC_S_FMT is checked anyway.
 Status CheckV4l2ModeOffered(const std::vector<V4l2Mode>& modes, const std::string& device, uint32_t fourcc,

@@ -48,6 +48,10 @@ TEST(V4l2Modes, RefusalNamesTheDeviceWhatWasAskedAndWhatItOffers) {
   EXPECT_TRUE(Contains(size.message(), "  YUYV 640x480 @ 30, 15 fps\n")) << size.message();
   const Status rate = CheckV4l2ModeOffered(Webcam(), "/dev/video2", V4L2_PIX_FMT_YUYV, 1280, 720, 1.0 / 30);
   EXPECT_TRUE(Contains(rate.message(), "(not at that frame rate)")) << rate.message();
+  // No rate asked for (period 0): the size and format decide, the driver's rate is taken.
+  EXPECT_TRUE(CheckV4l2ModeOffered(Webcam(), "/dev/video2", V4L2_PIX_FMT_YUYV, 1280, 720, 0).ok());
+  const Status any_rate = CheckV4l2ModeOffered(Webcam(), "/dev/video2", V4L2_PIX_FMT_YUYV, 1920, 1080, 0);
+  EXPECT_TRUE(Contains(any_rate.message(), "does not offer YUYV 1920x1080 (not at that size)")) << any_rate.message();
   const Status format = CheckV4l2ModeOffered(Webcam(), "/dev/video2", V4L2_PIX_FMT_GREY, 640, 480, 1.0 / 30);
   EXPECT_TRUE(Contains(format.message(), "GREY 640x480 at 30 fps (no such pixel format)")) << format.message();
   EXPECT_TRUE(Contains(format.message(), "--camera-width-px")) << format.message();
