@@ -17,7 +17,10 @@
 //     exposure time and one frame period.
 // Timeout (V3): no such frame within timeout_s is kTimeout. Vanished camera (V4): a failed trigger, the
 // device's control-lost signal, or after a timeout a register that cannot be read any more gives
-// kDisconnected, sticky until Close; frames already returned stay valid.
+// kDisconnected, sticky until Close; frames already returned stay valid. Detecting a vanished GigE camera
+// takes Aravis' GVCP retries (2.5-3.5 s with arv-fake-gv-camera), and Close of it about 10 s more (Aravis
+// gives up on the device when it is released; 0.8 has no setting for it). UNTESTED on real cameras: USB3
+// Vision, packet loss (Aravis' incomplete buffers are kBadFrame), cameras without Mono8 (refused).
 #pragma once
 
 #include <cstdint>

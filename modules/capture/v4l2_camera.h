@@ -1,6 +1,10 @@
 // A V4L2 camera (USB/UVC webcams, industrial cameras with a V4L2 driver) as a FrameSource, through
-// ViSP's vpV4l2Grabber (mmap streaming, conversion to 8-bit grey), with the checks ViSP leaves out
-// (RELIABILITY.md section 3).
+// ViSP's vpV4l2Grabber (mmap streaming, conversion to 8-bit grey) for the uncompressed formats and
+// capture's own mmap stream and MJPEG decoder for MJPEG, with the checks ViSP leaves out (RELIABILITY.md
+// section 3). Any size, pixel format and frame interval the device lists (v4l2_modes.h).
+//
+// The MJPEG path (v4l2_stream.h, mjpeg_decode.h) is UNTESTED on a device: no V4L2 device (nor
+// v4l2loopback) exists where the tests run; its decoding is tested on recorded frames.
 //
 // Clock (V5). Exposure timestamps are the driver's buffer timestamps, read as CLOCK_MONOTONIC seconds
 // (MonotonicNowS()). That is the V4L2 default for current drivers (uvcvideo stamps the start of exposure
