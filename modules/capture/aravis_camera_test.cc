@@ -174,7 +174,8 @@ TEST(AravisGvFake, SoftwareTriggerGivesTheFrameOfTheSettleAndATimeoutWhenTheSett
   const double asked = MonotonicNowS();
   Result<Frame> late = camera.Grab(asked + 5.0, 0.3);
   EXPECT_EQ(CaptureErrorOf(late.status()), CaptureError::kTimeout) << late.status().message();
-  EXPECT_NEAR(MonotonicNowS() - asked, 0.3, 0.2);
+  EXPECT_GE(MonotonicNowS() - asked, 0.3);
+  EXPECT_LT(MonotonicNowS() - asked, 1.5);  // the timeout and one register read to tell it from a lost camera
   EXPECT_TRUE(camera.Grab(MonotonicNowS(), 2.0).ok()) << "a timeout is not a lost camera";
 }
 
