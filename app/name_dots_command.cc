@@ -15,10 +15,10 @@
 #include "acquisition/dot_naming.h"
 #include "app/cli_util.h"
 #include "app/output_options.h"
+#include "app/camera_options.h"
 #include "app/commands.h"
 #include "app/identify_options.h"
 #include "base/atomic_file.h"
-#include "capture/v4l2_camera.h"
 #include "session/setup_file.h"
 
 namespace selfcal::app {
@@ -27,7 +27,9 @@ namespace {
 
 struct NameDotsSettings {
   std::string image;   // an image file, or...
-  std::string device;  // ...a V4L2 camera
+  std::string device;  // ...a V4L2 camera, or...
+  std::string camera;  // ...--camera aravis[:ID] (v4l2: --device)
+  CameraMode mode;
   std::string setup;
   std::string out_png;
   bool show = false;
@@ -50,12 +52,13 @@ Result<capture::Frame> GrabFrame(const NameDotsSettings& a) {
     frame.source = a.image;
     return frame;
   }
-  capture::V4l2Options options;
-  options.device = a.device;
-  capture::V4l2Camera camera(options);
-  if (Status s = camera.Open(); !s.ok()) return s;
-  Result<capture::Frame> grabbed = camera.Grab(0.0, 2.0);
-  camera.Close();
+  Result<std::unique_ptr<capture::FrameSource>> camera =
+      MakeLiveCamera(a.camera == "aravis" ? "aravis" : "v4l2", a.device, a.mode);
+  if (!camera.ok()) return camera.status();
+  if (Status s = (*camera)->Open(); !s.ok()) return s;
+  std::cout << "camera: " << (*camera)->Describe() << "\n";
+  Result<capture::Frame> grabbed = (*camera)->Grab(capture::MonotonicNowS(), 2.0);
+  (*camera)->Close();
   return grabbed;
 }
 
@@ -122,8 +125,14 @@ void Show(const vpImage<vpRGBa>& annotated, const std::string& title) {
 }
 
 int NameDotsFromSettings(const NameDotsSettings& a) {
-  if (a.image.empty() == a.device.empty()) {
-    return Fail(Status::Error(ErrorCode::kInvalidInput, "give exactly one of --image FILE and --device DEVICE"));
+  const int sources = (a.image.empty() ? 0 : 1) + (a.device.empty() ? 0 : 1) + (a.camera == "aravis" ? 1 : 0);
+  if (sources != 1 || (a.camera == "v4l2" && a.device.empty())) {
+    return Fail(Status::Error(ErrorCode::kInvalidInput,
+                              "give exactly one of --image FILE, --device DEVICE (a V4L2 camera) and --camera "
+                              "aravis[:ID]"));
+  }
+  if (!a.image.empty() && !a.mode.IsDefault()) {
+    return Fail(Status::Error(ErrorCode::kInvalidInput, "the camera options do not apply to --image " + a.image));
   }
   if (!a.yardstick.empty() && (a.yardstick.size() != 2 || !(a.length_mm > 0))) {
     return Fail(
@@ -177,6 +186,7 @@ Command AddNameDotsCommand(CLI::App& app) {
       "Grab one frame, detect and name its dots, save it with every id drawn, set the yardstick in the setup");
   cmd->add_option("--image", a->image, "Name the dots of this image file (PNG, JPEG, PGM)");
   cmd->add_option("--device", a->device, "...or of one frame of this V4L2 camera (e.g. /dev/video0)");
+  AddCameraOptions(cmd, &a->camera, &a->mode, {"v4l2", "aravis"});
   AddOutputOption(cmd, "--setup", &a->setup, OutputKind::kUpdatedFile,
                   "Setup file to write or update (docs/session-format.md; outside any session)")->required();
   AddOutputOption(cmd, "--out", &a->out_png, OutputKind::kFile, "Annotated PNG to write")->required();

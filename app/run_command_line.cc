@@ -3,6 +3,7 @@
 #include <memory>
 #include <string>
 
+#include "app/camera_options.h"
 #include "app/commands.h"
 #include "app/identify_options.h"
 #include "app/output_options.h"
@@ -47,7 +48,7 @@ Command AddRunCommand(CLI::App& app) {
       ->delimiter(',')
       ->expected(3)
       ->check(CLI::Range(1, 65535));
-  cmd->add_option("--camera", a->camera_backend, "Camera backend")->check(CLI::IsMember({"sim", "v4l2"}));
+  AddCameraOptions(cmd, &a->camera_backend, &a->camera_mode, {"sim", "v4l2", "aravis"});
   cmd->add_option("--device", a->device, "v4l2 camera device");
   cmd->add_option("--velocity-scaling", a->velocity_scaling,
                   "Fraction of the joint velocity limits (default 1 simulated, 0.1 real)")

@@ -20,7 +20,6 @@
 #include "app/cli_util.h"
 #include "app/output_options.h"
 #include "app/commands.h"
-#include "capture/v4l2_camera.h"
 #include "io/observations_file.h"
 #include "io/report_json.h"
 #include "io/robot_config.h"
@@ -91,7 +90,9 @@ json RunJson(const RunSettings& a) {
           // run.json of earlier simulated sessions is unchanged.
           {"address", ""},
           {"camera", a.camera_backend},
-          {"device", a.camera_backend == "v4l2" ? a.device : ""},
+          {"device", a.camera_backend == "v4l2"     ? a.device
+                     : a.camera_backend == "aravis" ? a.camera_mode.aravis_id
+                                                    : ""},
           {"velocity_scaling", a.velocity_scaling},
           {"seed", a.seed},
           {"grey_noise", a.grey_noise},
@@ -106,6 +107,8 @@ json RunJson(const RunSettings& a) {
   // The jog's delay only when not the default, so that the run.json of earlier sessions is unchanged.
   if (a.fault_jog_delay_s != RunSettings().fault_jog_delay_s) run["faults"]["jog_delay_s"] = a.fault_jog_delay_s;
   if (!a.fault_never_settle_moves.empty()) run["faults"]["never_settle_moves"] = a.fault_never_settle_moves;
+  const json camera_mode = CameraModeJson(a.camera_mode);  // only when given: earlier run.json unchanged
+  if (a.camera_backend != "sim" && !camera_mode.empty()) run["camera_mode"] = camera_mode;
   return run;
 }
 
@@ -389,9 +392,9 @@ Status MakeBackends(const RunSettings& a, RunPlan* run, Backends* b) {
     if (!b->owned_identifier) b->identifier = run->cell->identifier.get();
     return Status::Ok();
   }
-  capture::V4l2Options options;
-  options.device = a.device;
-  b->owned_camera = std::make_unique<capture::V4l2Camera>(options);
+  Result<std::unique_ptr<capture::FrameSource>> camera = MakeLiveCamera(a.camera_backend, a.device, a.camera_mode);
+  if (!camera.ok()) return camera.status();
+  b->owned_camera = std::move(camera).value();
   b->camera = b->owned_camera.get();
   return Status::Ok();
 }

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "app/camera_options.h"
 #include "app/identify_options.h"
 #include "base/status.h"
 #include "observations/observation_set.h"
@@ -30,6 +31,7 @@ struct RunSettings {
   std::vector<int> ur_ports;  // --robot ur: RTDE, secondary, Dashboard ports; empty: a controller's
   std::string camera_backend = "sim";
   std::string device = "/dev/video0";
+  CameraMode camera_mode;  // --camera-width-px, ..., and aravis' camera id
   double velocity_scaling = -1;  // default: 1.0 simulated, 0.1 otherwise (R1)
   uint64_t seed = 1;
   double grey_noise = 2.0;

@@ -22,7 +22,10 @@
 #include <visp3/core/vpException.h>
 #include <visp3/sensor/vpV4l2Grabber.h>
 
+#include "capture/mjpeg_decode.h"
 #include "capture/v4l2_device.h"
+#include "capture/v4l2_modes.h"
+#include "capture/v4l2_stream.h"
 
 namespace selfcal::capture {
 
@@ -49,6 +52,8 @@ vpV4l2Grabber::vpV4l2PixelFormatType VispFormat(V4l2PixelFormat format) {
       return vpV4l2Grabber::V4L2_BGR24_FORMAT;
     case V4l2PixelFormat::kRgb32:
       return vpV4l2Grabber::V4L2_RGB32_FORMAT;
+    case V4l2PixelFormat::kMjpeg:
+      break;  // not through ViSP: MmapStream + DecodeMjpegFrame
   }
   return vpV4l2Grabber::V4L2_YUYV_FORMAT;
 }
@@ -84,7 +89,9 @@ struct V4l2Camera::Impl {
   V4l2DeviceInfo info;
   std::vector<V4l2ControlReport> controls;
   DeviceFd control_fd;  // our own descriptor: formats and controls are per device, not per descriptor
-  std::unique_ptr<vpV4l2Grabber> grabber;
+  std::unique_ptr<vpV4l2Grabber> grabber;  // uncompressed formats
+  internal::MmapStream mjpeg_stream;        // MJPEG, on control_fd
+  std::vector<V4l2Mode> modes;              // what the device offers, read at Open
   bool open = false;
 
   // Shared with the reader thread.
@@ -94,6 +101,7 @@ struct V4l2Camera::Impl {
   std::atomic<bool> stop{false};
   std::optional<Status> failure;  // sticky until Close
   Frame latest;                   // sequence -1: none yet
+  std::optional<Status> latest_bad;  // why `latest` cannot be used (an MJPEG frame that did not decode)
   int64_t received = 0;
 
   // Grab's bookkeeping.
@@ -106,6 +114,8 @@ struct V4l2Camera::Impl {
   void SetControl(const char* name, uint32_t id, int64_t wanted, bool required_by_user);
   Status VerifyFormat(const char* when);
   void ReadLoop();
+  bool AcquireMjpeg(vpImage<unsigned char>* image, timeval* stamp, std::optional<Status>* bad);
+  Status StartStreaming();
   void Shutdown();
 };
 
@@ -115,6 +125,12 @@ Status V4l2Camera::Impl::Configure() {
   fmt.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
   if (Ioctl(control_fd.get(), VIDIOC_G_FMT, &fmt) != 0) {
     return CaptureFailure(CaptureError::kNotV4l2, who + "VIDIOC_G_FMT failed (" + ErrnoText(errno) + ")");
+  }
+  modes = EnumerateV4l2Modes(control_fd.get());
+  if (Status s = CheckV4l2ModeOffered(modes, options.device, Fourcc(options.pixel_format), options.width_px,
+                                      options.height_px, options.exact_frame_period ? options.frame_period_s : 0);
+      !s.ok()) {
+    return s;
   }
   fmt.fmt.pix.width = static_cast<uint32_t>(options.width_px);
   fmt.fmt.pix.height = static_cast<uint32_t>(options.height_px);
@@ -137,12 +153,21 @@ Status V4l2Camera::Impl::Configure() {
   // Frame period: only where the driver supports it; the period in effect is read back either way.
   v4l2_streamparm parm{};
   parm.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+  bool period_settable = false;
   if (Ioctl(control_fd.get(), VIDIOC_G_PARM, &parm) == 0 && (parm.parm.capture.capability & V4L2_CAP_TIMEPERFRAME)) {
     parm.parm.capture.timeperframe.numerator = 1000;
     parm.parm.capture.timeperframe.denominator = static_cast<uint32_t>(std::lround(1000.0 / options.frame_period_s));
-    Ioctl(control_fd.get(), VIDIOC_S_PARM, &parm);
+    period_settable = Ioctl(control_fd.get(), VIDIOC_S_PARM, &parm) == 0;
   }
   ReadFormat(control_fd.get(), &info);
+  if (options.exact_frame_period && period_settable &&
+      std::abs(info.frame_period_s - options.frame_period_s) > 0.01 * options.frame_period_s) {
+    std::ostringstream why;
+    why << who << "asked for " << 1.0 / options.frame_period_s << " fps, the driver set " << 1.0 / info.frame_period_s
+        << " fps; it offers:\n"
+        << V4l2ModesText(modes);
+    return CaptureFailure(CaptureError::kFormatMismatch, why.str());
+  }
   return Status::Ok();
 }
 
@@ -152,8 +177,9 @@ Status V4l2Camera::Impl::VerifyFormat(const char* when) {
   ReadFormat(control_fd.get(), &now);
   const uint32_t want_fourcc = Fourcc(options.pixel_format);
   const uint32_t want_bpl = static_cast<uint32_t>(options.width_px) * BytesPerPixel(options.pixel_format);
+  const bool compressed = options.pixel_format == V4l2PixelFormat::kMjpeg;  // no fixed row length
   if (now.width_px != options.width_px || now.height_px != options.height_px || now.pixel_format != want_fourcc ||
-      now.bytes_per_line != want_bpl) {
+      (!compressed && now.bytes_per_line != want_bpl)) {
     return CaptureFailure(
         CaptureError::kFormatMismatch,
         "camera " + options.device + ": requested " +
@@ -211,11 +237,50 @@ void V4l2Camera::Impl::LockControls() {
   }
 }
 
+// One MJPEG frame from the stream, decoded (`bad` set when it cannot be used). False: nothing within the
+// poll period (the caller loops), or the stream failed (`failure` set).
+bool V4l2Camera::Impl::AcquireMjpeg(vpImage<unsigned char>* image, timeval* stamp, std::optional<Status>* bad) {
+  bool timed_out = false;
+  Result<internal::DequeuedBuffer> buffer = mjpeg_stream.Dequeue(0.2, &timed_out);
+  if (!buffer.ok()) {
+    if (timed_out) return false;
+    std::lock_guard<std::mutex> lock(mutex);
+    failure = CaptureFailure(CaptureError::kDisconnected,
+                             buffer.status().message() +
+                                 "; samples already captured stay valid; reconnect with Close() then Open()");
+    arrived.notify_all();
+    return false;
+  }
+  const std::string source = options.device + " frame " + std::to_string(received);
+  if (buffer->driver_error) {
+    *bad = CaptureFailure(CaptureError::kBadFrame, source + ": the driver flagged the MJPEG frame as damaged");
+  } else {
+    Result<vpImage<unsigned char>> decoded =
+        DecodeMjpegFrame(buffer->data, buffer->bytes_used, source, options.width_px, options.height_px);
+    if (decoded.ok()) {
+      *image = std::move(decoded).value();
+    } else {
+      *bad = decoded.status();
+    }
+  }
+  stamp->tv_sec = static_cast<time_t>(buffer->timestamp_s);
+  stamp->tv_usec = static_cast<suseconds_t>(std::lround(1e6 * (buffer->timestamp_s - std::floor(buffer->timestamp_s))));
+  mjpeg_stream.Requeue(buffer->index);
+  return true;
+}
+
 void V4l2Camera::Impl::ReadLoop() {
   while (!stop.load()) {
     vpImage<unsigned char> image;
     timeval stamp{};
-    try {
+    std::optional<Status> bad;
+    if (!grabber) {
+      if (!AcquireMjpeg(&image, &stamp, &bad)) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (failure) return;
+        continue;
+      }
+    } else try {
       grabber->acquire(image, stamp);
     } catch (const vpException& e) {
       const int error = errno;
@@ -242,6 +307,7 @@ void V4l2Camera::Impl::ReadLoop() {
     latest.exposure_time_s = static_cast<double>(stamp.tv_sec) + 1e-6 * static_cast<double>(stamp.tv_usec);
     latest.sequence = received++;
     latest.source = options.device;
+    latest_bad = std::move(bad);
     arrived.notify_all();
   }
 }
@@ -249,6 +315,7 @@ void V4l2Camera::Impl::ReadLoop() {
 void V4l2Camera::Impl::Shutdown() {
   stop.store(true);
   if (reader.joinable()) reader.join();
+  mjpeg_stream.Stop();
   if (grabber) {
     try {
       grabber->close();
@@ -261,11 +328,41 @@ void V4l2Camera::Impl::Shutdown() {
   open = false;
   failure.reset();
   latest = Frame();
+  latest_bad.reset();
   received = 0;
   last_returned = -1;
   last_examined = -1;
   stale = 0;
   stop.store(false);
+}
+
+// The stream: MJPEG on our own descriptor, the other formats through ViSP's grabber.
+Status V4l2Camera::Impl::StartStreaming() {
+  if (options.pixel_format == V4l2PixelFormat::kMjpeg) {
+    return mjpeg_stream.Start(control_fd.get(), std::max(options.num_buffers, 2), options.device);
+  }
+  grabber = std::make_unique<vpV4l2Grabber>();
+  grabber->setDevice(options.device);
+  grabber->setInput(0);  // webcams have one input, 0; ViSP's default (2) is for TV cards
+  grabber->setWidth(static_cast<unsigned>(options.width_px));
+  grabber->setHeight(static_cast<unsigned>(options.height_px));
+  grabber->setPixelFormat(VispFormat(options.pixel_format));
+  grabber->setNBuffers(static_cast<unsigned>(options.num_buffers));
+  grabber->setFramerate(vpV4l2Grabber::framerate_25fps);  // only selects full frames (not fields) in ViSP
+  try {
+    vpImage<unsigned char> first;
+    grabber->open(first);
+  } catch (const vpException& e) {
+    const int error = errno;
+    const std::string who =
+        "camera " + options.device + ": ViSP could not start streaming (" + e.getStringMessage() + ")";
+    if (error == EBUSY)
+      return CaptureFailure(CaptureError::kDeviceBusy, who + ": busy (" + ErrnoText(error) + ")");
+    if (error == ENODEV) return CaptureFailure(CaptureError::kDisconnected, who + ": " + ErrnoText(error));
+    return CaptureFailure(CaptureError::kFormatMismatch, who);
+  }
+  // ViSP falls back to other pixel formats without saying so (V2).
+  return VerifyFormat("after vpV4l2Grabber::open");
 }
 
 V4l2Camera::V4l2Camera(V4l2Options options) : impl_(std::make_unique<Impl>(std::move(options))) {}
@@ -311,28 +408,7 @@ Status V4l2Camera::Open() {
   if (Status s = m.Configure(); !s.ok()) return fail(s);
   m.LockControls();
 
-  m.grabber = std::make_unique<vpV4l2Grabber>();
-  m.grabber->setDevice(m.options.device);
-  m.grabber->setInput(0);  // webcams have one input, 0; ViSP's default (2) is for TV cards
-  m.grabber->setWidth(static_cast<unsigned>(m.options.width_px));
-  m.grabber->setHeight(static_cast<unsigned>(m.options.height_px));
-  m.grabber->setPixelFormat(VispFormat(m.options.pixel_format));
-  m.grabber->setNBuffers(static_cast<unsigned>(m.options.num_buffers));
-  m.grabber->setFramerate(vpV4l2Grabber::framerate_25fps);  // only selects full frames (not fields) in ViSP
-  try {
-    vpImage<unsigned char> first;
-    m.grabber->open(first);
-  } catch (const vpException& e) {
-    const int error = errno;
-    const std::string who =
-        "camera " + m.options.device + ": ViSP could not start streaming (" + e.getStringMessage() + ")";
-    if (error == EBUSY)
-      return fail(CaptureFailure(CaptureError::kDeviceBusy, who + ": busy (" + ErrnoText(error) + ")"));
-    if (error == ENODEV) return fail(CaptureFailure(CaptureError::kDisconnected, who + ": " + ErrnoText(error)));
-    return fail(CaptureFailure(CaptureError::kFormatMismatch, who));
-  }
-  // ViSP falls back to other pixel formats without saying so (V2).
-  if (Status s = m.VerifyFormat("after vpV4l2Grabber::open"); !s.ok()) return fail(s);
+  if (Status s = m.StartStreaming(); !s.ok()) return fail(s);
   ReadFormat(m.control_fd.get(), &m.info);
 
   m.open = true;
@@ -376,6 +452,7 @@ Result<Frame> V4l2Camera::Grab(double not_before_s, double timeout_s) {
       if (m.latest.sequence > m.last_examined) {
         m.last_examined = m.latest.sequence;
         if (m.latest.exposure_time_s >= not_before_s) {
+          if (m.latest_bad) return *m.latest_bad;  // a fresh frame that did not decode: the caller retries
           frame = m.latest;
           break;
         }

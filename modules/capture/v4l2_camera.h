@@ -1,6 +1,10 @@
 // A V4L2 camera (USB/UVC webcams, industrial cameras with a V4L2 driver) as a FrameSource, through
-// ViSP's vpV4l2Grabber (mmap streaming, conversion to 8-bit grey), with the checks ViSP leaves out
-// (RELIABILITY.md section 3).
+// ViSP's vpV4l2Grabber (mmap streaming, conversion to 8-bit grey) for the uncompressed formats and
+// capture's own mmap stream and MJPEG decoder for MJPEG, with the checks ViSP leaves out (RELIABILITY.md
+// section 3). Any size, pixel format and frame interval the device lists (v4l2_modes.h).
+//
+// The MJPEG path (v4l2_stream.h, mjpeg_decode.h) is UNTESTED on a device: no V4L2 device (nor
+// v4l2loopback) exists where the tests run; its decoding is tested on recorded frames.
 //
 // Clock (V5). Exposure timestamps are the driver's buffer timestamps, read as CLOCK_MONOTONIC seconds
 // (MonotonicNowS()). That is the V4L2 default for current drivers (uvcvideo stamps the start of exposure
@@ -22,7 +26,9 @@
 //      VIDIOC_S_FMT returning EBUSY; messages name the node, errno and its name. TESTED without hardware:
 //      missing node, regular file, directory, a character device that is not V4L2 (/dev/null).
 //      UNTESTED (needs hardware or an unprivileged user): busy, permission denied, metadata-only node.
-//   V2 (format) - code: VIDIOC_S_FMT then VIDIOC_G_FMT on our own descriptor before ViSP opens, and
+//   V2 (format) - code: the device's modes enumerated (VIDIOC_ENUM_FMT / ENUM_FRAMESIZES /
+//      ENUM_FRAMEINTERVALS, v4l2_modes.h) and the requested format, size and frame period refused with the
+//      list when it is not among them (TESTED on the check, without hardware); VIDIOC_S_FMT then VIDIOC_G_FMT on our own descriptor before ViSP opens, and
 //      VIDIOC_G_FMT again after (ViSP silently falls back to other pixel formats); any difference in
 //      width, height, pixel format or a padded row (ViSP copies rows without stride) is kFormatMismatch.
 //      UNTESTED without hardware.
@@ -36,7 +42,8 @@
 //      Open. UNTESTED without hardware (the same rule is tested on the recorded and simulated sources).
 //   V6 (bad frames) - code: CheckFrame on every returned frame (kBadFrame); duplicates cannot occur (each
 //      frame is returned once). Truncated buffers (bytesused) are not visible through vpV4l2Grabber: NOT
-//      COVERED. The checks themselves are tested in frame_checks.
+//      COVERED for the uncompressed formats; an MJPEG frame that is truncated, corrupt or flagged
+//      V4L2_BUF_FLAG_ERROR is kBadFrame (the decoding TESTED on recorded frames, the stream UNTESTED). The checks themselves are tested in frame_checks.
 //   V7 (exposure / focus) - code: V4L2_CID_EXPOSURE_AUTO = manual, V4L2_CID_EXPOSURE_AUTO_PRIORITY = 0,
 //      V4L2_CID_AUTOGAIN = 0, V4L2_CID_FOCUS_AUTO = 0 (optionally absolute values), each read back with
 //      VIDIOC_G_CTRL and reported in controls() and Describe(); an absent or refused control is reported,
@@ -55,9 +62,14 @@
 
 namespace selfcal::capture {
 
-// The pixel formats vpV4l2Grabber converts to grey.
-enum class V4l2PixelFormat { kGrey, kYuyv, kRgb24, kBgr24, kRgb32 };
-const char* V4l2PixelFormatName(V4l2PixelFormat format);  // "GREY", "YUYV", "RGB3", "BGR3", "RGB4" (fourcc)
+// The pixel formats read: the uncompressed ones through vpV4l2Grabber, which converts them to grey; MJPEG
+// (most USB cameras at 1280x720 and above) through capture's own memory-mapped stream (v4l2_stream.h) and
+// libjpeg-turbo (mjpeg_decode.h), the luminance plane alone.
+enum class V4l2PixelFormat { kGrey, kYuyv, kRgb24, kBgr24, kRgb32, kMjpeg };
+// "GREY", "YUYV", "RGB3", "BGR3", "RGB4", "MJPG" (fourcc)
+const char* V4l2PixelFormatName(V4l2PixelFormat format);
+// The format of a fourcc name (case-sensitive, as above); false when none.
+bool V4l2PixelFormatFromName(const std::string& name, V4l2PixelFormat* format);
 
 struct V4l2Options {
   std::string device = "/dev/video0";
@@ -66,6 +78,9 @@ struct V4l2Options {
   V4l2PixelFormat pixel_format = V4l2PixelFormat::kYuyv;  // what UVC webcams deliver natively
   int num_buffers = 1;                // ViSP's advice for non-real-time use; the reader thread drains anyway
   double frame_period_s = 1.0 / 30;   // requested with VIDIOC_S_PARM when supported; read back
+  // Refuse a frame period the device does not list, or that the driver does not set (a rate the user
+  // chose); otherwise whatever period the driver sets is taken.
+  bool exact_frame_period = false;
   double open_timeout_s = 3.0;        // the test frame of Open must arrive within this
   bool lock_exposure = true;          // manual exposure, no auto gain, no frame-rate priority (V7)
   int exposure_absolute_100us = -1;   // with lock_exposure: V4L2_CID_EXPOSURE_ABSOLUTE; -1 keeps the current value

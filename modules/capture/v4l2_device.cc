@@ -61,6 +61,8 @@ uint32_t Fourcc(V4l2PixelFormat format) {
       return V4L2_PIX_FMT_BGR24;
     case V4l2PixelFormat::kRgb32:
       return V4L2_PIX_FMT_RGB32;
+    case V4l2PixelFormat::kMjpeg:
+      return V4L2_PIX_FMT_MJPEG;
   }
   return 0;
 }
@@ -76,6 +78,8 @@ uint32_t BytesPerPixel(V4l2PixelFormat format) {
       return 3;
     case V4l2PixelFormat::kRgb32:
       return 4;
+    case V4l2PixelFormat::kMjpeg:
+      return 0;  // compressed: no fixed row length
   }
   return 0;
 }
@@ -176,8 +180,21 @@ const char* V4l2PixelFormatName(V4l2PixelFormat format) {
       return "BGR3";
     case V4l2PixelFormat::kRgb32:
       return "RGB4";
+    case V4l2PixelFormat::kMjpeg:
+      return "MJPG";
   }
   return "?";
+}
+
+bool V4l2PixelFormatFromName(const std::string& name, V4l2PixelFormat* format) {
+  for (V4l2PixelFormat f : {V4l2PixelFormat::kGrey, V4l2PixelFormat::kYuyv, V4l2PixelFormat::kRgb24,
+                            V4l2PixelFormat::kBgr24, V4l2PixelFormat::kRgb32, V4l2PixelFormat::kMjpeg}) {
+    if (name == V4l2PixelFormatName(f)) {
+      *format = f;
+      return true;
+    }
+  }
+  return false;
 }
 
 std::string FourccToString(uint32_t fourcc) {

@@ -124,14 +124,14 @@ void ReadRunHeader(const json& run, JsonFields* fields, RunBackends* backends) {
     fields->Add(JsonPath{}.Member("version"), "`version` must be 1 (found " + std::to_string(version) + ")");
   }
   GetStringOf(run, "robot", {"sim", "network", "manual", "ur"}, fields, &backends->robot);
-  GetStringOf(run, "camera", {"sim", "v4l2"}, fields, &backends->camera);
+  GetStringOf(run, "camera", {"sim", "v4l2", "aravis"}, fields, &backends->camera);
   std::string text;
   fields->GetString(run, {}, "address", &text);
   fields->GetString(run, {}, "device", &text);
   double scaling = 0;
   GetDoubleIn(run, {}, "velocity_scaling", 1e-3, 1, fields, &scaling);
   fields->CheckKnown(run, {}, {"format", "version", "robot", "address", "camera", "device", "velocity_scaling", "seed",
-                               "grey_noise", "blur_px", "supersampling", "faults"});
+                               "grey_noise", "blur_px", "supersampling", "faults", "camera_mode"});
 }
 
 }  // namespace

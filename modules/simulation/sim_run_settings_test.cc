@@ -189,6 +189,18 @@ TEST(SimRunSettings, OnlyTheSimulatedRobotAndCameraAreASimulatedRun) {
   EXPECT_FALSE(backends->simulated());
 }
 
+TEST(SimRunSettings, AnAravisCameraAndItsRecordedModeAreARealRun) {
+  nlohmann::json run = RunJson();
+  run["robot"] = "network";
+  run["camera"] = "aravis";
+  run["device"] = "Basler-acA1920-40gm-12345678";
+  run["camera_mode"] = {{"width_px", 1920}, {"height_px", 1200}, {"exposure_ms", 4}};
+  const Result<RunBackends> backends = ReadRunBackends(Text(run));
+  ASSERT_TRUE(backends.ok()) << backends.status().message();
+  EXPECT_EQ(backends->camera, "aravis");
+  EXPECT_FALSE(backends->simulated());
+}
+
 TEST(SimRunSettings, RefusesBackendsThatAreNotNamesNamingTheLine) {
   nlohmann::json run = RunJson();
   run["robot"] = 5;
