@@ -108,7 +108,9 @@ TEST(UrFakeBinary, AControllerIsIdentifiedAndNothingMovesWithoutACamera) {
                             "  - {a_mm: -425, alpha_deg: 0, d_mm: 0, theta_offset_deg: 0}"))
         << output;
     EXPECT_EQ(Has(output, "opening the camera"), !dry) << output;
-    if (!dry) EXPECT_TRUE(Has(output, "HALTED before any motion command: nothing was sent to the arm")) << output;
+    if (!dry) {
+      EXPECT_TRUE(Has(output, "HALTED before any motion command: nothing was sent to the arm")) << output;
+    }
     EXPECT_FALSE(fs::exists(dir / "s"));
   }
   const std::string log = fake.Stop();
