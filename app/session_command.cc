@@ -217,8 +217,7 @@ Status LoadRunPlan(const RunSettings& a, RunPlan* run) {
   run->nominal = *nominal;
   Result<session::SessionInput> plan_input = session::ReadInputFile("plan.yaml", ResolveDataPath(a.plan));
   if (!plan_input.ok()) return plan_input.status();
-  // A plan for another robot is a usage error naming both; the limits are the plan check's (preflight),
-  // in the words of `plan --check`.
+  // A plan for another robot is a usage error naming both; the limits are `plan --check`'s (preflight).
   Result<io::TrajectoryFile> plan_file = io::LoadTrajectoryFileForRobot(ResolveDataPath(a.plan), run->nominal, a.robot_config);
   if (!plan_file.ok()) return plan_file.status();
   run->plan = PlanPoses(*plan_file);
@@ -230,8 +229,7 @@ Status LoadRunPlan(const RunSettings& a, RunPlan* run) {
     return Status::Error(ErrorCode::kDegenerateData, acquisition::PreflightRefusal(acquisition::PreflightProblems(check)));
   }
   run->inputs = {robot_input, *plan_input, {"run.json", RunJsonText(a)}};
-  // The simulated cell (--camera sim, with any robot) is built before the session so that its setup can be
-  // recorded.
+  // The simulated cell (--camera sim, with any robot) is built before the session: its setup is recorded.
   if (a.camera_backend == "sim") {
     run->cell = simulation::MakeSimCell(run->nominal, run->plan, SimCellOptionsFor(a), run->plan.front().joints_rad, 0);
     if (!run->cell.ok()) return run->cell.status();
@@ -314,8 +312,7 @@ Result<session::Session> CreateRunSession(const RunSettings& a, const RunPlan& r
   return session::CreateSession(a.session, run.inputs, SELFCAL_VERSION, create);
 }
 
-// The joint limits the manual backend checks targets against: the nominal model's, with a nominal
-// velocity limit (the operator moves the arm; only used for timing).
+// The manual backend's joint limits: the nominal model's, a nominal velocity (the operator moves; timing only).
 robot::JointLimits ManualJointLimits(const RobotModel& nominal) {
   robot::JointLimits limits;
   const int n = nominal.num_joints();

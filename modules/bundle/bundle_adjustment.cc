@@ -15,6 +15,7 @@
 
 #include "bundle/bundle_problem.h"
 #include "bundle/kinematic_lm.h"
+#include "bundle/weak_holding.h"
 #include "identification/identifiability.h"
 #include "identification/triangulation.h"
 
@@ -192,36 +193,6 @@ bool AnalyzeStartGauge(const BundleData& data, const BundleState& state, const B
   return true;
 }
 
-// The weak joint parameters of the free set, judged at the nominal model (the start's dots and intrinsics):
-// at the stated pixel noise, or under `model`. False when the nominal model cannot be evaluated.
-bool FindWeakAtNominal(const BundleData& data, const BundleOptions& options, const internal::Gauge& gauge,
-                       const BundleState& state, std::vector<identification::WeakColumn>* weak) {
-  BundleState nominal = state;
-  nominal.rho = KinematicParameters::Nominal(data.robot);
-  return internal::FindWeakParameters(data, nominal, gauge, options.intrinsics, options.weak_length_tolerance_m,
-                                      options.weak_angle_tolerance_rad, weak);
-}
-
-// Holds `weak` at the robot description's values (the state moved there) and names them in the report.
-void HoldAtNominal(const std::vector<identification::WeakColumn>& weak, bool under_error_model, const BundleData& data,
-                   internal::Gauge* gauge, BundleState* state, BundleReport* report) {
-  const Eigen::VectorXd nominal_rho = KinematicParameters::Nominal(data.robot);
-  const KinematicParameters params(data.robot.num_joints());
-  for (const identification::WeakColumn& w : weak) {
-    report->weak.push_back({params.name(w.column), params.kind(w.column) == ParameterKind::kLength,
-                            w.conditional_std, w.tolerance, w.combination, under_error_model});
-    report->fixed_names.push_back(params.name(w.column));
-    state->rho[w.column] = nominal_rho[w.column];
-    if (w.column < report->stddev.size()) report->stddev[w.column] = NAN;
-    auto it = std::find(gauge->free_kinematic.begin(), gauge->free_kinematic.end(), w.column);
-    if (it != gauge->free_kinematic.end()) gauge->free_kinematic.erase(it);
-  }
-  gauge->free_names.clear();
-  for (int i : gauge->free_kinematic) gauge->free_names.push_back(params.name(i));
-  report->free_indices = gauge->free_kinematic;
-  report->free_names = gauge->free_names;
-}
-
 // Weak directions: the joint parameters these poses determine worse than their manufacturing tolerance are
 // held at the robot description's value (the start moved back there) and named, with the joints that barely
 // move. False when the nominal model cannot be evaluated (a dot behind a camera).
@@ -229,57 +200,7 @@ bool HoldWeakParameters(const BundleData& data, const BundleOptions& options, in
                         BundleState* state, BundleReport* report) {
   if (data.base_from_flange.empty()) report->barely_moving = BarelyMovingJoints(data.joints);
   if (options.weak_length_tolerance_m <= 0 && options.weak_angle_tolerance_rad <= 0) return true;
-  std::vector<identification::WeakColumn> weak;
-  if (!FindWeakAtNominal(data, options, *gauge, *state, &weak)) return false;
-  HoldAtNominal(weak, false, data, gauge, state, report);
-  return true;
-}
-
-// Weak directions under the cell's error model, once the fit has estimated it: the first judgement
-// (HoldWeakParameters, each parameter given the ones before it, at the stated pixel noise) misses what each
-// image's pose error (joint reading noise, what the model does not hold) leaves poorly determined. The free
-// joint parameter whose standard deviation under the model exceeds its tolerance by the most is held at the
-// description's value and named with the free parameters it is most correlated with; true when one was
-// (the caller refits and asks again).
-bool HoldWeakestUnderErrorModel(const BundleData& data, const BundleOptions& options, internal::Gauge* gauge,
-                                BundleState* state, BundleReport* report) {
-  const ErrorModel& model = report->error_model;
-  if (!report->covariance_available || !model.estimated || !(model.pose_translation_m > 0 || model.pose_rotation_rad > 0)) {
-    return false;
-  }
-  const KinematicParameters params(data.robot.num_joints());
-  const std::vector<int>& free = gauge->free_kinematic;
-  int worst = -1;
-  double worst_ratio = 1.0;
-  for (size_t k = 0; k < free.size(); ++k) {
-    const int c = free[k];
-    if (c < KinematicParameters::JointOffset(0) || c >= params.CamOffset()) continue;
-    const double tolerance =
-        params.kind(c) == ParameterKind::kLength ? options.weak_length_tolerance_m : options.weak_angle_tolerance_rad;
-    if (!(tolerance > 0) || !(report->stddev[c] > tolerance * worst_ratio)) continue;
-    worst = static_cast<int>(k);
-    worst_ratio = report->stddev[c] / tolerance;
-  }
-  if (worst < 0) return false;
-  identification::WeakColumn w;
-  w.column = free[worst];
-  w.conditional_std = report->stddev[w.column];
-  w.tolerance = w.conditional_std / worst_ratio;
-  std::vector<std::pair<double, int>> partners;
-  for (size_t k = 0; k < free.size(); ++k) {
-    if (static_cast<int>(k) != worst) partners.push_back({report->correlation_free(worst, k), free[k]});
-  }
-  std::sort(partners.begin(), partners.end(),
-            [](const auto& x, const auto& y) { return std::abs(x.first) > std::abs(y.first); });
-  std::ostringstream combination;
-  combination << "correlated with";
-  for (size_t k = 0; k < std::min<size_t>(2, partners.size()); ++k) {
-    combination << (k ? ", " : " ") << params.name(partners[k].second) << " (" << std::setprecision(2)
-                << partners[k].first << ")";
-  }
-  w.combination = combination.str();
-  HoldAtNominal({w}, true, data, gauge, state, report);
-  return true;
+  return internal::HoldWeakAtNominal(data, options, gauge, state, report);
 }
 
 // Why the free set cannot be estimated from these poses (K3), or empty when it can.
@@ -588,7 +509,7 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
   EstimateCovariance(data, state, gauge.free_kinematic, options, summary.final_cost, &report);
   // At most one round per free parameter; each holds one.
   for (size_t round = 0; round < report.free_indices.size() &&
-                         HoldWeakestUnderErrorModel(data, options, &gauge, &state, &report);
+                         internal::HoldWeakestUnderErrorModel(data, options, &gauge, &state, &report);
        ++round) {
     summary = Solve(data, gauge.free_kinematic, options, false, &state);
     report.iterations += summary.iterations;

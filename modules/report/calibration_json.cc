@@ -92,7 +92,8 @@ json WeakJson(const bundle::BundleReport& b) {
                     {"unit", unit},
                     {"conditional_std", w.conditional_std * scale},
                     {"tolerance", w.tolerance * scale},
-                    {"combination", w.combination}});
+                    {"combination", w.combination},
+                    {"under_error_model", w.under_error_model}});
   }
   json joints = json::array();
   for (const BarelyMovingJoint& j : b.barely_moving) {

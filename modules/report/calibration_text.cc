@@ -136,8 +136,9 @@ void PrintWeakDirections(const bundle::BundleReport& b, std::ostream& out) {
     const double scale = w.length ? kMm : RadToDeg(1.0);
     const char* unit = w.length ? " mm" : " deg";
     out << "  held (weak): " << w.name << " at the robot description's value: these poses determine it only to +- "
-        << std::setprecision(3) << w.conditional_std * scale << unit << " given the others (tolerance "
-        << w.tolerance * scale << unit << "; the direction " << w.combination << ")\n";
+        << std::setprecision(3) << w.conditional_std * scale << unit
+        << (w.under_error_model ? " under the estimated pose error (tolerance " : " given the others (tolerance ")
+        << w.tolerance * scale << unit << (w.under_error_model ? "; " : "; the direction ") << w.combination << ")\n";
   }
 }
 
