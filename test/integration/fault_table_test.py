@@ -11,9 +11,9 @@ ur-session: `run --robot ur` of the default plan (25 poses, seed 1) against the 
   the same free set, check distances below 0.5 mm RMS); the journal records the controller's identity (model,
   serial, factory calibration id) and session.json names the session.
 BACKEND:FAULT: one row of the fault table. The fault is injected during move #2 (pose p02, the third); the
-  run must halt with exit 4 (a killed selfcal: SIGKILL) and a message naming the cause, send no motion
-  command after the faulted one, and have recorded the samples of poses p00 and p01; then the fault is
-  cleared as a person would (UR: the Dashboard's `unlock protective stop`; reference server: SIGUSR1, the
+  run must halt with exit 4 (a killed selfcal: SIGKILL) and a message naming the cause, say truthfully
+  whether its stop command reached the controller (counted there), send no motion command after the
+  faulted one, and have recorded the samples of poses p00 and p01; then the fault is cleared as a person would (UR: the Dashboard's `unlock protective stop`; reference server: SIGUSR1, the
   acknowledgement at the controller; a server that ended: started again) and `run --resume` (the same command)
   completes the session: 25 samples, the samples recorded before the fault unchanged (none lost), and
   `calibrate` accepts it. The row is printed in the table's form (docs/universal-robots.md,
@@ -71,6 +71,9 @@ class UrFake:
     def motion_commands(self):
         return sum(1 for line in list(self.lines) if line.startswith("secondary: movej("))
 
+    def stop_commands(self):
+        return sum(1 for line in list(self.lines) if line.startswith(("secondary: stopj(", "dashboard: stop")))
+
     def wait_for_motion_command(self, count, timeout_s=60.0):
         deadline = time.monotonic() + timeout_s
         while self.motion_commands() < count:
@@ -102,6 +105,9 @@ class ReferenceServer(reference_server_test.Server):
 
     def motion_commands(self):
         return self.moves_started()
+
+    def stop_commands(self):
+        return sum(1 for line in list(self.lines) if "stop requested (STOP request)" in line)
 
     def wait_for_motion_command(self, count, timeout_s=60.0):
         self.wait_for(r"move #%d started" % (count - 1), timeout_s)
@@ -202,7 +208,11 @@ def fault_row(kind, selfcal, ur_fake, src, tmp, failures):
         code, out = run(selfcal, src, robot, session)
     else:
         code, out = inject(selfcal, src, robot, session, act)
-    sent = robot.motion_commands()
+    sent, stops = robot.motion_commands(), robot.stop_commands()
+    # The closing line says truthfully whether the stop went out (none reaches a controller that is gone).
+    told = "The robot was told to stop." in out
+    if act != "kill selfcal" and (told != (stops > 0) or (not told and "could not be sent" not in out)):
+        failures.append("%s: %d stop commands reached the controller, and the run said:\n%s" % (kind, stops, out[-1500:]))
     halted = [line for line in out.splitlines() if line.startswith("run: halted")]
     printed = halted[0] if halted else "(killed: nothing printed)"
     before = accepted_samples(session) if os.path.exists(os.path.join(session, "journal.log")) else {}
@@ -246,9 +256,9 @@ def fault_row(kind, selfcal, ur_fake, src, tmp, failures):
         verdict = "calibrate: %s" % (report["verdict"] if report else "failed")
         if report is not None and not report["accepted"]:
             failures.append("%s: calibrate after the resume: %s" % (kind, report["verdict"]))
-    print("| fault | printed | exit | motion commands after it | samples before / lost | `--resume` after clearing |")
-    print("| %s | `%s` | %d | %d | %d / %d | exit %d, %d samples, %s |" %
-          (kind, printed[:200], code, sent - (FAULT_MOVE + 1), len(before), len(lost), rcode, len(after), verdict))
+    print("| fault | printed | exit | stop commands | motion commands after it | samples before / lost | `--resume` after clearing |")
+    print("| %s | `%s` | %d | %d | %d | %d / %d | exit %d, %d samples, %s |" %
+          (kind, printed[:200], code, stops, sent - (FAULT_MOVE + 1), len(before), len(lost), rcode, len(after), verdict))
 
 
 def main():
