@@ -199,6 +199,9 @@ void UrFakeController::ServeDashboard(const Log& log) {
       reply = options_.model;
     } else if (line == "get_serial_number") {
       reply = options_.serial;
+    } else if (line == "unlock protective stop") {  // a person at the pendant, after inspecting the cause
+      state_.safety_status_bits = ur::kSafetyNormal;
+      reply = "Protective stop releasing";
     } else if (line == "stop") {
       ++stop_commands_;
       moving_ = false;

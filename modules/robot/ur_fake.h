@@ -5,7 +5,8 @@
 // documents as ur_protocol.h and speaking its byte formats. The arm moves each joint linearly to a movej
 // target, all arriving together, the leading joint at movej's v. Faults on request: the connections
 // dropped during a move, a protective stop during a move, a move that stops short and never finishes,
-// a wrong answer to the recipe setup, remote control off. It counts the motion commands (movej) it
+// a wrong answer to the recipe setup, remote control off. A protective stop stays until the Dashboard's
+// `unlock protective stop` (what a person does at the pendant; selfcal never sends it). It counts the motion commands (movej) it
 // received, and every line it receives is passed to `log`. It serves the newest client of each port (a new
 // connection replaces the one before); not a real controller.
 #pragma once

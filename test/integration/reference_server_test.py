@@ -25,11 +25,13 @@ import socket
 import struct
 import subprocess
 import sys
-import tempfile
 import threading
 import time
 
 import yaml
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import rehearsal_test  # noqa: E402  (run_mode)
 
 PLAN = "config/trajectories/initial_puma560.yaml"
 CYCLE_S = 0.008
@@ -267,21 +269,9 @@ def terminate(selfcal, src, tmp, failures):
 
 def main():
     mode, selfcal, src = sys.argv[1:4]
-    failures = []
-    with tempfile.TemporaryDirectory(prefix="refserver-") as tmp:
-        try:
-            {"protocol": protocol, "session": session, "kill": kill, "exception": exception,
-             "protective": protective, "emergency": emergency, "terminate": terminate}[mode](selfcal, src, tmp, failures)
-        except AssertionError as e:
-            failures.append(str(e))
-        finally:
-            for proc in STARTED:
-                if proc.poll() is None:
-                    proc.kill()
-                    proc.wait()
-    for f in failures:
-        print("FAILED: " + f)
-    return 1 if failures else 0
+    body = {"protocol": protocol, "session": session, "kill": kill, "exception": exception,
+            "protective": protective, "emergency": emergency, "terminate": terminate}[mode]
+    return rehearsal_test.run_mode("refserver-", lambda tmp, failures: body(selfcal, src, tmp, failures), STARTED)
 
 
 if __name__ == "__main__":
