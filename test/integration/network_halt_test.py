@@ -16,8 +16,9 @@ import re
 import signal
 import subprocess
 import sys
-import tempfile
-import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import rehearsal_test  # noqa: E402  (run_mode: the loopback tests' temporary directory and clean-up)
 
 STARTED = []
 
@@ -94,19 +95,9 @@ def unconfirmed(selfcal, robot_sim, ur_fake, src, tmp, failures):
 
 def main():
     mode, selfcal, robot_sim, ur_fake, src = sys.argv[1:6]
-    failures = []
-    with tempfile.TemporaryDirectory(prefix="network-halt-") as tmp:
-        try:
-            {"never-settle": never_settle, "unconfirmed": unconfirmed}[mode](selfcal, robot_sim, ur_fake, src, tmp,
-                                                                              failures)
-        finally:
-            for proc in STARTED:
-                if proc.poll() is None:
-                    proc.kill()
-                    proc.wait()
-    for f in failures:
-        print("FAILED: " + f)
-    return 1 if failures else 0
+    body = {"never-settle": never_settle, "unconfirmed": unconfirmed}[mode]
+    return rehearsal_test.run_mode("network-halt-", lambda tmp, failures: body(selfcal, robot_sim, ur_fake, src, tmp,
+                                                                                  failures), STARTED)
 
 
 if __name__ == "__main__":
