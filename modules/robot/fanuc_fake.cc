@@ -157,8 +157,9 @@ void FanucFakeController::ServeSession(const Log& log) {
   while (session_client_.is_open()) {
     const LineIoResult io = session_client_.ReadLine(&line, 0);
     if (io.outcome == LineIo::kTimeout) return;
-    if (!io.ok()) {
+    if (!io.ok()) {  // the client went away: RMI ends with it unless an instruction still runs
       session_client_.Close();
+      if (!moving_) status_.rmi_motion_status = 0;
       return;
     }
     Say(log, "session: " + line);

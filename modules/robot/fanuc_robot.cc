@@ -71,7 +71,7 @@ FanucRobot::FanucRobot(std::string host, FanucRobotOptions options)
   SELFCAL_CHECK(valid.ok(), valid.message());
 }
 
-FanucRobot::~FanucRobot() { Close(); }
+FanucRobot::~FanucRobot() { Disconnect(); }
 
 void FanucRobot::Close() {
   socket_.Close();
