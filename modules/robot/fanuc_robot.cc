@@ -200,12 +200,18 @@ Status FanucRobot::ConnectUnchecked() {
   const Status rest = CheckStartAtRest([this] { return ReadJoints(); }, [this](double t) { clock_.SleepFor(t); },
                                        options_.limits, options_.rest, name_);
   if (!rest.ok()) return rest;
+  initialized_ = false;  // FRC_Initialize before the first move: a dry run leaves RMI as it found it
+  return Status::Ok();
+}
+
+Status FanucRobot::Initialize() {
   Result<fanuc::Packet> init = Ask(PacketKind::kCommand, "FRC_Initialize", fanuc::SimpleRequest(PacketKind::kCommand, "FRC_Initialize"));
   if (!init.ok()) return init.status();
   if (init->error_id != 0) {
-    return RobotFailure(RobotError::kRejected, name_ + ": FRC_Initialize refused (ErrorID " + std::to_string(init->error_id) +
-                                                   "): read the alarm at the teach pendant");
+    return RobotFailure(RobotError::kRejected, name_ + ": move refused before sending: FRC_Initialize refused (ErrorID " +
+                                                   std::to_string(init->error_id) + "): read the alarm at the teach pendant");
   }
+  initialized_ = true;
   next_sequence_id_ = 1;
   return Status::Ok();
 }
@@ -277,6 +283,7 @@ Status FanucRobot::StartMove(const Eigen::VectorXd& target_rad, double velocity_
   if (const RobotStatus now = fanuc::StatusOf(*state); now.state != MotionState::kIdle) {
     return RobotFailure(RobotError::kRejected, name_ + ": move refused before sending: " + now.message);
   }
+  if (Status init = initialized_ ? Status::Ok() : Initialize(); !init.ok()) return init;
   const int percent = std::clamp(static_cast<int>(std::lround(velocity_scaling * 100)), 1, 100);
   const int sequence = next_sequence_id_++;
   if (LineIoResult io = Send(&socket_, fanuc::JointMotionRequest(sequence, target_rad, percent), options_.reply_timeout_s);

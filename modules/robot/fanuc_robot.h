@@ -6,8 +6,8 @@
 // controller sends when the instruction has run.
 // Connect() checks, before anything is sent that could move the arm: the teach pendant is disabled, the
 // servos are ready, no program runs, the identity (and a reconnect's: the same controller), the start
-// reading at rest within the robot config's limits; only then FRC_Initialize. A refusal at connect sends no
-// instruction. selfcal never sends FRC_Reset: clearing an alarm is a person's act at the pendant.
+// reading at rest within the robot config's limits. FRC_Initialize is sent before the first move, so that a
+// refusal or a dry run leaves the controller's RMI as it was. selfcal never sends FRC_Reset: clearing an alarm is a person's act at the pendant.
 // A move is done when its instruction was answered without error and every joint lies within
 // target_tolerance_rad of the target. Stop() is FRC_Abort (on a fresh connection when the link is lost).
 // A lost connection, FRC_Terminate or a wrong answer is kDisconnected/kProtocol on every later call until
@@ -76,6 +76,8 @@ class FanucRobot : public Robot {
  private:
   Status ConnectUnchecked();
   Status CheckIdentity();
+  // FRC_Initialize (RMI's program started on the controller), sent before the first move.
+  Status Initialize();
   // FRC_Connect on the connect port: its answer (with the session's port).
   Result<fanuc::Packet> SessionPort();
   // Sends `request` and reads packets until the answer named `name` (of `kind`); instruction answers and
@@ -97,6 +99,7 @@ class FanucRobot : public Robot {
   std::string broken_reason_;
   RobotIdentity identity_;
   std::optional<RobotIdentity> first_identity_;
+  bool initialized_ = false;
   int next_sequence_id_ = 1;
   std::optional<int> pending_sequence_;  // the move in progress
   bool pending_answered_ = false;
