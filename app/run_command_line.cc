@@ -38,10 +38,11 @@ Command AddRunCommand(CLI::App& app) {
   cmd->add_option("--setup", a->setup,
                   "Camera, yardstick and checks (docs/session-format.md); refused with --robot sim, whose cell makes "
                   "its own");
-  cmd->add_option("--robot", a->robot_backend, "Robot backend")->check(CLI::IsMember({"sim", "network", "manual", "ur"}));
+  cmd->add_option("--robot", a->robot_backend, "Robot backend")->check(CLI::IsMember({"sim", "network", "manual", "ur", "fanuc"}));
   cmd->add_option("--address", a->address,
                   "network backend: HOST:PORT (docs/robot-protocol.md); ur: the controller's HOST "
-                  "(docs/universal-robots.md)");
+                  "(docs/universal-robots.md); fanuc: HOST[:PORT], PORT the RMI connect port (default 16001, "
+                  "docs/fanuc.md)");
   cmd->add_option("--ur-ports", a->ur_ports,
                   "ur: the RTDE, secondary interface and Dashboard ports (default 30004,30002,29999; another set for "
                   "selfcal-ur-fake)")

@@ -20,6 +20,7 @@
 #include "app/cli_util.h"
 #include "app/output_options.h"
 #include "app/commands.h"
+#include "app/vendor_robots.h"
 #include "io/observations_file.h"
 #include "io/report_json.h"
 #include "io/robot_config.h"
@@ -32,7 +33,6 @@
 #include "simulation/sim_session.h"
 #include "robot/manual_robot.h"
 #include "robot/network_robot.h"
-#include "robot/ur_robot.h"
 #include "session/samples.h"
 #include "session/session_cleanup.h"
 #include "session/session_dir.h"
@@ -365,19 +365,15 @@ Status MakeBackends(const RunSettings& a, RunPlan* run, Backends* b) {
     options.config_limits = ManualJointLimits(run->nominal);
     options.log = log;
     b->owned_robot = std::make_unique<robot::NetworkRobot>(a.address.substr(0, colon), port, options);
-  } else if (a.robot_backend == "ur") {
-    if (a.address == RunSettings().address) {
-      return Status::Error(ErrorCode::kInvalidInput, "--robot ur needs --address HOST, the controller's (docs/universal-robots.md)");
-    }
-    Result<robot::UrRobotOptions> ur = robot::UrRunOptions(a.address, a.ur_ports, ManualJointLimits(run->nominal));
-    if (!ur.ok()) return ur.status();
-    ur.value().log = log;
-    b->owned_robot = std::make_unique<robot::UrRobot>(a.address, *ur);
+  } else if (a.robot_backend == "ur" || a.robot_backend == "fanuc") {
+    Result<std::unique_ptr<robot::Robot>> vendor = MakeVendorRobot(a, ManualJointLimits(run->nominal), log);
+    if (!vendor.ok()) return vendor.status();
+    b->owned_robot = std::move(vendor).value();
   } else if (a.robot_backend == "manual") {
     b->owned_robot = std::make_unique<robot::ManualRobot>(std::cin, JsonMode() ? std::cerr : std::cout,
                                                           ManualJointLimits(run->nominal), *b->clock);
   } else {
-    return Status::Error(ErrorCode::kInvalidInput, "--robot must be sim, network, manual or ur");
+    return Status::Error(ErrorCode::kInvalidInput, "--robot must be sim, network, manual, ur or fanuc");
   }
   b->arm = b->owned_robot.get();
   if (b->owned_identifier) b->identifier = b->owned_identifier.get();

@@ -107,6 +107,23 @@ std::string CheckJointLimits(const JointLimits& limits) {
   return "";
 }
 
+std::string IdentityRefusal(const RobotIdentity& now, const std::optional<RobotIdentity>& first,
+                            const std::optional<RobotIdentity>& expected, const std::string& name) {
+  const auto differs = [](const RobotIdentity& a, const RobotIdentity& b, bool skip_empty) {
+    const auto field = [&](const std::string& x, const std::string& y) { return !(skip_empty && x.empty()) && x != y; };
+    return field(a.model, b.model) || field(a.serial, b.serial) || field(a.calibration_id, b.calibration_id);
+  };
+  const auto said = [](const RobotIdentity& i) { return i.model + " serial " + i.serial + " " + i.calibration_id; };
+  if (first && differs(*first, now, false)) {
+    return name + ": the controller is not the one first connected (" + said(*first) + ", now " + said(now) +
+           "); refusing it";
+  }
+  if (expected && differs(*expected, now, true)) {
+    return name + ": the controller is not the expected robot (" + said(now) + "); refusing it";
+  }
+  return "";
+}
+
 std::string CheckMoveTarget(const JointLimits& limits, const Eigen::VectorXd& target_rad, double velocity_scaling) {
   std::ostringstream problem;
   problem.precision(10);

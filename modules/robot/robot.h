@@ -16,6 +16,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 
 #include <Eigen/Core>
@@ -55,6 +56,12 @@ struct RobotIdentity {
   std::string calibration_id;  // the controller's own calibration/version id (R13), "" if none
   bool real_hardware = false;  // true when commands can move a physical arm (R12)
 };
+
+// The refusal of a controller at connect ("" when none): `now` differs from `first` (the identity of the
+// first connect, a reconnect to another arm, R13) in any field, or from `expected` in a non-empty field
+// (R12). Names both identities; `name` prefixes the message.
+std::string IdentityRefusal(const RobotIdentity& now, const std::optional<RobotIdentity>& first,
+                            const std::optional<RobotIdentity>& expected, const std::string& name);
 
 struct JointLimits {
   Eigen::VectorXd lower_rad;

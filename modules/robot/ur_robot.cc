@@ -314,18 +314,9 @@ Status UrRobot::ConnectUnchecked() {
   identity_.backend = "ur";
   identity_.calibration_id = ur::CalibrationIdOf(*kinematics_);
   identity_.real_hardware = true;
-  const auto differs = [](const RobotIdentity& a, const RobotIdentity& b, bool skip_empty) {
-    const auto field = [&](const std::string& x, const std::string& y) { return !(skip_empty && x.empty()) && x != y; };
-    return field(a.model, b.model) || field(a.serial, b.serial) || field(a.calibration_id, b.calibration_id);
-  };
-  const auto said = [](const RobotIdentity& i) { return i.model + " serial " + i.serial + " " + i.calibration_id; };
-  if (first_identity_ && differs(*first_identity_, identity_, false)) {
-    return RobotFailure(RobotError::kProtocol, name_ + ": the controller is not the one first connected (" +
-                                                   said(*first_identity_) + ", now " + said(identity_) + "); refusing it");
-  }
-  if (options_.expected_identity && differs(*options_.expected_identity, identity_, true)) {
-    return RobotFailure(RobotError::kProtocol, name_ + ": the controller is not the expected robot (" +
-                                                   said(identity_) + "); refusing it");
+  if (const std::string refusal = IdentityRefusal(identity_, first_identity_, options_.expected_identity, name_);
+      !refusal.empty()) {
+    return RobotFailure(RobotError::kProtocol, refusal);
   }
   if (Status s = open(&rtde_, options_.rtde_port); !s.ok()) return s;
   if (Status s = StartRtde(); !s.ok()) return s;

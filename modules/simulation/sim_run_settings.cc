@@ -123,7 +123,7 @@ void ReadRunHeader(const json& run, JsonFields* fields, RunBackends* backends) {
   if (fields->GetInt(run, {}, "version", &version) && version != 1) {
     fields->Add(JsonPath{}.Member("version"), "`version` must be 1 (found " + std::to_string(version) + ")");
   }
-  GetStringOf(run, "robot", {"sim", "network", "manual", "ur"}, fields, &backends->robot);
+  GetStringOf(run, "robot", {"sim", "network", "manual", "ur", "fanuc"}, fields, &backends->robot);
   GetStringOf(run, "camera", {"sim", "v4l2", "aravis"}, fields, &backends->camera);
   std::string text;
   fields->GetString(run, {}, "address", &text);
