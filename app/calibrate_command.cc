@@ -263,8 +263,8 @@ Status WriteOutputs(const LoadedInput& loaded, const calibration::CalibrationRep
   // An earlier run's model files in this directory (there only with --force, output_options.h) would sit
   // beside a report of this run: gone before this run writes its own, or none.
   for (const char* name : {"calibrated_model.yaml", "calibrated.urdf", "calibrated_robot.yaml",
-                           "camera_static_transform.yaml", "hand_eye.yaml", "camera_info.yaml",
-                           "ur_calibrated_kinematics.yaml"}) {
+                           "camera_static_transform.yaml", "camera_static_transform.launch.py", "hand_eye.yaml",
+                           "camera_info.yaml", "ur_calibrated_kinematics.yaml"}) {
     std::error_code error;
     if (std::filesystem::remove(out / name, error)) {
       std::cout << "removed the earlier run's " << (out / name).string() << (report.model ? "" : " (this run wrote no model)")
@@ -332,7 +332,7 @@ void AddParameterMaskOptions(CLI::App* cmd, std::vector<std::string>* fix, std::
 std::vector<std::string> CalibrationOutputFiles() {
   return {"observations.yaml", "report.json",           "report.html",           "image_residuals.csv",
           "calibrated_model.yaml", "calibrated.urdf", "calibrated_robot.yaml", "camera_static_transform.yaml",
-          "hand_eye.yaml", "camera_info.yaml", "ur_calibrated_kinematics.yaml"};
+          "camera_static_transform.launch.py", "hand_eye.yaml", "camera_info.yaml", "ur_calibrated_kinematics.yaml"};
 }
 
 int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {

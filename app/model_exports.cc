@@ -138,6 +138,10 @@ Status WriteCameraStaticTransform(const Rigid3& flange_from_cam, const io::Robot
   std::cout << "flange-to-camera static transform (" << names.tip_link << " -> " << names.camera_link << "): " << path
             << "\n";
   AddOutputFile("camera_static_transform", path);
+  const std::string launch_path = (std::filesystem::path(out_dir) / "camera_static_transform.launch.py").string();
+  if (Status s = io::SaveStaticTransformLaunch(transform, launch_path); !s.ok()) return s;
+  std::cout << "the same as a ROS 2 launch file: " << launch_path << "\n";
+  AddOutputFile("camera_static_transform_launch", launch_path);
   return Status::Ok();
 }
 

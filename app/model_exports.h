@@ -1,7 +1,7 @@
 // The calibrated model's exports beside calibrated_model.yaml (calibrate, simulate, identify-tracker):
 // calibrated.urdf (docs/urdf.md), the DH table in the convention the robot was entered in
 // (calibrated_robot.yaml, docs/calibrated-model-format.md) and the flange-to-camera static transform
-// (camera_static_transform.yaml, docs/ros-static-transform.md). Each said on stdout and named in --json.
+// (camera_static_transform.yaml and camera_static_transform.launch.py, docs/ros-static-transform.md). Each said on stdout and named in --json.
 #pragma once
 
 #include <string>
@@ -24,7 +24,8 @@ Status WriteModelExports(const RobotModel& calibrated, const io::RobotOrigin& or
                          const std::string& out_dir);
 
 // camera_static_transform.yaml in `out_dir`: flange_from_cam from the tip link (parent) to the camera link
-// (child), named from the URDF the robot came from, else tool0 and camera_optical_frame.
+// (child), named from the URDF the robot came from, else tool0 and camera_optical_frame; and the same
+// transform as the ROS 2 launch file camera_static_transform.launch.py.
 Status WriteCameraStaticTransform(const Rigid3& flange_from_cam, const io::RobotOrigin& origin,
                                   const std::string& out_dir);
 

@@ -1,3 +1,15 @@
+// Module acquisition (ARCHITECTURE.md): the session loop RunSession (this header) and Preflight
+// (motion_safety.h: limits, travel, velocity limits). The dots are named by dot_prediction.h (tracked ones
+// checked against, lost ones named again by, their position predicted from the accepted samples; a dot seen
+// once confirmed along its epipolar segment), bundled_cameras.h (from three samples on, the samples' cameras
+// and f_x bundled from their own images over bundle/free_camera_bundle.h), late_naming.h (after the last
+// pose, each accepted image read again and its missing dots named), seen_once.h (dots held by at most three
+// samples named where further samples support it), identifiers.h (the first frame's identifiers of
+// `run --identify`: detection order, grid, AprilTag, the setup's reference dots) and dot_naming.h (one frame
+// named). Every frame goes to RunContext::observe as a FrameView (for a live view; no display code here).
+// Never calibrates: its only solves are the predictions'. Uses planning, tracking, robot, session, capture,
+// observations, kinematics, camera; bundle, geometry, base private.
+//
 // The operator's session loop (issue 6; DESIGN.md "move / grab / track / record"; RELIABILITY.md design
 // rule 3): drives a robot::Robot through a plan, grabs frames from a capture::FrameSource, tracks the dots
 // through every move (identities never jump: vpDot2 follows them frame to frame), and records every event

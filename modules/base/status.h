@@ -1,3 +1,23 @@
+// Module base (the bottom layer; ARCHITECTURE.md): Status / Result<T> with a domain ErrorCode (invalid
+// input, degenerate data, hardware, solver, interrupted, internal; the exit codes are chosen in app/exit_codes.h
+// only) and SELFCAL_CHECK (this header); and the small services every layer shares:
+//   atomic_file.h         atomic file publication and size-capped reads (io, capture and session use it)
+//   crc32.h, sha256.h     CRC-32 (zlib, private) and SHA-256 (nettle, private: OpenSSL's libcrypto cost 3 ms of
+//                         every start): session journals and manifests, report provenance
+//   progress.h            ProgressSink, the abstract progress of a long step (an optional pointer in the options
+//                         of RunStudy, PlanMeasurements, Calibrate, RunSession's context, DetectAllImagePoints)
+//   terminal_text.h       TerminalSafe: control characters of controller and file text escaped for a terminal
+//   closest_name.h        EditDistance / ClosestName: did-you-mean for YAML keys and the CLI
+//   json_lines.h          JsonLines: the line of every key of a JSON text and the first repeated key, for
+//                         refusals of setup.json and session.json that name file:line (nlohmann_json private)
+//   process_heap.h        PrepareProcessHeap: malloc's large steps and transparent huge pages, first in main
+//   time_limited_child.h  RunInTimeLimitedChild: work in a forked child killed at a wall-clock limit (OpenCV's
+//                         YAML reader loops forever on some camera files); a crash of the child told apart
+//   xml_scan.h            ScanXml: size, depth, tags (optionally UTF-8, repeated siblings) of an XML text checked
+//                         without recursion before a parser sees it (URDFs, ViSP and OpenCV camera files)
+//   install_layout.h      FindDataFile: config/, plotly.min.js and the private library found from the program's
+//                         own location (cmake/SelfcalInstall.cmake); the source tree only from a build tree
+//
 // Error and outcome vocabulary shared by every module.
 //
 // Three kinds of failure, three mechanisms (STYLE.md, "Errors"):

@@ -1,3 +1,20 @@
+// Module bundle (ARCHITECTURE.md): the kinematic bundle adjustment (this header), called by
+// calibration::RunBundleStage (the product's default method) and the study. Its files:
+//   error_model.h           the cell's error model from the residuals by variance components: pixel noise and
+//                           each image's pose error, the covariance under it, the score test of held values
+//   kinematic_lm.h          the solver: Ceres' trust-region Levenberg-Marquardt rule for rule, dots eliminated by
+//                           their Schur complement in closed form, the globals' normal matrix one rank update
+//   ceres_reference_solve.h the Ceres DENSE_SCHUR solve it replaced, kept as the tests' reference
+//   weak_directions.cc      joint parameters the poses determine worse than a manufacturing tolerance held at the
+//                           description's value and named
+//   free_camera_bundle.h    every image's camera free, for checking recorded poses against the images
+//   pose_noise_bundle.h     the hand-eye bundle with a stated flange pose noise (a corrected pose per image)
+//   small_solve.h           both of those with the nine intrinsics as one block, the held ones fixed by a
+//                           ceres::SubsetManifold
+// Intrinsics by an IntrinsicsMask over camera/camera.h's nine (f_x by default), parameters held or freed by name
+// (--fix / --free, the groups lens and intrinsics); an intrinsic the poses cannot separate is refused by name.
+// Uses identification, observations, kinematics, camera, base; Ceres private.
+//
 // Kinematic bundle adjustment (DESIGN.md section 5): one least-squares problem over every identification
 // image, beyond the paper's pipeline (which only initialises it).
 //

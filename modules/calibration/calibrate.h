@@ -1,3 +1,21 @@
+// Module calibration (ARCHITECTURE.md): the solve; no files, no hardware, no simulator. This facade and:
+//   paper_pipeline.h        RunPaperPipeline, section 4.1 steps 2-5
+//   bundle_stage.h          RunBundleStage: the bundle from the paper's model (or the nominal one when it
+//                           failed) and its held-out verification
+//   heldout_reprojection.h  the identification images' dots projected into the verification images with the
+//                           calibrated and the nominal model, a chi-square/F test with the prediction's covariance
+//   acceptance.h            the checks that turn a verdict to kRejected (see Calibrate below)
+//   cross_validation.h      CrossValidate: without verification poses, the bundle re-run without each fold and
+//                           the fold predicted
+//   hand_eye_start.h        StartHandEye (flange poses: Procrustes rotation, a linear translation with one length
+//                           per pair; on a flat target twoview/planar_views.h) and StartCameraFromImages
+//   motion_check.h          CheckImageMotions: the free-camera bundle's camera motions against the flange
+//                           motions, pair by pair, and each image's pose against the model's
+//   fit_geometry.h          camera poses and residuals at the bundle's solution, for the report's plots
+//   predicted_error.h       PredictDistanceErrors: first-order 3-D error of held-out distances
+//   scene_moves.h           SceneMovesOf: where each scene's points lie against the first's (a board that moved)
+// Uses bundle, identification, twoview, observations, kinematics, geometry, camera, base.
+//
 // The calibration facade: one entry point from an observation set to a report that carries the verdict
 // and, when the verdict is "accepted", the model to write.
 //

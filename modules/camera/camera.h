@@ -1,3 +1,8 @@
+// Module camera (ARCHITECTURE.md): the pinhole model of eq. (8) with OpenCV's lens (this header),
+// inverted by Newton; the templated projection with every intrinsic an unknown (ProjectWithIntrinsics, the
+// Intrinsic order fx, mu, cx, cy, k1, k2, p1, p2, k3) and the IntrinsicsMask of which ones an estimator moves.
+// Uses geometry.
+//
 // Pinhole camera of eq. (2)/(8) of the paper with OpenCV's radial-tangential lens model (the five
 // coefficients of cv::calibrateCamera, in OpenCV's order k1, k2, p1, p2, k3).
 //

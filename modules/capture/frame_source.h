@@ -1,3 +1,13 @@
+// Module capture (ARCHITECTURE.md): FrameSource (this header: Open / Grab(not_before, timeout) / Close,
+// typed CaptureError); frame_checks.h (per-frame checks, V6, V9); recorded_sequence.h (index.yaml + PNG,
+// atomic writer, validating reader: V8); v4l2_camera.h (V4l2Camera over vpV4l2Grabber with device, format,
+// clock and control checks, V1-V5, V7), v4l2_modes.h (any size, format and frame interval the device lists:
+// ENUM_FMT / FRAMESIZES / FRAMEINTERVALS, refusals with the list), v4l2_stream.h (MJPEG through its own mmap
+// stream) and mjpeg_decode.h (libjpeg-turbo; damaged frames refused, tested on test/data/mjpeg);
+// aravis_camera.h (GigE Vision / USB3 Vision through Aravis 0.8: exposure and gain locked, a software trigger
+// after the settle, vanished cameras kDisconnected; tested against Aravis' fake camera). Uses base, yaml
+// (private), ViSP; libjpeg, Aravis and OpenCV private.
+//
 // Frame sources: the one interface through which a session gets images, whether from a V4L2 camera
 // (v4l2_camera.h), a recorded sequence folder (recorded_sequence.h) or the simulator
 // (sim/simulated_camera.h). The session code cannot tell them apart (DESIGN.md section 2, STYLE.md

@@ -1,3 +1,5 @@
+// Module compensation (ARCHITECTURE.md): Compensate, this header only. Uses kinematics, geometry, base.
+//
 // Compensation (docs/compensation.md): the joint angles that put the flange or the camera at target poses
 // on the calibrated arm, for a controller that takes joint angles and no model.
 //

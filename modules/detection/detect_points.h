@@ -1,3 +1,13 @@
+// Module detection (ARCHITECTURE.md): `selfcal detect`'s core, images in memory in. blob_candidates.h
+// (the polarity, and the texture filter of blobs unlike the target's); circle_grid.h (grids without an origin
+// dot through cv::findCirclesGrid) and grid_orientation.h (their rotation per image chosen from the robot
+// poses); chessboard.h (cv::findChessboardCorners, ordered across images by handedness, the squares' colour and
+// continuity); charuco.h (a ChArUco board named by its markers through OpenCV's aruco module, Debian's
+// libopencv-contrib-dev, this module only); corner_refine.h (both refined along their edges); charuco_pattern.h
+// (a ChArUco board's printed pattern and metric corners, the tests' reference and
+// test/tools/selfcal_corner_precision's); contact_sheet.h (the contact sheet PNG in memory). No file I/O.
+// Uses tracking, observations, kinematics, geometry, base, ViSP; OpenCV private.
+//
 // The points of a list of images, by id, for `selfcal detect` (docs/detect.md): images in memory in,
 // per image the id -> pixel of every point named, and the ObservationSet of the images with their robot
 // poses. No file I/O: the caller reads the images and poses (io/image_files.h, io/pose_files.h) and writes

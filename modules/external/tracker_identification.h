@@ -1,3 +1,6 @@
+// Module external (ARCHITECTURE.md): this header only; tested on the Fanuc data read by io in
+// test/cross_module. Uses identification, kinematics, geometry, base.
+//
 // Kinematic identification from poses of a body measured by an external instrument (laser tracker: three
 // SMRs in a nest on the flange), through the same relative-pose identification as the camera pipeline
 // (identification/identification.h): the nest plays the camera's part, `flange_from_cam` is flange_from_nest.

@@ -1,3 +1,5 @@
+// Module geometry (ARCHITECTURE.md): Rigid3T<T> (b_from_a), rotations, SO(3) exp/log. Uses Eigen only.
+//
 // Rigid transforms and rotations, templated on the scalar so that Ceres Jets flow through them.
 //
 // Naming: a transform `b_from_a` maps coordinates of a point in frame a to frame b:

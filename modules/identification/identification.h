@@ -1,3 +1,8 @@
+// Module identification (ARCHITECTURE.md): identifiability (identifiability.h: rank analysis, named null
+// space; rank_selection.h, shared with bundle), LM identification with covariance (this header), eq. (21)
+// scale, triangulation and the yardstick scale (triangulation.h). Uses kinematics, camera, geometry, base;
+// Ceres private.
+//
 // Kinematic identification from measured relative camera poses (paper section 2.3, eq. (6); section 4.1
 // step 3): Levenberg-Marquardt (Ceres) over the identifiable parameters, started from the nominal model.
 #pragma once

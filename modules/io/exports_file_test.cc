@@ -98,6 +98,23 @@ TEST(StaticTransformFile, YamlCppReadsTheTransformBack) {
   EXPECT_LE(d.rotation_rad, 1e-12);
 }
 
+TEST(StaticTransformFile, LaunchFileCarriesTheYamlsNumbersAndQuotesFrameNames) {
+  const Rigid3 flange_from_cam(RotZ(-2.9) * RotX(0.3), Eigen::Vector3d(0.0412345678901, -1e-5, 0.0612));
+  const StaticTransform transform{"tool0", "cam's\\frame\n", flange_from_cam};
+  const std::string launch = StaticTransformLaunchPy(transform);
+  const YAML::Node doc = YAML::Load(StaticTransformYaml(transform));
+  const YAML::Node t = doc["transform"]["translation"], r = doc["transform"]["rotation"];
+  const std::string expected_numbers = "'--x', '" + t["x"].as<std::string>() + "', '--y', '" + t["y"].as<std::string>() +
+                                       "', '--z', '" + t["z"].as<std::string>() + "',\n                '--qx', '" +
+                                       r["x"].as<std::string>() + "', '--qy', '" + r["y"].as<std::string>() +
+                                       "', '--qz', '" + r["z"].as<std::string>() + "', '--qw', '" +
+                                       r["w"].as<std::string>() + "',";
+  EXPECT_NE(launch.find(expected_numbers), std::string::npos) << launch;
+  EXPECT_NE(launch.find("'--frame-id', 'tool0',"), std::string::npos) << launch;
+  EXPECT_NE(launch.find("'--child-frame-id', 'cam\\'s\\\\frame\\x0a',"), std::string::npos) << launch;
+  EXPECT_NE(launch.find("executable='static_transform_publisher'"), std::string::npos);
+}
+
 TEST(RobotOrigin, UrdfNamesSurviveTheSessionsRecordedRobot) {
   const std::vector<std::string> expected = {"shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint",
                                              "wrist_1_joint",      "wrist_2_joint",       "wrist_3_joint"};

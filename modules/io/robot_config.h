@@ -1,3 +1,29 @@
+// Module io (ARCHITECTURE.md): the only file I/O of the core, every reader strict (yaml/yaml_reader.h,
+// yaml_schema.h) and every writer atomic (base/atomic_file.h). Its files:
+//   robot_config.h, urdf_robot_config.h  robot configs (also one naming a URDF, converted by urdf; LoadRobotConfig:
+//                           the model with its source and home_deg) and calibrated models (this header)
+//   observations_file.h, trajectory_file.h, hand_eye_file.h, fanuc_tracker_csv.h, report_json.h, targets_file.h
+//                           observations (joints or flange poses), trajectories (LoadTrajectoryFileForRobot: a
+//                           trajectory for another robot refused naming both), hand-eye results, Fanuc tracker CSV,
+//                           JSON files, compensate's targets
+//   file_lists.h, image_files.h, pose_files.h, json_pose_file.h, skipped_images_file.h
+//                           `selfcal detect`'s inputs: files sorted by the number in their names, grey images of one
+//                           size, ROS / ViSP / selfcal pose lists (a folder per pose: PoseFolder; tool poses made
+//                           the flange's; rotations made rotations within 1e-4 by transform_yaml.h's MakeRotation),
+//                           the images --skip-failed left out
+//   dh_config_file.h, static_transform_file.h, camera_info_file.h, ur_kinematics_file.h, robot_origin.h
+//                           the exports: a DH table as a robot config, ROS's TransformStamped YAML and launch file,
+//                           ROS's camera_info YAML, ur_description's kinematics; how the robot was entered (its DH
+//                           convention or URDF names, also `entered_as` in a session's recorded robot)
+//   camera_file.h, camera_xml.h, camera_formats.h, opencv_lines.h
+//                           camera files (docs/camera-files.md): OpenCV FileStorage (its text checked first by the
+//                           strict reader or base/xml_scan.h; key lines found by opencv_lines.h) and ViSP's XML
+//                           (read by camera_xml.h, written by ViSP); the OpenCV and ViSP calls sit behind
+//                           camera_formats.h in selfcal_io_camera_formats, which `selfcal` loads by dlopen as
+//                           libselfcal_camera_formats.so when a camera file first needs it (the target property
+//                           SELFCAL_LOAD_CAMERA_FORMATS); every other program links it
+// Uses yaml, urdf, planning, observations, kinematics, geometry, base.
+//
 // Robot description files (config/robots/*.yaml) and calibrated-model files.
 //
 // A robot config (mm and degrees in the file, SI inside; keys carry their unit, and either unit of a

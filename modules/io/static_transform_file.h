@@ -12,6 +12,10 @@
 //
 // with the equivalent `ros2 run tf2_ros static_transform_publisher` command line as a comment. Numbers
 // are shortest round-trip decimals, so the transform reads back to rounding.
+//
+// The same transform as a ROS 2 launch file (camera_static_transform.launch.py): one launch_ros `Node` of
+// tf2_ros' static_transform_publisher with the named arguments (--x --y --z --qx --qy --qz --qw --frame-id
+// --child-frame-id) of ROS 2 Humble and later; the same numbers, as strings, in the same convention.
 #pragma once
 
 #include <string>
@@ -31,5 +35,11 @@ std::string StaticTransformYaml(const StaticTransform& transform);
 
 // StaticTransformYaml written atomically to `path`.
 Status SaveStaticTransform(const StaticTransform& transform, const std::string& path);
+
+// The ROS 2 launch file (Python) that publishes `transform` with static_transform_publisher.
+std::string StaticTransformLaunchPy(const StaticTransform& transform);
+
+// StaticTransformLaunchPy written atomically to `path`.
+Status SaveStaticTransformLaunch(const StaticTransform& transform, const std::string& path);
 
 }  // namespace selfcal::io

@@ -1,3 +1,9 @@
+// Module kinematics (ARCHITECTURE.md): RobotModel (this header: modified DH + Hayati beta, the parameter
+// vector and names, templated forward kinematics, autodiff Jacobians, IK); damped_least_squares.h (the IK's
+// damped least-squares loop, shared with the planner's candidate pool); dh_table.h (a model as a standard,
+// modified or modified_hayati DH table when exact, else the reasons and their cost); joint_motion.h.
+// Uses geometry, base; Ceres (Jets).
+//
 // Serial-arm kinematic model and its identification parameterisation.
 //
 // Convention (DESIGN.md section 4). Joint i (1-based) is revolute about the z axis of its own frame and

@@ -1,3 +1,6 @@
+// Module liveview (ARCHITECTURE.md): this header and x11_connection.h. Uses acquisition, capture, base,
+// ViSP (visp_gui) and X11.
+//
 // The live view of a session (`selfcal run` / `simulate --live-view`): every frame the session loop
 // looks at (acquisition::FrameView, through RunContext::observe) drawn in an X11 window through ViSP's
 // vpDisplayX: the grey image, a cross and the id per dot coloured by its state (green tracked, cyan

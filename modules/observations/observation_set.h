@@ -1,3 +1,8 @@
+// Module observations (ARCHITECTURE.md): ObservationSet (this header; UsesFlangePoses, BaseFromCamAt) and
+// known distances; pool_recordings.h: several recordings of one arm pooled, each a scene of its own;
+// joint_limits.h: the poses whose recorded joints lie outside the limits, named (kept: the controller's
+// reading). Uses kinematics, camera.
+//
 // What a calibration consumes, independent of where it came from (simulator, session, or a file written
 // by another tool; docs/observations-format.md is the file form): the nominal robot, the camera, and per
 // pose the joint angles and the pixel of each detected dot, by dot id. Data recorded by a cell that logs

@@ -1,3 +1,12 @@
+// Module planning (ARCHITECTURE.md; docs/planning.md): eq. (39) with exact gradients (pose_twists.h:
+// spatial twists of every parameter, Jets in the joints) by L-BFGS in a log barrier (barrier_objective.h);
+// robots up to 7 joints; D-/A-optimal exchange designs on the bundle's Fisher information (fisher_design.h,
+// exchange_kernels.h) over a seeded candidate pool (candidate_pool.h); repair of infeasible starts; the visit
+// order the session can track (visit_order.h: every move within the image-motion and travel bounds where an
+// order allows it); CheckPlan (plan_check.h: C5-C7, every constraint named by pose); observability indices
+// and predicted parameter std (observability.h). Uses identification, kinematics, camera, geometry, base;
+// Ceres private.
+//
 // Measurement-configuration planning (issue 4): from a feasible start plan, m poses (the first
 // num_identification_poses identify, the rest verify) that minimise a criterion under the constraints of
 // planning/plan_problem.h.

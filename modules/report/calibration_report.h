@@ -1,3 +1,14 @@
+// Module report (ARCHITECTURE.md): every report as JSON, text and HTML, and nothing of files or exit codes
+// (the app hands it the exit code and the input's provenance). This header (report.json, docs/report-format.md,
+// schema docs/report.schema.json) and calibration_json_plots.h (the bundle's plot_data); study_report.h (the
+// study tables and document, the bound sweep); html_report.h (report.html: one self-contained page of a
+// report.json or study document, plotly.js handed in as text), html_writer.h (escaping, tables, the page),
+// calibration_html_figures.h (the plotly figures); literature.h (the paper's Table 2 as data);
+// terminal_progress.h (the progress line: bar, done/total, elapsed, time left; quiet off a terminal);
+// plan_json.h (a plan's and its observability's figures for `plan --json`); image_residuals.h
+// (image_residuals.csv, one row per image). Uses calibration, simulation, session, planning, kinematics,
+// geometry, base.
+//
 // report.json of a calibration (schema: docs/report-format.md, "selfcal-calibration-report" version 3)
 // and its on-screen summary. Every value in the JSON is SI with the unit in the key (_m, _rad, _px, _s);
 // the text prints mm and degrees. The top level carries the chosen method's verdict and figures; the

@@ -1,3 +1,10 @@
+// Module robot (ARCHITECTURE.md): the Robot interface (this header: asynchronous moves, typed RobotError;
+// clock.h: the session Clock); SimulatedRobot (quintic moves, ring-down, fault injection R4-R10, command
+// counts); the network line protocol (NetworkRobot, RobotServer; docs/robot-protocol.md); the manual backend;
+// Universal Robots natively (ur_robot.h, UrRobot: RTDE readings, movej/stopj on the secondary interface, the
+// Dashboard's checks and the factory kinematics at connect; the byte formats in ur_protocol.h; ur_fake.h, the
+// loopback fake UrFakeController; docs/universal-robots.md). Uses base.
+//
 // The robot interface (DESIGN.md section 2, layer 2): what a calibration session needs from an arm, and
 // nothing else. Backends: the simulated robot (simulated_robot.h), the network line protocol
 // (network_robot.h, docs/robot-protocol.md; robot_server.h serves any Robot with it) and the manual

@@ -1,3 +1,9 @@
+// Module rosbag (ARCHITECTURE.md): ROS 2 recordings for `selfcal detect --bag`: mcap_reader.h (an MCAP file
+// scanned record by record from the specification, zstd chunks through libzstd, every length checked,
+// refusals naming the byte offset), ros_messages.h (JointState, Image, CompressedImage from CDR; images made
+// grey with ViSP's conversions, compressed ones decoded by OpenCV), this header (joints by the URDF robot's
+// names through io). Uses io, base, ViSP; libzstd and OpenCV private.
+//
 // A ROS 2 recording (a rosbag2 MCAP file) as the images and joint angles of `selfcal detect --bag`
 // (docs/detect.md, "ROS 2 recordings"): the joint states of one topic (sensor_msgs/msg/JointState) and the
 // images of another (sensor_msgs/msg/Image or CompressedImage), each image kept only when the arm was still

@@ -1,3 +1,15 @@
+// Module session (ARCHITECTURE.md): session directories (this header, docs/session-format.md):
+// journal.h (append-only, length + CRC framing, fdatasync per record, torn-tail recovery, refusal of damage),
+// session_lock.h (flock with stale-lock takeover), samples.h (record types and ReadSessionLog: plan, accepted
+// samples, skips, counts, resume point), planned_pose.h (the plan's pose, also the session loop's),
+// session_snapshot.h (the read-only ReadSession of offline readers and `run --resume --dry-run`: no lock,
+// nothing written, every input checked against its SHA-256), session_observations.h
+// (LoadSessionObservations), setup_file.h (setup.json), json_fields.h (file:line refusals through
+// base/json_lines.h), output_path.h (CheckOutputPath: the one rule of every command's output paths, never
+// inside a session, never over an input, never over an existing file without --force, a place that can be
+// written). Rejected frames of skipped poses live in images/rejected/, journaled as frame_rejected; readers
+// never use them. Uses base, observations; io private (the robot config).
+//
 // A calibration session directory (docs/session-format.md; RELIABILITY.md P1-P6, C9, C10): the durable,
 // resumable record of one session, from which `selfcal calibrate SESSION` solves offline and
 // `selfcal run --resume SESSION` continues after a crash.

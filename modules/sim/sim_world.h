@@ -1,3 +1,13 @@
+// Module sim (ARCHITECTURE.md): the simulated world with hidden truth (this header: robot errors, hand-eye,
+// f_x, dots, pixel noise; a flat sheet of random dots or a modified circle grid with a larger origin dot);
+// trajectory_generator.h (smooth arcs); image_renderer.h (perspective discs, supersampled with only the
+// samples nearest the rim projected, blur, noise; per-dot truth incl. the ellipse-centre bias) over
+// image_formation.h (coverage -> grey -> blur around the dots -> seeded ziggurat noise, frame buffers kept
+// per thread); simulated_camera.h (SimulatedCamera, a capture::FrameSource); render_sequence.h (a simulated
+// session rendered into a recorded sequence with its truth); board_renderer.h (a flat printed board:
+// chessboard, ChArUco, any pattern as a grey level per board point, rendered anti-aliased through the lens,
+// with known corners). Uses observations, identification, kinematics, camera, geometry, capture.
+//
 // The simulated world of DESIGN.md section 6: a true robot (nominal + hidden errors drawn from a seed),
 // a hidden flange-to-camera transform and focal length, a scene of non-coplanar dots (or, with
 // flat_sheet, dots on one plane) in view of every pose, a yardstick, and image points projected with

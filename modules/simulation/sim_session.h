@@ -1,3 +1,16 @@
+// Module simulation (ARCHITECTURE.md): the only module above sim that links it. This header (the cell;
+// SimCellOptionsFor in sim_run_settings.h: the cell of a run.json, shared by `run` and the audit) and:
+//   identity_audit.h, session_audit.h  AuditIdentities / AuditSession: a simulated session's dot identities
+//                           scored against the hidden truth, the world rebuilt from the session's inputs and
+//                           checked against its setup.json
+//   rendered_observations.h ObserveRendered: observations from rendered images
+//   bound_sweep.h           SweepTwoViewBound
+//   study.h                 RunStudy: Table 2 / Fig. 6 Monte Carlo, both methods, the bundle's Cramer-Rao bound per
+//                           parameter and for the 3-D error, coverage; flat dot sheets
+//   detect_folder.h         WriteDetectFolder: the cell as a folder of images, poses and hidden truth, the input of
+//                           `selfcal detect` (test/tools/selfcal_render_sequence --detect-folder)
+// Uses calibration, acquisition, sim, tracking, kinematics, session; geometry, camera, io, base private.
+//
 // A simulated cell for sessions: the simulated world (hidden robot errors, hand-eye, f_x, spaced dots),
 // a SimulatedRobot moving the true arm on a simulated clock, and the rendered SimulatedCamera looking
 // through the true kinematics at the arm's true joints at every exposure, so that RunSession runs on it

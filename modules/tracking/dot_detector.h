@@ -1,3 +1,9 @@
+// Module tracking (ARCHITECTURE.md): dot detection (this header; blob_trace.h reproduces vpDot2's border
+// following to the bit), tracking with vpDot2 (dot_tracker.h: per-dot status, swap/merge consistency by a
+// robust planar fit, D1-D8), grid identity from the larger origin dot (grid_identity.h), AprilTag 36h11 via
+// ViSP (apriltag_identity.h), gated naming by predicted position with an ambiguity test and the prediction's
+// robust correction (predicted_match.h). Uses base, ViSP, Eigen.
+//
 // Dark dots on a light background, found in one grey image with ViSP's vpDot2 (RELIABILITY.md D2, D3, D6,
 // D7).
 //

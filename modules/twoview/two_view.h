@@ -1,3 +1,11 @@
+// Module twoview (ARCHITECTURE.md): the factor method (this header: 8-point, f_x from Q (Bougnoux),
+// Theorem 1 factorisation + cheirality, RANSAC, the homography path with the plane of both solutions, LM on
+// eq. (13) with Ceres manifolds; epipolar_cost.h writes the Jacobian out, its autodiff functor kept as the
+// test reference); an OpenCV reference; the two-view Cramer-Rao bound; planar_views.h: every view of one flat
+// target from a reference view at once, the shared plane normal resolving each view's two-fold ambiguity and
+// fixing f_x (three or more views), translations in one scale. Uses camera, geometry, base; Ceres, OpenCV
+// private.
+//
 // Two-view relative pose with an unknown focal length: the paper's refined nonlinear factor method
 // (section 3.1, eq. (8)-(13)), made robust (RANSAC, planar scenes, cheirality, degeneracy outcomes).
 //

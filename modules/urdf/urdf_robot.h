@@ -1,3 +1,11 @@
+// Module urdf (ARCHITECTURE.md; docs/urdf.md): LoadUrdfRobot (this header), checked against KDL's chain of
+// the same URDF (kdl_chain.h builds it from urdfdom's model; kdl_parser's tree only in the tests) to 1e-9 at
+// seeded random joints; urdf_writer.h: WriteUrdf, a model as a URDF, checked with KDL before it is written;
+// urdf_calibrated.h: CalibratedUserUrdf, the user's own URDF with only the joint origins changed, checked the
+// same way; urdf_parse.h: the text scanned by base/xml_scan.h, then tinyxml for a syntax error's line, then
+// urdfdom with its console_bridge messages captured and placed at the line of the element they name.
+// Uses kinematics, geometry, base; urdfdom, tinyxml, console_bridge and KDL private.
+//
 // A URDF robot as selfcal's nominal RobotModel (docs/urdf.md).
 //
 // The chain from `base_link` to `tip_link` of a URDF read with urdfdom becomes the modified-DH + Hayati

@@ -1,3 +1,6 @@
+// Module yaml (ARCHITECTURE.md): the strict YAML reader, uses only base; libyaml (its C event parser,
+// yaml_parser_parse) private. Shared by io's files and capture's recorded-sequence index.
+//
 // Strict YAML reading: the only way selfcal reads a YAML file (C1-C3, C8, P8). Bottom layer (uses only
 // base), so that io's files and capture's recorded-sequence index share one reader.
 //

@@ -10,10 +10,15 @@ readCalibration over the C++ parser) when it is installed, which must return the
 The OpenCV file of --write-camera-opencv must stay refused by that parser (it is OpenCV's format). The UR5e's
 ur_calibrated_kinematics.yaml is read the same way against ur_description's keys, and its chain, built as
 ur_description's xacro builds it, against the forward kinematics of calibrated_model.yaml computed here with
-numpy (not selfcal's code) at 1000 random joint vectors, to 1e-9.
+numpy (not selfcal's code) at 1000 random joint vectors, to 1e-9. camera_static_transform.launch.py is parsed
+by Python's ast (ROS 2 is not installed here, so launch and launch_ros are not imported): one launch_ros Node of
+tf2_ros' static_transform_publisher with the named arguments of ROS 2 Humble and later, whose translation
+and quaternion equal calibrated_model.yaml's flange_from_cam to 1e-9 and camera_static_transform.yaml's
+numbers and frames exactly (the same (x, y, z, w) order, w >= 0).
 
   ros_outputs_test.py SELFCAL_BINARY SOURCE_DIR
 """
+import ast
 import math
 import os
 import random
@@ -155,6 +160,75 @@ def check_ur_kinematics(path, model, failures):
         failures.append(f"{path}: the xacro's chain differs from the calibrated model by {worst:.3g}")
 
 
+def transform_of(node):
+    """A calibrated_model.yaml transform (xyz_mm + rpy_deg, or xyz_m + rotation) as a 4x4 matrix."""
+    if "xyz_m" in node:
+        t = trans(*node["xyz_m"])
+        t[:3, :3] = numpy.array(node["rotation"], dtype=float)
+        return t
+    x, y, z = (v / 1000 for v in node["xyz_mm"])
+    return trans(x, y, z) @ rpy(*(math.radians(v) for v in node["rpy_deg"]))
+
+
+def quaternion_matrix(qx, qy, qz, qw):  # Hamilton, (x, y, z, w) as ROS's geometry_msgs/Quaternion
+    return numpy.array([[1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)],
+                        [2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)],
+                        [2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)]])
+
+
+def launch_node(path, failures):
+    """The keyword arguments of the one launch_ros Node call in generate_launch_description, as literals."""
+    with open(path) as f:
+        tree = ast.parse(f.read(), filename=path)
+    imports = {(n.module, a.name) for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) for a in n.names}
+    if not {("launch", "LaunchDescription"), ("launch_ros.actions", "Node")} <= imports:
+        failures.append(f"{path}: imports {sorted(imports)}")
+    functions = [n.name for n in tree.body if isinstance(n, ast.FunctionDef)]
+    if functions != ["generate_launch_description"]:
+        failures.append(f"{path}: functions {functions}")
+    nodes = [n for n in ast.walk(tree) if isinstance(n, ast.Call) and getattr(n.func, "id", None) == "Node"]
+    if len(nodes) != 1:
+        failures.append(f"{path}: {len(nodes)} Node calls, expected 1")
+        return None
+    return {k.arg: ast.literal_eval(k.value) for k in nodes[0].keywords}
+
+
+def check_launch_file(path, model, static_path, failures):
+    """camera_static_transform.launch.py against calibrated_model.yaml's flange_from_cam (1e-9) and against
+    camera_static_transform.yaml (the same numbers, frames and quaternion order)."""
+    if not os.path.exists(path):
+        failures.append(f"{path}: not written")
+        return
+    node = launch_node(path, failures)
+    if node is None:
+        return
+    if node.get("package") != "tf2_ros" or node.get("executable") != "static_transform_publisher":
+        failures.append(f"{path}: package {node.get('package')!r}, executable {node.get('executable')!r}")
+    args = node.get("arguments", [])
+    names = ["--x", "--y", "--z", "--qx", "--qy", "--qz", "--qw", "--frame-id", "--child-frame-id"]
+    if not all(isinstance(a, str) for a in args) or args[0::2] != names:
+        failures.append(f"{path}: arguments {args}, expected the named form {names}")
+        return
+    value = dict(zip(args[0::2], args[1::2]))
+    x, y, z, qx, qy, qz, qw = (float(value[n]) for n in names[:7])
+    with open(static_path) as f:
+        static = yaml.safe_load(f)
+    t, r = static["transform"]["translation"], static["transform"]["rotation"]
+    if [x, y, z, qx, qy, qz, qw] != [t["x"], t["y"], t["z"], r["x"], r["y"], r["z"], r["w"]] or \
+            value["--frame-id"] != static["header"]["frame_id"] or \
+            value["--child-frame-id"] != static["child_frame_id"]:
+        failures.append(f"{path}: {value} differs from {static_path}: {static}")
+    if qw < 0 or abs(math.sqrt(qx * qx + qy * qy + qz * qz + qw * qw) - 1) > 1e-12:
+        failures.append(f"{path}: quaternion {(qx, qy, qz, qw)} is not unit with w >= 0")
+    flange_from_cam = transform_of(model["flange_from_cam"])
+    worst = max(float(numpy.abs(numpy.array([x, y, z]) - flange_from_cam[:3, 3]).max()),
+                float(numpy.abs(quaternion_matrix(qx, qy, qz, qw) - flange_from_cam[:3, :3]).max()))
+    print(f"{path}: {value['--frame-id']} -> {value['--child-frame-id']}, against calibrated_model.yaml's "
+          f"flange_from_cam: worst {worst:.3g}")
+    if worst > 1e-9:
+        failures.append(f"{path}: differs from calibrated_model.yaml's flange_from_cam by {worst:.3g}")
+
+
 def main():
     binary, source = sys.argv[1], sys.argv[2]
     failures = []
@@ -172,6 +246,8 @@ def main():
             model = yaml.safe_load(f)
         k, d = check_camera_info(os.path.join(out, "camera_info.yaml"), model["camera"], failures)
         check_ur_kinematics(os.path.join(out, "ur_calibrated_kinematics.yaml"), model, failures)
+        check_launch_file(os.path.join(out, "camera_static_transform.launch.py"), model,
+                          os.path.join(out, "camera_static_transform.yaml"), failures)
         p = subprocess.run([binary, "calibrate", "--no-html", "--quiet", os.path.join(out, "observations.yaml"),
                             "--out", os.path.join(tmp, "again"), "--write-camera-opencv", opencv],
                            capture_output=True, text=True)
