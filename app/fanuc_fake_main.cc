@@ -3,26 +3,21 @@
 // arm; not a simulator of a FANUC's motion or safety system (docs/fanuc.md). Prints its connect port on
 // the first line of stdout, then every packet it receives; SIGINT and SIGTERM stop it (exit 0) after a last
 // line with the motion instructions and aborts counted.
-#include <signal.h>
-
 #include <atomic>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
-#include "app/cli_numbers.h"
 #include "app/exit_codes.h"
+#include "app/fake_main.h"
 #include "robot/fanuc_fake.h"
 
 namespace {
 
 constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
-
-std::atomic<bool> g_stop{false};  // set by the signal handler only
-
-extern "C" void OnStopSignal(int) { g_stop.store(true); }
 
 }  // namespace
 
@@ -45,27 +40,17 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--servo-off-at-start", options.servo_off_at_start, "Start with the servos off (ServoReady 0)");
   app.add_flag("--teach-pendant-enabled", options.teach_pendant_enabled, "Start with the teach pendant enabled (TPMode 1)");
-  selfcal::app::CheckNumbersStrictly(app);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : static_cast<int>(selfcal::app::ExitCode::kUsage);
-  }
+  if (const std::optional<int> exit_code = selfcal::app::ParseFakeCommandLine(app, argc, argv)) return *exit_code;
   for (size_t j = 0; j < start_deg.size(); ++j) options.start_rad[static_cast<int>(j)] = start_deg[j] * kRadPerDeg;
   Result<robot::FanucFakeController> fake = robot::FanucFakeController::Listen(options);
   if (!fake.ok()) {
     std::cerr << "selfcal-fanuc-fake: " << fake.status().ToString() << "\n";
     return static_cast<int>(selfcal::app::ExitCodeFor(fake.status().code()));
   }
-  struct sigaction action {};
-  action.sa_handler = OnStopSignal;
-  sigemptyset(&action.sa_mask);
-  ::sigaction(SIGINT, &action, nullptr);
-  ::sigaction(SIGTERM, &action, nullptr);
+  const std::atomic<bool>& stop = selfcal::app::StopOnSignals();
   std::cout << "listening on 127.0.0.1:" << fake->connect_port() << " (session port " << fake->session_port() << ")"
             << std::endl;
-  fake.value().Serve(g_stop, [](const std::string& line) { std::cout << line << std::endl; });
+  fake.value().Serve(stop, [](const std::string& line) { std::cout << line << std::endl; });
   std::cout << "stopped; motion commands " << fake->motion_commands() << ", stop commands " << fake->stop_commands()
             << std::endl;
   return 0;

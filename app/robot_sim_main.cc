@@ -3,20 +3,19 @@
 // SimulatedRobotFaults on the command line. For running the network backend without an arm, and as a
 // reference peer for anyone writing a protocol server or client. SIGINT and SIGTERM stop it cleanly
 // (the arm is stopped, the socket closed, exit 0).
-#include <signal.h>
-
 #include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
-#include "app/cli_numbers.h"
 #include "app/exit_codes.h"
+#include "app/fake_main.h"
 #include "base/install_layout.h"
 #include "base/status.h"
 #include "io/robot_config.h"
@@ -28,10 +27,6 @@
 namespace {
 
 constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
-
-std::atomic<bool> g_stop{false};  // set by the signal handler only (R11)
-
-extern "C" void OnStopSignal(int) { g_stop.store(true); }
 
 struct Args {
   std::string robot = "config/robots/puma560.yaml";
@@ -98,13 +93,7 @@ int main(int argc, char** argv) {
   AddFaultOption(app, "--stale-read", &args.stale_read, "Joint reading N is stale");
   AddFaultOption(app, "--nan-read", &args.nan_read, "Joint reading N has NaN in joint 2");
   AddFaultOption(app, "--short-read", &args.short_read, "Joint reading N lacks a joint");
-  selfcal::app::CheckNumbersStrictly(app);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : static_cast<int>(selfcal::app::ExitCode::kUsage);
-  }
+  if (const std::optional<int> exit_code = selfcal::app::ParseFakeCommandLine(app, argc, argv)) return *exit_code;
 
   const Result<RobotModel> model = io::LoadRobotModel(FindDataFile(args.robot));
   if (!model.ok()) return Fail(model.status());
@@ -169,14 +158,10 @@ int main(int argc, char** argv) {
   robot::RobotServer server(robot, server_options);
   if (const Status listening = server.Listen(); !listening.ok()) return Fail(listening);
 
-  struct sigaction action {};
-  action.sa_handler = OnStopSignal;
-  sigemptyset(&action.sa_mask);
-  ::sigaction(SIGINT, &action, nullptr);
-  ::sigaction(SIGTERM, &action, nullptr);
+  const std::atomic<bool>& stop = selfcal::app::StopOnSignals();
 
   std::cout << "listening on 127.0.0.1:" << server.port() << std::endl;
-  const Status served = server.Serve(g_stop);
+  const Status served = server.Serve(stop);
   const robot::CommandCounts& counts = robot.counts();
   std::cerr << "selfcal-robot-sim: stopped; moves accepted " << robot.accepted_moves().size() << " of "
             << counts.start_move << ", readings " << counts.read << ", stops " << counts.stop << "\n";

@@ -3,26 +3,21 @@
 // `selfcal run --robot ur` without an arm; not a simulator of a UR's motion or safety system
 // (docs/universal-robots.md). Prints its three ports on the first line of stdout, then every line it
 // receives; SIGINT and SIGTERM stop it (exit 0) after a last line with the motion and stop commands counted.
-#include <signal.h>
-
 #include <atomic>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
-#include "app/cli_numbers.h"
 #include "app/exit_codes.h"
+#include "app/fake_main.h"
 #include "robot/ur_fake.h"
 
 namespace {
 
 constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
-
-std::atomic<bool> g_stop{false};  // set by the signal handler only
-
-extern "C" void OnStopSignal(int) { g_stop.store(true); }
 
 }  // namespace
 
@@ -54,28 +49,18 @@ int main(int argc, char** argv) {
                "The Dashboard says remote control is off (and scripts are ignored)");
   app.add_flag("--protective-stop-at-start", options.protective_stop_at_start, "Start in a protective stop");
   app.add_flag("--program-running", options.program_running, "A program runs on the controller (runtime_state 2)");
-  selfcal::app::CheckNumbersStrictly(app);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : static_cast<int>(selfcal::app::ExitCode::kUsage);
-  }
+  if (const std::optional<int> exit_code = selfcal::app::ParseFakeCommandLine(app, argc, argv)) return *exit_code;
   for (size_t j = 0; j < start_deg.size(); ++j) options.start_rad[static_cast<int>(j)] = start_deg[j] * kRadPerDeg;
   Result<robot::UrFakeController> fake = robot::UrFakeController::Listen(options);
   if (!fake.ok()) {
     std::cerr << "selfcal-ur-fake: " << fake.status().ToString() << "\n";
     return static_cast<int>(selfcal::app::ExitCodeFor(fake.status().code()));
   }
-  struct sigaction action {};
-  action.sa_handler = OnStopSignal;
-  sigemptyset(&action.sa_mask);
-  ::sigaction(SIGINT, &action, nullptr);
-  ::sigaction(SIGTERM, &action, nullptr);
+  const std::atomic<bool>& stop = selfcal::app::StopOnSignals();
   const robot::UrFakeController::Ports ports = fake->ports();
   std::cout << "listening on 127.0.0.1 rtde " << ports.rtde << " secondary " << ports.secondary << " dashboard "
             << ports.dashboard << std::endl;
-  fake.value().Serve(g_stop, [](const std::string& line) { std::cout << line << std::endl; });
+  fake.value().Serve(stop, [](const std::string& line) { std::cout << line << std::endl; });
   std::cout << "stopped; motion commands " << fake->motion_commands() << ", stop commands " << fake->stop_commands()
             << std::endl;
   return 0;

@@ -1,0 +1,37 @@
+#include "app/fake_main.h"
+
+#include <signal.h>
+
+#include "app/cli_numbers.h"
+#include "app/exit_codes.h"
+
+namespace selfcal::app {
+namespace {
+
+std::atomic<bool> g_stop{false};  // set by the signal handler only
+
+extern "C" void OnStopSignal(int) { g_stop.store(true); }
+
+}  // namespace
+
+std::optional<int> ParseFakeCommandLine(CLI::App& app, int argc, char** argv) {
+  CheckNumbersStrictly(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : static_cast<int>(ExitCode::kUsage);
+  }
+  return std::nullopt;
+}
+
+const std::atomic<bool>& StopOnSignals() {
+  struct sigaction action {};
+  action.sa_handler = OnStopSignal;
+  sigemptyset(&action.sa_mask);
+  ::sigaction(SIGINT, &action, nullptr);
+  ::sigaction(SIGTERM, &action, nullptr);
+  return g_stop;
+}
+
+}  // namespace selfcal::app
