@@ -5,10 +5,6 @@
 // run at connect with the hardware exit code and nothing sent; each fault during a move (the connection
 // dropped, the servos off, a move that never finishes, a wrong answer) halts the run with the hardware exit
 // code, FRC_Abort sent, and no instruction after the fault. Bad --address values are usage errors.
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "support/cli.h"
+#include "support/loopback_fake.h"
 
 namespace selfcal {
 namespace {
@@ -32,45 +29,26 @@ const char* kFirstPoseDeg = "33.1545,19.3429,-188.822,75.3602,43.4552,-25.34";
 // selfcal-fanuc-fake with `extra` options; its address (127.0.0.1:PORT), its stdout kept in `log`.
 class FanucFake {
  public:
-  FanucFake(const std::vector<std::string>& extra, const fs::path& log) : log_(log) {
-    const pid_t pid = ::fork();
-    if (pid == 0) {
-      std::FILE* out = std::fopen(log.c_str(), "w");
-      ::dup2(::fileno(out), 1);
-      std::vector<std::string> args = {SELFCAL_FANUC_FAKE, "--start-deg", kFirstPoseDeg};
-      args.insert(args.end(), extra.begin(), extra.end());
-      std::vector<char*> argv;
-      for (std::string& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      ::execv(argv[0], argv.data());
-      ::_exit(127);
-    }
-    pid_ = pid;
-    for (int i = 0; i < 200 && address_.empty(); ++i) {
-      ::usleep(10000);
-      int port = 0;
-      if (std::sscanf(testing::ReadFile(log.string()).c_str(), "listening on 127.0.0.1:%d", &port) == 1) {
-        address_ = "127.0.0.1:" + std::to_string(port);
-      }
-    }
-  }
-  ~FanucFake() { Stop(); }
+  FanucFake(const std::vector<std::string>& extra, const fs::path& log)
+      : process_(Args(extra), log, [this](const std::string& printed) {
+          int port = 0;
+          if (std::sscanf(printed.c_str(), "listening on 127.0.0.1:%d", &port) == 1) {
+            address_ = "127.0.0.1:" + std::to_string(port);
+          }
+          return !address_.empty();
+        }) {}
   // Stops the fake; returns everything it printed.
-  std::string Stop() {
-    if (pid_ > 0) {
-      ::kill(pid_, SIGTERM);
-      int status = 0;
-      ::waitpid(pid_, &status, 0);
-      pid_ = -1;
-    }
-    return testing::ReadFile(log_.string());
-  }
+  std::string Stop() { return process_.Stop(); }
   const std::string& address() const { return address_; }
 
  private:
-  fs::path log_;
-  pid_t pid_ = -1;
-  std::string address_;
+  static std::vector<std::string> Args(const std::vector<std::string>& extra) {
+    std::vector<std::string> args = {SELFCAL_FANUC_FAKE, "--start-deg", kFirstPoseDeg};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return args;
+  }
+  std::string address_;  // before process_: set while process_ is constructed
+  testing::LoopbackFake process_;
 };
 
 // `run --robot fanuc --camera sim` at full speed; the operator types the serial (the address) to arm.

@@ -5,10 +5,6 @@
 // refuses the run at connect with the hardware exit code, a message saying what to do, no session, and no
 // motion command at the fake. Bad --address values are usage errors before anything is connected.
 // (The session loop's halts during a move: test/cross_module/ur_session_test.cc.)
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -17,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "support/cli.h"
+#include "support/loopback_fake.h"
 
 namespace selfcal {
 namespace {
@@ -28,46 +25,27 @@ bool Has(const std::string& text, const std::string& part) { return text.find(pa
 // selfcal-ur-fake with `extra` options; its three ports as --ur-ports' value, its stdout kept in `log`.
 class UrFake {
  public:
-  explicit UrFake(const std::vector<std::string>& extra, const fs::path& log) : log_(log) {
-    const pid_t pid = ::fork();
-    if (pid == 0) {
-      std::FILE* out = std::fopen(log.c_str(), "w");
-      ::dup2(::fileno(out), 1);
-      std::vector<std::string> args = {SELFCAL_UR_FAKE};
-      args.insert(args.end(), extra.begin(), extra.end());
-      std::vector<char*> argv;
-      for (std::string& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      ::execv(argv[0], argv.data());
-      ::_exit(127);
-    }
-    pid_ = pid;
-    for (int i = 0; i < 200 && ports_.empty(); ++i) {
-      ::usleep(10000);
-      int rtde = 0, secondary = 0, dashboard = 0;
-      if (std::sscanf(testing::ReadFile(log.string()).c_str(), "listening on 127.0.0.1 rtde %d secondary %d dashboard %d",
-                      &rtde, &secondary, &dashboard) == 3) {
-        ports_ = std::to_string(rtde) + "," + std::to_string(secondary) + "," + std::to_string(dashboard);
-      }
-    }
-  }
-  ~UrFake() { Stop(); }
+  explicit UrFake(const std::vector<std::string>& extra, const fs::path& log)
+      : process_(Args(extra), log, [this](const std::string& printed) {
+          int rtde = 0, secondary = 0, dashboard = 0;
+          if (std::sscanf(printed.c_str(), "listening on 127.0.0.1 rtde %d secondary %d dashboard %d", &rtde,
+                          &secondary, &dashboard) == 3) {
+            ports_ = std::to_string(rtde) + "," + std::to_string(secondary) + "," + std::to_string(dashboard);
+          }
+          return !ports_.empty();
+        }) {}
   // Stops the fake; returns everything it printed.
-  std::string Stop() {
-    if (pid_ > 0) {
-      ::kill(pid_, SIGTERM);
-      int status = 0;
-      ::waitpid(pid_, &status, 0);
-      pid_ = -1;
-    }
-    return testing::ReadFile(log_.string());
-  }
+  std::string Stop() { return process_.Stop(); }
   const std::string& ports() const { return ports_; }
 
  private:
-  fs::path log_;
-  pid_t pid_ = -1;
-  std::string ports_;
+  static std::vector<std::string> Args(const std::vector<std::string>& extra) {
+    std::vector<std::string> args = {SELFCAL_UR_FAKE};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return args;
+  }
+  std::string ports_;  // before process_: set while process_ is constructed
+  testing::LoopbackFake process_;
 };
 
 // A setup.json for the real-camera path: the one a short simulated run records.
