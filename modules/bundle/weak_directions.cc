@@ -44,17 +44,7 @@ bool FindWeakParameters(const BundleData& data, const BundleState& state, const 
   return true;
 }
 
-// The weak joint parameters of the free set, judged at the nominal model (the start's dots and intrinsics):
-// at the stated pixel noise, or under `model`. False when the nominal model cannot be evaluated.
 namespace {
-
-bool FindWeakAtNominal(const BundleData& data, const BundleOptions& options, const Gauge& gauge,
-                       const BundleState& state, std::vector<identification::WeakColumn>* weak) {
-  BundleState nominal = state;
-  nominal.rho = KinematicParameters::Nominal(data.robot);
-  return FindWeakParameters(data, nominal, gauge, options.intrinsics, options.weak_length_tolerance_m,
-                                      options.weak_angle_tolerance_rad, weak);
-}
 
 // Holds `weak` at the robot description's values (the state moved there) and names them in the report.
 void HoldAtNominal(const std::vector<identification::WeakColumn>& weak, bool under_error_model, const BundleData& data,
@@ -80,8 +70,14 @@ void HoldAtNominal(const std::vector<identification::WeakColumn>& weak, bool und
 
 bool HoldWeakAtNominal(const BundleData& data, const BundleOptions& options, Gauge* gauge, BundleState* state,
                        BundleReport* report) {
+  // Judged at the nominal model, with the start's dots and intrinsics.
+  BundleState nominal = *state;
+  nominal.rho = KinematicParameters::Nominal(data.robot);
   std::vector<identification::WeakColumn> weak;
-  if (!FindWeakAtNominal(data, options, *gauge, *state, &weak)) return false;
+  if (!FindWeakParameters(data, nominal, *gauge, options.intrinsics, options.weak_length_tolerance_m,
+                          options.weak_angle_tolerance_rad, &weak)) {
+    return false;
+  }
   HoldAtNominal(weak, false, data, gauge, state, report);
   return true;
 }
@@ -90,18 +86,17 @@ bool HoldWeakAtNominal(const BundleData& data, const BundleOptions& options, Gau
 // (HoldWeakParameters, each parameter given the ones before it, at the stated pixel noise) misses what each
 // image's pose error (joint reading noise, what the model does not hold) leaves poorly determined. Of the free
 // joint parameters whose standard deviation under the model exceeds their tolerance, mostly through the pose
-// error (the pixel noise alone would not), the one that exceeds it by the most is held at the description's value and named with
-// the free parameters it is most correlated with; true when one was (the caller refits and asks again).
+// error (the pixel noise alone would not), the one that exceeds it by the most is held at the description's
+// value and named with the free parameters it is most correlated with; true when one was (the caller refits
+// and asks again).
 bool HoldWeakestUnderErrorModel(const BundleData& data, const BundleOptions& options, Gauge* gauge,
                                 BundleState* state, BundleReport* report) {
-  const ErrorModel& model = report->error_model;
-  if (!report->covariance_available || !model.estimated || !(model.pose_translation_m > 0 || model.pose_rotation_rad > 0)) {
-    return false;
-  }
+  // The pose part of the covariance exists only under an estimated model.
+  if (!report->covariance_available || !report->error_model.estimated) return false;
   const KinematicParameters params(data.robot.num_joints());
   const std::vector<int>& free = gauge->free_kinematic;
   int worst = -1;
-  double worst_ratio = 1.0;
+  double worst_ratio = 1.0, worst_tolerance = 0;
   for (size_t k = 0; k < free.size(); ++k) {
     const int c = free[k];
     if (c < KinematicParameters::JointOffset(0) || c >= params.CamOffset()) continue;
@@ -118,12 +113,13 @@ bool HoldWeakestUnderErrorModel(const BundleData& data, const BundleOptions& opt
     }
     worst = static_cast<int>(k);
     worst_ratio = report->stddev[c] / tolerance;
+    worst_tolerance = tolerance;
   }
   if (worst < 0) return false;
   identification::WeakColumn w;
   w.column = free[worst];
   w.conditional_std = report->stddev[w.column];
-  w.tolerance = w.conditional_std / worst_ratio;
+  w.tolerance = worst_tolerance;
   std::vector<std::pair<double, int>> partners;
   for (size_t k = 0; k < free.size(); ++k) {
     if (static_cast<int>(k) != worst) partners.push_back({report->correlation_free(worst, k), free[k]});
