@@ -11,6 +11,21 @@
 
 namespace selfcal {
 
+const char* CameraMountName(CameraMount mount) {
+  return mount == CameraMount::kEyeToHand ? "eye_to_hand" : "eye_in_hand";
+}
+
+bool ParseCameraMount(const std::string& text, CameraMount* mount) {
+  if (text == "eye_in_hand") {
+    *mount = CameraMount::kEyeInHand;
+  } else if (text == "eye_to_hand") {
+    *mount = CameraMount::kEyeToHand;
+  } else {
+    return false;
+  }
+  return true;
+}
+
 RobotModel RobotModel::FromDh(const std::string& name, DhConvention convention, const std::vector<DhRow>& rows,
                               const std::vector<JointLimits>& limits, const Rigid3& base_from_link0,
                               const Rigid3& flange_from_cam) {
@@ -109,7 +124,12 @@ RobotModel ApplyParameters(const RobotModel& model, const Eigen::VectorXd& rho) 
     const double* p = rho.data() + KinematicParameters::JointOffset(i);
     out.links[i] = LinkParameters{p[0], p[1], p[2], p[3], p[4]};
   }
-  out.flange_from_cam = model.flange_from_cam * RigidFromTranslationRotvec(rho.data() + 6 + 5 * n);
+  const Rigid3 cam_correction = RigidFromTranslationRotvec(rho.data() + 6 + 5 * n);
+  if (model.mount == CameraMount::kEyeToHand) {
+    out.base_from_cam = model.base_from_cam * cam_correction;
+  } else {
+    out.flange_from_cam = model.flange_from_cam * cam_correction;
+  }
   return out;
 }
 
@@ -119,6 +139,10 @@ Rigid3 BaseFromFlange(const RobotModel& model, const Eigen::VectorXd& rho, const
 
 Rigid3 BaseFromCam(const RobotModel& model, const Eigen::VectorXd& rho, const Eigen::VectorXd& q) {
   return BaseFromCam<double>(model, rho.data(), q.data());
+}
+
+Rigid3 PointsFromCam(const RobotModel& model, const Eigen::VectorXd& rho, const Eigen::VectorXd& q) {
+  return PointsFromCam<double>(model, rho.data(), q.data());
 }
 
 std::vector<int> ParallelAxisPairs(const RobotModel& model, double tol) {
@@ -143,6 +167,7 @@ void ScaleLengths(double s, RobotModel* model, Eigen::VectorXd* rho) {
   model->base_from_link0.translation *= s;
   model->link_n_from_flange.translation *= s;
   model->flange_from_cam.translation *= s;
+  model->base_from_cam.translation *= s;
 }
 
 bool WithinLimits(const RobotModel& model, const Eigen::VectorXd& q, double margin_rad) {

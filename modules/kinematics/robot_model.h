@@ -23,6 +23,15 @@
 //                           * link_n_from_flange                      (constant, from the DH table)
 //                           * flange_from_cam * Exp(cam correction)
 //
+// A fixed camera looking at points carried by the flange (eye-to-hand, RobotModel::mount) swaps the roles:
+//
+//   base_from_cam(rho)       = base_from_cam * Exp(cam correction)              (RobotModel::base_from_cam)
+//   points_from_cam(q; rho)  = base_from_flange(q; rho)^-1 * base_from_cam(rho)  (points: the flange frame)
+//
+// where base_from_flange is the chain above up to the flange (flange_from_cam takes no part). The points'
+// frame is the base in eye-in-hand and the flange in eye-to-hand: PointsFromCam is the camera in it, the
+// pose every projection of the unknown points goes through.
+//
 // Parameter vector rho (SI units: m and rad), for n joints, size 5n + 12:
 //   [0, 6)            base correction: tx ty tz (m), rx ry rz (rotation vector, rad)
 //   [6 + 5(i-1), +5)  joint i: alpha, a, beta, theta, d
@@ -57,13 +66,23 @@ struct DhRow {
 };
 enum class DhConvention { kStandard, kModified };
 
+// Where the camera is: on the flange, looking at points fixed in the base frame (eye-in-hand), or fixed in
+// the base frame, looking at points carried by the flange (eye-to-hand).
+enum class CameraMount { kEyeInHand, kEyeToHand };
+// "eye_in_hand", "eye_to_hand": the names files and reports use.
+const char* CameraMountName(CameraMount mount);
+// False (mount untouched) for any other text.
+bool ParseCameraMount(const std::string& text, CameraMount* mount);
+
 struct RobotModel {
   std::string name;
   std::vector<LinkParameters> links;  // nominal, one per joint
   std::vector<JointLimits> limits;
   Rigid3 base_from_link0;             // nominal base transform
   Rigid3 link_n_from_flange;          // constant tail of the DH table
-  Rigid3 flange_from_cam;             // nominal hand-eye transform
+  Rigid3 flange_from_cam;             // nominal hand-eye transform (eye-in-hand)
+  CameraMount mount = CameraMount::kEyeInHand;
+  Rigid3 base_from_cam;               // nominal fixed camera (eye-to-hand; unused in eye-in-hand)
 
   int num_joints() const { return static_cast<int>(links.size()); }
   int num_parameters() const { return 5 * num_joints() + 12; }
@@ -130,10 +149,20 @@ Rigid3T<T> BaseFromFlange(const RobotModel& model, const T* rho, const T* q) {
   return chain * model.link_n_from_flange.Cast<T>();
 }
 
+// The camera in the base frame: through the arm (eye-in-hand), or the fixed camera (eye-to-hand, q unused).
 template <typename T>
 Rigid3T<T> BaseFromCam(const RobotModel& model, const T* rho, const T* q) {
   const T* cam = rho + 6 + 5 * model.num_joints();
+  if (model.mount == CameraMount::kEyeToHand) return model.base_from_cam.Cast<T>() * RigidFromTranslationRotvec(cam);
   return BaseFromFlange(model, rho, q) * model.flange_from_cam.Cast<T>() * RigidFromTranslationRotvec(cam);
+}
+
+// The camera in the frame of the unknown points: BaseFromCam (eye-in-hand), the flange from the fixed camera
+// (eye-to-hand).
+template <typename T>
+Rigid3T<T> PointsFromCam(const RobotModel& model, const T* rho, const T* q) {
+  if (model.mount == CameraMount::kEyeInHand) return BaseFromCam(model, rho, q);
+  return BaseFromFlange(model, rho, q).Inverse() * BaseFromCam(model, rho, q);
 }
 
 // The camera of a pose whose flange pose was recorded by the controller (data without joint angles):
@@ -146,9 +175,21 @@ Rigid3T<T> BaseFromCamGivenFlange(const RobotModel& model, const T* rho, const R
          model.flange_from_cam.Cast<T>() * RigidFromTranslationRotvec(cam);
 }
 
+// PointsFromCam of a pose whose flange pose was recorded: BaseFromCamGivenFlange (eye-in-hand); for
+// eye-to-hand (base_from_link0 * Exp(base correction) * base_from_flange)^-1 * base_from_cam * Exp(cam).
+template <typename T>
+Rigid3T<T> PointsFromCamGivenFlange(const RobotModel& model, const T* rho, const Rigid3& base_from_flange) {
+  if (model.mount == CameraMount::kEyeInHand) return BaseFromCamGivenFlange(model, rho, base_from_flange);
+  const T* cam = rho + 6 + 5 * model.num_joints();
+  const Rigid3T<T> flange_in_base =
+      model.base_from_link0.Cast<T>() * RigidFromTranslationRotvec(rho) * base_from_flange.Cast<T>();
+  return flange_in_base.Inverse() * model.base_from_cam.Cast<T>() * RigidFromTranslationRotvec(cam);
+}
+
 // Double convenience overloads.
 Rigid3 BaseFromFlange(const RobotModel& model, const Eigen::VectorXd& rho, const Eigen::VectorXd& q);
 Rigid3 BaseFromCam(const RobotModel& model, const Eigen::VectorXd& rho, const Eigen::VectorXd& q);
+Rigid3 PointsFromCam(const RobotModel& model, const Eigen::VectorXd& rho, const Eigen::VectorXd& q);
 
 // Pairs (i, i+1), 1-based joint numbers, whose axes are parallel at the nominal model (|sin alpha| and
 // |beta| below tol): the places where plain DH would be singular.
