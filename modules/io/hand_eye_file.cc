@@ -21,7 +21,9 @@ std::string MaybeNumber(double v) { return std::isfinite(v) ? YamlNumber(v) : st
 }  // namespace
 
 Status SaveHandEye(const HandEyeResult& result, const std::string& path) {
-  const Rigid3& x = result.flange_from_cam;
+  const bool eye_to_hand = result.mount == CameraMount::kEyeToHand;
+  const Rigid3& x = eye_to_hand ? result.base_from_cam : result.flange_from_cam;
+  const std::string key = eye_to_hand ? "base_from_cam" : "flange_from_cam";
   if (!x.translation.allFinite() || !x.rotation.allFinite() || !std::isfinite(result.fx_px) || result.fx_px <= 0) {
     return Status::Error(ErrorCode::kInvalidInput, "refusing to write a non-finite hand-eye result to " + path);
   }
@@ -32,17 +34,24 @@ Status SaveHandEye(const HandEyeResult& result, const std::string& path) {
   }
   const Eigen::Quaterniond q(x.rotation);
   std::ostringstream out;
-  out << "# selfcal hand-eye calibration on recorded flange poses: the camera frame in the flange frame\n"
-      << "# (p_in_flange = flange_from_cam * p_in_cam), camera z forward, x right, y down.\n"
-      << "format: " << kHandEyeFormat << "\n"
-      << "version: 1\n";
+  if (eye_to_hand) {
+    out << "# selfcal hand-eye calibration on recorded flange poses, eye-to-hand: the fixed camera frame in the\n"
+        << "# robot base frame (p_in_base = base_from_cam * p_in_cam), camera z forward, x right, y down.\n";
+  } else {
+    out << "# selfcal hand-eye calibration on recorded flange poses: the camera frame in the flange frame\n"
+        << "# (p_in_flange = flange_from_cam * p_in_cam), camera z forward, x right, y down.\n";
+  }
+  // Version 1.1 added eye-to-hand; an eye-in-hand result stays readable by every 1.x reader.
+  out << "format: " << kHandEyeFormat << "\n"
+      << "version: " << (eye_to_hand ? "1.1" : "1") << "\n";
+  if (eye_to_hand) out << "configuration: " << CameraMountName(result.mount) << "\n";
   if (!result.source.empty()) out << "source: " << YamlQuoted(result.source) << "\n";
-  out << "flange_from_cam: " << TransformYaml(x, TransformStyle::kMillimetreDegree) << "\n"
-      << "flange_from_cam_exact: " << TransformYaml(x, TransformStyle::kExact) << "\n"
-      << "flange_from_cam_quat_xyzw: " << YamlNumberList(std::vector<double>{q.x(), q.y(), q.z(), q.w()}) << "\n";
+  out << key << ": " << TransformYaml(x, TransformStyle::kMillimetreDegree) << "\n"
+      << key << "_exact: " << TransformYaml(x, TransformStyle::kExact) << "\n"
+      << key << "_quat_xyzw: " << YamlNumberList(std::vector<double>{q.x(), q.y(), q.z(), q.w()}) << "\n";
   const Eigen::Matrix<double, 6, 1>& s = result.stddev;
   if (s.allFinite()) {
-    out << "flange_from_cam_stddev: {xyz_mm: "
+    out << key << "_stddev: {xyz_mm: "
         << YamlNumberList(std::vector<double>{s[0] * 1e3, s[1] * 1e3, s[2] * 1e3})
         << ", rotvec_deg: " << YamlNumberList(std::vector<double>{RadToDeg(s[3]), RadToDeg(s[4]), RadToDeg(s[5])})
         << "}  # of a correction in the camera frame\n";
@@ -70,13 +79,21 @@ Result<HandEyeResult> LoadHandEye(const std::string& path) {
     return problems.ToStatus("hand-eye result");
   }
   HandEyeResult result;
+  std::string configuration = CameraMountName(result.mount);
+  if (root.OptionalString("configuration", &configuration) && !ParseCameraMount(configuration, &result.mount)) {
+    problems.Add("`configuration` = `" + configuration + "` at " + problems.At(root.KeyLine("configuration")) +
+                 " must be eye_in_hand or eye_to_hand");
+  }
+  const bool eye_to_hand = result.mount == CameraMount::kEyeToHand;
+  const std::string key = eye_to_hand ? "base_from_cam" : "flange_from_cam";
+  Rigid3& exact = eye_to_hand ? result.base_from_cam : result.flange_from_cam;
   Rigid3 rounded;
   root.OptionalString("source", &result.source);
-  ReadTransform(&root, "flange_from_cam", /*required=*/true, &rounded);
-  ReadTransform(&root, "flange_from_cam_exact", /*required=*/true, &result.flange_from_cam);
-  root.Optional("flange_from_cam_quat_xyzw");
-  if (const yaml::YamlNode* node = root.Optional("flange_from_cam_stddev")) {
-    MapReader map(*node, "flange_from_cam_stddev", &problems);
+  ReadTransform(&root, key, /*required=*/true, &rounded);
+  ReadTransform(&root, key + "_exact", /*required=*/true, &exact);
+  root.Optional(key + "_quat_xyzw");
+  if (const yaml::YamlNode* node = root.Optional(key + "_stddev")) {
+    MapReader map(*node, key + "_stddev", &problems);
     std::vector<double> xyz, rotvec;
     if (map.QuantityList("xyz", Unit::kLength, 3, Range::Closed(0, 10), &xyz) &&
         map.QuantityList("rotvec", Unit::kAngle, 3, Range::Closed(0, 10), &rotvec)) {
@@ -89,9 +106,9 @@ Result<HandEyeResult> LoadHandEye(const std::string& path) {
   ReadOptionalCamera(&root, &problems, &result.camera);
   ReadIntrinsicsStddev(&root, &result.intrinsics_stddev);
   root.Finish();
-  if (problems.empty() && ((rounded.translation - result.flange_from_cam.translation).norm() > 1e-6 ||
-                           (rounded.rotation - result.flange_from_cam.rotation).norm() > 1e-6)) {
-    problems.Add("`flange_from_cam` and `flange_from_cam_exact` disagree: one of them was edited");
+  if (problems.empty() && ((rounded.translation - exact.translation).norm() > 1e-6 ||
+                           (rounded.rotation - exact.rotation).norm() > 1e-6)) {
+    problems.Add("`" + key + "` and `" + key + "_exact` disagree: one of them was edited");
   }
   if (!problems.empty()) return problems.ToStatus("hand-eye result");
   return result;

@@ -275,6 +275,41 @@ bool ReadPose(const yaml::YamlNode& node, const std::string& name, const RobotMo
   return ok;
 }
 
+// The top-level `configuration` into *mount (left as it is when absent): eye_in_hand or eye_to_hand, and
+// the same as a calibrated robot's (`robot`, null when none was read) when that says eye_to_hand.
+bool ReadConfiguration(MapReader* root, Problems* problems, const RobotModel* robot, CameraMount* mount) {
+  if (root->Optional("configuration") == nullptr) return true;
+  std::string name;
+  if (!root->OptionalString("configuration", &name)) return false;
+  const std::string at = problems->At(root->KeyLine("configuration"));
+  if (!ParseCameraMount(name, mount)) {
+    problems->Add("`configuration` = `" + name + "` at " + at + " must be eye_in_hand or eye_to_hand");
+    return false;
+  }
+  if (robot != nullptr && robot->mount == CameraMount::kEyeToHand && *mount != robot->mount) {
+    problems->Add("`configuration` = `" + name + "` at " + at + ", but the robot is a calibrated " +
+                  CameraMountName(robot->mount) + " model");
+    return false;
+  }
+  return true;
+}
+
+// The top-level camera key of the other configuration is refused: an eye_to_hand set's camera is the fixed
+// `base_from_cam`, an eye_in_hand set's the camera on the flange, `flange_from_cam`.
+bool CameraKeyFitsConfiguration(MapReader* root, Problems* problems, CameraMount mount) {
+  const bool eye_to_hand = mount == CameraMount::kEyeToHand;
+  const char* wrong = eye_to_hand ? "flange_from_cam" : "base_from_cam";
+  if (root->Optional(wrong) == nullptr) return true;
+  const bool stated = root->Optional("configuration") != nullptr;
+  problems->Add("`" + std::string(wrong) + "` at " + problems->At(root->KeyLine(wrong)) + " does not fit `configuration: " +
+                CameraMountName(mount) + "`" + (stated ? " (at " + problems->At(root->KeyLine("configuration")) + ")" : " (the default)") +
+                (eye_to_hand ? ": an eye_to_hand set's camera is fixed in the base frame, given as `base_from_cam`; the "
+                               "flange carries the points"
+                             : ": `base_from_cam` is the fixed camera of an eye_to_hand set; add `configuration: "
+                               "eye_to_hand` if the camera does not move with the flange"));
+  return false;
+}
+
 }  // namespace
 
 namespace {
@@ -344,19 +379,34 @@ Result<ObservationSet> ParseObservations(const yaml::YamlDocument& doc, std::vec
     }
   }
   const bool robot_given = robot || robot_file;
+  // The robot's own configuration (eye_in_hand for every robot config; a calibrated eye-to-hand model's
+  // otherwise) unless the file says which.
+  const RobotModel robot_read = set.robot;
+  CameraMount mount = robot_ok ? robot_read.mount : CameraMount::kEyeInHand;
+  const bool mount_ok = ReadConfiguration(&root, &problems, robot_ok ? &robot_read : nullptr, &mount);
+  const bool eye_to_hand = mount == CameraMount::kEyeToHand;
   Rigid3 flange_from_cam;
-  if (robot_given && root.Optional("flange_from_cam")) {
+  if (mount_ok && !CameraKeyFitsConfiguration(&root, &problems, mount)) {
+    // refused, named by CameraKeyFitsConfiguration
+  } else if (robot_given && !eye_to_hand && root.Optional("flange_from_cam")) {
     problems.Add("`flange_from_cam` at " + problems.At(root.KeyLine("flange_from_cam")) +
                  " is for sets of flange poses; with a robot it belongs in the robot's block");
   } else if (!robot_given) {
-    set.flange_from_cam_known = root.Optional("flange_from_cam") != nullptr;
+    set.flange_from_cam_known = !eye_to_hand && root.Optional("flange_from_cam") != nullptr;
     if (const yaml::YamlNode* noise = root.Optional("flange_pose_noise")) {
       MapReader map(*noise, "flange_pose_noise", &problems);
       map.Quantity("translation", Unit::kLength, Range::Positive(0.1), &set.flange_translation_sigma_m);
       map.Quantity("rotation", Unit::kAngle, Range::Positive(DegToRad(10)), &set.flange_rotation_sigma_rad);
     }
-    ReadTransform(&root, "flange_from_cam", /*required=*/false, &flange_from_cam);
+    if (!eye_to_hand) ReadTransform(&root, "flange_from_cam", /*required=*/false, &flange_from_cam);
     set.robot = FlangePoseModel(flange_from_cam);
+  }
+  set.robot.mount = mount;
+  if (eye_to_hand) {
+    // The nominal fixed camera: given here, else a calibrated eye-to-hand robot's, else started from the images.
+    const bool given = root.Optional("base_from_cam") != nullptr;
+    ReadTransform(&root, "base_from_cam", /*required=*/false, &set.robot.base_from_cam);
+    set.flange_from_cam_known = given || (robot_ok && robot_read.mount == CameraMount::kEyeToHand);
   }
   const bool camera_ok = ReadCamera(&root, &problems, &set.camera);
   root.Double("pixel_noise_px", Range::Closed(kMinPixelNoisePx, kMaxPixelNoisePx), &set.pixel_noise_px);
@@ -416,18 +466,24 @@ Status SaveObservations(const ObservationSet& set, const std::string& path) {
   out << "# selfcal observations (docs/observations-format.md), written in SI units (m, rad) so that the\n"
       << "# file loads back bit-identical. Pixels: origin at the centre of the top-left pixel, u right, v down.\n"
       << "format: " << kObservationsFormat << "\n";
+  // Version 1.1 added flange poses, 1.2 the eye-to-hand configuration; a set of joint angles seen by a camera
+  // on the flange stays readable by every 1.x reader.
+  const bool eye_to_hand = set.robot.mount == CameraMount::kEyeToHand;
+  out << "version: " << (eye_to_hand ? "1.2" : set.UsesFlangePoses() ? "1.1" : std::to_string(kObservationsVersion)) << "\n";
+  if (eye_to_hand) {
+    out << "configuration: " << CameraMountName(set.robot.mount) << "\n";
+    if (set.flange_from_cam_known) out << "base_from_cam: " << TransformYaml(set.robot.base_from_cam, TransformStyle::kExact) << "\n";
+  }
   if (set.UsesFlangePoses()) {
-    // Version 1.1 added flange poses; a set of joint angles stays readable by every 1.x reader.
-    out << "version: 1.1\n";
     if (set.flange_translation_sigma_m > 0) {
       out << "flange_pose_noise: {translation_m: " << YamlNumber(set.flange_translation_sigma_m)
           << ", rotation_rad: " << YamlNumber(set.flange_rotation_sigma_rad) << "}\n";
     }
-    if (set.flange_from_cam_known) out << "flange_from_cam: " << TransformYaml(set.robot.flange_from_cam, TransformStyle::kExact) << "\n";
+    if (set.flange_from_cam_known && !eye_to_hand) {
+      out << "flange_from_cam: " << TransformYaml(set.robot.flange_from_cam, TransformStyle::kExact) << "\n";
+    }
   } else {
-    out << "version: " << kObservationsVersion << "\n"
-        << "robot:\n"
-        << RobotModelYaml(set.robot, TransformStyle::kExact, 2);
+    out << "robot:\n" << RobotModelYaml(set.robot, TransformStyle::kExact, 2);
   }
   out << "camera: " << CameraYaml(c) << "\n"
       << "pixel_noise_px: " << YamlNumber(set.pixel_noise_px) << "\n";

@@ -150,6 +150,33 @@ bool ReadHome(MapReader* map, const std::vector<JointRow>& rows, std::vector<dou
   return ok;
 }
 
+// A calibrated model's `configuration` (eye_in_hand by default) and, for eye_to_hand, its required
+// `base_from_cam`, the calibrated fixed camera (`flange_from_cam` is then the robot config's, unused).
+bool ReadCalibratedMount(MapReader* map, CameraMount* mount, Rigid3* base_from_cam) {
+  std::string name = CameraMountName(CameraMount::kEyeInHand);
+  if (map->Optional("configuration") != nullptr && !map->OptionalString("configuration", &name)) return false;
+  if (!ParseCameraMount(name, mount)) {
+    map->problems()->Add("`" + map->Path("configuration") + "` = `" + name + "` at " +
+                         map->problems()->At(map->KeyLine("configuration")) + " must be eye_in_hand or eye_to_hand");
+    return false;
+  }
+  if (*mount == CameraMount::kEyeToHand) return ReadTransform(map, "base_from_cam", /*required=*/true, base_from_cam);
+  map->Disallow("base_from_cam", "only with `configuration: eye_to_hand`");
+  return true;
+}
+
+// The keys only a calibrated model has: its configuration and fixed camera (into *mounted's mount and
+// base_from_cam), fx_px, camera, intrinsics_stddev, parameters, provenance.
+bool ReadCalibratedKeys(MapReader* map, int num_joints, CalibratedModel* out, RobotModel* mounted) {
+  bool ok = ReadCalibratedMount(map, &mounted->mount, &mounted->base_from_cam);
+  ok &= map->OptionalDouble("fx_px", Range::Positive(1e6), &out->fx_px);
+  ok &= ReadOptionalCamera(map, map->problems(), &out->camera);
+  ok &= ReadIntrinsicsStddev(map, &out->intrinsics_stddev);
+  ReadParameters(map, num_joints, &out->parameters);
+  ReadProvenance(map, &out->provenance);
+  return ok;
+}
+
 CalibratedModel Parse(const yaml::YamlNode& node, const std::string& name, Problems* problems, std::string* format) {
   CalibratedModel out;
   const size_t problems_before = problems->size();
@@ -226,14 +253,11 @@ CalibratedModel Parse(const yaml::YamlNode& node, const std::string& name, Probl
   } else {
     ok &= ReadTransform(&map, "link_n_from_flange", /*required=*/false, &link_n_from_flange);
   }
+  RobotModel mounted;  // a calibrated model's configuration and fixed camera, set once the model is built
   if (calibrated) {
-    ok &= map.OptionalDouble("fx_px", Range::Positive(1e6), &out.fx_px);
-    ok &= ReadOptionalCamera(&map, problems, &out.camera);
-    ok &= ReadIntrinsicsStddev(&map, &out.intrinsics_stddev);
-    ReadParameters(&map, static_cast<int>(rows.size()), &out.parameters);
-    ReadProvenance(&map, &out.provenance);
+    ok &= ReadCalibratedKeys(&map, static_cast<int>(rows.size()), &out, &mounted);
   } else {
-    for (const char* key : {"fx_px", "camera", "intrinsics_stddev", "parameters", "provenance"}) {
+    for (const char* key : {"fx_px", "camera", "intrinsics_stddev", "parameters", "provenance", "configuration", "base_from_cam"}) {
       map.Disallow(key, std::string("only in a `format: ") + kCalibratedModelFormat + "` file");
     }
   }
@@ -259,6 +283,8 @@ CalibratedModel Parse(const yaml::YamlNode& node, const std::string& name, Probl
     for (size_t i = 0; i < rows.size(); ++i) model.links[i].beta = rows[i].link.beta;
     model.link_n_from_flange = link_n_from_flange;
   }
+  model.mount = mounted.mount;
+  model.base_from_cam = mounted.base_from_cam;
   // The model's own checks, each at the line of the joint row it names ("joint 3: ..."), else the robot's.
   std::istringstream invalid(model.Validate());
   for (std::string line; std::getline(invalid, line);) {
@@ -364,13 +390,22 @@ Status SaveCalibratedModel(const CalibratedModel& calibrated, const std::string&
   if (!problems.empty()) {
     return Status::Error(ErrorCode::kInvalidInput, "refusing to write an invalid calibrated model to " + path + ":\n" + problems);
   }
+  const bool eye_to_hand = model.mount == CameraMount::kEyeToHand;
   std::ostringstream out;
   out << "# selfcal calibrated robot model (docs/calibrated-model-format.md). Lengths in mm, angles in degrees.\n"
-      << "# base_from_cam(q) = base_from_link0 * link_1(q_1) * ... * link_n(q_n) * link_n_from_flange * flange_from_cam\n"
+      << (eye_to_hand ? "# base_from_flange(q) = base_from_link0 * link_1(q_1) * ... * link_n(q_n) * link_n_from_flange; the camera\n"
+                        "# is fixed at base_from_cam (eye-to-hand)\n"
+                      : "# base_from_cam(q) = base_from_link0 * link_1(q_1) * ... * link_n(q_n) * link_n_from_flange * flange_from_cam\n")
       << "format: " << kCalibratedModelFormat << "\n"
-      << "version: " << kCalibratedModelVersion << "\n";
+      // 1.1 added the eye-to-hand configuration: an eye-in-hand model stays readable by every 1.x reader.
+      << "version: " << (eye_to_hand ? "1.1" : std::to_string(kCalibratedModelVersion)) << "\n";
   if (!calibrated.source.empty()) out << "source: " << YamlQuoted(calibrated.source) << "\n";
   out << RobotModelYaml(model, TransformStyle::kMillimetreDegree, 0);
+  if (eye_to_hand) {
+    out << "configuration: " << CameraMountName(model.mount) << "  # the camera fixed, the points on the flange\n"
+        << "base_from_cam: " << TransformYaml(model.base_from_cam, TransformStyle::kMillimetreDegree)
+        << "  # the calibrated fixed camera (flange_from_cam above takes no part)\n";
+  }
   if (calibrated.fx_px > 0) out << "fx_px: " << YamlNumber(calibrated.fx_px) << "\n";
   if (calibrated.camera) out << "camera: " << CameraYaml(*calibrated.camera) << "  # the calibrated intrinsics\n";
   if (const std::string sd = IntrinsicsStddevYaml(calibrated.intrinsics_stddev); !sd.empty()) {
