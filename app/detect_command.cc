@@ -41,6 +41,7 @@ struct DetectSettings {
   bool asymmetric = false;  // circles: OpenCV's asymmetric grid
   std::string dictionary, board;  // charuco: the markers' dictionary and the board's squares ROWSxCOLS
   std::string robot, hand_eye;
+  std::string configuration = "eye_in_hand";  // or eye_to_hand: the camera fixed, the points on the flange
   double fx_px = 0, cx_px = NAN, cy_px = NAN, mu = 1.0, k1 = 0.0;
   std::string camera_file, camera_name;  // instead of the --camera-* values
   bool camera_values_given = false;      // any --camera-fx-px, -cx-px, -cy-px, -mu, -k1
@@ -158,10 +159,21 @@ Result<detection::ObservationSetup> ToSetup(const DetectSettings& a, const vpIma
     if (!ints || !(a.yardstick[2] > 0)) return Usage("--yardstick A,B,LENGTH_MM: two point ids and a length > 0 mm");
     setup.yardsticks.push_back({static_cast<int>(a.yardstick[0]), static_cast<int>(a.yardstick[1]), a.yardstick[2] * 1e-3});
   }
+  if (!ParseCameraMount(a.configuration, &setup.mount)) {
+    return Usage("--configuration " + a.configuration + ": eye_in_hand or eye_to_hand");
+  }
   if (!a.hand_eye.empty()) {
     Result<io::HandEyeResult> hand_eye = io::LoadHandEye(a.hand_eye);
     if (!hand_eye.ok()) return hand_eye.status();
-    setup.flange_from_cam = hand_eye->flange_from_cam;
+    if (hand_eye->mount != setup.mount) {
+      return Usage("--hand-eye " + a.hand_eye + " is an " + CameraMountName(hand_eye->mount) + " result; this set is " +
+                   CameraMountName(setup.mount) + " (--configuration)");
+    }
+    if (setup.mount == CameraMount::kEyeToHand) {
+      setup.base_from_cam = hand_eye->base_from_cam;
+    } else {
+      setup.flange_from_cam = hand_eye->flange_from_cam;
+    }
   }
   setup.skip_failed = a.skip_failed;
   return setup;
@@ -224,7 +236,7 @@ Status WriteContactSheet(const DetectSettings& a, const detection::DetectionOpti
   detection::ContactSheetOptions so;
   so.max_tile_width_px = a.sheet_tile_px;
   so.failed_label = failed_label;
-  if (options.identity == detection::Identity::kGrid) {
+  if (options.identity == detection::Identity::kGrid && options.detector != detection::Detector::kAprilTag) {
     // A ChArUco board of cols squares has cols - 1 corners a row.
     so.grid_cols = options.detector == detection::Detector::kCharuco ? options.cols - 1 : options.cols;
   }
@@ -268,6 +280,7 @@ void RecordDetectFigures(const std::vector<io::NamedImage>& images, const std::v
                                 {"images_with_points", set.poses.size()},
                                 {"points", total},
                                 {"poses", set.UsesFlangePoses() ? "flange" : "joint"},
+                                {"configuration", CameraMountName(set.robot.mount)},
                                 {"per_image", per_image}};
 }
 
@@ -344,7 +357,14 @@ int DetectFromSettings(const DetectSettings& a) {
   detect_options.progress = Progress();
   std::vector<detection::ImagePoints> points = detection::DetectAllImagePoints(pixels, detect_options);
   detection::OrientCircleGrids(detect_options, robot_poses, *setup, &points);
-  Result<ObservationSet> set = detection::BuildObservationSet(ids, points, robot_poses, *setup);
+  detection::ObservationSetup with_tags = *setup;
+  if (options->detector == detection::Detector::kAprilTag && options->tag_side_m > 0) {
+    // The tags' known side: each tag's bottom edge a yardstick, its top edge a check distance.
+    const detection::TagEdges edges = detection::TagEdgeDistances(points, options->tag_side_m);
+    with_tags.yardsticks.insert(with_tags.yardsticks.end(), edges.yardsticks.begin(), edges.yardsticks.end());
+    with_tags.check_distances = edges.check_distances;
+  }
+  Result<ObservationSet> set = detection::BuildObservationSet(ids, points, robot_poses, with_tags);
   // A detection that failed (kDegenerateData) still gets its contact sheet: each image's reason, for a person.
   const bool detection_failed = !set.ok() && set.status().code() == ErrorCode::kDegenerateData;
   PrintPerImage(*images, points, set.ok() ? "SKIPPED" : "FAILED");
@@ -374,8 +394,9 @@ int DetectFromSettings(const DetectSettings& a) {
   RecordDetectFigures(*images, points, *set);
   AddOutputFile("observations", a.out);
   if (!a.contact_sheet.empty()) AddOutputFile("contact_sheet", a.contact_sheet);
-  std::printf("%zu of %zu images with points (%zu to %zu points each), %s poses; wrote %s%s%s (%.2f s)\n",
+  std::printf("%zu of %zu images with points (%zu to %zu points each), %s poses, %s; wrote %s%s%s (%.2f s)\n",
               set->poses.size(), images->size(), fewest, most, set->UsesFlangePoses() ? "flange" : "joint",
+              CameraMountName(set->robot.mount),
               a.out.c_str(), a.contact_sheet.empty() ? "" : " and ", a.contact_sheet.c_str(), seconds);
   return 0;
 }
@@ -417,8 +438,10 @@ Command AddDetectCommand(CLI::App& app) {
                   "Also write every image with its points and ids as one PNG");
   cmd->add_option("--contact-sheet-tile-px", a->sheet_tile_px, "Largest thumbnail width on the contact sheet, px")
       ->check(CLI::Range(64, 8192));
-  cmd->add_option("--detector", a->detector, "dots, circles (a circle grid without an origin dot), chessboard or charuco")
-      ->check(CLI::IsMember({"dots", "circles", "chessboard", "charuco"}));
+  cmd->add_option("--detector", a->detector,
+                  "dots, circles (a circle grid without an origin dot), chessboard, charuco or apriltag (the corners "
+                  "of every AprilTag 36h11: id = tag id * 4 + corner; with --tag-side-mm a yardstick per tag)")
+      ->check(CLI::IsMember({"dots", "circles", "chessboard", "charuco", "apriltag"}));
   cmd->add_option("--grid", a->grid, "ROWSxCOLS: the dot grid (default 10x10), the circle grid or the chessboard's inner corners");
   cmd->add_flag("--asymmetric", a->asymmetric, "circles: OpenCV's asymmetric grid (every other row shifted by half a step)");
   cmd->add_option("--polarity", a->polarity, "dots and circles: dark dots (default), light dots on a dark board, or auto")
@@ -427,14 +450,22 @@ Command AddDetectCommand(CLI::App& app) {
   cmd->add_option("--board", a->board, "charuco: the board's squares XxY (OpenCV's squaresX x squaresY), e.g. 5x7");
   cmd->add_option("--identity", a->identity, "How dots are named: grid (larger origin dot), apriltag, order")
       ->check(CLI::IsMember({"grid", "apriltag", "order"}));
-  cmd->add_option("--tag-side-mm", a->tag_side_mm, "apriltag: outer side of the tags' black border, mm")
+  cmd->add_option("--tag-side-mm", a->tag_side_mm,
+                  "apriltag: outer side of the tags' black border, mm (the apriltag detector: its edges as yardstick "
+                  "and check distance)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--tag-dots-mm", a->tag_dots_mm, "apriltag: x1,y1,x2,y2,... of the dots around every tag, mm")
       ->delimiter(',');
   cmd->add_option("--tag-tolerance-px", a->tag_tolerance_px, "apriltag: a dot this close to its prediction is named")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--robot", a->robot, "Robot config (config/robots/*.yaml): needed for joint-angle poses");
-  cmd->add_option("--hand-eye", a->hand_eye, "Flange poses: a nominal hand-eye transform (selfcal-hand-eye file)");
+  cmd->add_option("--hand-eye", a->hand_eye,
+                  "A nominal camera transform (selfcal-hand-eye file): flange_from_cam for flange poses, or, with "
+                  "--configuration eye_to_hand, the fixed camera base_from_cam");
+  cmd->add_option("--configuration", a->configuration,
+                  "eye_in_hand (default: the camera on the flange, the points fixed) or eye_to_hand (the camera fixed "
+                  "in the base frame, the points carried by the flange)")
+      ->check(CLI::IsMember({"eye_in_hand", "eye_to_hand"}));
   cmd->add_option("--camera-file", a->camera_file,
                   "The camera's intrinsics from an OpenCV FileStorage or ViSP XML file (docs/camera-files.md), instead "
                   "of the --camera-* values");

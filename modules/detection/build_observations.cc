@@ -23,11 +23,18 @@ Result<ObservationSet> BuildObservationSet(const std::vector<std::string>& pose_
   ObservationSet set;
   set.robot = flange_set ? FlangePoseModel(setup.flange_from_cam.value_or(Rigid3())) : setup.robot;
   set.flange_from_cam_known = !flange_set || setup.flange_from_cam.has_value();
+  if (setup.mount == CameraMount::kEyeToHand) {
+    SELFCAL_CHECK(!setup.flange_from_cam.has_value(), "BuildObservationSet: eye-to-hand takes base_from_cam");
+    set.robot.mount = CameraMount::kEyeToHand;
+    set.robot.base_from_cam = setup.base_from_cam.value_or(Rigid3());
+    set.flange_from_cam_known = setup.base_from_cam.has_value();
+  }
   set.camera = setup.camera;
   set.pixel_noise_px = setup.pixel_noise_px;
   set.flange_translation_sigma_m = setup.flange_translation_sigma_m;
   set.flange_rotation_sigma_rad = setup.flange_rotation_sigma_rad;
   set.yardsticks = setup.yardsticks;
+  set.check_distances = setup.check_distances;
   std::string failed;
   for (size_t i = 0; i < points.size(); ++i) {
     if (!points[i].ok || points[i].points_px.empty()) {

@@ -1,5 +1,7 @@
 #include "detection/detect_points.h"
 
+#include <cmath>
+#include <set>
 #include <sstream>
 
 #include "detection/circle_grid.h"
@@ -147,6 +149,33 @@ ImagePoints ChessboardPoints(const vpImage<unsigned char>& image, const Detectio
   return out;
 }
 
+ImagePoints TagCornerPoints(const vpImage<unsigned char>& image, const DetectionOptions& options) {
+  const std::vector<tracking::AprilTagDetection> tags = tracking::DetectAprilTags(image, options.apriltag);
+  std::map<int, int> seen;  // tag id -> how many times: a tag printed twice names no point
+  for (const tracking::AprilTagDetection& tag : tags) ++seen[tag.id];
+  ImagePoints out;
+  out.candidates = static_cast<int>(tags.size());
+  int repeated = 0;
+  for (const tracking::AprilTagDetection& tag : tags) {
+    if (seen[tag.id] != 1) {
+      ++repeated;
+      continue;
+    }
+    for (int k = 0; k < 4; ++k) out.points_px[TagCornerId(tag.id, k)] = tag.corners_px[static_cast<size_t>(k)];
+  }
+  out.ok = !out.points_px.empty();
+  std::ostringstream m;
+  m << tags.size() << " AprilTag" << (tags.size() == 1 ? "" : "s");
+  if (!tags.empty()) {
+    m << " (id";
+    for (const auto& [id, count] : seen) m << " " << id;
+    m << "), " << out.points_px.size() << " corners";
+  }
+  if (repeated > 0) m << "; " << repeated << " detections of a tag seen twice left out";
+  out.message = tags.empty() ? "no AprilTag found" : m.str();
+  return out;
+}
+
 ImagePoints CharucoPoints(const vpImage<unsigned char>& image, const DetectionOptions& options) {
   CharucoOptions co = options.charuco;
   co.rows = options.rows;
@@ -168,6 +197,7 @@ const char* DetectorName(Detector detector) {
     case Detector::kCircles: return "circles";
     case Detector::kChessboard: return "chessboard";
     case Detector::kCharuco: return "charuco";
+    case Detector::kAprilTag: return "apriltag";
   }
   return "unknown";
 }
@@ -186,7 +216,9 @@ Result<Detector> ParseDetector(const std::string& name) {
   if (name == "circles") return Detector::kCircles;
   if (name == "chessboard") return Detector::kChessboard;
   if (name == "charuco") return Detector::kCharuco;
-  return Status::Error(ErrorCode::kInvalidInput, "unknown detector `" + name + "`: dots, circles, chessboard or charuco");
+  if (name == "apriltag") return Detector::kAprilTag;
+  return Status::Error(ErrorCode::kInvalidInput,
+                       "unknown detector `" + name + "`: dots, circles, chessboard, charuco or apriltag");
 }
 
 Result<Identity> ParseIdentity(const std::string& name) {
@@ -211,6 +243,9 @@ Status DetectionOptions::Validate() const {
     co.rows = rows;
     co.cols = cols;
     if (Status v = co.Validate(); !v.ok()) s << v.message();
+  } else if (detector == Detector::kAprilTag) {
+    if (Status v = apriltag.Validate(); !v.ok()) s << v.message();
+    if (tag_side_m < 0 || !std::isfinite(tag_side_m)) s << "apriltag detector: the tag side must be positive\n";
   } else if (detector == Detector::kCharuco) {
     CharucoOptions co = charuco;
     co.rows = rows;
@@ -242,7 +277,21 @@ ImagePoints DetectImagePoints(const vpImage<unsigned char>& image, const Detecti
   SELFCAL_CHECK(valid.ok(), "invalid DetectionOptions:\n" << valid.message());
   if (options.detector == Detector::kChessboard) return ChessboardPoints(image, options, previous);
   if (options.detector == Detector::kCharuco) return CharucoPoints(image, options);
+  if (options.detector == Detector::kAprilTag) return TagCornerPoints(image, options);
   return DotPoints(image, options);
+}
+
+TagEdges TagEdgeDistances(const std::vector<ImagePoints>& points, double side_m) {
+  std::set<int> tags;
+  for (const ImagePoints& image : points) {
+    for (const auto& [id, px] : image.points_px) tags.insert(id / 4);
+  }
+  TagEdges out;
+  for (int tag : tags) {
+    out.yardsticks.push_back({TagCornerId(tag, 0), TagCornerId(tag, 1), side_m});
+    out.check_distances.push_back({TagCornerId(tag, 3), TagCornerId(tag, 2), side_m});
+  }
+  return out;
 }
 
 std::vector<ImagePoints> DetectAllImagePoints(const std::vector<const vpImage<unsigned char>*>& images,

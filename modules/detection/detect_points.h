@@ -30,7 +30,11 @@
 //   chessboard        inner corners, ordered consistently (detection/chessboard.h): id = row * cols + col;
 //   charuco           a ChArUco board's inner corners named by its ArUco markers (detection/charuco.h):
 //                     OpenCV's ChArUco corner ids, the same physical corner in every image however much of
-//                     the board is seen.
+//                     the board is seen;
+//   apriltag          the four outer corners of every AprilTag (tracking::DetectAprilTags, ViSP's detector):
+//                     id = tag id * 4 + k, k = 0 bottom-left, 1 bottom-right, 2 top-right, 3 top-left (the tag's
+//                     printed orientation, whatever its rotation in the image). The centre is not a point: its
+//                     pixel is the diagonals' intersection, a function of the corners' pixels, not a measurement.
 // Dots of either polarity (detection/blob_candidates.h): dark, light, or auto, per image the polarity whose
 // grid (dots + grid, circles) is found, else (and when both are, or for apriltag and order) the one whose
 // dots have the larger ContrastScore. Texture blobs are left out by ConsistentBlobs for circles and order
@@ -59,11 +63,11 @@
 
 namespace selfcal::detection {
 
-enum class Detector { kDots, kCircles, kChessboard, kCharuco };
+enum class Detector { kDots, kCircles, kChessboard, kCharuco, kAprilTag };
 enum class Identity { kGrid, kAprilTag, kOrder };
 const char* DetectorName(Detector detector);
 const char* IdentityName(Identity identity);
-// "dots" / "circles" / "chessboard" / "charuco", "grid" / "apriltag" / "order"; kInvalidInput otherwise.
+// "dots" / "circles" / "chessboard" / "charuco" / "apriltag", "grid" / "apriltag" / "order"; kInvalidInput otherwise.
 Result<Detector> ParseDetector(const std::string& name);
 Result<Identity> ParseIdentity(const std::string& name);
 
@@ -77,8 +81,8 @@ struct DetectionOptions {
   Polarity polarity = Polarity::kDark;  // dots and circles
   BlobFilterOptions blob_filter;        // circles and dots + order
   tracking::GridIdentityOptions grid;  // rows and cols are taken from above
-  tracking::AprilTagOptions apriltag;
-  double tag_side_m = 0;                    // apriltag: the black border's outer side
+  tracking::AprilTagOptions apriltag;       // the apriltag identity and the apriltag detector
+  double tag_side_m = 0;                    // apriltag: the black border's outer side (detector: optional)
   std::vector<Eigen::Vector2d> tag_dots_m;  // apriltag: the layout around every tag, (x, y) in its frame
   double tag_tolerance_px = 3.0;
   ChessboardOptions chessboard;  // rows and cols are taken from above
@@ -106,6 +110,17 @@ ImagePoints DetectImagePoints(const vpImage<unsigned char>& image, const Detecti
 std::vector<ImagePoints> DetectAllImagePoints(const std::vector<const vpImage<unsigned char>*>& images,
                                               const DetectionOptions& options);
 
+// The apriltag detector's point ids: corner k (0 bottom-left ... 3 top-left) of tag `tag_id`.
+inline int TagCornerId(int tag_id, int corner) { return 4 * tag_id + corner; }
+
+// Known distances of the apriltag detector's corners, for every tag seen in `points` (in tag id order), of
+// a tag of outer side `side_m`: the yardstick its bottom edge (corners 0-1), and the check distance its top
+// edge (corners 3-2, no corner of the yardstick's: an independent check).
+struct TagEdges {
+  std::vector<KnownDistance> yardsticks, check_distances;
+};
+TagEdges TagEdgeDistances(const std::vector<ImagePoints>& points, double side_m);
+
 // The robot pose of one image: the flange in the base frame, or the joint angles.
 struct ImageRobotPose {
   std::optional<Rigid3> base_from_flange;
@@ -115,18 +130,25 @@ struct ImageRobotPose {
 
 struct ObservationSetup {
   RobotModel robot;                    // nominal; for joint poses (a flange-pose set has FlangePoseModel)
-  std::optional<Rigid3> flange_from_cam;  // flange poses: the nominal hand-eye transform, when known
+  // Where the camera is; eye-to-hand: the camera fixed in the base frame, the points on the flange.
+  CameraMount mount = CameraMount::kEyeInHand;
+  // The nominal camera transform, when known: flange_from_cam (eye-in-hand, flange poses; a joint set's is
+  // the robot's) or base_from_cam (eye-to-hand, for flange poses and joint angles alike).
+  std::optional<Rigid3> flange_from_cam;
+  std::optional<Rigid3> base_from_cam;
   CameraIntrinsics camera;             // nominal (width and height are the images')
   double pixel_noise_px = 0.5;
   // Flange poses: the stated noise of the recorded poses (0: exact); both or neither (ObservationSet).
   double flange_translation_sigma_m = 0, flange_rotation_sigma_rad = 0;
   std::vector<KnownDistance> yardsticks;
+  std::vector<KnownDistance> check_distances;  // held out from the solve
   bool skip_failed = false;            // leave images without points out instead of refusing the set
 };
 
 // One pose per image, id `pose_ids[i]`, role robot_poses[i].role, with the image's points and robot pose: joint
 // angles on setup.robot, or flange poses (every image, or none) on FlangePoseModel(flange_from_cam), with
-// flange_from_cam_known when it was given. An image whose detection failed is refused (kDegenerateData
+// flange_from_cam_known when it was given; in eye-to-hand (setup.mount) the model's mount and base_from_cam,
+// flange_from_cam_known when base_from_cam was given (ObservationSet). An image whose detection failed is refused (kDegenerateData
 // naming the pose id and why) unless skip_failed; so is a set with no points; mixed flange and joint
 // poses, and any set ObservationSet::Validate() refuses, are kInvalidInput.
 Result<ObservationSet> BuildObservationSet(const std::vector<std::string>& pose_ids,
