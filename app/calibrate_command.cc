@@ -207,7 +207,9 @@ Status WriteCameraInfo(const CameraIntrinsics& camera, const std::string& camera
 Status WriteHandEye(const LoadedInput& loaded, const calibration::CalibrationReport& report, const std::string& out_dir,
                     const io::RobotOrigin& origin) {
   io::HandEyeResult result;
+  result.mount = report.model->robot.mount;
   result.flange_from_cam = report.model->robot.flange_from_cam;
+  result.base_from_cam = report.model->robot.base_from_cam;
   result.fx_px = report.model->camera.fx_px;
   result.stddev = report.model->flange_from_cam_stddev;
   result.fx_stddev_px = report.model->intrinsics_stddev[kFx];
@@ -222,7 +224,9 @@ Status WriteHandEye(const LoadedInput& loaded, const calibration::CalibrationRep
   if (Status s = io::SaveHandEye(result, path); !s.ok()) return s;
   std::cout << "hand-eye result: " << path << "\n";
   AddOutputFile("hand_eye", path);
-  return WriteCameraStaticTransform(result.flange_from_cam, origin, out_dir);
+  return WriteCameraStaticTransform(result.mount,
+                                    result.mount == CameraMount::kEyeToHand ? result.base_from_cam : result.flange_from_cam,
+                                    origin, out_dir);
 }
 
 // --json: the answer at report.json's top level (docs/report-format.md), without its per-method sections.
@@ -380,7 +384,7 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
                                                           : calibration::FlangeScale::kAuto;
   options.progress = Progress();
   calibration::CalibrationReport report = calibration::Calibrate(loaded->observations, options);
-  report::PrintCalibrationSummary(report, std::cout);
+  report::PrintCalibrationSummary(loaded->observations, report, std::cout);
   if (Status s = CheckCameraOutputs(request, report); !s.ok()) return Fail(s);
   if (Status s = EnsureDirectory(request.out_dir); !s.ok()) return Fail(s);
   if (from_session) {

@@ -126,17 +126,21 @@ Status WriteModelExports(const RobotModel& calibrated, const io::RobotOrigin& or
   AddOutputFile("calibrated_urdf", urdf_path);
   if (Status s = WriteDhTable(calibrated, origin.dh_convention, source, out); !s.ok()) return s;
   if (Status s = WriteUrKinematics(calibrated, origin, out); !s.ok()) return s;
-  return WriteCameraStaticTransform(calibrated.flange_from_cam, origin, out_dir);
+  const bool eye_to_hand = calibrated.mount == CameraMount::kEyeToHand;
+  return WriteCameraStaticTransform(calibrated.mount, eye_to_hand ? calibrated.base_from_cam : calibrated.flange_from_cam,
+                                    origin, out_dir);
 }
 
-Status WriteCameraStaticTransform(const Rigid3& flange_from_cam, const io::RobotOrigin& origin,
+Status WriteCameraStaticTransform(CameraMount mount, const Rigid3& parent_from_cam, const io::RobotOrigin& origin,
                                   const std::string& out_dir) {
   const urdf::UrdfNames names = NamesOf(origin, static_cast<int>(origin.joint_names.size()));
-  const io::StaticTransform transform{names.tip_link, names.camera_link, flange_from_cam};
+  const bool eye_to_hand = mount == CameraMount::kEyeToHand;
+  const std::string& parent = eye_to_hand ? names.base_link : names.tip_link;
+  const io::StaticTransform transform{parent, names.camera_link, parent_from_cam};
   const std::string path = (std::filesystem::path(out_dir) / "camera_static_transform.yaml").string();
   if (Status s = io::SaveStaticTransform(transform, path); !s.ok()) return s;
-  std::cout << "flange-to-camera static transform (" << names.tip_link << " -> " << names.camera_link << "): " << path
-            << "\n";
+  std::cout << (eye_to_hand ? "base-to-camera" : "flange-to-camera") << " static transform (" << parent << " -> "
+            << names.camera_link << "): " << path << "\n";
   AddOutputFile("camera_static_transform", path);
   const std::string launch_path = (std::filesystem::path(out_dir) / "camera_static_transform.launch.py").string();
   if (Status s = io::SaveStaticTransformLaunch(transform, launch_path); !s.ok()) return s;

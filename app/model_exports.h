@@ -1,6 +1,7 @@
 // The calibrated model's exports beside calibrated_model.yaml (calibrate, simulate, identify-tracker):
 // calibrated.urdf (docs/urdf.md), the DH table in the convention the robot was entered in
-// (calibrated_robot.yaml, docs/calibrated-model-format.md) and the flange-to-camera static transform
+// (calibrated_robot.yaml, docs/calibrated-model-format.md) and the camera's static transform (flange-to-camera,
+// or base-to-camera in eye-to-hand)
 // (camera_static_transform.yaml and camera_static_transform.launch.py, docs/ros-static-transform.md). Each said on stdout and named in --json.
 #pragma once
 
@@ -23,10 +24,11 @@ io::RobotOrigin OriginOfInput(const std::string& robot_config, const std::string
 Status WriteModelExports(const RobotModel& calibrated, const io::RobotOrigin& origin, const std::string& source,
                          const std::string& out_dir);
 
-// camera_static_transform.yaml in `out_dir`: flange_from_cam from the tip link (parent) to the camera link
-// (child), named from the URDF the robot came from, else tool0 and camera_optical_frame; and the same
-// transform as the ROS 2 launch file camera_static_transform.launch.py.
-Status WriteCameraStaticTransform(const Rigid3& flange_from_cam, const io::RobotOrigin& origin,
+// camera_static_transform.yaml in `out_dir`: the camera link (child) in its parent, `parent_from_cam`: eye-in-hand
+// flange_from_cam from the tip link, eye-to-hand base_from_cam from the base link; the links named from the
+// URDF the robot came from, else tool0 (base_link) and camera_optical_frame; and the same transform as the
+// ROS 2 launch file camera_static_transform.launch.py.
+Status WriteCameraStaticTransform(CameraMount mount, const Rigid3& parent_from_cam, const io::RobotOrigin& origin,
                                   const std::string& out_dir);
 
 }  // namespace selfcal::app

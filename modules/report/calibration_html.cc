@@ -90,6 +90,7 @@ void VerdictSection(const json& r, Page* page) {
   const json& heldout = At(r, {"heldout_reprojection"});
   const json& verification = At(r, {"verification"});
   Table t({"figure", accepted ? "calibrated model" : "result (not accepted)", "nominal model"});
+  t.Row({"configuration (camera on the flange: eye_in_hand; fixed: eye_to_hand)", Text(At(r, {"configuration"})), ""});
   t.Row({"f_x (px)", Text(At(r, {"fx_px"}), 7), ""});
   const json& bundle = At(r, {"methods", "bundle"});
   t.Row({"fit: reprojection RMS (px)",
@@ -305,14 +306,17 @@ void PaperSection(const json& r, Page* page) {
 void ContextSection(const json& r, Page* page) {
   const json& hand_eye = At(r, {"hand_eye"});
   if (!hand_eye.is_null()) {
+    // The calibrated camera transform: the fixed camera's in eye-to-hand, else the hand-eye one.
+    const std::string name = At(r, {"configuration"}) == "eye_to_hand" ? "base_from_cam" : "flange_from_cam";
+    const char* key = name.c_str();
     page->Heading(2, "Hand-eye (flange poses)", "hand-eye");
     Table t({"item", "value"});
     t.Row({"start from the images", Text(At(hand_eye, {"start", "message"}))});
     t.Row({"image motions against the flange", Text(At(hand_eye, {"image_motions", "message"}))});
     t.Row({"pose-noise bundle", Text(At(hand_eye, {"pose_noise", "message"}))});
-    t.Row({"flange_from_cam translation (mm)", Mm(At(hand_eye, {"flange_from_cam", "xyz_m"}))});
-    t.Row({"flange_from_cam rotation vector (deg)", Text(At(hand_eye, {"flange_from_cam", "rotvec_rad"}), 5, kDeg)});
-    t.Row({"sigma translation (mm)", Mm(At(hand_eye, {"flange_from_cam", "stddev", "xyz_m"}))});
+    t.Row({name + " translation (mm)", Mm(At(hand_eye, {key, "xyz_m"}))});
+    t.Row({name + " rotation vector (deg)", Text(At(hand_eye, {key, "rotvec_rad"}), 5, kDeg)});
+    t.Row({"sigma translation (mm)", Mm(At(hand_eye, {key, "stddev", "xyz_m"}))});
     page->Add(t);
   }
   const json& session = At(r, {"session"});

@@ -455,25 +455,29 @@ json HandEyeJson(const calibration::CalibrationReport& report) {
                        {"correction_translation_m", n.correction_translation_m},
                        {"correction_rotation_rad", n.correction_rotation_rad}};
   }
-  j["flange_from_cam"] = json();
-  if (report.model) {
-    const Rigid3& x = report.model->robot.flange_from_cam;
-    const Eigen::Vector3d w = LogSO3(x.rotation);
-    json calibrated = {{"xyz_m", {x.translation.x(), x.translation.y(), x.translation.z()}},
-                       {"rotvec_rad", {w.x(), w.y(), w.z()}}};
-    json rows = json::array();
-    for (int r = 0; r < 3; ++r) rows.push_back({x.rotation(r, 0), x.rotation(r, 1), x.rotation(r, 2)});
-    calibrated["rotation"] = rows;
-    calibrated["stddev"] = json();
-    const Eigen::Matrix<double, 6, 1>& sd = report.model->flange_from_cam_stddev;
-    if (sd.allFinite()) {
-      calibrated["stddev"] = {{"xyz_m", {sd[0], sd[1], sd[2]}},
-                              {"rotvec_rad", {sd[3], sd[4], sd[5]}},
-                              {"frame", "camera (of a correction flange_from_cam * Exp(delta))"}};
-    }
-    j["flange_from_cam"] = calibrated;
-  }
   return j;
+}
+
+// The calibrated camera transform of a flange-pose set, null without a model: flange_from_cam (eye-in-hand) or
+// the fixed camera's base_from_cam (eye-to-hand), with the standard deviations of its correction.
+json CalibratedCameraJson(const calibration::CalibrationReport& report, bool eye_to_hand) {
+  if (!report.model) return json();
+  const Rigid3& x = eye_to_hand ? report.model->robot.base_from_cam : report.model->robot.flange_from_cam;
+  const Eigen::Vector3d w = LogSO3(x.rotation);
+  json calibrated = {{"xyz_m", {x.translation.x(), x.translation.y(), x.translation.z()}},
+                     {"rotvec_rad", {w.x(), w.y(), w.z()}}};
+  json rows = json::array();
+  for (int r = 0; r < 3; ++r) rows.push_back({x.rotation(r, 0), x.rotation(r, 1), x.rotation(r, 2)});
+  calibrated["rotation"] = rows;
+  calibrated["stddev"] = json();
+  const Eigen::Matrix<double, 6, 1>& sd = report.model->flange_from_cam_stddev;
+  if (sd.allFinite()) {
+    calibrated["stddev"] = {{"xyz_m", {sd[0], sd[1], sd[2]}},
+                            {"rotvec_rad", {sd[3], sd[4], sd[5]}},
+                            {"frame", std::string("camera (of a correction ") +
+                                          (eye_to_hand ? "base_from_cam" : "flange_from_cam") + " * Exp(delta))"}};
+  }
+  return calibrated;
 }
 
 }  // namespace
@@ -498,6 +502,7 @@ json CalibrationReportJson(const ObservationSet& obs, const calibration::Calibra
                                  {"sha256", context.input.camera_file_sha256},
                                  {"camera_name", context.input.camera_name}};
   }
+  j["configuration"] = CameraMountName(obs.robot.mount);
   j["method"] = calibration::MethodName(report.method);
   j["verdict"] = calibration::VerdictName(report.verdict);
   j["accepted"] = report.accepted();
@@ -534,7 +539,11 @@ json CalibrationReportJson(const ObservationSet& obs, const calibration::Calibra
   j["scene_moves"] = moves;
   j["methods"] = methods;
   j["session"] = context.session ? SessionJson(context.input, *context.session) : json();
-  if (report.hand_eye_start) j["hand_eye"] = HandEyeJson(report);
+  if (report.hand_eye_start) {
+    const bool eye_to_hand = obs.robot.mount == CameraMount::kEyeToHand;
+    j["hand_eye"] = HandEyeJson(report);
+    j["hand_eye"][eye_to_hand ? "base_from_cam" : "flange_from_cam"] = CalibratedCameraJson(report, eye_to_hand);
+  }
   // Timing in one place, so that two reports of the same input compare equal without it.
   const calibration::PaperPipelineReport& p = report.paper;
   const calibration::BundleStageReport* b = report.bundle ? &*report.bundle : nullptr;

@@ -58,9 +58,11 @@ struct ReportContext {
 nlohmann::json CalibrationReportJson(const ObservationSet& observations, const calibration::CalibrationReport& report,
                                      const ReportContext& context);
 
-// The text summary: the paper pipeline, then the bundle adjustment when it ran. Lines longer than
-// kSummaryLineWidth characters are wrapped at spaces, the rest indented under the line's own indent.
-void PrintCalibrationSummary(const calibration::CalibrationReport& report, std::ostream& out);
+// The text summary: the configuration (eye-in-hand or eye-to-hand, of observations.robot.mount), the paper
+// pipeline, then the bundle adjustment when it ran. Lines longer than kSummaryLineWidth characters are wrapped
+// at spaces, the rest indented under the line's own indent.
+void PrintCalibrationSummary(const ObservationSet& observations, const calibration::CalibrationReport& report,
+                             std::ostream& out);
 inline constexpr int kSummaryLineWidth = 120;
 
 // The verdict and the held-out figure it rests on, for the last line of `selfcal calibrate`

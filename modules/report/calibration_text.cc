@@ -207,10 +207,11 @@ void PrintHandEye(const calibration::CalibrationReport& report, std::ostream& ou
               : "")
       << "\n";
   if (!report.model || !report.bundle) return;
-  const Rigid3& x = report.model->robot.flange_from_cam;
+  const bool eye_to_hand = report.model->robot.mount == CameraMount::kEyeToHand;
+  const Rigid3& x = eye_to_hand ? report.model->robot.base_from_cam : report.model->robot.flange_from_cam;
   const Eigen::Vector3d rotvec = LogSO3(x.rotation);
   const Eigen::Matrix<double, 6, 1>& sd = report.model->flange_from_cam_stddev;
-  out << std::fixed << std::setprecision(3) << "flange_from_cam: translation [" << x.translation.x() * kMm << ", "
+  out << std::fixed << std::setprecision(3) << (eye_to_hand ? "base_from_cam" : "flange_from_cam") << ": translation [" << x.translation.x() * kMm << ", "
       << x.translation.y() * kMm << ", " << x.translation.z() * kMm << "] mm, rotation vector ["
       << RadToDeg(rotvec.x()) << ", " << RadToDeg(rotvec.y()) << ", " << RadToDeg(rotvec.z()) << "] deg";
   if (sd.allFinite()) {
@@ -304,8 +305,13 @@ std::string PxAndMm(double px, double mm) {
 
 }  // namespace
 
-void PrintCalibrationSummary(const calibration::CalibrationReport& report, std::ostream& out) {
+void PrintCalibrationSummary(const ObservationSet& observations, const calibration::CalibrationReport& report,
+                             std::ostream& out) {
   std::ostringstream text;
+  text << "configuration: " << CameraMountName(observations.robot.mount)
+       << (observations.robot.mount == CameraMount::kEyeToHand
+               ? " (the camera fixed in the robot base frame, the points carried by the flange)\n"
+               : " (the camera on the flange, the points fixed in the robot base frame)\n");
   PrintSummaryLines(report, text);
   out << WrapLines(text.str(), kSummaryLineWidth);
 }

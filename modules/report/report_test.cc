@@ -94,7 +94,7 @@ TEST(CalibrationReport, SummaryNamesTheEstimatedIntrinsics) {
   const calibration::CalibrationReport report = calibration::Calibrate(world.observations, options);
   ASSERT_TRUE(report.accepted()) << report.message;
   std::ostringstream text;
-  PrintCalibrationSummary(report, text);
+  PrintCalibrationSummary(world.observations, report, text);
   EXPECT_NE(text.str().find("free kinematic parameters + f_x + cx + cy,"), std::string::npos) << text.str();
   EXPECT_NE(text.str().find("  intrinsics: cx = "), std::string::npos) << text.str();
   const nlohmann::json j = CalibrationReportJson(world.observations, report, {});
@@ -111,7 +111,7 @@ TEST(CalibrationReport, AHeldFocalLengthIsStatedAsHeld) {
   const calibration::CalibrationReport report = calibration::Calibrate(world.observations, options);
   ASSERT_TRUE(report.bundle.has_value());
   std::ostringstream text;
-  PrintCalibrationSummary(report, text);
+  PrintCalibrationSummary(world.observations, report, text);
   EXPECT_EQ(text.str().find("nan"), std::string::npos) << text.str();
   std::ostringstream fx;
   fx << std::fixed << std::setprecision(3) << world.observations.camera.fx_px;
@@ -174,7 +174,7 @@ TEST(CalibrationReport, AbsentFiguresAreNullNotZero) {
   EXPECT_EQ(j["heldout_reprojection"]["calibrated_model"]["poses"].size(),
             world.observations.PosesWithRole(PoseRole::kVerification).size());
   std::ostringstream text;
-  PrintCalibrationSummary(report, text);
+  PrintCalibrationSummary(world.observations, report, text);
   EXPECT_NE(text.str().find("held-out reprojection on"), std::string::npos) << text.str();
   EXPECT_EQ(text.str().find("held-out distances"), std::string::npos) << text.str();
 }

@@ -122,8 +122,13 @@ Result<std::string> UrdfOfModel(const RobotModel& model, const UrdfNames& names,
   text.Link(names.tip_link);
   text.Joint(parent + "_to_" + names.tip_link, parent, names.tip_link, model.link_n_from_flange, nullptr);
   text.Link(names.camera_link);
-  text.Joint(names.tip_link + "_to_" + names.camera_link, names.tip_link, names.camera_link, model.flange_from_cam,
-             nullptr);
+  if (model.mount == CameraMount::kEyeToHand) {  // the camera fixed in the base frame
+    text.Joint(names.base_link + "_to_" + names.camera_link, names.base_link, names.camera_link, model.base_from_cam,
+               nullptr);
+  } else {
+    text.Joint(names.tip_link + "_to_" + names.camera_link, names.tip_link, names.camera_link, model.flange_from_cam,
+               nullptr);
+  }
   const std::string robot = names.robot.empty() ? model.name : names.robot;
   const std::string urdf =
       "<?xml version=\"1.0\"?>\n<!-- Written by selfcal (docs/urdf.md): modified DH + Hayati, "

@@ -1,7 +1,8 @@
 // A RobotModel (typically the calibrated one) written as a URDF (docs/urdf.md): base_link, one revolute
 // joint per model joint whose origin is that joint's calibrated RotX(alpha) TransX(a) RotY(beta)
 // RotZ(theta) TransZ(d) (axis z, the model's limits), fixed joints for base_from_link0, link_n_from_flange
-// (to `tip_link`) and flange_from_cam (to `camera_link`, the camera's optical frame); effort 0 and velocity
+// (to `tip_link`) and flange_from_cam (to `camera_link`, the camera's optical frame; in eye-to-hand base_from_cam from
+// `base_link`, the camera fixed); effort 0 and velocity
 // kDefaultJointVelocityRadPerS in every <limit>. Rotations whose
 // roll-pitch-yaw would be near gimbal lock are written through an intermediate link, so that every
 // origin is exact to rounding. The text is checked with urdfdom + KDL before it is returned.
