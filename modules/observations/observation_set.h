@@ -54,7 +54,8 @@ struct ObservationSet {
   RobotModel robot;                  // nominal model
   CameraIntrinsics camera;           // fx_px is the nominal / initial value (f_x is estimated)
   // False for a flange-pose set that gave no nominal hand-eye transform (robot.flange_from_cam is then
-  // the identity): the calibration starts it from the images and the flange motions.
+  // the identity): the calibration starts it from the images and the flange motions. In eye-to-hand
+  // (robot.mount) it says the same of the nominal fixed camera robot.base_from_cam, for every kind of set.
   bool flange_from_cam_known = true;
   // A flange-pose set's stated pose noise (std per axis of the recorded flange poses); 0: exact poses.
   double flange_translation_sigma_m = 0;
