@@ -1,5 +1,5 @@
 // Calibrate() end to end on synthetic eye-to-hand cells (test/support/eye_to_hand_world.h): a joint-angle set
-// (the start from the nominal flange poses, the bundle, the held-out test) and a flange-pose set of 5 points x 8
+// (PUMA, UR5e, Panda: the start from the nominal flange poses, the bundle, the held-out test) and a flange-pose set of 5 points x 8
 // poses like ViSP's eye-to-hand data, against the hidden truth with tolerances from the reported sigmas.
 #include <cmath>
 #include <iostream>
@@ -34,7 +34,7 @@ void ExpectWithin(const Eigen::Matrix<double, 6, 1>& error, const Eigen::Matrix<
 }
 
 TEST(EyeToHandCalibrate, JointAngleSetIsAcceptedWithTheFixedCameraAndKinematicsWithinTheirSigmas) {
-  for (const RobotModel& robot : {selfcal::testing::Puma560(), selfcal::testing::Ur5e()}) {
+  for (const RobotModel& robot : {selfcal::testing::Puma560(), selfcal::testing::Ur5e(), selfcal::testing::Panda()}) {
     EyeToHandOptions options;
     options.noise_px = 0.3;
     options.num_verification = 6;
@@ -63,7 +63,9 @@ TEST(EyeToHandCalibrate, JointAngleSetIsAcceptedWithTheFixedCameraAndKinematicsW
     // distance joins two dots of the flange's plate: the nominal model measures it about as well, from the
     // flange motions between the verification poses, so it decides nothing here.)
     ASSERT_TRUE(report.bundle->heldout.ok) << report.bundle->heldout.message;
-    EXPECT_LT(report.bundle->heldout.overall.rms_px, 0.5 * report.bundle->heldout_nominal.overall.rms_px);
+    // At the noise (0.3 px per coordinate; the prediction's own error adds a few percent), below the nominal.
+    EXPECT_LT(report.bundle->heldout.overall.rms_px, 1.2 * options.noise_px);
+    EXPECT_LT(report.bundle->heldout.overall.rms_px, report.bundle->heldout_nominal.overall.rms_px);
     EXPECT_GT(report.verification_calibrated().num_ok, 0);
     std::cout << "[ figure ] " << robot.name << " eye-to-hand Calibrate at 0.3 px: verdict "
               << VerdictName(report.verdict) << ", base_from_cam error "
