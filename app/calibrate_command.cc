@@ -211,7 +211,8 @@ Status WriteHandEye(const LoadedInput& loaded, const calibration::CalibrationRep
   result.flange_from_cam = report.model->robot.flange_from_cam;
   result.base_from_cam = report.model->robot.base_from_cam;
   result.fx_px = report.model->camera.fx_px;
-  result.stddev = report.model->flange_from_cam_stddev;
+  result.stddev = result.mount == CameraMount::kEyeToHand ? report.model->base_from_cam_stddev
+                                                          : report.model->flange_from_cam_stddev;
   result.fx_stddev_px = report.model->intrinsics_stddev[kFx];
   result.camera = report.model->camera;
   result.intrinsics_stddev = report.model->intrinsics_stddev;

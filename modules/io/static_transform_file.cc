@@ -50,7 +50,7 @@ std::string PythonQuoted(const std::string& text) {
 std::string StaticTransformYaml(const StaticTransform& transform) {
   const TransformNumbers n = NumbersOf(transform.parent_from_child);
   std::ostringstream out;
-  out << "# The calibrated flange-to-camera transform as a geometry_msgs/TransformStamped (selfcal,\n"
+  out << "# The calibrated camera transform (parent: the flange, or the base for a fixed camera) as a geometry_msgs/TransformStamped (selfcal,\n"
       << "# docs/ros-static-transform.md): translation in m, rotation a unit quaternion (x, y, z, w) of\n"
       << "# parent_from_child. The same transform on the command line:\n"
       << "#   ros2 run tf2_ros static_transform_publisher --x " << n.x << " --y " << n.y << " --z " << n.z << " --qx "
@@ -72,7 +72,7 @@ Status SaveStaticTransform(const StaticTransform& transform, const std::string& 
 std::string StaticTransformLaunchPy(const StaticTransform& transform) {
   const TransformNumbers n = NumbersOf(transform.parent_from_child);
   std::ostringstream out;
-  out << "# The calibrated flange-to-camera transform published by tf2_ros' static_transform_publisher\n"
+  out << "# The calibrated camera transform (parent: the flange, or the base for a fixed camera) published by tf2_ros' static_transform_publisher\n"
       << "# (selfcal, docs/ros-static-transform.md): the transform of camera_static_transform.yaml, translation\n"
       << "# in m, rotation the unit quaternion (x, y, z, w) of parent_from_child. Named arguments: ROS 2 Humble\n"
       << "# and later. Start it with `ros2 launch ./camera_static_transform.launch.py`.\n"

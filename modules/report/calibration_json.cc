@@ -470,7 +470,7 @@ json CalibratedCameraJson(const calibration::CalibrationReport& report, bool eye
   for (int r = 0; r < 3; ++r) rows.push_back({x.rotation(r, 0), x.rotation(r, 1), x.rotation(r, 2)});
   calibrated["rotation"] = rows;
   calibrated["stddev"] = json();
-  const Eigen::Matrix<double, 6, 1>& sd = report.model->flange_from_cam_stddev;
+  const Eigen::Matrix<double, 6, 1>& sd = eye_to_hand ? report.model->base_from_cam_stddev : report.model->flange_from_cam_stddev;
   if (sd.allFinite()) {
     calibrated["stddev"] = {{"xyz_m", {sd[0], sd[1], sd[2]}},
                             {"rotvec_rad", {sd[3], sd[4], sd[5]}},

@@ -210,7 +210,7 @@ void PrintHandEye(const calibration::CalibrationReport& report, std::ostream& ou
   const bool eye_to_hand = report.model->robot.mount == CameraMount::kEyeToHand;
   const Rigid3& x = eye_to_hand ? report.model->robot.base_from_cam : report.model->robot.flange_from_cam;
   const Eigen::Vector3d rotvec = LogSO3(x.rotation);
-  const Eigen::Matrix<double, 6, 1>& sd = report.model->flange_from_cam_stddev;
+  const Eigen::Matrix<double, 6, 1>& sd = eye_to_hand ? report.model->base_from_cam_stddev : report.model->flange_from_cam_stddev;
   out << std::fixed << std::setprecision(3) << (eye_to_hand ? "base_from_cam" : "flange_from_cam") << ": translation [" << x.translation.x() * kMm << ", "
       << x.translation.y() * kMm << ", " << x.translation.z() * kMm << "] mm, rotation vector ["
       << RadToDeg(rotvec.x()) << ", " << RadToDeg(rotvec.y()) << ", " << RadToDeg(rotvec.z()) << "] deg";

@@ -30,7 +30,9 @@ calibration::CalibrationReport ReportOf(CameraMount mount) {
   model.robot.mount = mount;
   model.robot.base_from_cam = Rigid3(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix(),
                                      Eigen::Vector3d(0.954, -0.0512, 0.4762));
-  model.flange_from_cam_stddev << 1e-3, 2e-3, 3e-3, 1e-3, 1e-3, 1e-3;
+  // Each transform's own: a writer that took the other's would show the wrong sigma.
+  (mount == CameraMount::kEyeToHand ? model.base_from_cam_stddev : model.flange_from_cam_stddev) << 1e-3, 2e-3, 3e-3,
+      1e-3, 1e-3, 1e-3;
   report.model = model;
   return report;
 }
