@@ -131,7 +131,7 @@ void TriangulateStartDots(const Eigen::VectorXd& rho_start, BundleData* data, Bu
                           std::vector<int>* dropped) {
   std::vector<Rigid3> base_from_cam;
   for (size_t p = 0; p < data->joints.size(); ++p) {
-    base_from_cam.push_back(internal::BaseFromCamOfPose(*data, static_cast<int>(p), rho_start));
+    base_from_cam.push_back(internal::PointsFromCamOfPose(*data, static_cast<int>(p), rho_start));
   }
   std::vector<identification::PointTrack> tracks(data->dot_ids.size());
   for (const internal::Observation& o : data->observations) {
@@ -185,10 +185,15 @@ bool AnalyzeStartGauge(const BundleData& data, const BundleState& state, const B
   report->held_names = gauge->held_names;
   report->null_combinations = gauge->null_combinations;
   report->condition_number = gauge->condition_number;
-  // A flange-pose set has no kinematics: what generic motions identify is the hand-eye transform.
+  // A flange-pose set has no kinematics: what generic motions identify is the hand-eye transform. Eye-to-hand
+  // the chain is seen from the other end (the camera correction absorbs the base and joint 1, the points the
+  // tail, as the points and the camera correction do eye-in-hand): the relative-pose analysis of the
+  // eye-in-hand chain counts the same rank (bundle tests compare the two for PUMA, UR5e and Panda).
+  RobotModel in_hand = data.robot;
+  in_hand.mount = CameraMount::kEyeInHand;
   report->generic_rank = !data.base_from_flange.empty()
                              ? 6
-                             : identification::GenericRank(data.robot, KinematicParameters::Nominal(data.robot),
+                             : identification::GenericRank(in_hand, KinematicParameters::Nominal(in_hand),
                                                            options.rank_tolerance);
   return true;
 }

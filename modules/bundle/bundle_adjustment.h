@@ -25,6 +25,12 @@
 //
 // with OpenCV's radial-tangential lens (intrinsics fx, mu, cx, cy, k1, k2, p1, p2, k3)
 //
+// Eye-to-hand (observations.robot.mount: a fixed camera, the dots on the flange) cam_i_from_base becomes
+// cam_i_from_flange = points_from_cam(q_i; rho)^-1 = base_from_cam(rho)^-1 * base_from_flange(q_i; rho) and the
+// dots p_j live in the flange frame (kinematics/robot_model.h, PointsFromCam; dots_in_base holds them there).
+// The gauge mirrors eye-in-hand's: the camera correction absorbs the base correction and joint 1, the points
+// the tail (j_n.theta, j_n.d), so the same selection order keeps the camera and fixes those.
+//
 // and, per yardstick (dots a, b, known length L), the length constraint
 //
 //   r_L = ( |p_a_in_base - p_b_in_base| - L ) / yardstick_sigma_m
@@ -166,7 +172,7 @@ struct BundleReport {
   // intrinsics after the names of held_parameters / free_parameters).
   IntrinsicsVector intrinsics{};
   IntrinsicsMask intrinsics_estimated{};
-  std::map<int, Eigen::Vector3d> dots_in_base;  // every dot that entered the solve
+  std::map<int, Eigen::Vector3d> dots_in_base;  // every dot that entered the solve (flange frame eye-to-hand)
   std::vector<int> free_indices;              // kinematic, in rho order
   std::vector<std::string> free_names, fixed_names;  // fixed: by the rank analysis and by request
   std::vector<std::string> held_names;        // held by request (BundleOptions::held_parameters, free_parameters)
@@ -231,6 +237,8 @@ std::vector<int> HeldParameterIndices(const BundleOptions& options, int num_join
 // The rho on `target` (same joint count) that gives the same base_from_cam(q) for every q as `source_rho`
 // on `source`: joint parameters copied, base and camera corrections re-expressed against target's
 // constant transforms (exact). E.g. the paper pipeline's metric calibrated model on the nominal model.
+// Eye-to-hand (target.mount) the camera correction is re-expressed against target's base_from_cam; a
+// different link_n_from_flange then moves the flange frame, which the points absorb.
 Eigen::VectorXd ExpressOnModel(const RobotModel& target, const RobotModel& source, const Eigen::VectorXd& source_rho);
 
 // The truth (or any point) of the bundle problem, for the bound.

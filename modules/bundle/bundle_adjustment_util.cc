@@ -152,8 +152,15 @@ Eigen::VectorXd ExpressOnModel(const RobotModel& target, const RobotModel& sourc
   // base_from_link0_t Exp(b_t) = base_from_link0_s Exp(b_s).
   as_vector(target.base_from_link0.Inverse() * source.base_from_link0 * RigidFromTranslationRotvec(source_rho.data()),
             rho.data());
-  // link_n_from_flange_t flange_from_cam_t Exp(c_t) = link_n_from_flange_s flange_from_cam_s Exp(c_s).
   const int cam = params.CamOffset();
+  if (target.mount == CameraMount::kEyeToHand) {
+    // base_from_cam_t Exp(c_t) = base_from_cam_s Exp(c_s); a change of link_n_from_flange moves the flange
+    // frame, which the points (in it) absorb.
+    as_vector(target.base_from_cam.Inverse() * source.base_from_cam * RigidFromTranslationRotvec(source_rho.data() + cam),
+              rho.data() + cam);
+    return rho;
+  }
+  // link_n_from_flange_t flange_from_cam_t Exp(c_t) = link_n_from_flange_s flange_from_cam_s Exp(c_s).
   as_vector((target.link_n_from_flange * target.flange_from_cam).Inverse() * source.link_n_from_flange *
                 source.flange_from_cam * RigidFromTranslationRotvec(source_rho.data() + cam),
             rho.data() + cam);

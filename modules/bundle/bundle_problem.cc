@@ -17,15 +17,15 @@ namespace selfcal::bundle::internal {
 namespace {
 
 template <typename T>
-Rigid3T<T> BaseFromCamOf(const BundleData& data, int pose, const T* rho, const T* q) {
-  if (!data.base_from_flange.empty()) return BaseFromCamGivenFlange<T>(data.robot, rho, data.base_from_flange[pose]);
-  return BaseFromCam<T>(data.robot, rho, q);
+Rigid3T<T> PointsFromCamOf(const BundleData& data, int pose, const T* rho, const T* q) {
+  if (!data.base_from_flange.empty()) return PointsFromCamGivenFlange<T>(data.robot, rho, data.base_from_flange[pose]);
+  return PointsFromCam<T>(data.robot, rho, q);
 }
 
 }  // namespace
 
-Rigid3 BaseFromCamOfPose(const BundleData& data, int pose, const Eigen::VectorXd& rho) {
-  return BaseFromCamOf<double>(data, pose, rho.data(), data.joints[pose].data());
+Rigid3 PointsFromCamOfPose(const BundleData& data, int pose, const Eigen::VectorXd& rho) {
+  return PointsFromCamOf<double>(data, pose, rho.data(), data.joints[pose].data());
 }
 
 namespace {
@@ -81,31 +81,58 @@ void AppendTranslation(int axis, double length, Rigid3* frame, Twist* twist) {
 }
 
 // The twist of every rho entry at one pose (zero for a link entry of a flange-pose set, which takes no
-// part), composing base_from_cam (BaseFromCam, or BaseFromCamGivenFlange for a flange-pose set) on the way.
-void CameraPoseAndTwists(const BundleData& data, int pose, const double* rho, std::vector<Twist>* twists) {
+// part), composing base_from_flange (through the joints, or base_from_link0 * Exp(base) * the recorded flange
+// pose) on the way. Returns that pose; the base and link twists are those of base_from_flange.
+Rigid3 FlangePoseAndTwists(const BundleData& data, int pose, const double* rho, std::vector<Twist>* twists) {
   const RobotModel& model = data.robot;
   twists->assign(model.num_parameters(), Twist());
   Rigid3 frame = model.base_from_link0;
   AppendCorrection(rho, &frame, twists->data());
-  if (!data.base_from_flange.empty()) {
-    frame = frame * data.base_from_flange[pose];
-  } else {
-    const Eigen::VectorXd& q = data.joints[pose];
-    for (int i = 0; i < model.num_joints(); ++i) {
-      const int o = KinematicParameters::JointOffset(i);
-      const double* p = rho + o;
-      Twist* t = twists->data() + o;
-      AppendRotation(0, p[0], &frame, &t[0]);
-      AppendTranslation(0, p[1], &frame, &t[1]);
-      AppendRotation(1, p[2], &frame, &t[2]);
-      AppendRotation(2, q[i] + p[3], &frame, &t[3]);
-      AppendTranslation(2, p[4], &frame, &t[4]);
-    }
-    frame = frame * model.link_n_from_flange;
+  if (!data.base_from_flange.empty()) return frame * data.base_from_flange[pose];
+  const Eigen::VectorXd& q = data.joints[pose];
+  for (int i = 0; i < model.num_joints(); ++i) {
+    const int o = KinematicParameters::JointOffset(i);
+    const double* p = rho + o;
+    Twist* t = twists->data() + o;
+    AppendRotation(0, p[0], &frame, &t[0]);
+    AppendTranslation(0, p[1], &frame, &t[1]);
+    AppendRotation(1, p[2], &frame, &t[2]);
+    AppendRotation(2, q[i] + p[3], &frame, &t[3]);
+    AppendTranslation(2, p[4], &frame, &t[4]);
   }
-  frame = frame * model.flange_from_cam;
+  return frame * model.link_n_from_flange;
+}
+
+// The adjoint of T^-1 for T = (R, p): Ad(omega, v) = (R^T omega, R^T (v - p x omega)).
+Twist InverseAdjoint(const Rigid3& t, const Twist& xi) {
+  Twist out;
+  out.omega = t.rotation.transpose() * xi.omega;
+  out.v = t.rotation.transpose() * (xi.v - t.translation.cross(xi.omega));
+  return out;
+}
+
+// The twist of every rho entry at one pose, for points_from_cam (R, p) in the points' frame: dR = [omega]x R,
+// dp = omega x p + v. Eye-in-hand that is base_from_cam in the base frame, the chain through the flange and
+// the camera correction. Eye-to-hand, points_from_cam = F^-1 C with F = base_from_flange and C = base_from_cam
+// * Exp(cam correction): a base or link twist xi of F gives -Ad(F^-1) xi, a camera twist xi_c of C gives
+// Ad(F^-1) xi_c (both twists in the base frame, the result in the flange frame).
+void CameraPoseAndTwists(const BundleData& data, int pose, const double* rho, std::vector<Twist>* twists) {
+  const RobotModel& model = data.robot;
+  Rigid3 frame = FlangePoseAndTwists(data, pose, rho, twists);
   const int cam = KinematicParameters(model.num_joints()).CamOffset();
-  AppendCorrection(rho + cam, &frame, twists->data() + cam);
+  if (model.mount == CameraMount::kEyeInHand) {
+    frame = frame * model.flange_from_cam;
+    AppendCorrection(rho + cam, &frame, twists->data() + cam);
+    return;
+  }
+  for (int k = 0; k < cam; ++k) {
+    const Twist t = InverseAdjoint(frame, (*twists)[k]);
+    (*twists)[k].omega = -t.omega;
+    (*twists)[k].v = -t.v;
+  }
+  Rigid3 camera = model.base_from_cam;
+  AppendCorrection(rho + cam, &camera, twists->data() + cam);
+  for (int k = cam; k < cam + 6; ++k) (*twists)[k] = InverseAdjoint(frame, (*twists)[k]);
 }
 
 }  // namespace
@@ -115,9 +142,9 @@ void ComputePoseCache(const BundleData& data, int pose, const double* rho, const
   const Eigen::VectorXd& q = data.joints[pose];
   const int m = static_cast<int>(columns.size());
   if (!derivatives || m == 0) {
-    const Rigid3 cam_from_base = BaseFromCamOf<double>(data, pose, rho, q.data()).Inverse();
-    out->rotation = cam_from_base.rotation;
-    out->translation = cam_from_base.translation;
+    const Rigid3 cam_from_points = PointsFromCamOf<double>(data, pose, rho, q.data()).Inverse();
+    out->rotation = cam_from_points.rotation;
+    out->translation = cam_from_points.translation;
     out->omega.assign(derivatives ? m : 0, Eigen::Vector3d::Zero());
     out->v.assign(derivatives ? m : 0, Eigen::Vector3d::Zero());
     return;
@@ -126,9 +153,9 @@ void ComputePoseCache(const BundleData& data, int pose, const double* rho, const
   // in another order).
   std::vector<Twist> twists;
   CameraPoseAndTwists(data, pose, rho, &twists);
-  const Rigid3 cam_from_base = BaseFromCamOf<double>(data, pose, rho, q.data()).Inverse();
-  out->rotation = cam_from_base.rotation;
-  out->translation = cam_from_base.translation;
+  const Rigid3 cam_from_points = PointsFromCamOf<double>(data, pose, rho, q.data()).Inverse();
+  out->rotation = cam_from_points.rotation;
+  out->translation = cam_from_points.translation;
   out->omega.resize(m);
   out->v.resize(m);
   for (int k = 0; k < m; ++k) {

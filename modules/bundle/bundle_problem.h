@@ -50,7 +50,7 @@ struct BundleData {
 struct BundleState {
   Eigen::VectorXd rho;
   IntrinsicsVector intrinsics{};      // every intrinsic, estimated or held
-  std::vector<Eigen::Vector3d> dots;  // by dot index, base frame
+  std::vector<Eigen::Vector3d> dots;  // by dot index, the points' frame (base eye-in-hand, flange eye-to-hand)
 };
 
 struct GlobalColumns {
@@ -59,15 +59,16 @@ struct GlobalColumns {
   int size() const { return static_cast<int>(kinematic.size() + intrinsics.size()); }
 };
 
-// cam_from_base = (R, t) of one pose (BaseFromCam, or BaseFromCamGivenFlange for a flange-pose set) and
-// its derivative with respect to rho[columns[c]] as the spatial twist (omega[c], v[c]) of the camera in the
-// base frame: d R = -R [omega]x, d t = -R v.
+// cam_from_points = (R, t) of one pose (PointsFromCam, or PointsFromCamGivenFlange for a flange-pose set:
+// the points' frame is the base eye-in-hand, the flange eye-to-hand) and its derivative with respect to
+// rho[columns[c]] as the spatial twist (omega[c], v[c]) of the camera in the points' frame: d R = -R [omega]x,
+// d t = -R v.
 struct PoseCache {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3d> omega, v;
 };
-Rigid3 BaseFromCamOfPose(const BundleData& data, int pose, const Eigen::VectorXd& rho);
+Rigid3 PointsFromCamOfPose(const BundleData& data, int pose, const Eigen::VectorXd& rho);
 void ComputePoseCache(const BundleData& data, int pose, const double* rho, const std::vector<int>& columns,
                       bool derivatives, PoseCache* out);
 

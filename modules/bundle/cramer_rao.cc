@@ -18,8 +18,9 @@ namespace selfcal::bundle {
 
 namespace {
 
-// Derivative of cam_ref_from_cam_v with respect to the free entries of rho: rows 0-2 the small-angle
-// rotation vector (in the cam_v frame, R0^T dR), rows 3-5 the translation (m).
+// Derivative of cam_ref_from_cam_v (the cameras relative to the points: PointsFromCam, eye-to-hand the
+// flange's motion seen from the fixed camera) with respect to the free entries of rho: rows 0-2 the
+// small-angle rotation vector (in the cam_v frame, R0^T dR), rows 3-5 the translation (m).
 Eigen::MatrixXd RelativePoseJacobian(const RobotModel& robot, const Eigen::VectorXd& rho, const std::vector<int>& free,
                                      const Eigen::VectorXd& q_ref, const Eigen::VectorXd& q_v) {
   Eigen::VectorXd x(free.size());
@@ -31,7 +32,7 @@ Eigen::MatrixXd RelativePoseJacobian(const RobotModel& robot, const Eigen::Vecto
     for (size_t k = 0; k < free.size(); ++k) r[free[k]] = values[k];
     for (int j = 0; j < q_ref.size(); ++j) qr[j] = T(q_ref[j]);
     for (int j = 0; j < q_v.size(); ++j) qv[j] = T(q_v[j]);
-    const Rigid3T<T> rel = BaseFromCam<T>(robot, r.data(), qr.data()).Inverse() * BaseFromCam<T>(robot, r.data(), qv.data());
+    const Rigid3T<T> rel = PointsFromCam<T>(robot, r.data(), qr.data()).Inverse() * PointsFromCam<T>(robot, r.data(), qv.data());
     for (int e = 0; e < 9; ++e) out[e] = rel.rotation(e % 3, e / 3);
     for (int e = 0; e < 3; ++e) out[9 + e] = rel.translation[e];
   };

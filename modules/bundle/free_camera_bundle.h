@@ -37,7 +37,7 @@ struct FreeCameraReport {
   bool ok = false;
   std::string message;
   std::vector<int> poses;              // indices into observations.poses, in order
-  std::vector<Rigid3> base_from_cam;   // per entry of poses, in the start's frame and scale
+  std::vector<Rigid3> base_from_cam;   // per entry of poses, in the start's frame and scale (the dots' frame: PointsFromCam)
   IntrinsicsVector intrinsics{};       // every intrinsic, held ones at the start
   int num_observations = 0, num_removed = 0;
   double rms_reprojection_px = 0;

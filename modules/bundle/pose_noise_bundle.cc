@@ -13,18 +13,23 @@ namespace selfcal::bundle {
 
 namespace {
 
+// x0 is the hand-eye transform: flange_from_cam (eye-in-hand: the points in the base frame) or base_from_cam
+// (eye_to_hand: the points in the flange frame, points_from_cam = (base_from_flange Exp(delta))^-1 x0 Exp(c)).
 struct Reprojection {
-  Reprojection(const Rigid3* base_from_flange, const Rigid3* x0, Eigen::Vector2d pixel, double sigma)
-      : base_from_flange(base_from_flange), x0(x0), pixel(std::move(pixel)), inv_sigma(1.0 / sigma) {}
+  Reprojection(const Rigid3* base_from_flange, const Rigid3* x0, bool eye_to_hand, Eigen::Vector2d pixel, double sigma)
+      : base_from_flange(base_from_flange), x0(x0), eye_to_hand(eye_to_hand), pixel(std::move(pixel)),
+        inv_sigma(1.0 / sigma) {}
   template <typename T>
   bool operator()(const T* delta, const T* c, const T* dot, const T* intrinsics, T* residual) const {
-    const Rigid3T<T> base_from_cam = base_from_flange->Cast<T>() * RigidFromTranslationRotvec(delta) *
-                                     x0->Cast<T>() * RigidFromTranslationRotvec(c);
-    const Vec3T<T> in_cam = base_from_cam.Inverse() * Vec3T<T>(dot[0], dot[1], dot[2]);
+    const Rigid3T<T> flange = base_from_flange->Cast<T>() * RigidFromTranslationRotvec(delta);
+    const Rigid3T<T> hand_eye = x0->Cast<T>() * RigidFromTranslationRotvec(c);
+    const Rigid3T<T> points_from_cam = eye_to_hand ? flange.Inverse() * hand_eye : flange * hand_eye;
+    const Vec3T<T> in_cam = points_from_cam.Inverse() * Vec3T<T>(dot[0], dot[1], dot[2]);
     return internal::WhitenedReprojection<T>(intrinsics, in_cam, pixel, inv_sigma, residual);
   }
   const Rigid3* base_from_flange;
   const Rigid3* x0;
+  bool eye_to_hand;
   Eigen::Vector2d pixel;
   double inv_sigma;
 };
@@ -94,6 +99,7 @@ PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
     report.message = "needs a flange-pose set and a positive pose noise";
     return report;
   }
+  const bool eye_to_hand = obs.robot.mount == CameraMount::kEyeToHand;
   const std::vector<int> poses = obs.PosesWithRole(PoseRole::kIdentification);
   std::vector<Rigid3> flanges;
   std::vector<Obs> all;
@@ -126,7 +132,7 @@ PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
     for (size_t k = 0; k < all.size(); ++k) {
       if (!keep[k] || !dots.count(all[k].dot)) continue;
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Reprojection, 2, 6, 6, 3, kNumIntrinsics>(
-                                   new Reprojection(&flanges[all[k].pose], &x0, all[k].pixel, sigma)),
+                                   new Reprojection(&flanges[all[k].pose], &x0, eye_to_hand, all[k].pixel, sigma)),
                                round == 0 ? new ceres::LossFunctionWrapper(&huber, ceres::DO_NOT_TAKE_OWNERSHIP) : nullptr,
                                deltas[all[k].pose].data(), c.data(), dots[all[k].dot].data(), intrinsics.data());
     }
@@ -147,7 +153,7 @@ PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
     for (const Obs& o : all) {
       double r[2] = {NAN, NAN};
       if (dots.count(o.dot)) {
-        Reprojection f(&flanges[o.pose], &x0, o.pixel, 1.0);
+        Reprojection f(&flanges[o.pose], &x0, eye_to_hand, o.pixel, 1.0);
         if (!f(deltas[o.pose].data(), c.data(), dots[o.dot].data(), intrinsics.data(), r)) r[0] = NAN;
       }
       errors.push_back(std::hypot(r[0], r[1]));
@@ -179,7 +185,7 @@ PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
   for (const KnownDistance& y : lengths) {
     report.yardstick_lengths_m.push_back((dots[y.dot_a] - dots[y.dot_b]).norm());
   }
-  report.flange_from_cam = x0 * RigidFromTranslationRotvec(c.data());
+  (eye_to_hand ? report.base_from_cam : report.flange_from_cam) = x0 * RigidFromTranslationRotvec(c.data());
   report.intrinsics = intrinsics;
   for (const auto& delta : deltas) {
     report.correction_translation_m.push_back(Eigen::Vector3d(delta[0], delta[1], delta[2]).norm());

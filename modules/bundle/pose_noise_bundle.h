@@ -3,6 +3,9 @@
 //
 //   base_from_cam_i = base_from_flange_i * Exp(delta_i) * flange_from_cam,   delta_i ~ N(0, diag(s_t, s_r)),
 //
+// (eye-to-hand, observations.robot.mount: the fixed camera base_from_cam is the hand-eye transform and the
+// points live in the flange frame, points_from_cam_i = (base_from_flange_i * Exp(delta_i))^-1 * base_from_cam)
+//
 // and the hand-eye transform, the intrinsics asked for (f_x by default), the dots and every delta_i are
 // estimated together
 // (autodiff, Huber while outliers are screened at 4 robust sigmas, then plain least squares). Started
@@ -38,10 +41,13 @@ struct PoseNoiseOptions {
 struct PoseNoiseReport {
   bool ok = false;
   std::string message;
+  // The hand-eye transform: flange_from_cam (eye-in-hand), or the fixed camera base_from_cam (eye-to-hand;
+  // flange_from_cam is then the identity).
   Rigid3 flange_from_cam;
+  Rigid3 base_from_cam;
   IntrinsicsVector intrinsics{};  // every intrinsic, held ones at the start
-  // Standard deviations of a correction flange_from_cam * Exp(c) (translation m, rotation vector rad,
-  // camera frame) and of the intrinsics, scaled by the residual variance; NaN when unavailable or held.
+  // Standard deviations of a correction hand_eye * Exp(c) (translation m, rotation vector rad, camera
+  // frame) and of the intrinsics, scaled by the residual variance; NaN when unavailable or held.
   Eigen::Matrix<double, 6, 1> stddev = Eigen::Matrix<double, 6, 1>::Constant(NAN);
   IntrinsicsVector intrinsics_stddev = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
   std::vector<std::string> pose_ids;                  // identification poses, in order
@@ -52,8 +58,8 @@ struct PoseNoiseReport {
   double rms_reprojection_px = 0;
 };
 
-// The intrinsics start at observations.camera's.
-PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& observations, const Rigid3& flange_from_cam_start,
+// The intrinsics start at observations.camera's; hand_eye_start: flange_from_cam, or base_from_cam eye-to-hand.
+PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& observations, const Rigid3& hand_eye_start,
                                    const std::map<int, Eigen::Vector3d>& dots_start, const PoseNoiseOptions& options);
 
 }  // namespace selfcal::bundle

@@ -77,7 +77,11 @@ ObservationSet PrepareFlangePoseSet(const ObservationSet& observations, const Ca
   start_options.two_view.seed = options.paper.two_view.seed;
   report->hand_eye_start = StartHandEye(observations, start_options);
   if (!observations.flange_from_cam_known && report->hand_eye_start->ok) {
-    prepared.robot.flange_from_cam = report->hand_eye_start->flange_from_cam;
+    if (observations.robot.mount == CameraMount::kEyeToHand) {
+      prepared.robot.base_from_cam = report->hand_eye_start->base_from_cam;
+    } else {
+      prepared.robot.flange_from_cam = report->hand_eye_start->flange_from_cam;
+    }
     // A held f_x is the stated one (a camera file's, to the bit), in this bundle and every solve after it.
     if (bundle::EstimatedIntrinsicsOf(options.bundle.bundle, prepared.robot.num_joints())[kFx]) {
       prepared.camera.fx_px = report->hand_eye_start->fx_px;
@@ -114,12 +118,15 @@ void CheckFlangePoses(const ObservationSet& observations, const ObservationSet& 
                       CalibrationReport* report) {
   const BundleStageReport& stage = *report->bundle;
   const bundle::BundleReport& b = stage.bundle;
-  if (!stage.calibrated_robot.flange_from_cam.rotation.allFinite() || b.dots_in_base.empty()) return;
+  // The hand-eye transform: flange_from_cam, or the fixed camera base_from_cam eye-to-hand.
+  const Rigid3& hand_eye = stage.calibrated_robot.mount == CameraMount::kEyeToHand ? stage.calibrated_robot.base_from_cam
+                                                                                  : stage.calibrated_robot.flange_from_cam;
+  if (!hand_eye.rotation.allFinite() || b.dots_in_base.empty()) return;
   ObservationSet calibrated = prepared;
   calibrated.camera = stage.calibrated_camera;
   bundle::FreeCameraOptions check_options = options.motion_check;
   check_options.intrinsics = b.intrinsics_estimated;
-  report->motion_check = CheckImageMotions(calibrated, stage.calibrated_robot.flange_from_cam, b.dots_in_base, check_options);
+  report->motion_check = CheckImageMotions(calibrated, hand_eye, b.dots_in_base, check_options);
   bundle::PoseNoiseOptions noise;
   if (!FlangePoseNoiseOf(observations, b, &noise.translation_sigma_m, &noise.rotation_sigma_rad,
                          &report->pose_noise_estimated)) {
@@ -131,7 +138,7 @@ void CheckFlangePoses(const ObservationSet& observations, const ObservationSet& 
     calibrated.yardsticks = observations.yardsticks;
     calibrated.check_distances = observations.check_distances;
   }
-  report->pose_noise = bundle::RunPoseNoiseBundle(calibrated, stage.calibrated_robot.flange_from_cam, b.dots_in_base, noise);
+  report->pose_noise = bundle::RunPoseNoiseBundle(calibrated, hand_eye, b.dots_in_base, noise);
   report->pose_noise_translation_m = noise.translation_sigma_m;
   report->pose_noise_rotation_rad = noise.rotation_sigma_rad;
   report->flange_scale_yardsticks = static_cast<int>(report->pose_noise->yardstick_lengths_m.size());
@@ -211,14 +218,66 @@ void CheckAcceptance(const ObservationSet& obs, const ObservationSet& original, 
   for (const std::string& reason : report->acceptance.Reasons()) report->message += "; " + reason;
 }
 
+// The chosen method's model of a report whose verdict gives one: the bundle's (with the pose-noise bundle's
+// hand-eye transform and camera when it ran) or the paper pipeline's. `obs`: the set the bundle solved.
+CalibratedModel ModelOf(const CalibrationReport& report, const ObservationSet& obs, const CameraIntrinsics& observed) {
+  const bool flange_poses = obs.UsesFlangePoses();
+  const bool eye_to_hand = obs.robot.mount == CameraMount::kEyeToHand;
+  CalibratedModel model;
+  if (report.bundle) {
+    const bundle::BundleReport& b = report.bundle->bundle;
+    model.robot = report.bundle->calibrated_robot;
+    model.camera = report.bundle->calibrated_camera;
+    model.intrinsics_estimated = b.intrinsics_estimated;
+    if (b.covariance_available) model.intrinsics_stddev = b.intrinsics_stddev;
+    model.parameters = b.rho;
+    model.method_description = flange_poses ? "hand-eye bundle adjustment on recorded flange poses"
+                                            : "kinematic bundle adjustment";
+    if (eye_to_hand) model.method_description += " (eye-to-hand: a fixed camera, the points on the flange)";
+    const int cam = KinematicParameters(obs.robot.num_joints()).CamOffset();
+    if (eye_to_hand && b.covariance_available && b.stddev.size() >= cam + 6) {
+      model.base_from_cam_stddev = b.stddev.segment<6>(cam);
+    } else if (flange_poses && b.covariance_available && b.stddev.size() >= cam + 6) {
+      model.flange_from_cam_stddev = b.stddev.segment<6>(cam);
+    }
+  } else {
+    model.robot = report.paper.calibrated_robot;
+    model.camera = observed;
+    model.camera.fx_px = report.paper.fx_px;
+    model.intrinsics_estimated = kFocalLengthOnly;
+    model.method_description = "paper pipeline";
+  }
+  if (report.pose_noise && report.pose_noise->ok) {
+    if (eye_to_hand) {
+      model.robot.base_from_cam = report.pose_noise->base_from_cam;
+      model.base_from_cam_stddev = report.pose_noise->stddev;
+    } else {
+      model.robot.flange_from_cam = report.pose_noise->flange_from_cam;
+      model.flange_from_cam_stddev = report.pose_noise->stddev;
+    }
+    model.camera = WithIntrinsics(model.camera, report.pose_noise->intrinsics);
+    model.intrinsics_stddev = report.pose_noise->intrinsics_stddev;
+    model.method_description += report.pose_noise_estimated ? ", flange poses with their noise estimated from the residuals"
+                                                            : ", flange poses with their stated noise";
+  }
+  return model;
+}
+
 // Calibrate without its total time.
 CalibrationReport CalibrateSteps(const ObservationSet& observations, const CalibrateOptions& options) {
   CalibrationReport report;
   report.method = options.method;
   const bool flange_poses = observations.UsesFlangePoses();
+  const bool eye_to_hand = observations.robot.mount == CameraMount::kEyeToHand;
   if (flange_poses && options.method == Method::kPaper) {
     report.verdict = Verdict::kInvalidInput;
     report.message = "the paper's method needs joint angles; these poses are flange poses (use the bundle method)";
+    return report;
+  }
+  if (eye_to_hand && options.method == Method::kPaper) {
+    report.verdict = Verdict::kInvalidInput;
+    report.message = "the paper's method needs a camera on the flange; this camera is fixed (eye_to_hand: use the "
+                     "bundle method)";
     return report;
   }
   // Flange poses: the start from the images, the bundle, its checks, the acceptance; joints: the paper's
@@ -287,36 +346,7 @@ CalibrationReport CalibrateSteps(const ObservationSet& observations, const Calib
   }
   progress.Advance();
   if (!report.has_model_verdict()) return report;  // no model for a result that is not to be applied
-  CalibratedModel model;
-  if (report.bundle) {
-    const bundle::BundleReport& b = report.bundle->bundle;
-    model.robot = report.bundle->calibrated_robot;
-    model.camera = report.bundle->calibrated_camera;
-    model.intrinsics_estimated = b.intrinsics_estimated;
-    if (b.covariance_available) model.intrinsics_stddev = b.intrinsics_stddev;
-    model.parameters = b.rho;
-    model.method_description = flange_poses ? "hand-eye bundle adjustment on recorded flange poses"
-                                            : "kinematic bundle adjustment";
-    const int cam = KinematicParameters(0).CamOffset();
-    if (flange_poses && b.covariance_available && b.stddev.size() >= cam + 6) {
-      model.flange_from_cam_stddev = b.stddev.segment<6>(cam);
-    }
-  } else {
-    model.robot = report.paper.calibrated_robot;
-    model.camera = observations.camera;
-    model.camera.fx_px = report.paper.fx_px;
-    model.intrinsics_estimated = kFocalLengthOnly;
-    model.method_description = "paper pipeline";
-  }
-  if (report.pose_noise && report.pose_noise->ok) {
-    model.robot.flange_from_cam = report.pose_noise->flange_from_cam;
-    model.camera = WithIntrinsics(model.camera, report.pose_noise->intrinsics);
-    model.flange_from_cam_stddev = report.pose_noise->stddev;
-    model.intrinsics_stddev = report.pose_noise->intrinsics_stddev;
-    model.method_description += report.pose_noise_estimated ? ", flange poses with their noise estimated from the residuals"
-                                                            : ", flange poses with their stated noise";
-  }
-  report.model = std::move(model);
+  report.model = ModelOf(report, obs, observations.camera);
   return report;
 }
 

@@ -117,6 +117,10 @@ struct CalibratedModel {
   // rotation vector rad, camera frame), from the solve that gave robot.flange_from_cam and the camera
   // (the pose-noise bundle when it ran, else the exact-pose bundle); NaN when unavailable.
   Eigen::Matrix<double, 6, 1> flange_from_cam_stddev = Eigen::Matrix<double, 6, 1>::Constant(NAN);
+  // Eye-to-hand (robot.mount; robot.base_from_cam the calibrated fixed camera): the standard deviations of a
+  // correction base_from_cam * Exp(c) (translation m, rotation vector rad, camera frame), joint-angle and
+  // flange-pose sets alike, from the same solve; flange_from_cam_stddev then stays NaN.
+  Eigen::Matrix<double, 6, 1> base_from_cam_stddev = Eigen::Matrix<double, 6, 1>::Constant(NAN);
 };
 
 struct CalibrationReport {

@@ -21,7 +21,7 @@ FitGeometry FitGeometryOf(const ObservationSet& obs, const bundle::BundleReport&
   std::set<std::pair<std::string, int>> removed;
   for (const bundle::RemovedObservation& o : b.removed) removed.insert({o.pose_id, o.dot_id});
   for (const PoseObservation& pose : obs.poses) {
-    const Rigid3 base_from_cam = BaseFromCamAt(obs.robot, b.rho, pose);
+    const Rigid3 base_from_cam = PointsFromCamAt(obs.robot, b.rho, pose);
     geometry.camera_poses.push_back({pose.id, pose.role, base_from_cam});
     if (pose.role != PoseRole::kIdentification) continue;
     const Rigid3 cam_from_base = base_from_cam.Inverse();

@@ -127,7 +127,12 @@ void SolvePlane(const ObservationSet& obs, const HandEyeStartOptions& options, H
     views.push_back(obs.poses[poses[k]].dots_px);
     if (views[k].size() > views[reference].size()) reference = static_cast<int>(k);
   }
-  report->plane = twoview::SolvePlanarViews(obs.camera, views, reference, options.plane);
+  // A single tag (4-5 points, e.g. an AprilTag's corners and centre) has fewer dots than the plane asks of a
+  // view by default (room for outliers): then every view must show the reference's dots, all of them.
+  twoview::PlanarViewsOptions plane = options.plane;
+  const int most = static_cast<int>(views[reference].size());
+  if (most < plane.min_points && most >= 4) plane.min_points = most;
+  report->plane = twoview::SolvePlanarViews(obs.camera, views, reference, plane);
   report->plane_reference = obs.poses[poses[reference]].id;
   if (report->plane->ok && report->plane->median_transfer_rms_px > options.max_plane_transfer_px) {
     report->plane->ok = false;
@@ -166,6 +171,7 @@ HandEyeStartReport StartHandEye(const ObservationSet& obs, const HandEyeStartOpt
     report.message = "the hand-eye start needs a flange pose in every pose";
     return report;
   }
+  const bool eye_to_hand = obs.robot.mount == CameraMount::kEyeToHand;
   std::vector<PairMotion> motions;
   std::vector<double> focal;
   std::map<int, int> view_of;
@@ -181,7 +187,10 @@ HandEyeStartReport StartHandEye(const ObservationSet& obs, const HandEyeStartOpt
     pair.pose_a = pi.id;
     pair.pose_b = pj.id;
     PairMotion pm;
-    pm.flange = pi.base_from_flange->Inverse() * *pj.base_from_flange;
+    // Eye-to-hand the camera moves against the flange's points as flange_from_base does against the base:
+    // A = (flange_from_base_i)^-1 * flange_from_base_j.
+    pm.flange = eye_to_hand ? *pi.base_from_flange * pj.base_from_flange->Inverse()
+                            : pi.base_from_flange->Inverse() * *pj.base_from_flange;
     pair.flange_angle_rad = RotationAngle(pm.flange.rotation);
     const Matches matches = MatchById(pi, pj);
     if (PlanarPair(report, view_of, i, j, options, &pair, &pm)) {
@@ -248,7 +257,7 @@ HandEyeStartReport StartHandEye(const ObservationSet& obs, const HandEyeStartOpt
     report.fx_px = focal[focal.size() / 2];
     report.fx_from_images = true;
   }
-  report.flange_from_cam = Rigid3(r_x, t_x);
+  (eye_to_hand ? report.base_from_cam : report.flange_from_cam) = Rigid3(r_x, t_x);
   report.ok = true;
   std::ostringstream msg;
   msg << "hand-eye start from " << report.rotation_pairs << " rotation and " << report.translation_pairs
@@ -281,7 +290,8 @@ HandEyeStartReport StartCameraFromImages(const ObservationSet& observations, con
   }
   HandEyeStartReport report = StartHandEye(flange, options);
   if (!report.ok) return report;
-  const Rigid3 correction = robot.flange_from_cam.Inverse() * report.flange_from_cam;
+  const Rigid3 correction = robot.mount == CameraMount::kEyeToHand ? robot.base_from_cam.Inverse() * report.base_from_cam
+                                                                   : robot.flange_from_cam.Inverse() * report.flange_from_cam;
   const int cam = KinematicParameters(robot.num_joints()).CamOffset();
   rho->segment<3>(cam) = correction.translation;
   rho->segment<3>(cam + 3) = LogSO3(correction.rotation);

@@ -21,6 +21,11 @@
 // even where a two-view estimate would call it ambiguous. A pair falls back to its two-view estimate
 // when the plane's motion does not turn by the flange's angle.
 //
+// Eye-to-hand (observations.robot.mount: a fixed camera, the dots on the flange) the roles swap: the camera
+// moves against the flange's dots as flange_from_base moves against the base, so A = base_from_flange_i *
+// base_from_flange_j^-1 (flange_from_base_i plays the flange pose), B is the same two-view motion, and
+// X = base_from_cam, the fixed camera; everything else as above.
+//
 // Works on an ObservationSet only (its poses' base_from_flange); no files, no hardware.
 #pragma once
 
@@ -48,7 +53,8 @@ struct HandEyePair {
 struct HandEyeStartReport {
   bool ok = false;
   std::string message;
-  Rigid3 flange_from_cam;
+  Rigid3 flange_from_cam;  // eye-in-hand: the hand-eye transform X
+  Rigid3 base_from_cam;    // eye-to-hand: X, the fixed camera (flange_from_cam then the identity)
   double fx_px = 0;
   bool fx_from_images = false;
   int rotation_pairs = 0, translation_pairs = 0;
@@ -75,7 +81,8 @@ HandEyeStartReport StartHandEye(const ObservationSet& observations, const HandEy
 
 // A joint-angle set's camera start from its images: the flange poses of the nominal kinematics at the
 // recorded joints stand in for recorded flange poses (StartHandEye), and the hand-eye transform found becomes
-// the camera correction of `rho` (robot.flange_from_cam times the correction), so that a wrong or absent
+// the camera correction of `rho` (robot.flange_from_cam, eye-to-hand robot.base_from_cam, times the
+// correction; the nominal flange poses of an eye-to-hand set give the fixed camera), so that a wrong or absent
 // camera mount in the robot description does not decide which minimum the bundle reaches. `rho` is left
 // as it is when the start fails (report.ok false, with the reason).
 HandEyeStartReport StartCameraFromImages(const ObservationSet& observations, const HandEyeStartOptions& options,

@@ -39,14 +39,14 @@ class Projector {
 
   PoseFrames Frames(const PoseObservation& q) const {
     PoseFrames f;
-    f.cam_from_base = BaseFromCamAt(model_.robot, model_.rho, q).Inverse();
+    f.cam_from_base = PointsFromCamAt(model_.robot, model_.rho, q).Inverse();
     if (!with_parameters_) return f;
     for (int index : model_.free_indices) {
       Eigen::VectorXd rho = model_.rho;
       rho[index] += kStepRho;
-      f.plus.push_back(BaseFromCamAt(model_.robot, rho, q).Inverse());
+      f.plus.push_back(PointsFromCamAt(model_.robot, rho, q).Inverse());
       rho[index] -= 2 * kStepRho;
-      f.minus.push_back(BaseFromCamAt(model_.robot, rho, q).Inverse());
+      f.minus.push_back(PointsFromCamAt(model_.robot, rho, q).Inverse());
     }
     return f;
   }
@@ -379,7 +379,7 @@ std::map<int, Eigen::Vector3d> TriangulateIdentificationDots(const ObservationSe
   std::map<int, identification::PointTrack> tracks;
   for (int i : obs.PosesWithRole(PoseRole::kIdentification)) {
     const PoseObservation& pose = obs.poses[i];
-    const Rigid3 base_from_cam = BaseFromCamAt(model.robot, model.rho, pose);
+    const Rigid3 base_from_cam = PointsFromCamAt(model.robot, model.rho, pose);
     for (const auto& [id, pixel] : pose.dots_px) {
       tracks[id].base_from_cam.push_back(base_from_cam);
       tracks[id].pixels.push_back(pixel);

@@ -44,15 +44,19 @@ std::vector<ImageCameraPose> CompareWithModel(const std::vector<std::string>& id
 
 }  // namespace
 
-MotionCheck CheckImageMotions(const ObservationSet& obs, const Rigid3& flange_from_cam,
+MotionCheck CheckImageMotions(const ObservationSet& obs, const Rigid3& hand_eye,
                               const std::map<int, Eigen::Vector3d>& dots_in_base, const bundle::FreeCameraOptions& options) {
+  const bool eye_to_hand = obs.robot.mount == CameraMount::kEyeToHand;
   MotionCheck check;
   if (!obs.UsesFlangePoses()) {
     check.message = "needs a flange pose in every pose";
     return check;
   }
   std::vector<Rigid3> start;
-  for (const PoseObservation& pose : obs.poses) start.push_back(*pose.base_from_flange * flange_from_cam);
+  // The camera in the dots' frame: base_from_flange * flange_from_cam, or flange_from_base * base_from_cam.
+  for (const PoseObservation& pose : obs.poses) {
+    start.push_back(eye_to_hand ? pose.base_from_flange->Inverse() * hand_eye : *pose.base_from_flange * hand_eye);
+  }
   check.images = bundle::RunFreeCameraBundle(obs, start, std::vector<bool>(obs.poses.size(), true), dots_in_base, options);
   if (!check.images.ok) {
     check.message = "the free-camera bundle did not solve: " + check.images.message;

@@ -49,8 +49,10 @@ struct MotionCheck {
 
 // Every pose of the flange-pose set `obs` (identification and verification), started at
 // base_from_flange * flange_from_cam with the dots given and the intrinsics of obs.camera (e.g. the
-// hand-eye bundle's dots and calibrated camera).
-MotionCheck CheckImageMotions(const ObservationSet& obs, const Rigid3& flange_from_cam,
+// hand-eye bundle's dots and calibrated camera). Eye-to-hand (obs.robot.mount) hand_eye is the fixed camera
+// base_from_cam, the start base_from_flange^-1 * base_from_cam and the cameras are in the flange frame (the
+// dots' frame); the angle of a camera motion is still the flange motion's.
+MotionCheck CheckImageMotions(const ObservationSet& obs, const Rigid3& hand_eye,
                               const std::map<int, Eigen::Vector3d>& dots_in_base, const bundle::FreeCameraOptions& options);
 
 }  // namespace selfcal::calibration

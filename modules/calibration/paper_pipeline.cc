@@ -35,7 +35,7 @@ std::vector<identification::YardstickView> YardstickViews(const ObservationSet& 
     v.length_m = y.length_m;
     for (int p : poses) {
       const PoseObservation& pose = obs.poses[p];
-      const Rigid3 base_from_cam = BaseFromCamAt(robot, rho, pose);
+      const Rigid3 base_from_cam = PointsFromCamAt(robot, rho, pose);
       auto a = pose.dots_px.find(y.dot_a);
       auto b = pose.dots_px.find(y.dot_b);
       if (a != pose.dots_px.end()) {
@@ -59,7 +59,7 @@ VerificationSummary VerifyDistances(const ObservationSet& obs, const std::vector
                                     const std::vector<KnownDistance>& distances) {
   VerificationSummary summary;
   std::vector<Rigid3> cams;
-  for (int p : pose_indices) cams.push_back(BaseFromCamAt(robot, rho, obs.poses[p]));
+  for (int p : pose_indices) cams.push_back(PointsFromCamAt(robot, rho, obs.poses[p]));
   auto triangulate = [&](int dot) {
     identification::PointTrack track;
     for (size_t k = 0; k < pose_indices.size(); ++k) {
@@ -290,6 +290,12 @@ PaperPipelineReport RunPaperPipeline(const ObservationSet& obs, const PaperPipel
   if (!problems.empty()) {
     report.outcome = Outcome::kInvalidInput;
     report.message = "invalid input:\n" + problems;
+    return report;
+  }
+  if (obs.robot.mount == CameraMount::kEyeToHand) {
+    // Its steps 3-4 fit the camera motions through the arm to the camera (identification/): eye-in-hand.
+    report.outcome = Outcome::kNotRun;
+    report.message = kPaperNotEyeToHand;
     return report;
   }
   const std::vector<int> id_poses = obs.PosesWithRole(PoseRole::kIdentification);

@@ -94,6 +94,12 @@ struct PaperPipelineReport {
   double seconds_two_view = 0, seconds_identification = 0, seconds_total = 0;
 };
 
+// An eye-to-hand set (observations.robot.mount) is not run (kNotRun, kPaperNotEyeToHand): the paper's steps
+// 3-4 fit camera motions through the arm to a camera on the flange. Calibrate starts the bundle of such a
+// set from the nominal model with the fixed camera from the images (bundle_stage.h).
+inline constexpr const char* kPaperNotEyeToHand =
+    "not run: the paper's method fits the camera's motions through the arm to a camera on the flange (eye-in-hand); "
+    "eye-to-hand starts from the nominal model with the fixed camera from the images";
 PaperPipelineReport RunPaperPipeline(const ObservationSet& observations, const PaperPipelineOptions& options);
 
 // Triangulates the ends of each known distance from the given poses with a model and f_x.

@@ -35,11 +35,11 @@ std::vector<ViewModel> Views(const ObservationSet& obs, const std::vector<int>& 
       for (int t = 0; t < nf; ++t) r[free_indices[t]] = free[t];
       Rigid3T<T> c;
       if (pose.base_from_flange) {
-        c = BaseFromCamGivenFlange<T>(robot, r.data(), *pose.base_from_flange);
+        c = PointsFromCamGivenFlange<T>(robot, r.data(), *pose.base_from_flange);
       } else {
         std::vector<T> q(pose.joints_rad.size());
         for (size_t j = 0; j < q.size(); ++j) q[j] = T(pose.joints_rad[j]);
-        c = BaseFromCam<T>(robot, r.data(), q.data());
+        c = PointsFromCam<T>(robot, r.data(), q.data());
       }
       for (int a = 0; a < 3; ++a) {
         for (int b = 0; b < 3; ++b) y[3 * a + b] = c.rotation(a, b);
@@ -47,7 +47,7 @@ std::vector<ViewModel> Views(const ObservationSet& obs, const std::vector<int>& 
       }
     };
     ViewModel v;
-    v.base_from_cam = BaseFromCamAt(robot, rho, pose);  // the same bits as the triangulation has always used
+    v.base_from_cam = PointsFromCamAt(robot, rho, pose);  // the same bits as the triangulation has always used
     v.d_pose = AutodiffJacobian<8>(f, x, 12);
     views.push_back(std::move(v));
   }

@@ -40,6 +40,11 @@ Rigid3 BaseFromCamAt(const RobotModel& robot, const Eigen::VectorXd& rho, const 
   return BaseFromCam(robot, rho, pose.joints_rad);
 }
 
+Rigid3 PointsFromCamAt(const RobotModel& robot, const Eigen::VectorXd& rho, const PoseObservation& pose) {
+  if (pose.base_from_flange) return PointsFromCamGivenFlange<double>(robot, rho.data(), *pose.base_from_flange);
+  return PointsFromCam(robot, rho, pose.joints_rad);
+}
+
 std::string ObservationSet::Validate() const {
   std::ostringstream out;
   bool any_flange_pose = false;

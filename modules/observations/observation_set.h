@@ -1,4 +1,4 @@
-// Module observations (ARCHITECTURE.md): ObservationSet (this header; UsesFlangePoses, BaseFromCamAt) and
+// Module observations (ARCHITECTURE.md): ObservationSet (this header; UsesFlangePoses, PointsFromCamAt) and
 // known distances; pool_recordings.h: several recordings of one arm pooled, each a scene of its own;
 // joint_limits.h: the poses whose recorded joints lie outside the limits, named (kept: the controller's
 // reading). Uses kinematics, camera.
@@ -82,6 +82,10 @@ RobotModel FlangePoseModel(const Rigid3& flange_from_cam);
 // The camera of `pose` in the base frame of `robot` with parameters rho: through the joints, or, for a
 // flange-pose set, through the recorded flange pose (kinematics/robot_model.h, BaseFromCamGivenFlange).
 Rigid3 BaseFromCamAt(const RobotModel& robot, const Eigen::VectorXd& rho, const PoseObservation& pose);
+// The camera of `pose` in the frame of the unknown points (kinematics/robot_model.h, PointsFromCam and
+// PointsFromCamGivenFlange): BaseFromCamAt eye-in-hand, the flange from the fixed camera eye-to-hand. Every
+// projection or triangulation of the dots goes through it.
+Rigid3 PointsFromCamAt(const RobotModel& robot, const Eigen::VectorXd& rho, const PoseObservation& pose);
 
 // Pixels of the dots seen in both poses, matched by id (D6: correspondence by id, never by index).
 struct Matches {
