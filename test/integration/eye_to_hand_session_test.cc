@@ -5,6 +5,7 @@
 // records its configuration; `run --resume` in the other configuration is refused with nothing written.
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include <gtest/gtest.h>
@@ -97,6 +98,41 @@ TEST_F(EyeToHandSessionTest, ResumeInTheOtherConfigurationIsRefusedAndChangesNot
   EXPECT_TRUE(Contains(output, "eye_to_hand")) << output;
   EXPECT_TRUE(Contains(output, "eye_in_hand")) << output;
   EXPECT_EQ(testing::TreeState(session), before);
+}
+
+// `selfcal simulate --configuration eye_to_hand` on the plan: the same session, calibrated offline from it and
+// compared with the hidden truth. Accepted (exit 0); every free parameter of the bundle within 4 of its
+// reported standard deviations of the truth (the pixel noise's own spread, 0.02 px centroids); the fixed
+// camera within 4 reported sigmas of its translation; f_x within 4 sigma; no wrong identity.
+// Disabled until the calibrate outputs handle eye-to-hand: the verdict is accepted, but writing
+// calibrated.urdf stops with internal_error (exit 70: the URDF's chain differs from KDL's by 1.6 m), and the
+// comparison is then not written. Enable with the outputs' fix.
+TEST_F(EyeToHandSessionTest, DISABLED_SimulateCalibratesTheSessionWithinItsReportedSigmas) {
+  const fs::path out = *root_ / "simulate";
+  std::string output;
+  ASSERT_EQ(RunSelfcal("simulate --configuration eye_to_hand --live-view off --no-html --seed 3 --trajectory " +
+                           (*root_ / "plan.yaml").string() + " --out " + out.string(),
+                       &output),
+            0)
+      << output;
+  const nlohmann::json comparison = nlohmann::json::parse(ReadFile((out / "comparison_with_truth.json").string()));
+  const nlohmann::json& bundle = comparison["bundle"];
+  ASSERT_FALSE(bundle["parameters"].empty()) << output;
+  double cam_sigma_mm2 = 0;
+  for (const nlohmann::json& p : bundle["parameters"]) {
+    const std::string name = p["name"];
+    const bool length = p.contains("error_mm");
+    const double error = length ? p["error_mm"].get<double>() : p["error_deg"].get<double>();
+    const double sigma = length ? p["stddev_mm"].get<double>() : p["stddev_deg"].get<double>();
+    EXPECT_LE(std::abs(error), 4 * sigma) << name << "\n" << output;
+    if (name.rfind("cam.t", 0) == 0) cam_sigma_mm2 += sigma * sigma;
+  }
+  EXPECT_LE(std::abs(bundle["fx_bundle_px"].get<double>() - bundle["fx_true_px"].get<double>()),
+            4 * bundle["fx_stddev_px"].get<double>());
+  ASSERT_TRUE(bundle["base_from_cam"].is_object()) << output;
+  EXPECT_LE(bundle["base_from_cam"]["error_mm"].get<double>(), 4 * std::sqrt(cam_sigma_mm2) + 1e-3) << output;
+  EXPECT_EQ(comparison["identities"]["samples_accepted"], 25);
+  EXPECT_EQ(comparison["identities"]["wrong_total"], 0);
 }
 
 }  // namespace
