@@ -9,6 +9,7 @@
 #include "app/cli_output.h"
 #include "app/cli_util.h"
 #include "app/output_options.h"
+#include "app/run_configuration.h"
 #include "app/commands.h"
 #include "io/robot_config.h"
 #include "io/trajectory_file.h"
@@ -23,6 +24,7 @@ namespace {
 
 struct PlanArgs {
   std::string robot = "config/robots/puma560.yaml";
+  std::string configuration = "eye_in_hand";
   std::string start;  // default: config/trajectories/initial_<robot name>.yaml
   std::string out = "out/plan.yaml";
   std::string check;
@@ -100,6 +102,7 @@ void PrintObservability(const planning::ObservabilityReport& r, const RobotModel
 
 void AddPlanOptions(CLI::App* cmd, PlanArgs* args) {
   AddRobotOption(cmd, &args->robot);
+  AddConfigurationOption(cmd, &args->configuration);
   cmd->add_option("--start", args->start,
                   "Start trajectory (offending poses are repaired from a pool); default: "
                   "config/trajectories/initial_<robot name>.yaml");
@@ -167,7 +170,10 @@ planning::PlanningProblem MakeProblem(const PlanArgs& args, const RobotModel& ro
 
 // The problem's scene: stand-in dots in the given box, or the simulator's dots. The exit code when the
 // command ends here.
-std::optional<int> SetScene(const PlanArgs& args, const RobotModel& robot, planning::PlanningProblem* problem) {
+// Without a box, the simulator's scene is placed for `start` (the eye-to-hand start, which has no file) or
+// for the poses of --scene-from.
+std::optional<int> SetScene(const PlanArgs& args, const RobotModel& robot, const io::TrajectoryFile* start,
+                            planning::PlanningProblem* problem) {
   if (args.box_center_mm.size() == 3 && args.box_size_mm.size() == 3) {
     const Eigen::Vector3d centre(args.box_center_mm[0], args.box_center_mm[1], args.box_center_mm[2]);
     const Eigen::Vector3d size(args.box_size_mm[0], args.box_size_mm[1], args.box_size_mm[2]);
@@ -178,15 +184,18 @@ std::optional<int> SetScene(const PlanArgs& args, const RobotModel& robot, plann
   } else {
     sim::SimOptions sim_options;
     sim_options.world_seed = args.sim_world_seed;
-    Result<io::TrajectoryFile> scene_poses = io::LoadTrajectoryFileForRobot(ResolveDataPath(args.scene_from), robot, args.robot);
+    Result<io::TrajectoryFile> scene_poses = start != nullptr ? Result<io::TrajectoryFile>(*start)
+                                                             : io::LoadTrajectoryFileForRobot(
+                                                                   ResolveDataPath(args.scene_from), robot, args.robot);
     if (!scene_poses.ok()) return Fail(scene_poses.status());
     const sim::SimResult world = sim::Simulate(robot, scene_poses->poses, sim_options);
     if (!world.ok) {
       return Fail(Status::Error(ErrorCode::kDegenerateData, "no simulated scene for " + args.scene_from + ": " + world.message));
     }
     problem->scene = planning::Scene::FromDots(world.truth.dots_in_base);
-    std::cout << "scene: the simulator's " << world.truth.dots_in_base.size() << " dots (world seed "
-              << args.sim_world_seed << ", placed for " << args.scene_from << ")\n";
+    std::cout << "scene: the simulator's " << world.truth.dots_in_base.size()
+              << (robot.mount == CameraMount::kEyeToHand ? " dots on the flange's plate" : " dots") << " (world seed "
+              << args.sim_world_seed << ", placed for " << (args.scene_from.empty() ? "the start" : args.scene_from) << ")\n";
   }
   return std::nullopt;
 }
@@ -204,6 +213,9 @@ int CheckOnly(const PlanArgs& args, const RobotModel& robot, const io::Trajector
   if (file.planned_for && check.ok) {
     planning::PlanningProblem problem;
     problem.robot = robot;
+    problem.robot.mount = file.planned_for->configuration;  // the configuration the plan was made for
+    problem.robot.base_from_cam = file.planned_for->base_from_cam;
+    std::cout << "  configuration " << CameraMountName(problem.robot.mount) << " (planned_for)\n";
     problem.camera = file.planned_for->camera;
     problem.scene = file.planned_for->scene;
     problem.constraints = file.planned_for->constraints;
@@ -250,7 +262,8 @@ int WritePlan(const PlanArgs& args, planning::Criterion criterion, const plannin
                      planning::CriterionName(criterion) + " --seed " + std::to_string(args.seed) +
                      (!box && args.sim_world_seed != 1 ? " --sim-world-seed " + std::to_string(args.sim_world_seed) : "") +
                      "` (docs/planning.md)";
-  plan.planned_for = planning::PlannedFor{problem.camera, problem.scene, problem.constraints};
+  plan.planned_for = planning::PlannedFor{problem.camera, problem.scene, problem.constraints, problem.robot.mount,
+                                          problem.robot.base_from_cam};
   std::ostringstream provenance;
   provenance << "criterion " << planning::CriterionName(criterion) << ", lambda " << args.lambda << ", seed " << args.seed
              << ", pool " << args.pool << "; eq39 " << r.eq39_start.total << " -> " << r.eq39_final.total
@@ -294,6 +307,38 @@ int PlanAndWrite(const PlanArgs& args, planning::Criterion criterion, const plan
   return WritePlan(args, criterion, problem, plan_path, r);
 }
 
+// --configuration eye_to_hand: the robot in the simulated eye-to-hand cell (its fixed camera in front of the
+// flange at home), from --start or the robot's eye-to-hand start; the scene the plate's dots.
+int PlanEyeToHand(const PlanArgs& given, const RobotModel& config_robot, planning::Criterion criterion) {
+  PlanArgs a = given;
+  // The plate fills a small part of the fixed camera's image: f_x is determined less well than from a wrist
+  // camera's scene, so the bound on its Cramer-Rao std is 1 % of f_x unless given.
+  if (a.max_fx_stddev_rel == planning::PlanConstraints().max_fx_stddev_rel) a.max_fx_stddev_rel = 0.01;
+  Result<RobotModel> robot = RobotInSimulatedCell(config_robot, a.robot, CameraMount::kEyeToHand);
+  if (!robot.ok()) return Fail(robot.status());
+  io::TrajectoryFile start;
+  std::string start_name = a.start;
+  if (a.start.empty()) {
+    Result<std::vector<Eigen::VectorXd>> poses = EyeToHandStart(*robot, a.robot, 25);
+    if (!poses.ok()) return Fail(poses.status());
+    start.poses = *poses;
+    start.robot = robot->name;
+    start_name = "the eye-to-hand start of " + a.robot;
+  } else {
+    Result<io::TrajectoryFile> file = io::LoadTrajectoryFileForRobot(ResolveDataPath(a.start), *robot, a.robot);
+    if (!file.ok()) return Fail(file.status());
+    start = *file;
+  }
+  std::cout << "configuration eye_to_hand: fixed camera at " << robot->base_from_cam.translation.transpose() * 1e3
+            << " mm in the base frame, dots on a plate carried by the flange\n";
+  planning::PlanningProblem problem = MakeProblem(a, *robot, start);
+  if (const std::optional<int> code = SetScene(a, *robot, a.scene_from.empty() ? &start : nullptr, &problem)) return *code;
+  if (const std::string invalid = problem.Validate(); !invalid.empty()) {
+    return Fail(Status::Error(ErrorCode::kInvalidInput, "plan options: " + invalid));
+  }
+  return PlanAndWrite(a, criterion, problem, start, start_name);
+}
+
 int RunPlanCommand(const PlanArgs& args) {
   Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(args.robot));
   if (!robot.ok()) return Fail(robot.status());
@@ -302,6 +347,9 @@ int RunPlanCommand(const PlanArgs& args) {
     return Fail(Status::Error(ErrorCode::kInvalidInput, "--criterion `" + args.criterion + "`: expected eq39, d-optimal or a-optimal"));
   }
   PlanArgs a = args;  // the defaults follow the robot
+  Result<CameraMount> mount = ParseConfiguration(a.configuration);
+  if (!mount.ok()) return Fail(mount.status());
+  if (*mount == CameraMount::kEyeToHand && a.check.empty()) return PlanEyeToHand(a, *robot, criterion);
   if (a.start.empty() && a.check.empty()) {
     Result<std::string> start = TrajectoryForRobot("", robot->name, a.robot);
     if (!start.ok()) return Fail(start.status());
@@ -314,7 +362,7 @@ int RunPlanCommand(const PlanArgs& args) {
   if (!file.ok()) return Fail(file.status());
   if (!a.check.empty()) return CheckOnly(a, *robot, *file, plan_path);
   planning::PlanningProblem problem = MakeProblem(a, *robot, *file);
-  if (const std::optional<int> code = SetScene(a, *robot, &problem)) return *code;
+  if (const std::optional<int> code = SetScene(a, *robot, nullptr, &problem)) return *code;
   if (const std::string invalid = problem.Validate(); !invalid.empty()) {
     return Fail(Status::Error(ErrorCode::kInvalidInput, "plan options: " + invalid));
   }

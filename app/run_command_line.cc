@@ -7,6 +7,7 @@
 #include "app/commands.h"
 #include "app/identify_options.h"
 #include "app/output_options.h"
+#include "app/run_configuration.h"
 #include "app/session_command.h"
 
 namespace selfcal::app {
@@ -34,6 +35,7 @@ Command AddRunCommand(CLI::App& app) {
                   "most N more times each (0: never)")
       ->check(CLI::Range(0, 100));
   cmd->add_option("--robot-config", a->robot_config, "Nominal robot config");
+  AddConfigurationOption(cmd, &a->configuration);
   cmd->add_option("--plan", a->plan, "Plan (trajectory file); default: config/trajectories/initial_<robot name>.yaml");
   cmd->add_option("--setup", a->setup,
                   "Camera, yardstick and checks (docs/session-format.md); refused with --robot sim, whose cell makes "

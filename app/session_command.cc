@@ -19,6 +19,7 @@
 #include "app/cli_output.h"
 #include "app/cli_util.h"
 #include "app/output_options.h"
+#include "app/run_configuration.h"
 #include "app/commands.h"
 #include "app/vendor_robots.h"
 #include "io/observations_file.h"
@@ -120,28 +121,6 @@ simulation::SimCellOptions SimCellOptionsFor(const RunSettings& a) {
   return simulation::SimCellOptionsFor(RunJsonText(a)).value();
 }
 
-// Typed confirmation before a real backend moves (R1): the operator types the robot's serial. The
-// preview holds the controller's identity text: printed escaped. With --json it goes to stderr, stdout
-// being the document's.
-bool ConfirmOnTerminal(const std::string& preview, const robot::RobotIdentity& identity, bool dry_run) {
-  std::ostream& out = JsonMode() ? std::cerr : std::cout;
-  ClearProgressLine();
-  out << TerminalSafe(preview);
-  if (dry_run) {
-    out << "dry run: nothing moved, no command was sent to the robot\n";
-    return false;
-  }
-  if (!identity.real_hardware) {
-    out << "simulated robot: armed without confirmation\n";
-    return true;
-  }
-  out << "This moves a REAL robot (" << TerminalSafe(identity.model) << ", serial " << TerminalSafe(identity.serial)
-      << "). Type the serial to arm, anything else to cancel: " << std::flush;
-  std::string answer;
-  if (!std::getline(std::cin, answer)) return false;
-  return answer == identity.serial;
-}
-
 // What the stages of a run share: the nominal robot, the plan, the session's inputs and, with the
 // simulated robot, the simulated cell.
 struct RunPlan {
@@ -173,7 +152,7 @@ Status OpenRunLiveView(const RunSettings& a, Backends* b) {
   Result<liveview::LiveViewMode> mode = liveview::ParseLiveViewMode(a.live_view);
   if (!mode.ok()) return mode.status();
   liveview::LiveViewOptions options;
-  options.title = "selfcal run " + a.session;
+  options.title = "selfcal run " + a.session + " (" + a.configuration + ")";
   options.log = [](const std::string& line) { std::cout << line << "\n" << std::flush; };
   std::string note;
   Result<std::unique_ptr<liveview::LiveView>> view = liveview::OpenLiveView(*mode, options, &note);
@@ -205,6 +184,17 @@ Status CheckRunSettings(RunSettings* a) {
   return Status::Ok();
 }
 
+// A real camera's setup.json (--setup) into *probe, refused when its configuration is not --configuration's.
+Status ReadRealSetup(const RunSettings& a, CameraMount mount, ObservationSet* probe) {
+  Result<session::SessionInput> setup = session::ReadInputFile(session::kSetupFileName, a.setup);
+  if (!setup.ok()) return setup.status();
+  if (Status s = session::ParseSetupFile(setup->contents, a.setup, probe); !s.ok()) return s;
+  if (probe->robot.mount == mount) return Status::Ok();
+  return Status::Error(ErrorCode::kInvalidInput, "--setup " + a.setup + " is for configuration " +
+                                                     CameraMountName(probe->robot.mount) + " (its `configuration`), "
+                                                     "this run is " + a.configuration + " (--configuration)");
+}
+
 // Stage 1: the robot config, the plan and the setup (made by the simulated cell, or --setup), as the
 // session's inputs.
 Status LoadRunPlan(const RunSettings& a, RunPlan* run) {
@@ -214,12 +204,28 @@ Status LoadRunPlan(const RunSettings& a, RunPlan* run) {
   const session::SessionInput robot_input{"robot.yaml", *robot_text};
   Result<RobotModel> nominal = io::LoadRobotModel(ResolveDataPath(a.robot_config));
   if (!nominal.ok()) return nominal.status();
+  Result<CameraMount> mount = ParseConfiguration(a.configuration);
+  if (!mount.ok()) return mount.status();
+  ObservationSet probe;  // a real camera's setup (with its fixed camera in eye-to-hand)
+  if (a.camera_backend != "sim") {
+    if (Status s = ReadRealSetup(a, *mount, &probe); !s.ok()) return s;
+    nominal.value().mount = *mount;
+    nominal.value().base_from_cam = probe.robot.base_from_cam;
+  } else {
+    nominal = RobotInSimulatedCell(*nominal, a.robot_config, *mount);
+    if (!nominal.ok()) return nominal.status();
+  }
   run->nominal = *nominal;
   Result<session::SessionInput> plan_input = session::ReadInputFile("plan.yaml", ResolveDataPath(a.plan));
   if (!plan_input.ok()) return plan_input.status();
   // A plan for another robot is a usage error naming both; the limits are `plan --check`'s (preflight).
   Result<io::TrajectoryFile> plan_file = io::LoadTrajectoryFileForRobot(ResolveDataPath(a.plan), run->nominal, a.robot_config);
   if (!plan_file.ok()) return plan_file.status();
+  if (plan_file->planned_for && plan_file->planned_for->configuration != *mount) {
+    return Status::Error(ErrorCode::kInvalidInput, "plan " + a.plan + " was planned for configuration " +
+                                                       CameraMountName(plan_file->planned_for->configuration) +
+                                                       ", this run is " + a.configuration + " (--configuration)");
+  }
   run->plan = PlanPoses(*plan_file);
   run->plan_check = acquisition::PlanToCheck{run->nominal, io::PlanSubjectOf(*plan_file)};
   // The plan check against the robot config before the simulated cell is built for the plan; the preflight
@@ -240,8 +246,6 @@ Status LoadRunPlan(const RunSettings& a, RunPlan* run) {
   }
   Result<session::SessionInput> setup = session::ReadInputFile(session::kSetupFileName, a.setup);
   if (!setup.ok()) return setup.status();
-  ObservationSet probe;
-  if (Status s = session::ParseSetupFile(setup->contents, a.setup, &probe); !s.ok()) return s;
   run->inputs.push_back(*setup);
   run->prediction = {run->nominal, probe.camera, probe.pixel_noise_px};
   return Status::Ok();
@@ -309,28 +313,8 @@ Result<session::Session> CreateRunSession(const RunSettings& a, const RunPlan& r
   session::CreateOptions create;
   create.created_utc = UtcNow();
   create.min_free_bytes = static_cast<std::uint64_t>(run.plan.size()) * 4 * 400 * 1024;
+  create.configuration = run.nominal.mount;
   return session::CreateSession(a.session, run.inputs, SELFCAL_VERSION, create);
-}
-
-// The manual backend's joint limits: the nominal model's, a nominal velocity (the operator moves; timing only).
-robot::JointLimits ManualJointLimits(const RobotModel& nominal) {
-  robot::JointLimits limits;
-  const int n = nominal.num_joints();
-  limits.lower_rad.resize(n);
-  limits.upper_rad.resize(n);
-  for (int j = 0; j < n; ++j) {
-    limits.lower_rad[j] = nominal.limits[j].min_rad;
-    limits.upper_rad[j] = nominal.limits[j].max_rad;
-  }
-  limits.max_velocity_rad_s = Eigen::VectorXd::Constant(n, 0.5);
-  return limits;
-}
-
-// The port of --address HOST:PORT: 1-65535, else -1.
-int PortNumber(const std::string& text) {
-  if (text.empty() || text.size() > 5 || !std::all_of(text.begin(), text.end(), ::isdigit)) return -1;
-  const int port = std::stoi(text);
-  return port >= 1 && port <= 65535 ? port : -1;
 }
 
 // Stage 3: the robot, camera, clock and dot identifier of the run.
@@ -574,8 +558,17 @@ Status ResolvePlanPath(RunSettings* a) {
 int RunFromSettings(RunSettings a, std::unique_ptr<sim::SimResult>* world) {
   if (Status s = CheckRunSettings(&a); !s.ok()) return Fail(s);
   if (Status s = ResolvePlanPath(&a); !s.ok()) return Fail(s);
+  if (a.resume) {  // before any input is read: a session keeps the configuration it was recorded in
+    Result<CameraMount> mount = ParseConfiguration(a.configuration);
+    if (!mount.ok()) return Fail(mount.status());
+    if (Status s = CheckResumeConfiguration(a.session, *mount); !s.ok()) return Fail(s);
+  }
   RunPlan run;
   if (Status s = LoadRunPlan(a, &run); !s.ok()) return Fail(s);
+  if (run.nominal.mount == CameraMount::kEyeToHand) {
+    std::cout << "configuration eye_to_hand: the camera fixed at " << run.nominal.base_from_cam.translation.transpose() * 1e3
+              << " mm in the base frame, the dots on the flange\n";
+  }
   Backends backends;  // a bad --address is refused before any session is touched
   if (Status s = MakeBackends(a, &run, &backends); !s.ok()) return Fail(s);
   if (Status s = OpenRunLiveView(a, &backends); !s.ok()) return Fail(s);

@@ -24,6 +24,7 @@ struct RunSettings {
   bool dry_run = false;
   int revisit_skipped = 1;  // --resume: further attempts per pose skipped for a revisitable reason
   std::string robot_config = "config/robots/puma560.yaml";
+  std::string configuration = "eye_in_hand";  // --configuration (run_configuration.h)
   std::string plan;  // default: the robot's shipped trajectory (TrajectoryForRobot in cli_util.h)
   std::string setup;  // required unless --camera sim
   std::string robot_backend = "sim";

@@ -14,6 +14,7 @@
 #include "app/cli_output.h"
 #include "app/cli_util.h"
 #include "app/output_options.h"
+#include "app/run_configuration.h"
 #include "app/commands.h"
 #include "io/report_json.h"
 #include "io/observations_file.h"
@@ -29,7 +30,8 @@ namespace {
 
 struct SimulateArgs {
   std::string robot = "config/robots/puma560.yaml";
-  std::string trajectory;  // default: the robot's shipped trajectory (TrajectoryForRobot)
+  std::string configuration = "eye_in_hand";
+  std::string trajectory;  // eye_to_hand: default the robot's eye-to-hand start (EyeToHandStart)  // default: the robot's shipped trajectory (TrajectoryForRobot)
   std::string out = "out/simulate";
   double noise_px = 0.2;
   double joint_noise_deg = 0;
@@ -55,12 +57,23 @@ nlohmann::json TruthJson(const sim::SimResult& world) {
   }
   nlohmann::json dots = nlohmann::json::array();
   for (const Eigen::Vector3d& p : world.truth.dots_in_base) dots.push_back({p.x() * 1e3, p.y() * 1e3, p.z() * 1e3});
-  return {{"format", "selfcal-sim-truth"},
-          {"version", 1},
-          {"note", "hidden from the solver; rho in the nominal model's parameterisation (corrections for base and cam)"},
-          {"fx_px", world.truth.camera_true.fx_px},
-          {"rho", rho},
-          {"dots_in_base_mm", dots}};
+  const bool e2h = world.truth.nominal.mount == CameraMount::kEyeToHand;
+  nlohmann::json truth = {
+      {"format", "selfcal-sim-truth"},
+      {"version", 1},
+      {"note", "hidden from the solver; rho in the nominal model's parameterisation (corrections for base and cam)"},
+      {"configuration", CameraMountName(world.truth.nominal.mount)},
+      {"fx_px", world.truth.camera_true.fx_px},
+      {"rho", rho},
+      {e2h ? "dots_in_flange_mm" : "dots_in_base_mm", dots}};
+  if (e2h) {
+    const Rigid3 c = sim::FixedCameraTruth(world.truth);
+    nlohmann::json rows = nlohmann::json::array();
+    for (int r = 0; r < 3; ++r) rows.push_back({c.rotation(r, 0), c.rotation(r, 1), c.rotation(r, 2)});
+    truth["base_from_cam"] = {{"xyz_mm", {c.translation.x() * 1e3, c.translation.y() * 1e3, c.translation.z() * 1e3}},
+                              {"rotation", rows}};
+  }
+  return truth;
 }
 
 // Mean error of the relative poses reference -> each verification pose predicted by a model against the
@@ -72,7 +85,7 @@ PoseDifference MeanVerificationPoseError(const sim::SimResult& world, const Obse
   for (int v : obs.PosesWithRole(PoseRole::kVerification)) {
     const Rigid3 truth_rel = world.truth.base_from_cam[ref].Inverse() * world.truth.base_from_cam[v];
     const Rigid3 model_rel =
-        BaseFromCam(model, rho, obs.poses[ref].joints_rad).Inverse() * BaseFromCam(model, rho, obs.poses[v].joints_rad);
+        PointsFromCam(model, rho, obs.poses[ref].joints_rad).Inverse() * PointsFromCam(model, rho, obs.poses[v].joints_rad);
     const PoseDifference d = ComparePoses(truth_rel, model_rel);
     mean.position_m += d.position_m;
     mean.rotation_rad += d.rotation_rad;
@@ -120,11 +133,15 @@ nlohmann::json CompareWithTruth(const sim::SimResult& world, const ObservationSe
                        {"true", v[1]}, {"calibrated", v[2]}, {"error", v[2] - v[1]}});
     }
   }
-  const PoseDifference cam_error = ComparePoses(true_robot.flange_from_cam, calibrated.flange_from_cam);
-  const PoseDifference cam_nominal = ComparePoses(true_robot.flange_from_cam, nominal.flange_from_cam);
-  out << "flange_from_cam error: nominal " << cam_nominal.position_m * 1e3 << " mm / "
-      << RadToDeg(cam_nominal.rotation_rad) << " deg, calibrated " << cam_error.position_m * 1e3 << " mm / "
-      << RadToDeg(cam_error.rotation_rad) << " deg (includes what the fixed joint-6 offsets absorb)\n";
+  const bool e2h = nominal.mount == CameraMount::kEyeToHand;
+  const char* cam_name = e2h ? "base_from_cam" : "flange_from_cam";
+  const PoseDifference cam_error = e2h ? ComparePoses(true_robot.base_from_cam, calibrated.base_from_cam)
+                                       : ComparePoses(true_robot.flange_from_cam, calibrated.flange_from_cam);
+  const PoseDifference cam_nominal = e2h ? ComparePoses(true_robot.base_from_cam, nominal.base_from_cam)
+                                         : ComparePoses(true_robot.flange_from_cam, nominal.flange_from_cam);
+  out << cam_name << " error: nominal " << cam_nominal.position_m * 1e3 << " mm / " << RadToDeg(cam_nominal.rotation_rad)
+      << " deg, calibrated " << cam_error.position_m * 1e3 << " mm / " << RadToDeg(cam_error.rotation_rad)
+      << (e2h ? " deg (includes what the base offsets absorb)\n" : " deg (includes what the fixed joint-6 offsets absorb)\n");
   out << "f_x: nominal " << obs.camera.fx_px << ", true " << world.truth.camera_true.fx_px << ", calibrated "
       << report.fx_px << " px\n";
   const Eigen::VectorXd rho0 = KinematicParameters::Nominal(nominal);
@@ -134,8 +151,8 @@ nlohmann::json CompareWithTruth(const sim::SimResult& world, const ObservationSe
   PrintVerificationPoseErrors(before, after, "calibrated", out);
   out.unsetf(std::ios::floatfield);
   return {{"links", links},
-          {"flange_from_cam_error_mm", cam_error.position_m * 1e3},
-          {"flange_from_cam_error_deg", RadToDeg(cam_error.rotation_rad)},
+          {std::string(cam_name) + "_error_mm", cam_error.position_m * 1e3},
+          {std::string(cam_name) + "_error_deg", RadToDeg(cam_error.rotation_rad)},
           {"fx_true_px", world.truth.camera_true.fx_px},
           {"fx_calibrated_px", report.fx_px},
           {"verification_pose_error_mean_mm", {{"nominal", before.position_m * 1e3}, {"calibrated", after.position_m * 1e3}}},
@@ -188,8 +205,17 @@ nlohmann::json CompareBundleWithTruth(const sim::SimResult& world, const Observa
   out << "3-D error of the held-out distances, RMS: nominal " << stage.verification_nominal.rms_error_m * 1e3
       << " mm, bundle " << stage.verification.rms_error_m * 1e3 << " mm (max " << stage.verification.max_error_m * 1e3
       << " mm)\n";
+  nlohmann::json fixed_camera;  // eye-to-hand: the fixed camera against the hidden one
+  if (nominal.mount == CameraMount::kEyeToHand) {
+    const PoseDifference d = ComparePoses(sim::FixedCameraTruth(world.truth),
+                                          BaseFromCam(nominal, b.rho, Eigen::VectorXd::Zero(nominal.num_joints())));
+    out << "base_from_cam error (the fixed camera): " << d.position_m * 1e3 << " mm / " << RadToDeg(d.rotation_rad)
+        << " deg\n";
+    fixed_camera = {{"error_mm", d.position_m * 1e3}, {"error_deg", RadToDeg(d.rotation_rad)}};
+  }
   out.unsetf(std::ios::floatfield);
   return {{"parameters", parameters},
+          {"base_from_cam", fixed_camera},
           {"gauge_perturbed", gauge_perturbed},
           {"free_within_2_sigma", within_2_sigma},
           {"free_count", count},
@@ -240,6 +266,24 @@ Status AddIdentityAudit(const sim::SimResult& world, const std::string& session,
   return Status::Ok();
 }
 
+// Eye-to-hand without --trajectory: the robot's eye-to-hand start (run_configuration.h) written to
+// <out>/eye_to_hand_trajectory.yaml (not overwritten: an earlier one of the same robot is the same file).
+Result<std::string> WriteEyeToHandStart(const SimulateArgs& args) {
+  Result<io::CalibratedModel> config = io::LoadRobotConfig(ResolveDataPath(args.robot));
+  if (!config.ok()) return config.status();
+  Result<RobotModel> robot = RobotInSimulatedCell(config->model, args.robot, CameraMount::kEyeToHand);
+  if (!robot.ok()) return robot.status();
+  Result<std::vector<Eigen::VectorXd>> joints = EyeToHandStart(*robot, args.robot, 25);
+  if (!joints.ok()) return joints.status();
+  if (Status s = EnsureDirectory(args.out); !s.ok()) return s;
+  const std::string path = (std::filesystem::path(args.out) / "eye_to_hand_trajectory.yaml").string();
+  if (std::filesystem::exists(path)) return path;
+  const std::string description = "the eye-to-hand start of selfcal simulate (sim::MakeEyeToHandTrajectory at home)";
+  if (Status s = io::SaveTrajectory(*joints, path, robot->name, description); !s.ok()) return s;
+  std::cout << "eye-to-hand trajectory (" << joints->size() << " poses): " << path << "\n";
+  return path;
+}
+
 // selfcal simulate (default): the simulated arm and rendered camera through a real session directory, the
 // offline calibration of that session, and the comparison with the hidden truth.
 int SimulateSession(const SimulateArgs& args) {
@@ -248,7 +292,13 @@ int SimulateSession(const SimulateArgs& args) {
   RunSettings run;
   run.session = FreshSessionPath(args.out);
   run.robot_config = args.robot;
+  run.configuration = args.configuration;
   run.plan = args.trajectory;
+  if (run.plan.empty() && args.configuration == CameraMountName(CameraMount::kEyeToHand)) {
+    Result<std::string> plan = WriteEyeToHandStart(args);  // no eye-to-hand trajectory is shipped
+    if (!plan.ok()) return Fail(plan.status());
+    run.plan = *plan;
+  }
   run.seed = args.seed;
   run.grey_noise = args.grey_noise;
   run.blur_px = args.blur_px;
@@ -297,8 +347,10 @@ Command AddSimulateCommand(CLI::App& app) {
   auto args = std::make_shared<SimulateArgs>();
   CLI::App* cmd = app.add_subcommand("simulate", "Simulated robot with hidden errors: observe, calibrate, compare");
   AddRobotOption(cmd, &args->robot);
+  AddConfigurationOption(cmd, &args->configuration);
   cmd->add_option("--trajectory", args->trajectory,
-                  "Trajectory file (for the robot); default: config/trajectories/initial_<robot name>.yaml");
+                  "Trajectory file (for the robot); default: config/trajectories/initial_<robot name>.yaml (eye_to_hand: "
+                  "a smooth path of the plate in front of the fixed camera, written to <out>)");
   AddOutputOption(cmd, "--out", &args->out, OutputKind::kDirectory, "Output directory (created if missing; outside any session)",
                   SimulateOutputFiles());
   CLI::Option* noise = cmd->add_option("--noise-px", args->noise_px,
@@ -340,8 +392,19 @@ Command AddSimulateCommand(CLI::App& app) {
       return Fail(Status::Error(ErrorCode::kInvalidInput, "--live-view on needs image mode: the fast --points mode "
                                                           "renders no image"));
     }
+    const bool e2h = args->configuration == CameraMountName(CameraMount::kEyeToHand);
+    if (e2h && args->trajectory.empty()) {
+      Result<std::string> start = WriteEyeToHandStart(*args);
+      if (!start.ok()) return Fail(start.status());
+      args->trajectory = *start;
+    }
     Result<RobotAndTrajectory> loaded = LoadRobotAndTrajectory(args->robot, args->trajectory);
     if (!loaded.ok()) return Fail(loaded.status());
+    if (e2h) {
+      Result<RobotModel> cell = RobotInSimulatedCell(loaded->robot, args->robot, CameraMount::kEyeToHand);
+      if (!cell.ok()) return Fail(cell.status());
+      loaded.value().robot = *cell;
+    }
     const RobotModel* robot = &loaded->robot;
     const std::vector<Eigen::VectorXd>* joints = &loaded->joints;
     std::cout << "robot " << robot->name << " (" << args->robot << "), trajectory " << loaded->trajectory_path << "\n";

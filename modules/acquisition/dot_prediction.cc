@@ -240,7 +240,7 @@ std::vector<Rigid3> SampleCameras(const PredictionModel& model, const std::vecto
   std::vector<Rigid3> base_from_cams;
   bool all_given = true;
   for (const ViewedSample& s : samples) {
-    base_from_cams.push_back(s.base_from_cam ? *s.base_from_cam : BaseFromCam(model.robot, rho, s.joints_rad));
+    base_from_cams.push_back(s.base_from_cam ? *s.base_from_cam : PointsFromCam(model.robot, rho, s.joints_rad));
     all_given = all_given && s.base_from_cam.has_value();
   }
   if (all_given) return base_from_cams;
@@ -254,7 +254,7 @@ DotPredictionReport PredictDots(const PredictionModel& model, const std::vector<
   const std::vector<Rigid3> base_from_cams = SampleCameras(model, samples, options);  // of every sample, once
   const RaysById rays = SampleRays(model, samples, base_from_cams);
   // The new frame's camera, resected on the dots already known in it when enough of them have points.
-  Rigid3 base_from_cam_now = BaseFromCam(model.robot, rho, joints_rad);
+  Rigid3 base_from_cam_now = PointsFromCam(model.robot, rho, joints_rad);
   if (options.resect_new_frame && samples.size() >= 2) {
     const std::map<int, Point> sample_points = TriangulateAll(model, options.ray_model_sigma_px, rays, false);
     if (const std::optional<Rigid3> c = Resect(model, base_from_cam_now, current_px, sample_points,

@@ -21,6 +21,10 @@
 // nearer or farther than the scene's middle. Cameras known better (bundled_cameras.h: the samples'
 // cameras and f_x from a bundle of their images, which the session loop gives) are used as given. Nothing
 // here is iterative beyond those rounds and one reweighting, and nothing is differentiated automatically.
+//
+// "Base" below is the frame of the points (kinematics/robot_model.h, PointsFromCam): the robot base in
+// eye-in-hand, the flange in eye-to-hand, where the fixed camera sees the dots the flange carries; every
+// sample's nominal camera is PointsFromCam of the model's mount.
 #pragma once
 
 #include <map>

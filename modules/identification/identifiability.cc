@@ -44,7 +44,7 @@ Eigen::MatrixXd RelativePoseJacobian(const RobotModel& model, const Eigen::Vecto
   // Measurements equal to the model: only the derivative matters and the residual is zero.
   const Rigid3 cam_ref_from_base = internal::CamRefFromBase<double>(model, rho.data(), joint_poses[reference_index]);
   std::vector<Rigid3> measured(num_poses);
-  for (int i = 0; i < num_poses; ++i) measured[i] = cam_ref_from_base * BaseFromCam(model, rho, joint_poses[i]);
+  for (int i = 0; i < num_poses; ++i) measured[i] = cam_ref_from_base * PointsFromCam(model, rho, joint_poses[i]);
 
   const double inv_sp = 1.0 / sigma_position_m, inv_sr = 1.0 / sigma_rotation_rad;
   auto residuals = [&](const auto* x, auto* y) {
@@ -98,7 +98,7 @@ IdentifiabilityReport AnalyzeIdentifiabilityOfJacobian(const RobotModel& model, 
     int row = 0;
     for (int i = 0; i < static_cast<int>(joint_poses.size()); ++i) {
       if (i == reference_index) continue;
-      const Rigid3 rel = cam_ref_from_base * BaseFromCam(model, rho, joint_poses[i]);
+      const Rigid3 rel = cam_ref_from_base * PointsFromCam(model, rho, joint_poses[i]);
       full.col(0).segment<3>(row + 3) = -rel.translation / options.sigma_position_m;
       row += 6;
     }

@@ -20,11 +20,12 @@ Eigen::Matrix<T, Eigen::Dynamic, 1> JointsAs(const Eigen::VectorXd& q) {
   return q.cast<T>();
 }
 
-// cam_ref_from_base at rho (the inverse of the reference camera pose).
+// cam_ref_from_base at rho (the inverse of the reference camera pose in the points' frame: PointsFromCam,
+// the base in eye-in-hand, the flange in eye-to-hand).
 template <typename T>
 Rigid3T<T> CamRefFromBase(const RobotModel& model, const T* rho, const Eigen::VectorXd& q_ref) {
   const auto q = JointsAs<T>(q_ref);
-  return BaseFromCam<T>(model, rho, q.data()).Inverse();
+  return PointsFromCam<T>(model, rho, q.data()).Inverse();
 }
 
 // Writes 6 residuals (3 when !translation_valid: rotation only) of a predicted cam_ref_from_cam_i.
@@ -47,7 +48,7 @@ void RelativePoseResidual(const RobotModel& model, const T* rho, const Rigid3T<T
                           const Eigen::VectorXd& q_i, const Rigid3& measured, bool translation_valid,
                           double inv_sigma_position, double inv_sigma_rotation, T* out) {
   const auto q = JointsAs<T>(q_i);
-  RelativePoseResidual<T>(cam_ref_from_base * BaseFromCam<T>(model, rho, q.data()), measured, translation_valid,
+  RelativePoseResidual<T>(cam_ref_from_base * PointsFromCam<T>(model, rho, q.data()), measured, translation_valid,
                           inv_sigma_position, inv_sigma_rotation, out);
 }
 

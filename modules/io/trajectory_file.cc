@@ -6,6 +6,7 @@
 
 #include "io/atomic_file.h"
 #include "io/observations_file.h"
+#include "io/transform_yaml.h"
 #include "yaml/yaml_reader.h"
 #include "io/yaml_schema.h"
 #include "io/yaml_writer.h"
@@ -67,6 +68,13 @@ void ReadPlannedFor(MapReader* root, Problems* problems, std::optional<planning:
   ok &= map.Double("max_condition_number", Range::Positive(1e300), &c.max_condition_number);
   ok &= ReadPointsMm(&map, "scene_dots_mm", true, problems, &p.scene.dots_in_base);
   ok &= ReadPointsMm(&map, "scene_extent_mm", false, problems, &p.scene.extent_in_base);
+  std::string configuration = CameraMountName(CameraMount::kEyeInHand);
+  if (map.OptionalString("configuration", &configuration) && !ParseCameraMount(configuration, &p.configuration)) {
+    problems->Add("`planned_for.configuration` at " + problems->At(node->line) + ": \"" + configuration +
+                  "\" is neither eye_in_hand nor eye_to_hand");
+    ok = false;
+  }
+  ok &= ReadTransform(&map, "base_from_cam", p.configuration == CameraMount::kEyeToHand, &p.base_from_cam);
   map.Finish();
   if (p.scene.extent_in_base.empty()) p.scene.extent_in_base = p.scene.dots_in_base;
   if (ok) {
@@ -105,6 +113,10 @@ std::string PlannedForYaml(const planning::PlannedFor& p) {
       << "  max_condition_number: " << YamlNumber(c.max_condition_number) << "\n";
   if (p.scene.extent_in_base != p.scene.dots_in_base) out << "  scene_extent_mm:\n" << PointsMm(p.scene.extent_in_base);
   out << "  scene_dots_mm:\n" << PointsMm(p.scene.dots_in_base);
+  if (p.configuration == CameraMount::kEyeToHand) {  // eye-in-hand plans keep their earlier bytes
+    out << "  configuration: " << CameraMountName(p.configuration) << "\n"
+        << "  base_from_cam: " << TransformYaml(p.base_from_cam, TransformStyle::kExact) << "\n";
+  }
   return out.str();
 }
 

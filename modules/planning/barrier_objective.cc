@@ -32,7 +32,7 @@ struct View {
 View ViewOf(const RobotModel& robot, const Eigen::VectorXd& q, bool with_derivatives) {
   View view;
   if (!with_derivatives) {
-    view.base_from_cam = BaseFromCam(robot, KinematicParameters::Nominal(robot), q);
+    view.base_from_cam = PointsFromCam(robot, KinematicParameters::Nominal(robot), q);
   } else {
     Eigen::Matrix<double, 3, Eigen::Dynamic> omega, v;
     view.base_from_cam = ComputeJointTwists<double>(robot, q.data(), &omega, &v);

@@ -31,6 +31,11 @@ bool ViewFits(const PlanningProblem& problem, const Rigid3& base_from_cam, doubl
       return false;
     }
   }
+  if (problem.robot.mount == CameraMount::kEyeToHand &&
+      PlateViewingAngle(base_from_cam, problem.scene.Centre()) > c.max_viewing_angle_rad) {
+    if (reason) *reason = "the plate seen more obliquely than the viewing angle";
+    return false;
+  }
   return true;
 }
 
@@ -63,7 +68,7 @@ bool SolveCameraIkNominal(const RobotModel& model, const Rigid3& target, const E
   };
   Eigen::VectorXd x = seed;
   MinimiseDampedLeastSquares(evaluate, &x);
-  const PoseDifference diff = ComparePoses(BaseFromCam(model, KinematicParameters::Nominal(model), x), target);
+  const PoseDifference diff = ComparePoses(PointsFromCam(model, KinematicParameters::Nominal(model), x), target);
   *q = x;
   return diff.position_m < 1e-10 && diff.rotation_rad < 1e-10;
 }
@@ -83,7 +88,7 @@ bool PoseFeasible(const PlanningProblem& problem, const Eigen::VectorXd& q, std:
       return false;
     }
   }
-  return ViewFits(problem, BaseFromCam(robot, KinematicParameters::Nominal(robot), q), 0.0, 0.0, reason);
+  return ViewFits(problem, PointsFromCam(robot, KinematicParameters::Nominal(robot), q), 0.0, 0.0, reason);
 }
 
 std::vector<Eigen::VectorXd> MakeCandidatePool(const PlanningProblem& problem,
@@ -102,7 +107,7 @@ std::vector<Eigen::VectorXd> MakeCandidatePool(const PlanningProblem& problem,
   std::uniform_real_distribution<double> unit(-1.0, 1.0), fraction(0.0, 1.0);
   std::uniform_int_distribution<size_t> pick(0, templates.size() - 1);
   std::vector<Rigid3> template_views;  // each template's camera, once
-  for (const Eigen::VectorXd& q : templates) template_views.push_back(BaseFromCam(robot, rho, q));
+  for (const Eigen::VectorXd& q : templates) template_views.push_back(PointsFromCam(robot, rho, q));
   std::vector<Eigen::VectorXd> pool;
   const int attempts = options.count * options.max_attempts_per_candidate;
   for (int attempt = 0; attempt < attempts && static_cast<int>(pool.size()) < options.count; ++attempt) {

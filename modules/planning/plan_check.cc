@@ -180,6 +180,20 @@ void CheckViewOfScene(const PlanningProblem& problem, const std::vector<Eigen::V
   }
 }
 
+// Eye-to-hand: the plate faces the fixed camera at every pose (PlanConstraints::max_viewing_angle_rad).
+void CheckViewingAngles(const PlanningProblem& problem, const std::vector<Rigid3>& flange_from_cam, PlanCheck* check) {
+  const double bound = problem.constraints.max_viewing_angle_rad;
+  const Eigen::Vector3d centre = problem.scene.Centre();
+  for (size_t i = 0; i < flange_from_cam.size(); ++i) {
+    const double angle = PlateViewingAngle(flange_from_cam[i], centre);
+    if (angle > bound) {
+      Add(check, PlanIssue::kViewingAngle, static_cast<int>(i), -1,
+          PoseName(static_cast<int>(i)) + ": the plate on the flange is seen " + Fmt("%.1f", RadToDeg(angle)) +
+              " deg off its normal by the fixed camera, more than " + Fmt("%.1f", RadToDeg(bound)) + " deg");
+    }
+  }
+}
+
 // Spread (duplicates, C7): camera centres at least min_spread_m apart. Each pose too close to an earlier
 // one is named once, with the first such pose: one problem per pair made a plan of n copies of one pose
 // n^2 / 2 problems (42,000 copies, the mutation campaign's, grew plan --check to 22 GB).
@@ -309,6 +323,7 @@ const char* PlanIssueName(PlanIssue issue) {
     case PlanIssue::kImageMotion: return "image_motion";
     case PlanIssue::kRobotMismatch: return "robot_mismatch";
     case PlanIssue::kVelocityLimit: return "velocity_limit";
+    case PlanIssue::kViewingAngle: return "viewing_angle";
   }
   return "unknown";
 }
@@ -334,12 +349,13 @@ void CheckGeometry(const PlanningProblem& problem, const std::vector<Eigen::Vect
   if (m < problem.num_identification_poses) return;
   const Eigen::VectorXd rho = KinematicParameters::Nominal(robot);
   std::vector<Rigid3> base_from_cam(m);
-  for (int i = 0; i < m; ++i) base_from_cam[i] = BaseFromCam(robot, rho, poses[i]);
+  for (int i = 0; i < m; ++i) base_from_cam[i] = PointsFromCam(robot, rho, poses[i]);
   // Every scene point in every image. Points: the extent (box corners or every dot), then every dot.
   std::vector<Eigen::Vector3d> points = problem.scene.extent_in_base;
   points.insert(points.end(), problem.scene.dots_in_base.begin(), problem.scene.dots_in_base.end());
   check->min_image_margin_px = std::numeric_limits<double>::infinity();
   for (int i = 0; i < m; ++i) CheckViewOfScene(problem, points, i, base_from_cam[i], check);
+  if (robot.mount == CameraMount::kEyeToHand) CheckViewingAngles(problem, base_from_cam, check);
   CheckSpread(c, base_from_cam, check);
   CheckAxisSines(c, base_from_cam, problem.num_identification_poses, check);
   CheckImageMotion(problem, poses, check);
@@ -353,7 +369,7 @@ void CheckGeometry(const PlanningProblem& problem, const std::vector<Eigen::Vect
 }  // namespace
 
 std::vector<Eigen::Vector2d> DotImages(const PlanningProblem& problem, const Eigen::VectorXd& q) {
-  const Rigid3 cam_from_base = BaseFromCam(problem.robot, KinematicParameters::Nominal(problem.robot), q).Inverse();
+  const Rigid3 cam_from_base = PointsFromCam(problem.robot, KinematicParameters::Nominal(problem.robot), q).Inverse();
   std::vector<Eigen::Vector2d> uv;
   uv.reserve(problem.scene.dots_in_base.size());
   for (const Eigen::Vector3d& x : problem.scene.dots_in_base) {
@@ -441,6 +457,8 @@ PlanCheck CheckPlanFor(const RobotModel* robot, const PlanSubject& plan, const C
   if (check.problems.empty() && plan.planned_for && robot != nullptr) {
     PlanningProblem problem;
     problem.robot = *robot;
+    problem.robot.mount = plan.planned_for->configuration;  // the frame of its scene
+    problem.robot.base_from_cam = plan.planned_for->base_from_cam;
     problem.camera = plan.planned_for->camera;
     problem.scene = plan.planned_for->scene;
     problem.constraints = c;
@@ -449,7 +467,8 @@ PlanCheck CheckPlanFor(const RobotModel* robot, const PlanSubject& plan, const C
     if (const std::string invalid = problem.Validate(); !invalid.empty()) {
       Add(&check, PlanIssue::kTooFewPoses, -1, -1, "the plan's `planned_for` block: " + invalid);
     } else {
-      check.scope.push_back("geometry (planned_for): " + std::to_string(problem.scene.dots_in_base.size()) +
+      check.scope.push_back(std::string("geometry (planned_for, ") + CameraMountName(problem.robot.mount) + "): " +
+                            std::to_string(problem.scene.dots_in_base.size()) +
                             " scene dots, " + std::to_string(problem.camera.width_px) + "x" +
                             std::to_string(problem.camera.height_px) + " px camera, f_x " +
                             Fmt("%.1f", problem.camera.fx_px) + " px: scene in image, depth, spread, f_x, "

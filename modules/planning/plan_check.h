@@ -33,6 +33,7 @@ enum class PlanIssue {
   kImageMotion,         // a move displaces the scene's dots in the image by more than the bound (median)
   kRobotMismatch,       // the plan file names another robot than the robot config
   kVelocityLimit,       // the controller reports no usable velocity limits (R3)
+  kViewingAngle,        // eye-to-hand: the plate seen more obliquely than max_viewing_angle_rad
 };
 const char* PlanIssueName(PlanIssue issue);
 
@@ -113,7 +114,8 @@ struct PlanSubject {
 // name; joint count and finite values (C5); the limits less the margin, of the config and of the
 // controller when given (C6); the joint travel per move (R2); the controller's velocity limits (R3); and,
 // when the plan records `planned_for`, every constraint of CheckPlan (scene in image, depth, spread,
-// f_x, excitation, image motion). Without `planned_for` only the robot-level checks run, with the
+// f_x, excitation, image motion; in eye-to-hand the viewing angle) in the configuration it records (the
+// robot's mount and fixed camera replaced by it: its scene is in that configuration's frame). Without `planned_for` only the robot-level checks run, with the
 // default margin and travel bound, and `scope` says so.
 // `robot` may be null (a session loop given no robot config): then only the controller's limits apply.
 PlanCheck CheckPlanFor(const RobotModel* robot, const PlanSubject& plan, const ControllerLimits* controller);

@@ -31,6 +31,12 @@ Scene Scene::FromDots(const std::vector<Eigen::Vector3d>& dots_in_base) {
   return scene;
 }
 
+Eigen::Vector3d Scene::Centre() const {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : extent_in_base) sum += p;
+  return extent_in_base.empty() ? sum : Eigen::Vector3d(sum / static_cast<double>(extent_in_base.size()));
+}
+
 std::string Scene::Validate() const {
   std::ostringstream out;
   if (dots_in_base.size() < 8) out << "the scene has " << dots_in_base.size() << " dots; at least 8 are needed\n";
@@ -64,6 +70,7 @@ std::string PlanConstraints::Validate() const {
   positive("pixel_noise_px", pixel_noise_px);
   if (!(min_axis_sine >= 0 && min_axis_sine < 1)) out << "min_axis_sine = " << min_axis_sine << " must lie in [0, 1)\n";
   positive("max_joint_travel_rad", max_joint_travel_rad);
+  positive("max_viewing_angle_rad", max_viewing_angle_rad);
   if (min_identification_poses < 3) out << "min_identification_poses = " << min_identification_poses << " must be >= 3\n";
   if (!(max_condition_number > 1)) out << "max_condition_number = " << max_condition_number << " must exceed 1\n";
   std::string s = out.str();

@@ -2,7 +2,9 @@
 // and the constraints every measurement configuration must satisfy. Shared by the planner
 // (planning/planner.h), the plan check (planning/plan_check.h) and the observability report.
 //
-// Frames and units: dots and box in the robot base frame (m); joint angles in rad; pixels as in
+// Frames and units: dots and box in the frame of the points (m): the robot base frame in eye-in-hand, the
+// flange frame in eye-to-hand (robot.mount; every view is then PointsFromCam, the fixed camera seen from the
+// flange, and the constraints apply to it); joint angles in rad; pixels as in
 // camera/camera.h; the camera's f_x is the nominal one (the planner never knows the true f_x).
 #pragma once
 
@@ -26,6 +28,8 @@ struct Scene {
 
   static Scene FromBox(const Eigen::Vector3d& center_m, const Eigen::Vector3d& size_m, int num_dots, uint64_t seed);
   static Scene FromDots(const std::vector<Eigen::Vector3d>& dots_in_base);
+  // The mean of the extent points (eye-to-hand: the plate's centre, PlateViewingAngle).
+  Eigen::Vector3d Centre() const;
   // Empty when valid; otherwise every problem, one per line.
   std::string Validate() const;
 };
@@ -58,6 +62,10 @@ struct PlanConstraints {
   double max_image_motion_px = 100.0;
   // Largest change of any joint between consecutive poses (the order the robot visits them).
   double max_joint_travel_rad = DegToRad(90.0);
+  // Eye-to-hand (robot.mount): the plate carried by the flange faces the fixed camera, its normal (the
+  // flange's z axis) within this angle of the direction from the scene's centre to the camera
+  // (PlateViewingAngle, view_geometry.h): past it the dots are seen too obliquely to be detected.
+  double max_viewing_angle_rad = DegToRad(55.0);
   // Fewer identification poses are refused (the paper's 6m > n; the rank check decides the rest).
   int min_identification_poses = 6;
   // Insufficient excitation (C7): refused when the identification poses identify fewer parameters than
@@ -74,6 +82,10 @@ struct PlannedFor {
   CameraIntrinsics camera;
   Scene scene;
   PlanConstraints constraints;
+  // Where the camera is: eye-in-hand (the scene in the base frame), or eye-to-hand (the scene on the plate
+  // in the flange frame, seen by the fixed camera base_from_cam). The check applies it to the robot config.
+  CameraMount configuration = CameraMount::kEyeInHand;
+  Rigid3 base_from_cam = Rigid3();  // eye-to-hand only: the nominal fixed camera the plan was made for
 };
 
 struct PlanningProblem {

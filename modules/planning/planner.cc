@@ -74,9 +74,9 @@ int RepairStart(const PlanningProblem& problem, const std::vector<Eigen::VectorX
                 std::vector<Eigen::VectorXd>* poses) {
   const Eigen::VectorXd rho = KinematicParameters::Nominal(problem.robot);
   std::vector<Rigid3> views;
-  for (const Eigen::VectorXd& q : *poses) views.push_back(BaseFromCam(problem.robot, rho, q));
+  for (const Eigen::VectorXd& q : *poses) views.push_back(PointsFromCam(problem.robot, rho, q));
   std::vector<Rigid3> pool_views;
-  for (const Eigen::VectorXd& q : pool) pool_views.push_back(BaseFromCam(problem.robot, rho, q));
+  for (const Eigen::VectorXd& q : pool) pool_views.push_back(PointsFromCam(problem.robot, rho, q));
   std::vector<bool> used(pool.size(), false);
   int replaced = 0;
   for (int i = 0; i < static_cast<int>(poses->size()); ++i) {
@@ -184,7 +184,7 @@ void PlanExchange(const PlanningProblem& problem, const PlannerOptions& options,
   std::vector<Rigid3> views;
   std::vector<std::vector<Eigen::Vector2d>> images;  // the dots' pixels: image motion between candidates
   for (const Eigen::VectorXd& q : candidates) {
-    views.push_back(BaseFromCam(problem.robot, rho, q));
+    views.push_back(PointsFromCam(problem.robot, rho, q));
     images.push_back(DotImages(problem, q));
   }
   // A candidate's Fisher contribution is computed when it is first evaluated (many never pass the
@@ -214,7 +214,7 @@ void PlanExchange(const PlanningProblem& problem, const PlannerOptions& options,
     return cached;
   };
   std::vector<Rigid3> verification;
-  for (int i = m_id; i < m; ++i) verification.push_back(BaseFromCam(problem.robot, rho, result->poses[i]));
+  for (int i = m_id; i < m; ++i) verification.push_back(PointsFromCam(problem.robot, rho, result->poses[i]));
   const PlanConstraints& c = problem.constraints;
   std::vector<int> chosen(m_id);
   for (int i = 0; i < m_id; ++i) chosen[i] = i;

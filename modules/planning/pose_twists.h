@@ -17,6 +17,13 @@
 // cam_r_from_cam_i: its rho-derivative in the reference camera frame is R_r^T [dw ; dw x p_i + dv] with
 // dw = omega_k(q_i) - omega_k(q_r), dv = v_k(q_i) - v_k(q_r). Rotating each 3-row group by its own
 // orthogonal matrix does not change singular values, so Cond(J) can be taken on [dw ; dw x p_i + dv].
+//
+// Eye-to-hand (RobotModel::mount): the camera that matters is the fixed one seen from the flange, the frame
+// of the points, X = F^-1 B (F = base_from_flange(q), B = the fixed camera): "base" below is then the flange
+// frame and base_from_cam is X (PointsFromCam). A chain parameter moves F by its spatial twist xi (base
+// frame), so dX = -[Ad_{F^-1} xi] X: its twist in the flange frame is -Ad_{F^-1} xi, with
+// Ad_G (omega, v) = (R_G omega, t_G x R_G omega + R_G v). The camera correction turns and shifts X about its
+// own axes, as the eye-in-hand camera correction does.
 #pragma once
 
 #include <vector>
@@ -33,6 +40,17 @@ struct CameraTwists {
   Rigid3T<T> base_from_cam;
   std::vector<Vec3T<T>> omega, v;  // per rho index, base frame
 };
+
+// Eye-to-hand: a spatial twist of the flange in the base frame as the twist of X = F^-1 B in the flange frame,
+// -Ad_{F^-1} (omega, v), in place.
+template <typename T>
+void FlangeTwistToPointsFrame(const Rigid3T<T>& base_from_flange, Vec3T<T>* omega, Vec3T<T>* v) {
+  const Mat3T<T> rt = base_from_flange.rotation.transpose();
+  const Vec3T<T> t = -(rt * base_from_flange.translation);
+  const Vec3T<T> w = rt * *omega;
+  *v = -(t.cross(w) + rt * *v);
+  *omega = -w;
+}
 
 template <typename T>
 CameraTwists<T> ComputeCameraTwists(const RobotModel& model, const T* q) {
@@ -68,8 +86,14 @@ CameraTwists<T> ComputeCameraTwists(const RobotModel& model, const T* q) {
     translation(off + 4, f, ez);
     f = f * Rigid3T<T>::FromTranslation(Vec3T<T>(T(0), T(0), T(p.d)));
   }
-  f = f * model.link_n_from_flange.Cast<T>() * model.flange_from_cam.Cast<T>();
   const int cam = 6 + 5 * n;
+  if (model.mount == CameraMount::kEyeToHand) {
+    const Rigid3T<T> flange = f * model.link_n_from_flange.Cast<T>();
+    for (int k = 0; k < cam; ++k) FlangeTwistToPointsFrame(flange, &out.omega[k], &out.v[k]);
+    f = flange.Inverse() * model.base_from_cam.Cast<T>();
+  } else {
+    f = f * model.link_n_from_flange.Cast<T>() * model.flange_from_cam.Cast<T>();
+  }
   for (int k = 0; k < 3; ++k) {
     translation(cam + k, f, axes[k]);
     rotation(cam + 3 + k, f, axes[k]);
@@ -100,6 +124,16 @@ Rigid3T<T> ComputeJointTwists(const RobotModel& model, const T* q, Eigen::Matrix
     v->col(i) = f.translation.cross(w);
     f = f * Rigid3T<T>::FromRotation(RotZ(q[i] + T(p.theta)));
     f = f * Rigid3T<T>::FromTranslation(Vec3T<T>(T(0), T(0), T(p.d)));
+  }
+  if (model.mount == CameraMount::kEyeToHand) {
+    const Rigid3T<T> flange = f * model.link_n_from_flange.Cast<T>();
+    for (int j = 0; j < n; ++j) {
+      Vec3T<T> w = omega->col(j), u = v->col(j);
+      FlangeTwistToPointsFrame(flange, &w, &u);
+      omega->col(j) = w;
+      v->col(j) = u;
+    }
+    return flange.Inverse() * model.base_from_cam.Cast<T>();
   }
   return f * model.link_n_from_flange.Cast<T>() * model.flange_from_cam.Cast<T>();
 }

@@ -35,4 +35,12 @@ T AxisSine(const Rigid3T<T>& base_from_cam_a, const Rigid3T<T>& base_from_cam_b)
   return abs(tau) / largest;
 }
 
+// Eye-to-hand: the angle (rad) between the plate's normal, the z axis of the flange frame (the frame of the
+// points), and the direction from `plate_centre` to the camera centre of `flange_from_cam`: 0 when the plate
+// faces the camera squarely, pi / 2 when the camera sees it edge-on.
+inline double PlateViewingAngle(const Rigid3& flange_from_cam, const Eigen::Vector3d& plate_centre) {
+  const Eigen::Vector3d to_camera = (flange_from_cam.translation - plate_centre).normalized();
+  return std::acos(std::clamp(to_camera.z(), -1.0, 1.0));
+}
+
 }  // namespace selfcal::planning

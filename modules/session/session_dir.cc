@@ -72,18 +72,20 @@ nlohmann::json ManifestToJson(const SessionManifest& manifest) {
           {"session_id", manifest.session_id},
           {"created_utc", manifest.created_utc},
           {"software_version", manifest.software_version},
+          {"configuration", CameraMountName(manifest.configuration)},
           {"inputs", inputs}};
 }
 
 // Problems of one JSON object's keys (the object at `path`, messages prefixed by `where`): missing
 // required ones (at the object's line) and unknown ones (at theirs).
 void CheckKeys(const nlohmann::json& object, const JsonPath& path, const std::string& where,
-               const std::vector<std::string>& keys, JsonFields* fields) {
+               const std::vector<std::string>& keys, JsonFields* fields, const std::vector<std::string>& optional = {}) {
   for (const std::string& key : keys) {
     if (!object.contains(key)) fields->Add(path, where + "missing key \"" + key + "\"");
   }
   for (const auto& item : object.items()) {
-    if (std::find(keys.begin(), keys.end(), item.key()) == keys.end()) {
+    if (std::find(keys.begin(), keys.end(), item.key()) == keys.end() &&
+        std::find(optional.begin(), optional.end(), item.key()) == optional.end()) {
       fields->Add(path.Member(item.key()), where + "unknown key \"" + TerminalSafe(item.key()) + "\"");
     }
   }
@@ -137,7 +139,8 @@ Result<SessionManifest> ParseManifest(const std::string& text, const std::string
                                            " (this selfcal reads " + std::to_string(kSessionFormatVersion) + ")");
     return fields.ToStatus();
   }
-  CheckKeys(json, root, "", {"format", "version", "session_id", "created_utc", "software_version", "inputs"}, &fields);
+  CheckKeys(json, root, "", {"format", "version", "session_id", "created_utc", "software_version", "inputs"}, &fields,
+            {"configuration"});
   auto string_field = [&](const char* key, std::string* out) {
     if (!json.contains(key)) return;
     if (!json[key].is_string()) {
@@ -149,6 +152,12 @@ Result<SessionManifest> ParseManifest(const std::string& text, const std::string
   string_field("session_id", &manifest.session_id);
   string_field("created_utc", &manifest.created_utc);
   string_field("software_version", &manifest.software_version);
+  std::string configuration = CameraMountName(CameraMount::kEyeInHand);  // sessions recorded before the key
+  string_field("configuration", &configuration);
+  if (!ParseCameraMount(configuration, &manifest.configuration)) {
+    fields.Add(root.Member("configuration"), "\"configuration\" \"" + TerminalSafe(configuration) +
+                                                 "\" is neither \"eye_in_hand\" nor \"eye_to_hand\"");
+  }
   if (json.contains("session_id") && !ValidSessionId(manifest.session_id)) {
     fields.Add(root.Member("session_id"),
                "\"session_id\" \"" + TerminalSafe(manifest.session_id) + "\" is not 1-128 of [A-Za-z0-9._-]");
@@ -436,6 +445,7 @@ Result<Session> CreateSession(const std::string& path, const SessionInputs& inpu
   manifest.session_id = options.session_id.empty() ? DeriveSessionId(path, options.created_utc) : options.session_id;
   manifest.created_utc = options.created_utc;
   manifest.software_version = software_version;
+  manifest.configuration = options.configuration;
   const std::string inputs_dir = Join(path, kInputsDirName);
   if (Status status = MakeDirectory(inputs_dir); !status.ok()) return status;
   for (const SessionInput& input : inputs) {

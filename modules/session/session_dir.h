@@ -15,7 +15,7 @@
 // `selfcal run --resume SESSION` continues after a crash.
 //
 //   <session>/session.json   manifest: format, version, session id, creation time, software version,
-//                            inputs with size and SHA-256 (written last at creation: the commit point)
+//                            configuration (eye_in_hand, eye_to_hand), inputs with size and SHA-256 (written last at creation: the commit point)
 //   <session>/lock           advisory lock, "<pid> <host> <start time>" of the holder (session_lock.h)
 //   <session>/journal.log    append-only journal of every event (journal.h; record types: samples.h)
 //   <session>/inputs/<name>  read-only (0444) copies of the config, robot, plan and camera files
@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "base/status.h"
+#include "kinematics/robot_model.h"
 #include "session/journal.h"
 #include "session/session_lock.h"
 
@@ -70,6 +71,9 @@ struct SessionManifest {
   std::string session_id;
   std::string created_utc;  // UTC ISO 8601, e.g. "2025-03-01T12:00:00Z"
   std::string software_version;
+  // Where the camera is (kinematics/robot_model.h): "configuration" in session.json, eye_in_hand when a
+  // session recorded before the key has none. A resume in the other configuration is refused.
+  CameraMount configuration = CameraMount::kEyeInHand;
   std::vector<InputDigest> inputs;
 
   const InputDigest* FindInput(const std::string& name) const;  // nullptr when absent
@@ -81,6 +85,7 @@ struct CreateOptions {
   // Free space the file system must have beyond the inputs (e.g. planned frames x frame size, C10).
   std::uint64_t min_free_bytes = 0;
   JournalLimits journal_limits;
+  CameraMount configuration = CameraMount::kEyeInHand;  // recorded in session.json
 };
 
 // What OpenSession found and did, for the session log.

@@ -63,7 +63,18 @@ Result<SessionObservations> LoadSessionObservations(const std::string& session_p
   if (!robot_text.ok()) return robot_text.status();
   Result<RobotModel> robot = io::ParseRobotModelText(*robot_text, InputPath(session_path, kRobotInputName));
   if (!robot.ok()) return robot.status();
+  // The robot of robot.yaml in the configuration of setup.json (its mount and nominal fixed camera).
+  const CameraMount mount = set.robot.mount;
+  const Rigid3 base_from_cam = set.robot.base_from_cam;
   set.robot = *robot;
+  set.robot.mount = mount;
+  set.robot.base_from_cam = base_from_cam;
+  if (snapshot->manifest.configuration != mount) {
+    return Status::Error(ErrorCode::kInvalidInput,
+                         "session " + session_path + ": session.json records configuration " +
+                             CameraMountName(snapshot->manifest.configuration) + " but inputs/setup.json " +
+                             CameraMountName(mount));
+  }
   const std::string journal_path = internal::Join(session_path, kJournalFileName);
   if (Status c = CheckSampleContents(*log, journal_path, set.camera, set.robot); !c.ok()) return c;
   for (const std::optional<AcceptedSample>& sample : log->accepted) {

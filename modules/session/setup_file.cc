@@ -1,5 +1,6 @@
 #include "session/setup_file.h"
 
+#include <cmath>
 #include <optional>
 #include <set>
 #include <utility>
@@ -92,6 +93,67 @@ void ParseDistances(const json& j, const std::string& key, JsonFields* fields, s
   }
 }
 
+// The numbers of `value` (an array of `count` numbers) into *out; false after naming the problem.
+bool Numbers(const json& value, const JsonPath& at, std::size_t count, JsonFields* fields, double* out) {
+  if (!value.is_array() || value.size() != count) {
+    fields->Add(at, "`" + at.name + "` must be an array of " + std::to_string(count) + " numbers");
+    return false;
+  }
+  for (std::size_t k = 0; k < count; ++k) {
+    if (!value[k].is_number() || !std::isfinite(value[k].get<double>())) {
+      fields->Add(at, "`" + at.name + "` must be an array of " + std::to_string(count) + " finite numbers");
+      return false;
+    }
+    out[k] = value[k].get<double>();
+  }
+  return true;
+}
+
+// "configuration" (default eye_in_hand) and, in eye-to-hand, "base_from_cam" {translation_m: [x, y, z],
+// rotation: [[row 0], [row 1], [row 2]]} (the nominal fixed camera) into robot->mount, robot->base_from_cam.
+void ParseConfiguration(const json& j, JsonFields* fields, RobotModel* robot) {
+  std::string configuration = CameraMountName(CameraMount::kEyeInHand);
+  if (j.contains("configuration") && fields->GetString(j, {}, "configuration", &configuration) &&
+      !ParseCameraMount(configuration, &robot->mount)) {
+    fields->Add(JsonPath{}.Member("configuration"),
+                "`configuration` \"" + configuration + "\" is neither eye_in_hand nor eye_to_hand");
+  }
+  const JsonPath at = JsonPath{}.Member("base_from_cam");
+  if (robot->mount == CameraMount::kEyeInHand) {
+    if (j.contains("base_from_cam")) {
+      fields->Add(at, "`base_from_cam` (a fixed camera) needs `configuration` eye_to_hand; eye_in_hand has none");
+    }
+    return;
+  }
+  const json* c = fields->Get(j, {}, "base_from_cam");
+  if (c == nullptr) return;
+  if (!c->is_object()) {
+    fields->Add(at, "`base_from_cam` must be an object {translation_m, rotation}");
+    return;
+  }
+  fields->CheckKnown(*c, at, {"translation_m", "rotation"});
+  double t[3], r[9];
+  const json* translation = fields->Get(*c, at, "translation_m");
+  const json* rotation = fields->Get(*c, at, "rotation");
+  if (translation == nullptr || rotation == nullptr) return;
+  bool ok = Numbers(*translation, at.Member("translation_m"), 3, fields, t);
+  if (!rotation->is_array() || rotation->size() != 3) {
+    fields->Add(at.Member("rotation"), "`base_from_cam.rotation` must be 3 rows of 3 numbers");
+    return;
+  }
+  for (std::size_t row = 0; row < 3; ++row) {
+    ok = Numbers((*rotation)[row], at.Member("rotation").Element(row), 3, fields, r + 3 * row) && ok;
+  }
+  if (!ok) return;
+  Eigen::Matrix3d m;
+  m << r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8];
+  if ((m.transpose() * m - Eigen::Matrix3d::Identity()).norm() > 1e-6 || m.determinant() < 0) {
+    fields->Add(at.Member("rotation"), "`base_from_cam.rotation` is not a rotation (orthonormal, determinant +1)");
+    return;
+  }
+  robot->base_from_cam = Rigid3(m, Eigen::Vector3d(t[0], t[1], t[2]));
+}
+
 }  // namespace
 
 std::string SetupFileText(const ObservationSet& setup, const SetupNaming& naming) {
@@ -103,6 +165,13 @@ std::string SetupFileText(const ObservationSet& setup, const SetupNaming& naming
             {"pixel_noise_px", setup.pixel_noise_px},
             {"yardsticks", KnownDistancesJson(setup.yardsticks)},
             {"check_distances", KnownDistancesJson(setup.check_distances)}};
+  if (setup.robot.mount == CameraMount::kEyeToHand) {  // eye-in-hand setups keep their earlier bytes
+    const Rigid3& c = setup.robot.base_from_cam;
+    j["configuration"] = CameraMountName(setup.robot.mount);
+    json rows = json::array();
+    for (int r = 0; r < 3; ++r) rows.push_back({c.rotation(r, 0), c.rotation(r, 1), c.rotation(r, 2)});
+    j["base_from_cam"] = {{"translation_m", {c.translation.x(), c.translation.y(), c.translation.z()}}, {"rotation", rows}};
+  }
   if (!naming.reference_image.empty()) j["reference_image"] = naming.reference_image;
   if (!naming.reference_dots.empty()) {
     json dots = json::array();
@@ -130,7 +199,8 @@ Status ParseSetupFile(const std::string& text, const std::string& name, Observat
     return fields.ToStatus();
   }
   fields.CheckKnown(j, {}, {"format", "version", "camera", "pixel_noise_px", "yardsticks", "check_distances",
-                           "reference_dots", "reference_image"});
+                           "reference_dots", "reference_image", "configuration", "base_from_cam"});
+  ParseConfiguration(j, &fields, &set->robot);
   ParseCamera(j, &fields, &set->camera);
   if (fields.GetDouble(j, {}, "pixel_noise_px", &set->pixel_noise_px) && !(set->pixel_noise_px > 0)) {
     fields.Add(JsonPath{}.Member("pixel_noise_px"), "`pixel_noise_px` must be positive");

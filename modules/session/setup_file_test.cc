@@ -22,6 +22,50 @@ ObservationSet ASetup() {
   return s;
 }
 
+TEST(SetupFile, EyeToHandRecordsItsFixedCameraExactly) {
+  ObservationSet setup = ASetup();
+  setup.robot.mount = CameraMount::kEyeToHand;
+  setup.robot.base_from_cam = Rigid3(RotZ(0.3) * RotX(2.9) * RotY(-0.1), Eigen::Vector3d(0.9540123456789, -0.0512, 0.4762));
+  const std::string text = SetupFileText(setup);
+  ObservationSet back;
+  ASSERT_TRUE(ParseSetupFile(text, "setup.json", &back).ok());
+  EXPECT_EQ(back.robot.mount, CameraMount::kEyeToHand);
+  EXPECT_EQ(back.robot.base_from_cam.rotation, setup.robot.base_from_cam.rotation);
+  EXPECT_EQ(back.robot.base_from_cam.translation, setup.robot.base_from_cam.translation);
+  // Eye-in-hand setups carry neither key, and read as eye-in-hand.
+  const std::string old_text = SetupFileText(ASetup());
+  EXPECT_EQ(old_text.find("configuration"), std::string::npos);
+  ObservationSet plain;
+  ASSERT_TRUE(ParseSetupFile(old_text, "setup.json", &plain).ok());
+  EXPECT_EQ(plain.robot.mount, CameraMount::kEyeInHand);
+}
+
+TEST(SetupFile, ConfigurationRefusalsNameTheKeyAndLine) {
+  ObservationSet setup = ASetup();
+  setup.robot.mount = CameraMount::kEyeToHand;
+  nlohmann::json j = nlohmann::json::parse(SetupFileText(setup));
+  auto refusal = [](const nlohmann::json& value) {
+    ObservationSet out;
+    const Status s = ParseSetupFile(value.dump(2), "s/inputs/setup.json", &out);
+    EXPECT_FALSE(s.ok());
+    return s.message();
+  };
+  nlohmann::json missing = j;
+  missing.erase("base_from_cam");
+  EXPECT_NE(refusal(missing).find("base_from_cam"), std::string::npos) << refusal(missing);
+  nlohmann::json other = j;
+  other["configuration"] = "eye_on_base";
+  EXPECT_NE(refusal(other).find("eye_on_base"), std::string::npos);
+  nlohmann::json reflection = j;
+  reflection["base_from_cam"]["rotation"][0] = {-1, 0, 0};
+  EXPECT_NE(refusal(reflection).find("not a rotation"), std::string::npos) << refusal(reflection);
+  nlohmann::json in_hand = j;
+  in_hand["configuration"] = "eye_in_hand";
+  const std::string message = refusal(in_hand);
+  EXPECT_NE(message.find("s/inputs/setup.json:"), std::string::npos) << message;
+  EXPECT_NE(message.find("needs `configuration` eye_to_hand"), std::string::npos) << message;
+}
+
 TEST(SetupFile, NamingKeysRoundTripAndAreOptional) {
   SetupNaming naming;
   naming.reference_dots = {{3, 120.25, 40.5, 96.0}, {10, 300.125, 200.0, 88.5}};

@@ -38,6 +38,14 @@ std::string SimOptions::Validate() const {
   if (num_identification_poses < 2) out << "num_identification_poses must be >= 2\n";
   non_negative(separation_dot_radius_m, "separation_dot_radius_m");
   non_negative(min_rim_gap_diameters, "min_rim_gap_diameters");
+  if (!(plate.half_size_m > 0) || !std::isfinite(plate.half_size_m)) out << "plate.half_size_m must be > 0\n";
+  non_negative(plate.standoff_m, "plate.standoff_m");
+  non_negative(plate.raised_m, "plate.raised_m");
+  if (plate.raised_every < 1) out << "plate.raised_every must be >= 1\n";
+  if (plate.num_dots < 8) out << "plate.num_dots = " << plate.num_dots << " must be >= 8\n";
+  if (!(plate.yardstick_length_m > 0) || !(plate.yardstick_length_m < 2 * std::sqrt(2.0) * plate.half_size_m)) {
+    out << "plate.yardstick_length_m must be > 0 and fit on the plate\n";
+  }
   return out.str();
 }
 
@@ -137,8 +145,10 @@ class ScenePlacer {
     for (const Rigid3& c : truth_.base_from_cam) cam_from_base_.push_back(c.Inverse());
   }
 
-  void Place(const Eigen::Vector3d& centre) {
-    if (options_.HasSheetGrid()) {
+  void Place(const Eigen::Vector3d& centre, CameraMount mount) {
+    if (mount == CameraMount::kEyeToHand) {
+      PlaceOnPlate();
+    } else if (options_.HasSheetGrid()) {
       PlaceGrid(centre);
     } else if (options_.flat_sheet) {
       PlaceOnSheet(centre);
@@ -253,6 +263,32 @@ class ScenePlacer {
     }
   }
 
+  // Eye-to-hand: on the plate carried by the flange (SimOptions::Plate), in the flange frame; the yardstick's
+  // ends on the face, every raised_every-th further dot raised above it.
+  void PlaceOnPlate() {
+    const SimOptions::Plate& plate = options_.plate;
+    std::uniform_real_distribution<double> uniform(-plate.half_size_m, plate.half_size_m);
+    auto on_face = [&](double u, double v) { return Eigen::Vector3d(u, v, plate.standoff_m); };
+    auto inside = [&](const Eigen::Vector3d& p) {
+      return std::abs(p.x()) <= plate.half_size_m && std::abs(p.y()) <= plate.half_size_m;
+    };
+    int tries = 0;
+    while (truth_.dots_in_base.size() < 2 && tries < kMaxTries) {
+      ++tries;
+      const double angle = kPi * uniform(rng_) / plate.half_size_m;
+      const Eigen::Vector3d half = 0.5 * plate.yardstick_length_m * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0);
+      const Eigen::Vector3d mid = on_face(0.5 * uniform(rng_), 0.5 * uniform(rng_));
+      if (inside(mid - half) && inside(mid + half)) PlacePair(mid - half, mid + half);
+    }
+    while (static_cast<int>(truth_.dots_in_base.size()) < plate.num_dots && tries < kMaxTries) {
+      ++tries;
+      Eigen::Vector3d p = on_face(uniform(rng_), uniform(rng_));
+      const int placed = static_cast<int>(truth_.dots_in_base.size()) - 2;
+      if (placed % plate.raised_every == plate.raised_every - 1) p.z() += plate.raised_m;
+      if (VisibleEverywhere(p)) Record(p);
+    }
+  }
+
   void PlaceInVolume(const Eigen::Vector3d& centre) {
     std::uniform_real_distribution<double> uniform(-kHalfSize, kHalfSize);
     int tries = 0;
@@ -284,6 +320,16 @@ class ScenePlacer {
 };
 
 }  // namespace
+
+Rigid3 FixedCameraTruth(const SimTruth& truth) {
+  return BaseFromCam(truth.nominal, truth.rho_true, Eigen::VectorXd::Zero(truth.nominal.num_joints()));
+}
+
+Rigid3 DefaultFixedCamera(const RobotModel& robot, const Eigen::VectorXd& home_joints_rad, double distance_m) {
+  const Rigid3 flange = BaseFromFlange(robot, KinematicParameters::Nominal(robot), home_joints_rad);
+  const Eigen::Matrix3d r = flange.rotation * RotX(kPi);  // z towards the flange, x along the flange's x
+  return Rigid3(r, flange.translation + distance_m * flange.rotation.col(2));
+}
 
 std::vector<KnownDistance> CheckPairs(const std::vector<Eigen::Vector3d>& dots) {
   std::vector<KnownDistance> pairs;
@@ -317,11 +363,14 @@ SimResult Simulate(const RobotModel& nominal, const std::vector<Eigen::VectorXd>
   truth.nominal = nominal;
   truth.nominal.flange_from_cam = nominal.flange_from_cam;
   PerturbModel(nominal, trajectory, options, &rng, &gauss, &truth);
-  for (const Eigen::VectorXd& q : trajectory) truth.base_from_cam.push_back(BaseFromCam(nominal, truth.rho_true, q));
+  for (const Eigen::VectorXd& q : trajectory) truth.base_from_cam.push_back(PointsFromCam(nominal, truth.rho_true, q));
 
-  ScenePlacer(options, &truth, &rng, &gauss).Place(ConvergencePoint(truth.base_from_cam));
-  const bool grid = options.HasSheetGrid();
-  const int num_dots = grid ? options.sheet_grid.rows * options.sheet_grid.cols : options.num_dots;
+  ScenePlacer(options, &truth, &rng, &gauss).Place(ConvergencePoint(truth.base_from_cam), nominal.mount);
+  const bool plate = nominal.mount == CameraMount::kEyeToHand;  // the plate in place of any sheet
+  const bool grid = options.HasSheetGrid() && !plate;
+  const int num_dots = plate  ? options.plate.num_dots
+                       : grid ? options.sheet_grid.rows * options.sheet_grid.cols
+                              : options.num_dots;
   if (static_cast<int>(truth.dots_in_base.size()) < num_dots) {
     std::ostringstream m;
     if (grid) {
@@ -329,7 +378,8 @@ SimResult Simulate(const RobotModel& nominal, const std::vector<Eigen::VectorXd>
         << 1e3 * options.sheet_grid.spacing_m << " mm does not fit in every view (margin " << options.image_margin_px
         << " px): choose fewer dots or a smaller spacing";
     } else {
-      m << "could not place " << num_dots << " dots in view of every pose: the views share too little of the scene";
+      m << "could not place " << num_dots << " dots in view of every pose: the views share too little of the "
+        << (plate ? "plate (does every pose keep it in the fixed camera's view?)" : "scene");
     }
     result.message = m.str();
     return result;
@@ -339,7 +389,10 @@ SimResult Simulate(const RobotModel& nominal, const std::vector<Eigen::VectorXd>
   result.observations.camera.fx_px = options.fx_nominal_px;
   const int far_end = grid ? num_dots - 1 : 1;
   result.observations.yardsticks = {
-      {0, far_end, grid ? (truth.dots_in_base[0] - truth.dots_in_base[far_end]).norm() : options.yardstick_length_m}};
+      {0, far_end,
+       grid    ? (truth.dots_in_base[0] - truth.dots_in_base[far_end]).norm()
+       : plate ? options.plate.yardstick_length_m
+               : options.yardstick_length_m}};
   result.observations.check_distances = CheckPairs(truth.dots_in_base);
   result.observations = Observe(result, trajectory, options.pixel_noise_px, options.noise_seed,
                                 options.num_identification_poses, options.joint_noise_rad);

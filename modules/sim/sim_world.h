@@ -13,6 +13,13 @@
 // flat_sheet, dots on one plane) in view of every pose, a yardstick, and image points projected with
 // Gaussian pixel noise. The solver only ever sees the
 // ObservationSet; the SimTruth is for scoring.
+//
+// Eye-to-hand (the nominal model's mount, kinematics/robot_model.h): the camera is fixed in the base frame at
+// the hidden true base_from_cam (the nominal RobotModel::base_from_cam corrected by the hidden camera
+// correction of rho) and the dots sit on a plate carried by the flange (SimOptions::Plate), at hidden
+// positions in the flange frame, a few of them raised so that they are not coplanar. Every camera pose of
+// the truth is then PointsFromCam, the camera in the flange frame, and the dots are in the flange frame:
+// the renderer, the observations and the scoring see one frame of the points whichever the mount.
 #pragma once
 
 #include <cstdint>
@@ -79,6 +86,19 @@ struct SimOptions {
   // any level. 0: readings exact.
   double joint_noise_rad = 0;
   int num_identification_poses = 15;  // the first ones; the rest are verification poses
+  // Eye-to-hand only (in place of num_dots and yardstick_length_m): num_dots dots on a square plate of side
+  // 2 half_size_m whose face is the plane z = standoff_m of the flange frame (facing along the flange's z
+  // axis), every raised_every-th dot raised_m above the face (not coplanar). The yardstick's two ends,
+  // yardstick_length_m apart, lie on the face.
+  struct Plate {
+    int num_dots = 16;
+    double yardstick_length_m = 0.12;
+    double half_size_m = 0.08;
+    double standoff_m = 0.03;
+    double raised_m = 0.025;
+    int raised_every = 4;
+  };
+  Plate plate;
   std::string Validate() const;
 };
 
@@ -87,8 +107,11 @@ struct SimTruth {
   Eigen::VectorXd rho_true;                 // hidden, in the nominal model's parameterisation
   std::vector<int> perturbed_indices;       // which entries of rho carry hidden errors
   CameraIntrinsics camera_true;             // hidden f_x
-  std::vector<Eigen::Vector3d> dots_in_base;  // dot id = index
-  std::vector<Rigid3> base_from_cam;        // true camera pose per pose
+  // In the points' frame: the base (eye-in-hand), the flange (eye-to-hand). dot id = index.
+  std::vector<Eigen::Vector3d> dots_in_base;
+  // True camera pose per pose in the points' frame: PointsFromCam(nominal, rho_true, q) (= BaseFromCam in
+  // eye-in-hand; the fixed camera in eye-to-hand is FixedCameraTruth).
+  std::vector<Rigid3> base_from_cam;
   std::vector<double> dot_radius_scale;     // per dot, of the rendered radius; empty: 1 for every dot
 };
 
@@ -98,6 +121,16 @@ struct SimResult {
   ObservationSet observations;
   SimTruth truth;
 };
+
+// Eye-to-hand: the true fixed camera in the base frame, BaseFromCam(nominal, rho_true, any joints).
+Rigid3 FixedCameraTruth(const SimTruth& truth);
+
+// The nominal fixed camera of a simulated eye-to-hand cell for `robot` (its DH and home_joints_rad, the
+// pose the arm rests in): distance_m in front of the flange along its z axis at home, looking back at the
+// flange, its x axis along the flange's x: the plate faces the camera at home, whatever the arm. Every
+// command that builds the simulated eye-to-hand cell (plan, run, simulate) takes this camera, so that a
+// plan and the session run on it agree.
+Rigid3 DefaultFixedCamera(const RobotModel& robot, const Eigen::VectorXd& home_joints_rad, double distance_m = 0.8);
 
 // Simulates a session on `trajectory` (joint angles, rad). Fails (ok = false, message) if the trajectory
 // leaves the joint limits or no scene of num_dots dots fits in every view.

@@ -37,4 +37,20 @@ struct GeneratedTrajectory {
 
 GeneratedTrajectory MakeArcTrajectory(const RobotModel& nominal, const ArcTrajectoryOptions& options);
 
+// Eye-to-hand (nominal.mount): a smooth path of the flange in front of the fixed camera (the nominal
+// RobotModel::base_from_cam). The plate's centre (plate_standoff_m along the flange's z) wanders a Lissajous
+// path around where it is at home, the plate's normal tilts about the direction to the camera and the flange
+// rolls about it, so that the plate stays in view, facing the camera, while every wrist joint moves. Joint
+// angles from the flange's inverse kinematics on the nominal model, continued pose to pose.
+struct EyeToHandTrajectoryOptions {
+  int num_poses = 25;
+  std::vector<double> home_joints_deg;  // where the plate faces the camera (sim::DefaultFixedCamera's home)
+  double plate_standoff_m = 0.03;
+  Eigen::Vector3d wander_m = Eigen::Vector3d(0.08, 0.06, 0.05);  // half-amplitudes in the camera's x, y, z
+  double tilt_deg = 22.0;       // plate normal away from the direction to the camera, at most
+  double roll_swing_deg = 45.0;
+  double joint_margin_rad = DegToRad(5.0);
+};
+GeneratedTrajectory MakeEyeToHandTrajectory(const RobotModel& nominal, const EyeToHandTrajectoryOptions& options);
+
 }  // namespace selfcal::sim

@@ -76,6 +76,7 @@ IdentityAudit AuditIdentities(const sim::SimResult& world, const session::Sessio
                               const IdentityAuditOptions& options) {
   IdentityAudit audit;
   audit.gate_px = options.gate_px;
+  audit.configuration = world.truth.nominal.mount;
   audit.poses_planned = log.num_poses;
   const sim::SimTruth& truth = world.truth;
   const sim::DotScene scene = sim::MakeDotScene(truth);
@@ -83,7 +84,7 @@ IdentityAudit AuditIdentities(const sim::SimResult& world, const session::Sessio
     if (!sample) continue;
     const Eigen::VectorXd joints = Eigen::Map<const Eigen::VectorXd>(sample->joints_rad.data(),
                                                                      static_cast<Eigen::Index>(sample->joints_rad.size()));
-    const Rigid3 base_from_cam = BaseFromCam(truth.nominal, truth.rho_true, joints);
+    const Rigid3 base_from_cam = PointsFromCam(truth.nominal, truth.rho_true, joints);  // the points' frame
     const sim::RenderedImage view = sim::RenderDots(truth.camera_true, base_from_cam, scene, GeometryOnly(), 0);
     audit.samples.push_back(AuditSample(*sample, view, options.gate_px, &audit.wrong));
   }
@@ -143,7 +144,8 @@ nlohmann::json IdentityAuditJson(const IdentityAudit& audit) {
   }
   nlohmann::json wrong = nlohmann::json::array();
   for (size_t k = 0; k < audit.wrong.size() && k < 50; ++k) wrong.push_back(WrongJson(audit.wrong[k]));
-  return {{"gate_px", audit.gate_px},
+  return {{"configuration", CameraMountName(audit.configuration)},
+          {"gate_px", audit.gate_px},
           {"poses_planned", audit.poses_planned},
           {"samples_accepted", audit.samples_accepted},
           {"named_per_sample", {{"mean", audit.named_mean}, {"min", audit.named_min}}},
@@ -160,7 +162,8 @@ std::string IdentityAuditSummary(const IdentityAudit& audit) {
   std::ostringstream out;
   out.setf(std::ios::fixed);
   out.precision(1);
-  out << audit.samples_accepted << "/" << audit.poses_planned << " samples accepted; named per sample mean "
+  out << CameraMountName(audit.configuration) << ": " << audit.samples_accepted << "/" << audit.poses_planned
+      << " samples accepted; named per sample mean "
       << audit.named_mean << ", min " << audit.named_min << " of in view mean " << audit.in_view_mean << " (ratio mean "
       << 100 * audit.ratio_mean << " %, min " << 100 * audit.ratio_min << " %); " << audit.wrong_total
       << " wrong identities (gate " << audit.gate_px << " px; right names within ";

@@ -2,7 +2,8 @@
 // every accepted sample, which dots the camera really had in view, how many of them the session named,
 // and which names are wrong.
 //
-// Truth per sample: the true camera pose BaseFromCam(nominal, rho_true, joints_rad) at the sample's
+// Truth per sample: the true camera pose PointsFromCam(nominal, rho_true, joints_rad) (in the points' frame:
+// the flange in eye-to-hand) at the sample's
 // recorded joints, the true camera (f_x, k1) and the world's dot discs (sim::MakeDotScene, as the
 // simulated camera renders them). Visibility is the renderer's (sim::RenderDots): a dot is in view when
 // its whole disc is in front of the camera and inside the image (RenderedDot in_front && fully_inside).
@@ -67,6 +68,7 @@ struct SampleIdentities {
 };
 
 struct IdentityAudit {
+  CameraMount configuration = CameraMount::kEyeInHand;  // the world's (its nominal robot's mount)
   double gate_px = 0;
   int poses_planned = 0;
   int samples_accepted = 0;

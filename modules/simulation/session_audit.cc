@@ -82,10 +82,17 @@ Result<SimCell> RebuildWorld(const session::SessionSnapshot& snapshot, const ses
     return Refuse("session " + path + ": the journal holds " + std::to_string(log.plan.size()) + " of " +
                   std::to_string(log.num_poses) + " planned poses; the world cannot be rebuilt without the plan");
   }
-  Result<SimCell> cell = MakeSimCell(*nominal, log.plan, options, log.plan.front().joints_rad, 0);
-  if (!cell.ok()) return cell.status();
   Result<std::string> setup = snapshot.Input(session::kSetupFileName);
   if (!setup.ok()) return setup.status();
+  ObservationSet recorded;  // the configuration and fixed camera of the cell (setup.json)
+  if (Status s = session::ParseSetupFile(*setup, path + "/inputs/" + session::kSetupFileName, &recorded); !s.ok()) {
+    return s;
+  }
+  RobotModel robot = *nominal;
+  robot.mount = recorded.robot.mount;
+  robot.base_from_cam = recorded.robot.base_from_cam;
+  Result<SimCell> cell = MakeSimCell(robot, log.plan, options, log.plan.front().joints_rad, 0);
+  if (!cell.ok()) return cell.status();
   if (Status s = CompareSetup(session::SetupFileText(SimSetup(*cell)), *setup, path); !s.ok()) return s;
   return cell;
 }

@@ -97,7 +97,7 @@ void RestartSimCell(SimCell* cell, const SimCellOptions& options, const Eigen::V
   const sim::SimTruth* truth = &cell->world->truth;
   const robot::SimulatedRobot* arm = cell->robot.get();
   cell->camera->SetPoseFunction(
-      [truth, arm](double t) { return BaseFromCam(truth->nominal, truth->rho_true, arm->JointsAt(t)); });
+      [truth, arm](double t) { return PointsFromCam(truth->nominal, truth->rho_true, arm->JointsAt(t)); });
   cell->identifier = std::make_unique<TruthIdentifier>(cell->camera.get(), MarkedDots(*cell->world));
 }
 
@@ -118,7 +118,7 @@ void FollowReportedJoints(SimCell* cell, const SimCellOptions& options, robot::R
     if (reading.ok() && reading->position_rad.size() == joints->size() && reading->position_rad.allFinite()) {
       *joints = reading->position_rad;
     }
-    return BaseFromCam(truth->nominal, truth->rho_true, *joints);
+    return PointsFromCam(truth->nominal, truth->rho_true, *joints);
   });
   cell->identifier = std::make_unique<TruthIdentifier>(cell->camera.get(), MarkedDots(*cell->world));
 }

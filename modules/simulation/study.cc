@@ -182,14 +182,14 @@ void ScoreRun(const sim::SimResult& world, const ObservationSet& obs, const cali
     if (c.ok) cell->error3d_calibrated_mm.Add(kMm * c.error_m);
   }
   const Eigen::VectorXd rho_nominal = KinematicParameters::Nominal(obs.robot);
-  const Rigid3 nominal_ref_from_base = BaseFromCam(obs.robot, rho_nominal, obs.poses[ref].joints_rad).Inverse();
+  const Rigid3 nominal_ref_from_base = PointsFromCam(obs.robot, rho_nominal, obs.poses[ref].joints_rad).Inverse();
   const Rigid3 calibrated_ref_from_base =
-      BaseFromCam(report.calibrated_robot, report.calibrated_rho, obs.poses[ref].joints_rad).Inverse();
+      PointsFromCam(report.calibrated_robot, report.calibrated_rho, obs.poses[ref].joints_rad).Inverse();
   for (int v : obs.PosesWithRole(PoseRole::kVerification)) {
     const Rigid3 true_rel = true_ref_from_base * truth.base_from_cam[v];
-    const Rigid3 nominal_rel = nominal_ref_from_base * BaseFromCam(obs.robot, rho_nominal, obs.poses[v].joints_rad);
+    const Rigid3 nominal_rel = nominal_ref_from_base * PointsFromCam(obs.robot, rho_nominal, obs.poses[v].joints_rad);
     const Rigid3 calibrated_rel = calibrated_ref_from_base *
-                                  BaseFromCam(report.calibrated_robot, report.calibrated_rho, obs.poses[v].joints_rad);
+                                  PointsFromCam(report.calibrated_robot, report.calibrated_rho, obs.poses[v].joints_rad);
     const PoseDifference before = ComparePoses(true_rel, nominal_rel);
     const PoseDifference after = ComparePoses(true_rel, calibrated_rel);
     cell->pose_position_nominal_mm.Add(kMm * before.position_m);
@@ -252,9 +252,9 @@ void ScoreBundle(const sim::SimResult& world, const ObservationSet& obs, const c
   const std::vector<int> id_poses = obs.PosesWithRole(PoseRole::kIdentification);
   const int ref = id_poses.front();
   const Rigid3 true_ref_from_base = truth.base_from_cam[ref].Inverse();
-  const Rigid3 model_ref_from_base = BaseFromCam(robot, b.rho, obs.poses[ref].joints_rad).Inverse();
+  const Rigid3 model_ref_from_base = PointsFromCam(robot, b.rho, obs.poses[ref].joints_rad).Inverse();
   auto relative_error = [&](int pose) {
-    const Rigid3 model = model_ref_from_base * BaseFromCam(robot, b.rho, obs.poses[pose].joints_rad);
+    const Rigid3 model = model_ref_from_base * PointsFromCam(robot, b.rho, obs.poses[pose].joints_rad);
     return ComparePoses(true_ref_from_base * truth.base_from_cam[pose], model);
   };
   for (size_t k = 1; k < id_poses.size(); ++k) {
