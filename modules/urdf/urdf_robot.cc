@@ -48,7 +48,12 @@ Result<FkCheck> CompareWithKdl(const std::string& text, const std::string& name,
   Result<std::vector<Rigid3>> tips = KdlChainPoses(text, name, spec.base_link, spec.tip_link, joints);
   if (!tips.ok()) return tips.status();
   Result<std::vector<Rigid3>> cams = tips;
-  if (!spec.camera_link.empty()) cams = KdlChainPoses(text, name, spec.base_link, spec.camera_link, joints);
+  if (!spec.camera_link.empty()) {
+    // A fixed camera (eye-to-hand) hangs from the base: its chain has no joints.
+    const bool fixed = model.mount == CameraMount::kEyeToHand;
+    cams = KdlChainPoses(text, name, spec.base_link, spec.camera_link,
+                         fixed ? std::vector<Eigen::VectorXd>(joints.size(), Eigen::VectorXd()) : joints);
+  }
   if (!cams.ok()) return cams.status();
   const Eigen::VectorXd rho = KinematicParameters::Nominal(model);
   FkCheck check;

@@ -58,6 +58,29 @@ TEST(UrdfWriter, CalibratedModelsKdlForwardKinematicsEqualsTheModel) {
   }
 }
 
+// Eye-to-hand: the camera hangs from base_link (a chain without joints), the arm as before; KDL agrees
+// with the model's fixed camera and flange.
+TEST(UrdfWriter, AFixedCameraHangsFromTheBase) {
+  RobotModel nominal = testing::Puma560();
+  nominal.mount = CameraMount::kEyeToHand;
+  nominal.base_from_cam = Rigid3(RotZ(0.4) * RotX(2.6), Eigen::Vector3d(0.8, -0.1, 0.5));
+  const RobotModel calibrated = CalibratedLike(nominal, 4);
+  Result<std::string> text = UrdfOfModel(calibrated, {});
+  ASSERT_TRUE(text.ok()) << text.status().message();
+  const std::vector<Eigen::VectorXd> joints = RandomJointsWithinLimits(calibrated, 100, 5);
+  Result<std::vector<Rigid3>> tips = KdlChainPoses(*text, "written", "base_link", "tool0", joints);
+  Result<std::vector<Rigid3>> cams = KdlChainPoses(*text, "written", "base_link", "camera_optical_frame",
+                                                   std::vector<Eigen::VectorXd>(1, Eigen::VectorXd()));
+  ASSERT_TRUE(tips.ok()) << tips.status().message();
+  ASSERT_TRUE(cams.ok()) << cams.status().message();
+  const Eigen::VectorXd rho = KinematicParameters::Nominal(calibrated);
+  EXPECT_TRUE(testing::RigidNear(calibrated.base_from_cam, cams->front(), 1e-9, 1e-9));
+  EXPECT_TRUE(testing::RigidNear(BaseFromCam(calibrated, rho, joints.front()), cams->front(), 1e-9, 1e-9));
+  for (size_t i = 0; i < joints.size(); ++i) {
+    ASSERT_TRUE(testing::RigidNear(BaseFromFlange(calibrated, rho, joints[i]), (*tips)[i], 1e-9, 1e-9)) << i;
+  }
+}
+
 TEST(UrdfWriter, OriginsNearGimbalLockStayExact) {
   RobotModel model = testing::Puma560();
   model.links[2].alpha = kPi / 2;
