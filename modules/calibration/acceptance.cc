@@ -190,6 +190,7 @@ AcceptanceCheck BeatsNominalHeldOut(const AcceptanceInputs& in) {
 AcceptanceCheck BeatsNominalDistances(const AcceptanceInputs& in) {
   AcceptanceCheck check{"beats_nominal_distances", CheckStatus::kNotAvailable, "no check distances in the set",
                         in.distances_decisive};
+  if (!in.no_distances_reason.empty()) check.sentence = in.no_distances_reason;
   if (in.distances_calibrated == nullptr || in.distances_nominal == nullptr ||
       in.distances_calibrated->checks.empty() || in.distances_nominal->checks.empty()) {
     return check;

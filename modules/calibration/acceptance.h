@@ -83,6 +83,9 @@ struct AcceptanceInputs {
   const VerificationSummary* distances_calibrated = nullptr;  // null or empty: no check distances
   const VerificationSummary* distances_nominal = nullptr;
   bool distances_decisive = true;
+  // Why the set's check distances were not measured (empty: none in the set, or measured): they are
+  // triangulated from the verification poses, and a set may name none.
+  std::string no_distances_reason;
   // The bundle's kinematic corrections: the parameters' names, kinds and corrections (estimate - nominal);
   // empty for the paper's method.
   const RobotModel* robot = nullptr;

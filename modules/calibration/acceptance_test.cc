@@ -78,5 +78,20 @@ TEST(Acceptance, OnlyAHeldOutCheckMakesAModelTested) {
   EXPECT_TRUE(a.HeldOutTested());
 }
 
+// Check distances a set gives but could not measure (no verification pose to triangulate them from) are
+// said to be there, with the reason, not called absent; a set without any says so.
+TEST(Acceptance, UnmeasuredCheckDistancesSayWhy) {
+  AcceptanceInputs in;
+  const VerificationSummary none;
+  in.distances_calibrated = &none;
+  in.distances_nominal = &none;
+  EXPECT_EQ(Check(AcceptanceOf(in), "beats_nominal_distances").sentence, "no check distances in the set");
+  in.no_distances_reason = "the set's 1 check distance(s) are measured on verification poses, and it names none";
+  const Acceptance acceptance = AcceptanceOf(in);
+  const AcceptanceCheck& check = Check(acceptance, "beats_nominal_distances");
+  EXPECT_EQ(check.status, CheckStatus::kNotAvailable);
+  EXPECT_EQ(check.sentence, in.no_distances_reason);
+}
+
 }  // namespace
 }  // namespace selfcal::calibration

@@ -170,6 +170,11 @@ void CheckAcceptance(const ObservationSet& obs, const ObservationSet& original, 
     in.distances_calibrated = &stage.verification;
     in.distances_nominal = &stage.verification_nominal;
     in.distances_decisive = false;
+    if (!obs.check_distances.empty() && obs.PosesWithRole(PoseRole::kVerification).empty()) {
+      in.no_distances_reason = "the set's " + std::to_string(obs.check_distances.size()) +
+                               " check distance(s) are measured on verification poses, and it names none (a pose's "
+                               "role: verification)";
+    }
     if (stage.bundle.rho.size() == obs.robot.num_parameters()) {
       in.robot = &obs.robot;
       in.corrections = stage.bundle.rho - KinematicParameters::Nominal(obs.robot);
