@@ -83,6 +83,25 @@ bool CameraStartFromImages(const ObservationSet& obs, const BundleStageOptions& 
   return start.ok;
 }
 
+// A camera start from the images that leads the bundle nowhere (the dots not triangulable from it, no
+// convergence) is a wrong start, not a verdict on the data: the bundle is run again from the camera at the
+// robot description's mount, and that run is kept when it converged.
+void RetryAtTheDescribedMount(const ObservationSet& obs, const BundleStageOptions& options, BundleStageReport* report) {
+  if (!report->camera_from_images || report->bundle.outcome == bundle::Outcome::kConverged ||
+      report->bundle.outcome == bundle::Outcome::kInvalidInput) {
+    return;
+  }
+  bundle::BundleReport again =
+      bundle::RunBundleAdjustment(obs, KinematicParameters::Nominal(obs.robot), report->fx_start_px, options.bundle);
+  if (again.outcome != bundle::Outcome::kConverged) return;
+  again.seconds += report->bundle.seconds;
+  report->start_note += std::string("; from the images' camera the bundle ended ") +
+                        bundle::OutcomeName(report->bundle.outcome) +
+                        ", so it started again from the camera at the robot description's mount";
+  report->bundle = std::move(again);
+  report->camera_from_images = false;
+}
+
 }  // namespace
 
 HeldOutReprojection HeldOutReprojectionOfBundle(const ObservationSet& obs, const bundle::BundleReport& b,
@@ -162,6 +181,7 @@ BundleStageReport RunBundleStage(const ObservationSet& obs, const PaperPipelineR
     report.fx_start_px = obs.camera.fx_px;
     report.start_note = note;
   }
+  RetryAtTheDescribedMount(obs, options, &report);
   const bundle::BundleReport& b = report.bundle;
   const std::vector<int> verification_poses = obs.PosesWithRole(PoseRole::kVerification);
   const bool valid = !verification_poses.empty() && obs.Validate().empty();
