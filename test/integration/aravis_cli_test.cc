@@ -5,7 +5,10 @@
 // these tests need (the camera's path through the session, not a calibration).
 #include <fcntl.h>
 #include <signal.h>
+#include <arpa/inet.h>
+#include <netinet/in.h>
 #include <sys/file.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -58,6 +61,24 @@ void Stop(pid_t* pid) {
     ::waitpid(*pid, nullptr, 0);
   }
   *pid = -1;
+}
+
+// Waits (up to 10 s) until the fake camera holds GVCP's port 3956 on 127.0.0.1, i.e. it answers discovery;
+// a fixed half second was too short on a loaded machine. True when it does.
+bool WaitForFakeCamera() {
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    if (fd < 0) return false;
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_port = htons(3956);
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    const bool taken = ::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) != 0;
+    ::close(fd);
+    if (taken) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return false;
 }
 
 // setup.json for the fake cameras' 512x512 frames.
@@ -129,7 +150,7 @@ TEST(AravisCli, RunHaltsWhenTheGigECameraVanishesAndResumesWhenItIsBack) {
   }
   ASSERT_GT(port, 0) << "selfcal-robot-sim did not print its port";
   pid_t camera = Spawn({kFakeGvCamera, "-i", "127.0.0.1"});
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  ASSERT_TRUE(WaitForFakeCamera()) << kFakeGvCamera << " did not take GVCP's port";
   const std::string run = "run --session " + session + " --plan " + plan + " --robot network --address 127.0.0.1:" +
                           std::to_string(port) + " --camera aravis:127.0.0.1 --setup " + setup + " --live-view off";
   std::string output;
@@ -149,7 +170,7 @@ TEST(AravisCli, RunHaltsWhenTheGigECameraVanishesAndResumesWhenItIsBack) {
   EXPECT_TRUE(std::filesystem::exists(session + "/images/rejected/p00_0.png")) << "the first pose's frame is kept";
   // The camera is back: the same command with --resume visits the rest.
   camera = Spawn({kFakeGvCamera, "-i", "127.0.0.1"});
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  ASSERT_TRUE(WaitForFakeCamera()) << kFakeGvCamera << " did not take GVCP's port";
   EXPECT_EQ(RunSelfcal(run + " --resume < /dev/null", &output), 3) << output;  // too few samples: no dots
   EXPECT_TRUE(Has(output, "every pose was visited")) << output;
   Stop(&camera);
