@@ -152,7 +152,9 @@ RankSelection SelectColumns(const Eigen::MatrixXd& jacobian, const std::vector<i
   for (int k = 0; k < sv.size(); ++k) svd_rank += sv[k] > threshold ? 1 : 0;
   std::vector<Eigen::VectorXd> null_vectors;
   if (cols - svd_rank == static_cast<int>(out.dependent.size())) {
-    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(ColumnsOf(normalized, out.kept));
+    // Eigen's QR of a matrix without columns reads past its ends: nothing kept, nothing to expand on.
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr;
+    if (!out.kept.empty()) qr.compute(ColumnsOf(normalized, out.kept));
     for (int c : out.dependent) {
       null_vectors.push_back(NullDirection(qr, out.kept, normalized.col(c), c, cols, !out.kept.empty() && !zero[c]));
     }
@@ -182,7 +184,8 @@ std::vector<WeakColumn> FindWeakColumns(const Eigen::MatrixXd& whitened, const s
     const double conditional_std = residual > 0 ? 1.0 / residual : std::numeric_limits<double>::infinity();
     if (tolerance[c] > 0 && conditional_std > tolerance[c]) {
       // The column on the earlier kept ones, all normalised: the direction the data cannot see.
-      const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(ColumnsOf(normalized, kept));
+      Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr;
+      if (!kept.empty()) qr.compute(ColumnsOf(normalized, kept));
       const Eigen::VectorXd x = NullDirection(qr, kept, normalized.col(c), c, cols, !kept.empty() && norm > 0);
       weak.push_back({c, conditional_std, tolerance[c], FormatCombination(x, names)});
       continue;

@@ -80,5 +80,20 @@ TEST(FindWeakColumns, AWeakColumnJoinsNoBasisSoALaterIndependentColumnStaysFree)
   EXPECT_EQ(weak[0].column, 2);
 }
 
+// A problem with no rows (every dot dropped) or only zero columns keeps nothing, names every column as
+// dependent, each alone, and does not crash (an empty QR read past its ends: calibrate died with SIGSEGV).
+TEST(SelectColumns, NothingToKeepMakesEveryColumnDependentAlone) {
+  const std::vector<std::string> names = {"a", "b", "c"};
+  for (const Eigen::MatrixXd& j : std::vector<Eigen::MatrixXd>{Eigen::MatrixXd(0, 3), Eigen::MatrixXd::Zero(5, 3)}) {
+    const RankSelection r = SelectColumns(j, {0, 1, 2}, 1e-10, names);
+    EXPECT_TRUE(r.kept.empty());
+    EXPECT_EQ(r.dependent, (std::vector<int>{0, 1, 2}));
+    ASSERT_EQ(r.null_combinations.size(), 3u);
+  }
+  Eigen::VectorXd tolerance = Eigen::VectorXd::Ones(3);
+  const std::vector<WeakColumn> weak = FindWeakColumns(Eigen::MatrixXd::Zero(5, 3), {0, 1, 2}, tolerance, names);
+  EXPECT_EQ(weak.size(), 3u);
+}
+
 }  // namespace
 }  // namespace selfcal::identification
