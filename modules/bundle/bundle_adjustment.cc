@@ -486,6 +486,12 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
     return finish(Outcome::kScaleUnresolved,
                   "no yardstick has both ends seen (and triangulable) in two or more identification poses");
   }
+  if (data.observations.empty()) {
+    return finish(Outcome::kDegenerate, "no dot could be placed: each of the " +
+                                            std::to_string(report.dropped_dots.size()) +
+                                            " was seen in fewer than two identification poses or was not "
+                                            "triangulable from the start's cameras");
+  }
 
   internal::Gauge gauge;
   if (!AnalyzeStartGauge(data, state, options, held, &gauge, &report)) {

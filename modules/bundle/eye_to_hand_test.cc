@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <map>
 
 #include <gtest/gtest.h>
 
@@ -98,6 +99,24 @@ TEST(EyeToHandBundle, RecoversTheHiddenArmCameraAndPointsExactlyWithoutNoise) {
 
 TEST(EyeToHandBundle, RecoversTheFixedCameraAndPointsOfAFlangePoseSetExactly) {
   ExpectExactRecovery(selfcal::testing::Puma560(), true);
+}
+
+// A set in which no dot can be placed (here: every dot seen by one pose only) ends degenerate and says so,
+// rather than blaming f_x (or, before, crashing in the rank selection of a problem without rows).
+TEST(EyeToHandBundle, NoDotPlacedIsDegenerateAndSaysWhy) {
+  EyeToHandOptions options;
+  options.flange_poses = true;
+  ObservationSet obs = MakeEyeToHandWorld(selfcal::testing::Puma560(), options).observations;
+  int pose_number = 0;
+  for (PoseObservation& pose : obs.poses) {
+    std::map<int, Eigen::Vector2d> renamed;
+    for (const auto& [id, pixel] : pose.dots_px) renamed[1000 * pose_number + id] = pixel;
+    pose.dots_px = renamed;
+    ++pose_number;
+  }
+  const BundleReport r = RunBundleAdjustment(obs, KinematicParameters::Nominal(obs.robot), obs.camera.fx_px, {});
+  EXPECT_EQ(r.outcome, Outcome::kDegenerate) << r.message;
+  EXPECT_NE(r.message.find("no dot could be placed"), std::string::npos) << r.message;
 }
 
 // The free set eye-to-hand has the size of the eye-in-hand one of the same poses (mirror gauges): the
