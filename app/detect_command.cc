@@ -12,6 +12,7 @@
 
 #include "app/cli_output.h"
 #include "app/cli_util.h"
+#include "app/run_configuration.h"
 #include "app/output_options.h"
 #include "app/commands.h"
 #include "base/atomic_file.h"
@@ -462,10 +463,7 @@ Command AddDetectCommand(CLI::App& app) {
   cmd->add_option("--hand-eye", a->hand_eye,
                   "A nominal camera transform (selfcal-hand-eye file): flange_from_cam for flange poses, or, with "
                   "--configuration eye_to_hand, the fixed camera base_from_cam");
-  cmd->add_option("--configuration", a->configuration,
-                  "eye_in_hand (default: the camera on the flange, the points fixed) or eye_to_hand (the camera fixed "
-                  "in the base frame, the points carried by the flange)")
-      ->check(CLI::IsMember({"eye_in_hand", "eye_to_hand"}));
+  AddConfigurationOption(cmd, &a->configuration);
   cmd->add_option("--camera-file", a->camera_file,
                   "The camera's intrinsics from an OpenCV FileStorage or ViSP XML file (docs/camera-files.md), instead "
                   "of the --camera-* values");

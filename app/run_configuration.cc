@@ -10,8 +10,8 @@ namespace selfcal::app {
 
 void AddConfigurationOption(CLI::App* cmd, std::string* configuration) {
   cmd->add_option("--configuration", *configuration,
-                  "eye_in_hand (camera on the flange, dots fixed in the base frame) or eye_to_hand (camera fixed in "
-                  "the base frame, dots on a plate carried by the flange)")
+                  "eye_in_hand (default: camera on the flange, dots fixed in the base frame) or eye_to_hand (camera "
+                  "fixed in the base frame, dots carried by the flange: a plate, a tag)")
       ->check(CLI::IsMember({CameraMountName(CameraMount::kEyeInHand), CameraMountName(CameraMount::kEyeToHand)}));
 }
 

@@ -1,4 +1,4 @@
-// --configuration eye_in_hand|eye_to_hand of `plan`, `run` and `simulate` (kinematics/robot_model.h,
+// --configuration eye_in_hand|eye_to_hand of `plan`, `run`, `simulate` and `detect` (kinematics/robot_model.h,
 // CameraMount): where the camera is. Eye-in-hand (the default) is the camera on the flange looking at dots
 // fixed in the base frame; eye-to-hand a camera fixed in the base frame looking at dots on a plate the flange
 // carries. The simulated eye-to-hand cell's nominal fixed camera is sim::DefaultFixedCamera at the robot
