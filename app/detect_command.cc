@@ -54,6 +54,7 @@ struct DetectSettings {
   double tag_tolerance_px = 3.0;
   int sheet_tile_px = 640;
   bool skip_failed = false;
+  std::string scene;                        // --scene: every pose's scene (a recording of its own)
   std::string skipped_out;                  // --skipped-out, default SkippedListPath(out) with --skip-failed
   io::JsonPoseKeys json;                    // --pose-*-key: the keys of JSON pose files
   std::string joints_unit = "rad", matrix_order = "row", quaternion_order = "xyzw";
@@ -377,6 +378,7 @@ int DetectFromSettings(const DetectSettings& a) {
     if (detection_failed) std::cerr << "selfcal: each image's outcome is on the contact sheet " << a.contact_sheet << "\n";
   }
   if (detection_failed) return Fail(set.status());
+  for (PoseObservation& pose : set.value().poses) pose.scene = a.scene;
   Status written = io::SaveObservations(*set, a.out);
   if (written.ok() && a.skip_failed) {
     written = WriteSkippedList(a, *images, ids, points, *set);
@@ -485,6 +487,10 @@ Command AddDetectCommand(CLI::App& app) {
   cmd->add_option("--yardstick", a->yardstick, "A,B,LENGTH_MM: a known distance between points A and B")
       ->delimiter(',')
       ->expected(3);
+  cmd->add_option("--scene", a->scene,
+                  "Every pose sees this scene: a recording whose points are its own (a board that moved), for "
+                  "observations pooled by hand with others (calibrate FIRST --also SECOND names each file's scene)")
+      ->check([](const std::string& name) { return name.empty() ? std::string("an empty scene name") : std::string(); });
   cmd->add_flag("--skip-failed", a->skip_failed,
                 "Leave images without points out instead of failing, and list them with their reasons (--skipped-out)");
   AddOutputOption(cmd, "--skipped-out", &a->skipped_out, OutputKind::kFile,

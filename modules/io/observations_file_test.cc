@@ -277,6 +277,10 @@ TEST_F(ObservationsEdits, SetLevelValidationNamesTheFileAndLine) {
   EXPECT_TRUE(Refused(Load("{dot_a: 0, dot_b: 2, length_mm: 250.0}", "{dot_a: 2, dot_b: 2, length_mm: 250.0}"),
                       path_ + ":" + yardstick + ": yardstick 2-2: both ends are the same dot"));
   EXPECT_TRUE(Refused(Load("id: v00", "id: p00"), path_ + ":" + line_of("id: v00") + ": pose p00: duplicate pose id"));
+  // A scene that only the verification pose sees: no point of it can be placed, refused at that pose's line.
+  EXPECT_TRUE(Refused(Load("    role: verification\n", "    role: verification\n    scene: next_day\n"),
+                      path_ + ":" + line_of("id: v00") + ": pose v00: its scene `next_day` is a scene that no "
+                                                          "identification pose sees"));
 }
 
 TEST_F(ObservationsEdits, RobotAndRobotFile) {

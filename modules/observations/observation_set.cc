@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include <cmath>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -45,6 +46,32 @@ Rigid3 PointsFromCamAt(const RobotModel& robot, const Eigen::VectorXd& rho, cons
   return PointsFromCam(robot, rho, pose.joints_rad);
 }
 
+namespace {
+
+// A scene that only verification poses see: none of its points can be placed, so those poses verify
+// nothing. Named at its first pose. Nothing when the set has no identification pose at all.
+std::string ScenesWithoutIdentification(const std::vector<PoseObservation>& poses) {
+  std::map<std::string, std::string> first_pose;  // scene -> its first pose id
+  std::set<std::string> identified;
+  for (const PoseObservation& pose : poses) {
+    first_pose.emplace(pose.scene, pose.id);
+    if (pose.role == PoseRole::kIdentification) identified.insert(pose.scene);
+  }
+  std::ostringstream out;
+  if (identified.empty() || first_pose.size() < 2) return out.str();
+  for (const auto& [scene, id] : first_pose) {
+    if (identified.count(scene)) continue;
+    out << "pose " << id << ": "
+        << (scene.empty() ? std::string("the poses without a `scene` key see a scene")
+                          : "its scene `" + scene + "` is a scene")
+        << " that no identification pose sees, so none of its points can be placed (give it identification "
+           "poses, or name a scene that has them)\n";
+  }
+  return out.str();
+}
+
+}  // namespace
+
 std::string ObservationSet::Validate() const {
   std::ostringstream out;
   bool any_flange_pose = false;
@@ -83,6 +110,7 @@ std::string ObservationSet::Validate() const {
       seen_dots.insert(dot);
     }
   }
+  out << ScenesWithoutIdentification(poses);
   auto check_distance = [&](const KnownDistance& k, const char* what) {
     if (!std::isfinite(k.length_m) || k.length_m <= 0) {
       out << what << " " << k.dot_a << "-" << k.dot_b << ": length " << k.length_m << " m must be finite and > 0\n";

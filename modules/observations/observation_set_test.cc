@@ -44,6 +44,25 @@ TEST(ObservationSet, ValidateNamesPoseAndDot) {
   EXPECT_NE(problems.find("check distance 2-5: length -1"), std::string::npos) << problems;
 }
 
+// A scene only verification poses see has no placed point: refused, named at its first pose (the set's
+// unnamed scene too); every scene with an identification pose is fine.
+TEST(ObservationSet, ValidateRefusesASceneNoIdentificationPoseSees) {
+  ObservationSet set = TwoPoses();
+  set.poses[1].scene = "moved";
+  EXPECT_EQ(set.Validate(), "");
+  set.poses[1].role = PoseRole::kVerification;
+  EXPECT_NE(set.Validate().find("pose b: its scene `moved` is a scene that no identification pose sees"),
+            std::string::npos)
+      << set.Validate();
+  set.poses[1].role = PoseRole::kIdentification;
+  set.poses[0].role = PoseRole::kVerification;
+  EXPECT_NE(set.Validate().find("pose a: the poses without a `scene` key see a scene that no identification pose"),
+            std::string::npos)
+      << set.Validate();
+  set.poses[1].scene.clear();  // one scene again: a set of verification poses and one identification pose
+  EXPECT_EQ(set.Validate(), "");
+}
+
 }  // namespace
 }  // namespace selfcal
 

@@ -359,6 +359,13 @@ TEST(DetectCli, JointAnglesFromAPosesListAndAYardstick) {
   ASSERT_EQ(set.yardsticks.size(), 1u);
   EXPECT_EQ(set.yardsticks[0].dot_b, 9);
   EXPECT_NEAR(set.yardsticks[0].length_m, 0.2286, 1e-15);
+  // --scene marks the folder a scene of its own: every pose says so in the file (read back as written).
+  ASSERT_EQ(RunSelfcal(base + " --robot " + std::string(SELFCAL_SOURCE_DIR) +
+                           "/config/robots/puma560.yaml --scene next_day --force",
+                       &out),
+            0)
+      << out;
+  for (const PoseObservation& pose : Load(dir / "obs.yaml").poses) EXPECT_EQ(pose.scene, "next_day") << pose.id;
 }
 
 }  // namespace
