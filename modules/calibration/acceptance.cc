@@ -290,10 +290,36 @@ AcceptanceCheck HeldValues(const AcceptanceInputs& in) {
 
 }  // namespace
 
+AcceptanceCheck YardstickScaleCheck(const AcceptanceInputs& in) {
+  AcceptanceCheck check{"yardstick_scale", CheckStatus::kNotAvailable,
+                        "the yardstick is not checked against the robot description (flange poses, or the paper's method)"};
+  if (in.yardstick_scale == nullptr) return check;
+  const YardstickScale& y = *in.yardstick_scale;
+  if (!y.available) {
+    check.sentence = "the yardstick is not checked against the robot description: " + y.reason;
+    return check;
+  }
+  std::string names;
+  for (const std::string& n : y.lengths) names += (names.empty() ? "" : ", ") + n;
+  const double deviation = std::abs(y.scale - 1);
+  const bool agrees = deviation <= kMaxScaleDeviation || (std::isfinite(y.stddev) && deviation <= 3 * y.stddev);
+  check.status = agrees ? CheckStatus::kPassed : CheckStatus::kFailed;
+  const std::string figure = Format("%.4f +- %.4f times the description's", y.scale, y.stddev);
+  check.sentence =
+      agrees ? "the yardstick agrees with the robot description: its scale makes the free link lengths (" + names +
+                   ") " + figure + Format(" (within %.0f %%)", 100 * kMaxScaleDeviation)
+             : "the yardstick disagrees with the robot description: its scale makes the free link lengths (" + names +
+                   ") " + figure + Format(", %.2f %% off: check the yardstick's length and its two dot ids (or the "
+                                          "description's link lengths)",
+                                          100 * (y.scale - 1));
+  return check;
+}
+
 Acceptance AcceptanceOf(const AcceptanceInputs& inputs) {
   Acceptance a;
-  a.checks = {HeldOutTest(inputs), CrossValidationTest(inputs), BeatsNominalHeldOut(inputs), BeatsNominalDistances(inputs),
-              PlausibleCorrections(inputs), HeldValues(inputs)};
+  a.checks = {HeldOutTest(inputs),          CrossValidationTest(inputs), BeatsNominalHeldOut(inputs),
+              BeatsNominalDistances(inputs), YardstickScaleCheck(inputs), PlausibleCorrections(inputs),
+              HeldValues(inputs)};
   return a;
 }
 

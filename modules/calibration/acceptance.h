@@ -19,6 +19,10 @@
 //   held_values              the parameters held by request (--fix) agree with the images: the score test
 //                            of bundle/error_model.h at kHeldOutTestLevel (a held value the data disagree
 //                            with leaves a pose error behind that the held-out test would take as noise)
+//   yardstick_scale          a joint-angle set's yardstick against the robot description's link lengths
+//                            (yardstick_scale.h): the free lengths uniformly within kMaxScaleDeviation (1 %)
+//                            of the description's, or within 3 sigma; refused beyond both (a wrong
+//                            yardstick length or wrong ends scale the whole arm and change no image)
 //   plausible_corrections    no angular correction of the kinematic model beyond kMaxAngularCorrectionRad
 //                            (45 deg) and no length correction beyond kMaxLengthCorrectionM (100 mm): a
 //                            calibration corrects a description by small amounts, and a model
@@ -47,6 +51,7 @@
 #include "calibration/cross_validation.h"
 #include "calibration/heldout_reprojection.h"
 #include "calibration/paper_pipeline.h"
+#include "calibration/yardstick_scale.h"
 
 namespace selfcal::calibration {
 
@@ -95,6 +100,8 @@ struct AcceptanceInputs {
   std::string no_cross_validation_reason = "not run";  // when cross_validation is null
   // The score test of the parameters held by request (bundle/error_model.h); null: none.
   const bundle::HeldValueTest* held_values = nullptr;
+  // The yardstick against the description's lengths (a joint-angle set's bundle); null: not a joint set.
+  const YardstickScale* yardstick_scale = nullptr;
 };
 
 inline constexpr double kMaxAngularCorrectionRad = 0.7853981633974483;  // 45 deg

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/test_robots.h"
+
 namespace selfcal::calibration {
 namespace {
 
@@ -91,6 +93,55 @@ TEST(Acceptance, UnmeasuredCheckDistancesSayWhy) {
   const AcceptanceCheck& check = Check(acceptance, "beats_nominal_distances");
   EXPECT_EQ(check.status, CheckStatus::kNotAvailable);
   EXPECT_EQ(check.sentence, in.no_distances_reason);
+}
+
+// The yardstick against the description: every free length of the PUMA scaled by 0.955 (a 198.252 mm
+// yardstick typed as 189.3 mm) is a factor of 0.955 exactly, refused; 0.3 % is a real arm's, passed; a
+// deviation inside 3 sigma of a poorly determined scale refuses nothing.
+TEST(Acceptance, TheYardstickIsCheckedAgainstTheDescriptionsLengths) {
+  const RobotModel robot = selfcal::testing::Puma560();
+  const KinematicParameters params(robot.num_joints());
+  bundle::BundleReport b;
+  b.rho = KinematicParameters::Nominal(robot);
+  for (int i = 0; i < params.size(); ++i) {
+    if (params.kind(i) == ParameterKind::kLength && std::abs(b.rho[i]) >= kMinScaleLengthM) b.free_indices.push_back(i);
+  }
+  ASSERT_GE(b.free_indices.size(), 3u);
+  b.free_indices.push_back(params.IndexOf("j2.alpha"));  // an angle: no part of the scale
+  const int free = static_cast<int>(b.free_indices.size());
+  b.covariance_available = true;
+  b.covariance_free = Eigen::MatrixXd::Identity(free + 1, free + 1) * 1e-8;  // + f_x; 0.1 mm per length
+  auto scaled = [&](double factor) {
+    bundle::BundleReport out = b;
+    for (int i : b.free_indices) {
+      if (params.kind(i) == ParameterKind::kLength) out.rho[i] *= factor;
+    }
+    out.rho[params.IndexOf("j2.alpha")] += 0.3;
+    return out;
+  };
+  const YardstickScale wrong = YardstickScaleOf(robot, scaled(0.955), 1);
+  ASSERT_TRUE(wrong.available) << wrong.reason;
+  EXPECT_NEAR(wrong.scale, 0.955, 1e-12);
+  EXPECT_GT(wrong.stddev, 0);
+  EXPECT_LT(wrong.stddev, 1e-3);
+  AcceptanceInputs in;
+  in.yardstick_scale = &wrong;
+  const AcceptanceCheck& refused = Check(AcceptanceOf(in), "yardstick_scale");
+  EXPECT_EQ(refused.status, CheckStatus::kFailed) << refused.sentence;
+  EXPECT_TRUE(refused.decisive);
+  EXPECT_NE(refused.sentence.find("-4.50 % off: check the yardstick's length and its two dot ids"), std::string::npos)
+      << refused.sentence;
+  const YardstickScale right = YardstickScaleOf(robot, scaled(1.003), 1);
+  in.yardstick_scale = &right;
+  EXPECT_EQ(Check(AcceptanceOf(in), "yardstick_scale").status, CheckStatus::kPassed);
+  YardstickScale uncertain = wrong;
+  uncertain.stddev = 0.02;
+  in.yardstick_scale = &uncertain;
+  EXPECT_EQ(Check(AcceptanceOf(in), "yardstick_scale").status, CheckStatus::kPassed);
+  const YardstickScale none = YardstickScaleOf(robot, scaled(0.955), 0);
+  in.yardstick_scale = &none;
+  EXPECT_FALSE(none.available);
+  EXPECT_EQ(Check(AcceptanceOf(in), "yardstick_scale").status, CheckStatus::kNotAvailable);
 }
 
 }  // namespace

@@ -148,6 +148,7 @@ void CheckFlangePoses(const ObservationSet& observations, const ObservationSet& 
 // kRejected, its sentences the message.
 void CheckAcceptance(const ObservationSet& obs, const ObservationSet& original, CalibrationReport* report) {
   AcceptanceInputs in;
+  YardstickScale yardstick_scale;
   in.stated_noise_px = obs.pixel_noise_px;
   if (report->bundle) {
     const BundleStageReport& stage = *report->bundle;
@@ -163,6 +164,10 @@ void CheckAcceptance(const ObservationSet& obs, const ObservationSet& original, 
       in.no_test_reason = "the flange poses have a stated noise, which the test does not model";
     }
     in.held_values = &stage.bundle.held_values;
+    if (!original.UsesFlangePoses()) {
+      yardstick_scale = YardstickScaleOf(obs.robot, stage.bundle, static_cast<int>(obs.yardsticks.size()));
+      in.yardstick_scale = &yardstick_scale;
+    }
     if (report->cross_validation) in.cross_validation = &*report->cross_validation;
     if (!obs.PosesWithRole(PoseRole::kVerification).empty()) {
       in.no_cross_validation_reason = "not run: the set has verification poses";

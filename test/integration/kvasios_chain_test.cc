@@ -102,10 +102,36 @@ TEST(KvasiosChain, EverySessionCalibratesWithTheDefaultsNamingWhatTheDataCannotD
     }
     EXPECT_TRUE(cv_test) << report.at("acceptance").dump();
     EXPECT_NE(output.find("cross-validation (4 folds"), std::string::npos) << output;
+    // The yardstick is also a check: against the Panda description's link lengths (measured 0.9969 +- 0.0030,
+    // 0.9980 +- 0.0032, 0.9991 +- 0.0055 for s1, s2, s3).
+    EXPECT_NE(output.find("passed: the yardstick agrees with the robot description"), std::string::npos) << output;
     // The camera's start came from the images, not from the shipped mount 44 deg away.
     EXPECT_NE(bundle.at("start_note").get<std::string>().find("camera correction from the images"), std::string::npos)
         << bundle.at("start_note");
   }
+}
+
+// A yardstick typed wrong (198.252 mm as 189.3 mm) scales the whole arm and changes no image: the held-out
+// tests pass (0.65 px), every correction looks plausible (18 mm at most), and only the description's lengths
+// tell. Refused (exit 6) naming the yardstick and the factor, no model written.
+TEST(KvasiosChain, AYardstickTypedWrongIsRefusedAgainstTheDescriptionsLengths) {
+  const fs::path dir = FreshDir("kvasios", "typo");
+  std::ifstream in(Detect("s1", dir));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string right = "length_m: 0.198252";
+  const size_t at = text.find(right);
+  ASSERT_NE(at, std::string::npos) << text.substr(0, 2000);
+  text.replace(at, right.size(), "length_m: 0.1893");
+  const fs::path typo = dir / "typo.yaml";
+  std::ofstream(typo) << text;
+  std::string output;
+  EXPECT_EQ(RunSelfcalInSource("calibrate " + typo.string() + " --out " + (dir / "cal").string() + " --no-html", &output),
+            6)
+      << output;
+  EXPECT_NE(output.find("the yardstick disagrees with the robot description"), std::string::npos) << output;
+  // The right yardstick's factor (0.9969) times 189.3 / 198.252: 0.9519.
+  EXPECT_NE(output.find("j7.a) 0.9519 +- 0.00"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(dir / "cal" / "calibrated_model.yaml"));
 }
 
 // Sessions s1 and s3 (recorded the next day, the board moved by about 7 mm and 2 deg) pooled as they are:
