@@ -24,6 +24,7 @@
 #include "io/hand_eye_file.h"
 #include "io/image_files.h"
 #include "io/observations_file.h"
+#include "io/plausible_limits.h"
 #include "io/pose_files.h"
 #include "io/robot_config.h"
 #include "io/skipped_images_file.h"
@@ -158,7 +159,9 @@ Result<detection::ObservationSetup> ToSetup(const DetectSettings& a, const vpIma
   if (!a.yardstick.empty()) {
     const bool ints = a.yardstick.size() == 3 && a.yardstick[0] >= 0 && a.yardstick[1] >= 0 &&
                       a.yardstick[0] == std::floor(a.yardstick[0]) && a.yardstick[1] == std::floor(a.yardstick[1]);
-    if (!ints || !(a.yardstick[2] > 0)) return Usage("--yardstick A,B,LENGTH_MM: two point ids and a length > 0 mm");
+    if (!ints || !(a.yardstick[2] >= io::kMinKnownDistanceM * 1e3 && a.yardstick[2] <= io::kMaxKnownDistanceM * 1e3)) {
+      return Usage("--yardstick A,B,LENGTH_MM: two point ids and their distance in [1, 100000] mm");
+    }
     setup.yardsticks.push_back({static_cast<int>(a.yardstick[0]), static_cast<int>(a.yardstick[1]), a.yardstick[2] * 1e-3});
   }
   if (!ParseCameraMount(a.configuration, &setup.mount)) {
@@ -455,8 +458,8 @@ Command AddDetectCommand(CLI::App& app) {
       ->check(CLI::IsMember({"grid", "apriltag", "order"}));
   cmd->add_option("--tag-side-mm", a->tag_side_mm,
                   "apriltag: outer side of the tags' black border, mm (the apriltag detector: its edges as yardstick "
-                  "and check distance)")
-      ->check(CLI::PositiveNumber);
+                  "and check distance; 1 to 100000)")
+      ->check(CLI::Range(io::kMinKnownDistanceM * 1e3, io::kMaxKnownDistanceM * 1e3));
   cmd->add_option("--tag-dots-mm", a->tag_dots_mm, "apriltag: x1,y1,x2,y2,... of the dots around every tag, mm")
       ->delimiter(',');
   cmd->add_option("--tag-tolerance-px", a->tag_tolerance_px, "apriltag: a dot this close to its prediction is named")

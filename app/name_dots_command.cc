@@ -19,6 +19,7 @@
 #include "app/commands.h"
 #include "app/identify_options.h"
 #include "base/atomic_file.h"
+#include "io/plausible_limits.h"
 #include "session/setup_file.h"
 
 namespace selfcal::app {
@@ -134,9 +135,11 @@ int NameDotsFromSettings(const NameDotsSettings& a) {
   if (!a.image.empty() && !a.mode.IsDefault()) {
     return Fail(Status::Error(ErrorCode::kInvalidInput, "the camera options do not apply to --image " + a.image));
   }
-  if (!a.yardstick.empty() && (a.yardstick.size() != 2 || !(a.length_mm > 0))) {
-    return Fail(
-        Status::Error(ErrorCode::kInvalidInput, "--yardstick takes two dot ids A,B and needs --length-mm L > 0"));
+  if (!a.yardstick.empty() && (a.yardstick.size() != 2 || !(a.length_mm >= io::kMinKnownDistanceM * 1e3) ||
+                               !(a.length_mm <= io::kMaxKnownDistanceM * 1e3))) {
+    return Fail(Status::Error(ErrorCode::kInvalidInput,
+                              "--yardstick takes two dot ids A,B and needs --length-mm L, the distance between their "
+                              "centres, in [1, 100000] mm"));
   }
   Result<capture::Frame> frame = GrabFrame(a);
   if (!frame.ok()) return Fail(frame.status());
@@ -148,6 +151,21 @@ int NameDotsFromSettings(const NameDotsSettings& a) {
   if (!identifier.ok()) return Fail(identifier.status());
   const acquisition::NamingResult named =
       acquisition::NameDots(*frame, identifier->get(), acquisition::RunOptions().detector);  // run's detector
+  // The yardstick's ends are checked before anything is written: a refusal leaves the PNG and the setup as
+  // they were (the table printed shows the ids named).
+  const acquisition::YardstickChoice choice{a.yardstick.empty() ? -1 : a.yardstick[0],
+                                            a.yardstick.empty() ? -1 : a.yardstick[1], a.length_mm * 1e-3};
+  std::vector<std::string> warnings;
+  if (!named.named.empty()) {
+    if (Status s = acquisition::ApplyNaming(named, a.yardstick.empty() ? nullptr : &choice, frame->source, &setup,
+                                            &naming, &warnings);
+        !s.ok()) {
+      PrintTable(named);
+      return Fail(Status::Error(s.code(), s.message() + "; nothing written (" + a.setup + " and " + a.out_png +
+                                              " left as they were; without --yardstick the image with every id drawn "
+                                              "is written)"));
+    }
+  }
   const vpImage<vpRGBa> annotated = acquisition::AnnotateDots(frame->image, named);
   Result<std::string> png = acquisition::EncodeColourPng(annotated);
   if (!png.ok()) return Fail(png.status());
@@ -158,14 +176,6 @@ int NameDotsFromSettings(const NameDotsSettings& a) {
   if (named.named.empty()) {
     return Fail(Status::Error(ErrorCode::kDegenerateData,
                               "no dot named: " + named.identifier_message + "; " + a.setup + " left unchanged"));
-  }
-  const acquisition::YardstickChoice choice{a.yardstick.empty() ? -1 : a.yardstick[0],
-                                            a.yardstick.empty() ? -1 : a.yardstick[1], a.length_mm * 1e-3};
-  std::vector<std::string> warnings;
-  if (Status s = acquisition::ApplyNaming(named, a.yardstick.empty() ? nullptr : &choice, frame->source, &setup,
-                                          &naming, &warnings);
-      !s.ok()) {
-    return Fail(Status::Error(s.code(), s.message() + "; " + a.setup + " left unchanged (see " + a.out_png + ")"));
   }
   for (const std::string& w : warnings) std::cerr << "warning: " << w << "\n";
   if (Status s = WriteFileAtomically(a.setup, session::SetupFileText(setup, naming)); !s.ok()) return Fail(s);
@@ -192,7 +202,7 @@ Command AddNameDotsCommand(CLI::App& app) {
   AddOutputOption(cmd, "--out", &a->out_png, OutputKind::kFile, "Annotated PNG to write")->required();
   cmd->add_flag("--show", a->show, "Also show the annotated image in an X11 window (click to close)");
   cmd->add_option("--yardstick", a->yardstick, "The yardstick's two end dots A,B (ids as drawn)")->delimiter(',');
-  cmd->add_option("--length-mm", a->length_mm, "The yardstick's length, mm")->check(CLI::PositiveNumber);
+  cmd->add_option("--length-mm", a->length_mm, "The yardstick's length, mm (1 to 100000)")->check(CLI::PositiveNumber);
   cmd->add_option("--fx-px", a->fx_px, "New setup: the camera's nominal focal length, px")->check(CLI::PositiveNumber);
   cmd->add_option("--pixel-noise-px", a->pixel_noise_px, "New setup: the dot centroid noise, px")
       ->check(CLI::PositiveNumber);

@@ -11,6 +11,7 @@
 #include "base/closest_name.h"
 #include "base/json_lines.h"
 #include "geometry/rigid3.h"
+#include "io/plausible_limits.h"
 #include "io/pose_files.h"
 #include "io/report_json.h"
 #include "io/transform_yaml.h"
@@ -20,7 +21,6 @@ namespace selfcal::io {
 
 namespace {
 
-constexpr double kMaxTranslationM = 100.0;
 constexpr double kMaxJointRad = 4 * kPi;
 
 std::string Short(double v) {
@@ -119,7 +119,8 @@ Status ReadJoints(const JsonPoseReader& reader, const JsonPoseKeys& keys, const 
 Status CheckTranslation(const JsonPoseReader& reader, const std::string& key, const Eigen::Vector3d& t) {
   if (!(t.cwiseAbs().maxCoeff() <= kMaxTranslationM)) {
     return reader.Error(key, "`" + key + "`'s translation (" + Short(t.x()) + ", " + Short(t.y()) + ", " +
-                                 Short(t.z()) + ") m is beyond 100 m: metres expected");
+                                 Short(t.z()) + ") m is beyond " + Short(kMaxTranslationM) +
+                                 " m: no arm reaches that far (metres expected)");
   }
   return Status::Ok();
 }

@@ -134,6 +134,10 @@ TEST(JsonPoseFile, BadFilesNameFileLineAndKey) {
   WriteFile(dir.File("other.json"), "{\"O_T_E\": []}");
   EXPECT_TRUE(MessageHas(LoadJsonPoseFile(dir.File("other.json"), keys, nullptr, &read),
                          "no key `O_T_EE` (--pose-matrix-key); did you mean `O_T_E`?"));
+  // A flange 48.9 m from the base: no arm's, and beyond what an observations file takes (10 m).
+  WriteFile(dir.File("far.json"), "{\n  \"O_T_EE\": [1, 0, 0, 0.7, 0, 1, 0, 0, 0, 0, 1, 48.9, 0, 0, 0, 1]\n}\n");
+  EXPECT_TRUE(MessageHas(LoadJsonPoseFile(dir.File("far.json"), keys, nullptr, &read),
+                         dir.File("far.json") + ":2: `O_T_EE`'s translation (0.7, 0, 48.9) m is beyond 10 m"));
   JsonPoseKeys two;
   two.matrix = "a";
   two.joints = "b";

@@ -8,6 +8,7 @@
 
 #include "io/atomic_file.h"
 #include "io/camera_file.h"
+#include "io/plausible_limits.h"
 #include "io/robot_config.h"
 #include "io/transform_yaml.h"
 #include "io/yaml_schema.h"
@@ -164,7 +165,7 @@ bool ReadDistances(MapReader* root, const std::string& key, bool required, Probl
     KnownDistance d;
     ok &= map.Int("dot_a", 0, INT_MAX, &a);
     ok &= map.Int("dot_b", 0, INT_MAX, &b);
-    ok &= map.Quantity("length", Unit::kLength, Range::Positive(100.0), &d.length_m);
+    ok &= map.Quantity("length", Unit::kLength, Range::Closed(kMinKnownDistanceM, kMaxKnownDistanceM), &d.length_m);
     d.dot_a = static_cast<int>(a);
     d.dot_b = static_cast<int>(b);
     out->push_back(d);
@@ -450,6 +451,15 @@ Result<ObservationSet> LoadObservations(const std::string& path) {
 
 Status SaveObservations(const ObservationSet& set, const std::string& path) {
   std::string problems = set.Validate();
+  for (const auto* list : {&set.yardsticks, &set.check_distances}) {
+    for (const KnownDistance& k : *list) {
+      if (!(k.length_m >= kMinKnownDistanceM && k.length_m <= kMaxKnownDistanceM)) {
+        problems += (list == &set.yardsticks ? "yardstick " : "check distance ") + std::to_string(k.dot_a) + "-" +
+                    std::to_string(k.dot_b) + ": length " + YamlNumber(k.length_m) + " m is not in [" +
+                    YamlNumber(kMinKnownDistanceM) + ", " + YamlNumber(kMaxKnownDistanceM) + "] m\n";
+      }
+    }
+  }
   if (problems.empty()) {
     for (const PoseObservation& pose : set.poses) {
       for (const auto& [dot, uv] : pose.dots_px) {

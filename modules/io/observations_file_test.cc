@@ -213,6 +213,21 @@ TEST_F(ObservationsEdits, C3CameraValues) {
   EXPECT_TRUE(Refused(Load("length_mm: 250.0", "length_mm: 0"), "`yardsticks[0].length_mm` = `0`"));
 }
 
+// Issue 36: a known distance of 1e-300 m (the mutation campaign's) was taken: positive, but no two dots' centres
+// are that close, and no scale comes from it. A length is at least 1 mm, at most 100 m, named by key and line.
+TEST_F(ObservationsEdits, AKnownDistanceShorterThanAMillimetreIsRefusedByLine) {
+  const std::string line = std::to_string(1 + std::count(example_.begin(), example_.begin() + static_cast<std::ptrdiff_t>(
+                                                                                example_.find("length_mm: 250.0")), '\n'));
+  EXPECT_TRUE(Refused(Load("length_mm: 250.0", "length_mm: 1e-300"),
+                      "`yardsticks[0].length_mm` = `1e-300` at " + path_ + ":" + line +
+                          " is out of range: must be in [1, 100000]"));
+  EXPECT_TRUE(Refused(Load("length_mm: 250.0", "length_mm: 0.999"), "`yardsticks[0].length_mm` = `0.999`"));
+  EXPECT_TRUE(Refused(Load("length_mm: 250.0", "length_m: 1e-300"), "`yardsticks[0].length_m` = `1e-300`"));
+  EXPECT_TRUE(Refused(Load("length_mm: 250.0", "length_mm: 100001"), "`yardsticks[0].length_mm` = `100001`"));
+  EXPECT_TRUE(Load("length_mm: 250.0", "length_mm: 1").ok());
+  EXPECT_TRUE(Load("length_mm: 250.0", "length_m: 100").ok());
+}
+
 TEST_F(ObservationsEdits, C3JointsOutsidePlausibleRanges) {
   EXPECT_TRUE(Refused(Load("[0, 30, -150, 0, 45, 0]", "[0, 30, 12000, 0, 45, 0]"),
                       "`poses[0].joints_deg[2]` = `12000` at " + path_ + ":13 is out of range: must be in [-720, 720]"));

@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "base/atomic_file.h"
+#include "io/plausible_limits.h"
 #include "io/transform_yaml.h"
 #include "io/yaml_schema.h"
 #include "io/yaml_writer.h"
@@ -20,7 +21,6 @@ namespace selfcal::io {
 
 namespace {
 
-constexpr double kMaxTranslationM = 100.0;
 const Range kTranslation = Range::Closed(-kMaxTranslationM, kMaxTranslationM);
 
 std::string Short(double v) {

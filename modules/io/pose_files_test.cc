@@ -48,6 +48,13 @@ constexpr char kRosPose[] =
     "x: 0.7169496300523684\ny: 0.00330346692205527\nz: 0.853313460465923\nqx: -0.01709391593413424\n"
     "qy: 0.99974825023776\nqz: -0.01437638468984423\nqw: -0.002133951223335981\n";
 
+// kRosPose with its first `from` replaced by `to`.
+std::string RosPoseWith(const std::string& from, const std::string& to) {
+  std::string text = kRosPose;
+  text.replace(text.find(from), from.size(), to);
+  return text;
+}
+
 TEST(PerImagePoseFile, RosQuaternionPose) {
   TempDir dir;
   WriteFile(dir.File("0.yaml"), kRosPose);
@@ -75,18 +82,14 @@ TEST(PerImagePoseFile, VispPoseVector) {
 TEST(PerImagePoseFile, BadFilesNameFileLineAndKey) {
   TempDir dir;
   const std::string bad_key = dir.File("1.yaml");
-  std::string text = kRosPose;
-  text.replace(text.find("qw:"), 3, "qq:");
-  WriteFile(bad_key, text);
+  WriteFile(bad_key, RosPoseWith("qw:", "qq:"));
   const Status s = LoadPerImagePoseFile(bad_key).status();
   EXPECT_TRUE(MessageHas(s, "unknown key `qq` at " + bad_key + ":7"));
   EXPECT_TRUE(MessageHas(s, "missing required key `qw`"));
   EXPECT_EQ(s.code(), ErrorCode::kInvalidInput);
 
   const std::string not_unit = dir.File("2.yaml");
-  text = kRosPose;
-  text.replace(text.find("qw: -0.002133951223335981"), 25, "qw: 0.5");
-  WriteFile(not_unit, text);
+  WriteFile(not_unit, RosPoseWith("qw: -0.002133951223335981", "qw: 0.5"));
   EXPECT_TRUE(MessageHas(LoadPerImagePoseFile(not_unit).status(), "quaternion (qx, qy, qz, qw) at " + not_unit + ":4 has norm"));
 
   const std::string short_visp = dir.File("3.yaml");
@@ -98,6 +101,27 @@ TEST(PerImagePoseFile, BadFilesNameFileLineAndKey) {
   EXPECT_TRUE(MessageHas(LoadPerImagePoseFile(quoted).status(), quoted + ":3"));
 
   EXPECT_TRUE(MessageHas(LoadPerImagePoseFile(dir.File("missing.yaml")).status(), dir.File("missing.yaml")));
+}
+
+// A flange this far from the base is no arm's, and the observations file detect writes from it is refused by
+// calibrate (`xyz_m` within 10 m): the pose file is refused at once, naming the line, the key and the value
+// (the mutation campaign's ROS pose with z 0.853 -> 48.89 m, taken by detect before).
+TEST(PerImagePoseFile, AFlangeBeyondTheReachOfAnArmIsRefusedByLine) {
+  TempDir dir;
+  const std::string far = dir.File("0.yaml");
+  WriteFile(far, RosPoseWith("z: 0.853313460465923", "z: 48.891259886400817"));
+  const Status s = LoadPerImagePoseFile(far).status();
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidInput);
+  EXPECT_TRUE(MessageHas(s, "`z` = `48.891259886400817` at " + far + ":3 is out of range: must be in [-10, 10]"))
+      << s.message();
+
+  const std::string far_visp = dir.File("1.yaml");
+  WriteFile(far_visp, "rows: 6\ncols: 1\ndata:\n  - [-10.5]\n  - [0]\n  - [0.3]\n  - [0]\n  - [0]\n  - [0]\n");
+  EXPECT_TRUE(MessageHas(LoadPerImagePoseFile(far_visp).status(), far_visp + ":4")) << LoadPerImagePoseFile(far_visp).status().message();
+
+  const std::string reach = dir.File("2.yaml");  // 10 m itself is taken, as in an observations file
+  WriteFile(reach, RosPoseWith("x: 0.7169496300523684", "x: -10"));
+  EXPECT_TRUE(LoadPerImagePoseFile(reach).ok()) << LoadPerImagePoseFile(reach).status().message();
 }
 
 constexpr char kPosesList[] =

@@ -6,13 +6,13 @@
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 
+#include "io/plausible_limits.h"
 #include "io/yaml_writer.h"
 
 namespace selfcal::io {
 
 namespace {
 
-constexpr double kMaxTranslationM = 10.0;
 bool ReadRotationMatrix(const yaml::YamlNode& node, const std::string& name, double tolerance, Problems* problems,
                         Eigen::Matrix3d* out, double* correction_rad) {
   if (!node.IsSequence() || node.items.size() != 3) {

@@ -1,12 +1,14 @@
 #include "session/setup_file.h"
 
 #include <cmath>
+#include <cstdio>
 #include <optional>
 #include <set>
 #include <utility>
 
 #include <nlohmann/json.hpp>
 
+#include "io/plausible_limits.h"
 #include "session/json_fields.h"
 
 namespace selfcal::session {
@@ -73,7 +75,14 @@ void ParseCamera(const json& j, JsonFields* fields, CameraIntrinsics* camera) {
   fields->GetDouble(*c, at, "k1", &camera->k1);
 }
 
-// yardsticks or check_distances: [{dot_a, dot_b, length_m}].
+std::string ShortNumber(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.6g", v);
+  return buffer;
+}
+
+// yardsticks or check_distances: [{dot_a, dot_b, length_m}], each length in [1 mm, 100 m] as in observations
+// files (io/observations_file.h).
 void ParseDistances(const json& j, const std::string& key, JsonFields* fields, std::vector<KnownDistance>* out) {
   const json* list = fields->GetArray(j, {}, key);
   if (list == nullptr) return;
@@ -86,10 +95,18 @@ void ParseDistances(const json& j, const std::string& key, JsonFields* fields, s
     }
     fields->CheckKnown(d, at, {"dot_a", "dot_b", "length_m"});
     KnownDistance distance;
-    if (fields->GetInt(d, at, "dot_a", &distance.dot_a) & fields->GetInt(d, at, "dot_b", &distance.dot_b) &
-        fields->GetDouble(d, at, "length_m", &distance.length_m)) {
-      out->push_back(distance);
+    if (!(fields->GetInt(d, at, "dot_a", &distance.dot_a) & fields->GetInt(d, at, "dot_b", &distance.dot_b) &
+          fields->GetDouble(d, at, "length_m", &distance.length_m))) {
+      continue;
     }
+    if (!(distance.length_m >= io::kMinKnownDistanceM && distance.length_m <= io::kMaxKnownDistanceM)) {
+      const JsonPath length = at.Member("length_m");
+      fields->Add(length, "`" + length.name + "` = " + ShortNumber(distance.length_m) + " m is out of range: must be in [" +
+                              ShortNumber(io::kMinKnownDistanceM) + ", " + ShortNumber(io::kMaxKnownDistanceM) +
+                              "] m (two dots' centres, at least 1 mm apart)");
+      continue;
+    }
+    out->push_back(distance);
   }
 }
 

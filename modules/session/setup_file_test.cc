@@ -137,6 +137,16 @@ TEST(SetupFile, EveryRefusalNamesTheFileAndTheLineOfItsKey) {
       {[](auto& j) { j["camera"]["k2"] = 0.1; }, "k2", "", 0, "unknown key `k2` in `camera`"},
       {[](auto& j) { j["yardsticks"][0]["length_mm"] = 200; }, "length_mm", "", 0,
        "unknown key `length_mm` in `yardsticks[0]`"},
+      // Issue 36: a check distance of 1e-300 m (the mutation campaign's) was taken: no two dots are that close.
+      {[](auto& j) { j["check_distances"][0]["length_m"] = 1e-300; }, "length_m", "check_distances", 0,
+       "`check_distances[0].length_m` = 1e-300 m is out of range: must be in [0.001, 100] m (two dots' centres, at "
+       "least 1 mm apart)"},
+      {[](auto& j) { j["yardsticks"][0]["length_m"] = 0.0009; }, "length_m", "yardsticks", 0,
+       "`yardsticks[0].length_m` = 0.0009 m is out of range: must be in [0.001, 100] m (two dots' centres, at least 1 "
+       "mm apart)"},
+      {[](auto& j) { j["yardsticks"][0]["length_m"] = 250; }, "length_m", "yardsticks", 0,
+       "`yardsticks[0].length_m` = 250 m is out of range: must be in [0.001, 100] m (two dots' centres, at least 1 mm "
+       "apart)"},
   };
   for (const Case& c : cases) {
     nlohmann::json j = nlohmann::json::parse(SetupFileText(ASetup()));

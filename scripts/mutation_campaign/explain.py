@@ -216,6 +216,11 @@ def _rule_for_value(kind, ctx, path, old, new):
     if kind.name == "urdf" and "<joint>" in keys and last == "@name" and isinstance(new, str) and new and \
             ctx.get("seed_text", b"").count(('"%s"' % old).encode()) == 1:
         return "the name of a URDF joint no element names (a label)"
+    if kind.name == "calibrated_model" and "parameters" in keys and last.endswith(("_deg", "_rad")) and \
+            _is_number(new) and math.isfinite(new) and abs(new if last.endswith("_deg") else math.degrees(new)) <= 720:
+        return ("an angle of the identified vector `parameters` within the reader's [-720, 720] deg: any angle is a "
+                "rotation (195 deg turns as -165 deg does), and the vector is a record of the solve: compensate "
+                "computes from the model the corrections are folded into (calibrated-model-format.md)")
     if kind.name == "calibrated_model" and "intrinsics_stddev" in keys and _is_number(new) and 0 <= new <= 1e6:
         return "an intrinsics standard deviation in its documented range [0, 1e6] (reported, not used by compensate)"
     if kind.name == "calibrated_model" and "parameters" in keys and _is_number(new) and abs(new) < 1e-12:
@@ -253,7 +258,27 @@ def _rule_for_value(kind, ctx, path, old, new):
     return None
 
 
-def _record_list_change(old, new, key_path):
+def _edited_record(kind, ctx, path, a, b):
+    """The rules under which record b is record a with some values changed (the same keys, each changed value
+    under a value rule), or None."""
+    fa, fb = flatten(a), flatten(b)
+    if set(fa) != set(fb):
+        return None
+    rules = set()
+    for sub in fa:
+        if fa[sub] != fb[sub]:
+            rule = _rule_for_value(kind, ctx, path + sub, fa[sub], fb[sub])
+            if not rule:
+                return None
+            rules.add(rule)
+    return rules
+
+
+def _record_list_change(old, new, key_path, kind=None, ctx=None):
+    """None when the list at key_path is not a list of the seed's records removed, repeated or reordered; else
+    the value rules (maybe none) under which each record that is not one of the seed's is one of the seed's
+    with values changed: the closest of the records the mutant lacks, each matched once (a row deleted and
+    another's reading changed are two rules at once)."""
     def get(doc, path):
         for p in path:
             doc = doc[p]
@@ -261,12 +286,33 @@ def _record_list_change(old, new, key_path):
     try:
         a, b = get(old, key_path), get(new, key_path)
     except (KeyError, IndexError, TypeError):
-        return False
-    if not isinstance(a, list) or not isinstance(b, list):
-        return False
+        return None
+    if not isinstance(a, list) or not isinstance(b, list) or not b:
+        return None
     norm = lambda v: json.dumps(v, sort_keys=True, default=str)  # noqa: E731
     items = {norm(x) for x in a}
-    return all(norm(x) in items for x in b) and len(b) >= 1
+    kept = {norm(x) for x in b}
+    unused = [x for x in a if norm(x) not in kept]  # the seed's records the mutant lacks: the edited ones' candidates
+    rules = set()
+    for j, x in enumerate(b):
+        if norm(x) in items:
+            continue
+        if kind is None:
+            return None
+        # the closest candidate (fewest values changed) whose changes the rules explain
+        best = None
+        for n, candidate in enumerate(unused):
+            fc, fx = flatten(candidate), flatten(x)
+            changed = sum(1 for q in set(fc) | set(fx) if fc.get(q) != fx.get(q))
+            if best is None or changed < best[0]:
+                match = _edited_record(kind, ctx, key_path + (j,), candidate, x)
+                if match is not None:
+                    best = (changed, n, match)
+        if best is None:
+            return None
+        del unused[best[1]]
+        rules |= best[2]
+    return rules
 
 
 def _normal(data):
@@ -382,10 +428,14 @@ def explain(kind, ctx, original, mutant, ops):
     ctx = dict(ctx, new_doc=new, seed_text=original)
     reasons = set()
     differing = (set(fa) ^ set(fb)) | {q for q in fa if q in fb and fa[q] != fb[q]}
-    covered = [p[:-1] for p in fa if len(p) >= 2 and p[-1] == "[]" and p[-2] in RECORD_LISTS and
-               any(q[:len(p) - 1] == p[:-1] for q in differing) and _record_list_change(old, new, p[:-1])]
-    for prefix in covered:
-        reasons.add("records of `%s` removed, repeated or reordered: a list of any length (%s)" % (prefix[-1], ", ".join(names)))
+    covered = []
+    for p in fa:
+        if len(p) >= 2 and p[-1] == "[]" and p[-2] in RECORD_LISTS and any(q[:len(p) - 1] == p[:-1] for q in differing):
+            edits = _record_list_change(old, new, p[:-1], kind, ctx)
+            if edits is not None:
+                covered.append(p[:-1])
+                reasons.add("records of `%s` removed, repeated or reordered: a list of any length (%s)%s" % (
+                    p[-2], ", ".join(names), "; within a record: " + "; ".join(sorted(edits)) if edits else ""))
     for path in sorted(set(fa) | set(fb), key=str):
         a, b = fa.get(path, None), fb.get(path, None)
         if path in fa and path in fb and a == b:

@@ -393,18 +393,22 @@ TEST(CliNameDots, NamesARecordedFrameWritesThePngAndASetupThatRunAccepts) {
   const std::string setup = (dir / "setup.json").string();
   const std::string png = (dir / "named.png").string();
   std::string output;
-  // A yardstick end that is not a detected dot: refused, nothing written.
+  // A bad yardstick (an end that is not a detected dot, both ends one dot, a length no two dots have) is refused
+  // before anything is written: neither the setup nor the PNG (issue 36: the PNG was written first).
+  for (const char* bad : {"3,9999 --length-mm 200", "3,3 --length-mm 200", "3,10 --length-mm 0.5",
+                          "3,10 --length-mm 100001"}) {
+    EXPECT_EQ(RunSelfcal("name-dots --image " + frame + " --setup " + setup + " --out " + png +
+                             " --fx-px 1000 --pixel-noise-px 0.02 --yardstick " + bad, &output), 2)
+        << bad << "\n" << output;
+    EXPECT_FALSE(fs::exists(setup)) << bad;
+    EXPECT_FALSE(fs::exists(png)) << bad;
+  }
   EXPECT_EQ(RunSelfcal("name-dots --image " + frame + " --setup " + setup + " --out " + png +
-                           " --fx-px 1000 --pixel-noise-px 0.02 --yardstick 3,9999 --length-mm 200", &output), 2)
-      << output;
-  EXPECT_NE(output.find("9999"), std::string::npos) << output;
-  EXPECT_FALSE(fs::exists(setup));
-  // The refusal leaves the annotated PNG for the operator to look at: the next tries replace it (--force).
-  EXPECT_EQ(RunSelfcal("name-dots --image " + frame + " --setup " + setup + " --out " + png +
-                           " --fx-px 1000 --pixel-noise-px 0.02 --yardstick 3,3 --length-mm 200 --force", &output), 2)
-      << output;
+                           " --fx-px 1000 --pixel-noise-px 0.02 --yardstick 3,9999 --length-mm 200", &output), 2);
+  EXPECT_NE(output.find("dot 9999 is not a named dot of this frame"), std::string::npos) << output;
+  EXPECT_NE(output.find("nothing written"), std::string::npos) << output;
   ASSERT_EQ(RunSelfcal("name-dots --image " + frame + " --setup " + setup + " --out " + png +
-                           " --fx-px 1000 --pixel-noise-px 0.02 --yardstick 3,10 --length-mm 200 --force", &output), 0)
+                           " --fx-px 1000 --pixel-noise-px 0.02 --yardstick 3,10 --length-mm 200", &output), 0)
       << output;
   std::ifstream png_in(png, std::ios::binary);
   std::string magic(8, '\0');

@@ -343,6 +343,11 @@ TEST(DetectCli, JointAnglesFromAPosesListAndAYardstick) {
   EXPECT_NE(out.find("need the robot's config"), std::string::npos) << out;
   EXPECT_EQ(RunSelfcal(base + " --robot " + std::string(SELFCAL_SOURCE_DIR) + "/config/robots/puma560.yaml --yardstick 0,9", &out), 2)
       << out;
+  // A length no two dots have (under 1 mm, the bound of every yardstick in a file) is refused before any image
+  // is read, not by the observations writer at the end.
+  EXPECT_EQ(RunSelfcal(base + " --robot " + std::string(SELFCAL_SOURCE_DIR) + "/config/robots/puma560.yaml --yardstick 0,9,0.5", &out), 2)
+      << out;
+  EXPECT_NE(out.find("--yardstick A,B,LENGTH_MM: two point ids and their distance in [1, 100000] mm"), std::string::npos) << out;
   EXPECT_FALSE(fs::exists(dir / "obs.yaml"));
   ASSERT_EQ(RunSelfcal(base + " --robot " + std::string(SELFCAL_SOURCE_DIR) +
                            "/config/robots/puma560.yaml --yardstick 0,9,228.6 --pixel-noise-px 0.3",
