@@ -1,9 +1,12 @@
 #include "bundle/pose_noise_bundle.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
 
+#include <Eigen/Cholesky>
+#include <Eigen/SparseCore>
 #include <ceres/ceres.h>
 
 #include "bundle/small_solve.h"
@@ -71,23 +74,48 @@ struct Obs {
   Eigen::Vector2d pixel;
 };
 
-// The standard deviations of the hand-eye correction `c` and of the estimated entries of the intrinsics block,
-// the covariance scaled by the residual variance s2; left NaN when the covariance is unavailable.
-void StandardDeviations(ceres::Problem* problem, const double* c, const double* intrinsics, const IntrinsicsMask& estimated,
-                        double s2, PoseNoiseReport* report) {
+// The covariance of the hand-eye correction `c` and of the estimated entries of the intrinsics block at the
+// stated noises, and the standard deviations with it scaled by the residual variance s2; left NaN (and the
+// covariance empty) when the normal matrix is singular. `others`: every other free block of the problem (dots,
+// flange corrections), marginalised. The inverse of the dense normal matrix J^T J: O(unknowns^3), where Ceres'
+// dense SVD of the whole Jacobian was O(residuals x unknowns^2) and most of the solve's time.
+void Covariances(ceres::Problem* problem, double* c, double* intrinsics, const IntrinsicsMask& estimated,
+                 const std::vector<double*>& others, double s2, PoseNoiseReport* report) {
   const std::vector<int> free = EstimatedIntrinsics(estimated);
-  ceres::Covariance::Options cov_options;
-  cov_options.algorithm_type = ceres::DENSE_SVD;
-  ceres::Covariance covariance(cov_options);
-  std::vector<std::pair<const double*, const double*>> blocks = {{c, c}};
-  if (!free.empty()) blocks.push_back({intrinsics, intrinsics});
-  if (!covariance.Compute(blocks, problem)) return;
-  double cc[36], ii[kNumIntrinsics * kNumIntrinsics];
-  covariance.GetCovarianceBlock(c, c, cc);
-  for (int k = 0; k < 6; ++k) report->stddev[k] = std::sqrt(s2 * cc[7 * k]);
-  if (free.empty()) return;
-  covariance.GetCovarianceBlock(intrinsics, intrinsics, ii);  // ambient: zero where held
-  for (int k : free) report->intrinsics_stddev[k] = std::sqrt(s2 * ii[(kNumIntrinsics + 1) * k]);
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.parameter_blocks = {c};
+  if (!free.empty()) evaluate.parameter_blocks.push_back(intrinsics);  // its tangent: the free entries, in order
+  evaluate.parameter_blocks.insert(evaluate.parameter_blocks.end(), others.begin(), others.end());
+  ceres::CRSMatrix crs;
+  double cost = 0;
+  if (!problem->Evaluate(evaluate, &cost, nullptr, nullptr, &crs)) return;
+  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor, int>> jacobian(
+      crs.num_rows, crs.num_cols, static_cast<int>(crs.values.size()), crs.rows.data(), crs.cols.data(),
+      crs.values.data());
+  const Eigen::MatrixXd normal = Eigen::MatrixXd(jacobian.transpose() * jacobian);
+  const int n = 6 + static_cast<int>(free.size());
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(normal);
+  const Eigen::VectorXd d = ldlt.vectorD();
+  if (ldlt.info() != Eigen::Success || normal.rows() < n || !(d.minCoeff() > 1e-14 * d.maxCoeff())) return;
+  const Eigen::MatrixXd columns = ldlt.solve(Eigen::MatrixXd::Identity(normal.rows(), n));
+  const Eigen::MatrixXd full = 0.5 * (columns.topRows(n) + columns.topRows(n).transpose());
+  report->covariance = full;
+  report->variance_factor = s2;
+  for (int k = 0; k < 6; ++k) report->stddev[k] = std::sqrt(s2 * full(k, k));
+  for (size_t a = 0; a < free.size(); ++a) report->intrinsics_stddev[free[a]] = std::sqrt(s2 * full(6 + a, 6 + a));
+}
+
+// The dots' and the flange corrections' blocks that are in `problem`.
+std::vector<double*> OtherBlocks(const ceres::Problem& problem, std::map<int, Eigen::Vector3d>* dots,
+                                 std::vector<std::array<double, 6>>* deltas) {
+  std::vector<double*> others;
+  for (auto& entry : *dots) {
+    if (problem.HasParameterBlock(entry.second.data())) others.push_back(entry.second.data());
+  }
+  for (auto& delta : *deltas) {
+    if (problem.HasParameterBlock(delta.data())) others.push_back(delta.data());
+  }
+  return others;
 }
 
 }  // namespace
@@ -177,17 +205,23 @@ PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
         2 * report.num_observations + 6 * static_cast<int>(deltas.size()) + static_cast<int>(lengths.size());
     const int dof = residuals - unknowns;
     if (dof > 0) {
-      StandardDeviations(&problem, c.data(), intrinsics.data(), options.intrinsics, 2.0 * summary.final_cost / dof,
-                         &report);
+      Covariances(&problem, c.data(), intrinsics.data(), options.intrinsics, OtherBlocks(problem, &dots, &deltas),
+                  2.0 * summary.final_cost / dof, &report);
     }
   }
   report.num_removed = static_cast<int>(std::count(keep.begin(), keep.end(), false));
+  for (size_t k = 0; k < all.size(); ++k) {
+    if (!keep[k]) report.removed.push_back({report.pose_ids[all[k].pose], all[k].dot});
+  }
+  report.dots = dots;
+  report.intrinsics_estimated = options.intrinsics;
   for (const KnownDistance& y : lengths) {
     report.yardstick_lengths_m.push_back((dots[y.dot_a] - dots[y.dot_b]).norm());
   }
   (eye_to_hand ? report.base_from_cam : report.flange_from_cam) = x0 * RigidFromTranslationRotvec(c.data());
   report.intrinsics = intrinsics;
   for (const auto& delta : deltas) {
+    report.corrections.push_back(Eigen::Map<const Eigen::Matrix<double, 6, 1>>(delta.data()));
     report.correction_translation_m.push_back(Eigen::Vector3d(delta[0], delta[1], delta[2]).norm());
     report.correction_rotation_rad.push_back(Eigen::Vector3d(delta[3], delta[4], delta[5]).norm());
   }

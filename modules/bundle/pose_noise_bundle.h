@@ -16,6 +16,7 @@
 
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -50,10 +51,22 @@ struct PoseNoiseReport {
   // frame) and of the intrinsics, scaled by the residual variance; NaN when unavailable or held.
   Eigen::Matrix<double, 6, 1> stddev = Eigen::Matrix<double, 6, 1>::Constant(NAN);
   IntrinsicsVector intrinsics_stddev = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
+  IntrinsicsMask intrinsics_estimated{};  // options.intrinsics
+  // The covariance of [c (6: translation m, rotation vector rad), the estimated intrinsics in camera/camera.h's
+  // order] at the stated noises (pixel, flange pose), not scaled by variance_factor: what a prediction at those
+  // noises uses (calibration/heldout_reprojection.h); empty when unavailable. variance_factor: the residuals'
+  // sum of squares over their degrees of freedom (stddev above = sqrt(variance_factor * diagonal)).
+  Eigen::MatrixXd covariance;
+  double variance_factor = NAN;
+  // The solved dots, in the points' frame (the base eye-in-hand, the flange eye-to-hand): those seen by two
+  // identification poses at least.
+  std::map<int, Eigen::Vector3d> dots;
   std::vector<std::string> pose_ids;                  // identification poses, in order
+  std::vector<Eigen::Matrix<double, 6, 1>> corrections;  // delta_i per pose (translation m, rotation vector rad)
   std::vector<double> correction_translation_m;       // |delta_i| translation per pose
   std::vector<double> correction_rotation_rad;        // |delta_i| rotation per pose
   int num_observations = 0, num_removed = 0;
+  std::vector<std::pair<std::string, int>> removed;   // (pose id, dot id) the screen left out
   std::vector<double> yardstick_lengths_m;            // the solved lengths of the yardsticks constrained
   double rms_reprojection_px = 0;
 };

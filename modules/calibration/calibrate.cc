@@ -114,8 +114,10 @@ bool FlangePoseNoiseOf(const ObservationSet& observations, const bundle::BundleR
 // flange pose noise (stated, or estimated from the residuals) the pose-noise bundle; both start from the
 // bundle's hand-eye transform, dots and calibrated camera, and estimate the intrinsics the bundle estimated.
 // The yardsticks constrain the scale there as options.flange_scale says.
+// When the pose-noise solve succeeded, its held-out reprojection of the verification poses and its fit geometry
+// (pose_noise_result.h); *calibrated and *noise: the set it solved and its options, for the cross-validation.
 void CheckFlangePoses(const ObservationSet& observations, const ObservationSet& prepared, const CalibrateOptions& options,
-                      CalibrationReport* report) {
+                      CalibrationReport* report, ObservationSet* calibrated_out, bundle::PoseNoiseOptions* noise_out) {
   const BundleStageReport& stage = *report->bundle;
   const bundle::BundleReport& b = stage.bundle;
   // The hand-eye transform: flange_from_cam, or the fixed camera base_from_cam eye-to-hand.
@@ -142,6 +144,20 @@ void CheckFlangePoses(const ObservationSet& observations, const ObservationSet& 
   report->pose_noise_translation_m = noise.translation_sigma_m;
   report->pose_noise_rotation_rad = noise.rotation_sigma_rad;
   report->flange_scale_yardsticks = static_cast<int>(report->pose_noise->yardstick_lengths_m.size());
+  if (!report->PoseNoiseIsTheResult()) return;
+  const bundle::PoseNoiseReport& solve = *report->pose_noise;
+  report->pose_noise_fit_geometry = PoseNoiseFitGeometry(calibrated, solve);
+  if (!calibrated.PosesWithRole(PoseRole::kVerification).empty() && calibrated.Validate().empty()) {
+    report->pose_noise_heldout = PoseNoiseHeldOut(calibrated, solve, noise);
+    HeldOutReprojection& h = *report->pose_noise_heldout;
+    const double depth = MedianCameraToDotDistance(calibrated, report->pose_noise_fit_geometry, solve.dots);
+    if (h.ok && std::isfinite(depth) && solve.intrinsics[kFx] > 0) {
+      h.mm_per_px = depth * 1e3 / solve.intrinsics[kFx];
+      h.rms_mm = h.overall.rms_px * h.mm_per_px;
+    }
+  }
+  *calibrated_out = std::move(calibrated);
+  *noise_out = noise;
 }
 
 // The acceptance checks of the chosen method's converged model; a failed one turns the verdict to
@@ -159,9 +175,13 @@ void CheckAcceptance(const ObservationSet& obs, const ObservationSet& original, 
       in.no_nominal_reason = "the set names no hand-eye transform, and the start the solver found from the images is "
                              "not a nominal model (give one with detect --hand-eye to compare with it)";
     }
-    if (original.flange_translation_sigma_m > 0) {
+    if (report->pose_noise_heldout) {
+      // The pose-noise solve is the result: its prediction, at the stated pixel noise and the flange pose noise.
+      in.calibrated = &*report->pose_noise_heldout;
+      in.test_at_stated_noise = &report->pose_noise_heldout->overall;
+    } else if (original.flange_translation_sigma_m > 0) {
       in.test_at_stated_noise = nullptr;
-      in.no_test_reason = "the flange poses have a stated noise, which the test does not model";
+      in.no_test_reason = "the flange poses have a stated noise, and the solve that models it did not succeed";
     }
     in.held_values = &stage.bundle.held_values;
     if (!original.UsesFlangePoses()) {
@@ -267,6 +287,14 @@ CalibratedModel ModelOf(const CalibrationReport& report, const ObservationSet& o
     }
     model.camera = WithIntrinsics(model.camera, report.pose_noise->intrinsics);
     model.intrinsics_stddev = report.pose_noise->intrinsics_stddev;
+    // The camera correction of the parameter vector: the pose-noise hand-eye transform on the set's nominal one.
+    const int cam = KinematicParameters(obs.robot.num_joints()).CamOffset();
+    if (model.parameters.size() >= cam + 6) {
+      const Rigid3 c = (eye_to_hand ? obs.robot.base_from_cam : obs.robot.flange_from_cam).Inverse() *
+                       (eye_to_hand ? report.pose_noise->base_from_cam : report.pose_noise->flange_from_cam);
+      model.parameters.segment<3>(cam) = c.translation;
+      model.parameters.segment<3>(cam + 3) = LogSO3(c.rotation);
+    }
     model.method_description += report.pose_noise_estimated ? ", flange poses with their noise estimated from the residuals"
                                                             : ", flange poses with their stated noise";
   }
@@ -332,14 +360,19 @@ CalibrationReport CalibrateSteps(const ObservationSet& observations, const Calib
     if (report.bundle->bundle.outcome == bundle::Outcome::kConverged) {
       report.scene_moves = SceneMovesOf(obs, report.bundle->bundle.dots_in_base);
     }
+    ObservationSet noise_set;
+    bundle::PoseNoiseOptions noise;
+    if (flange_poses) CheckFlangePoses(observations, obs, options, &report, &noise_set, &noise);
     if (report.bundle->bundle.outcome == bundle::Outcome::kConverged &&
         obs.PosesWithRole(PoseRole::kVerification).empty()) {
       report.cross_validation =
-          CrossValidate(obs, *report.bundle, stage_options, options.cross_validation_folds, options.paper.two_view.seed);
+          report.PoseNoiseIsTheResult()
+              ? CrossValidatePoseNoise(noise_set, *report.pose_noise, noise, options.cross_validation_folds,
+                                       options.paper.two_view.seed)
+              : CrossValidate(obs, *report.bundle, stage_options, options.cross_validation_folds, options.paper.two_view.seed);
     }
     progress.Advance();
   }
-  if (flange_poses && report.bundle) CheckFlangePoses(observations, obs, options, &report);
   if (flange_poses && options.flange_scale == FlangeScale::kYardstick && report.bundle &&
       report.bundle->bundle.outcome == bundle::Outcome::kConverged && !report.pose_noise) {
     report.verdict = Verdict::kInvalidInput;

@@ -7,6 +7,8 @@
 //   acceptance.h            the checks that turn a verdict to kRejected (see Calibrate below)
 //   cross_validation.h      CrossValidate: without verification poses, the bundle re-run without each fold and
 //                           the fold predicted
+//   pose_noise_result.h     a flange-pose set's pose-noise solve as the result: its prediction model, held-out
+//                           reprojection, cross-validation folds and fit geometry
 //   hand_eye_start.h        StartHandEye (flange poses: Procrustes rotation, a linear translation with one length
 //                           per pair; on a flat target twoview/planar_views.h) and StartCameraFromImages
 //   motion_check.h          CheckImageMotions: the free-camera bundle's camera motions against the flange
@@ -48,6 +50,7 @@
 #include "bundle/pose_noise_bundle.h"
 #include "calibration/motion_check.h"
 #include "calibration/paper_pipeline.h"
+#include "calibration/pose_noise_result.h"
 #include "calibration/scene_moves.h"
 #include "kinematics/robot_model.h"
 #include "observations/observation_set.h"
@@ -140,11 +143,18 @@ struct CalibrationReport {
   std::optional<bundle::PoseNoiseReport> pose_noise;
   bool pose_noise_estimated = false;  // the noise of pose_noise is the error model's, not the set's
   double pose_noise_translation_m = 0, pose_noise_rotation_rad = 0;  // the noise it modelled, per axis
+  // When the pose-noise solve succeeded it is the result (PoseNoiseIsTheResult; pose_noise_result.h): the model,
+  // the verdict's held-out test and every figure of the report come from it. Its held-out reprojection of the
+  // verification poses (when the set names some; the verdict's heldout_test), and the camera poses and
+  // identification residuals of its fit (the report's plots).
+  std::optional<HeldOutReprojection> pose_noise_heldout;
+  FitGeometry pose_noise_fit_geometry;
   // A flange-pose set: how many yardsticks constrained the scale beside the flange translations (0: the
   // flange translations alone; the yardsticks were checks).
   int flange_scale_yardsticks = 0;
   std::optional<BundleStageReport> bundle;  // when method == kBundle
-  // The bundle converged and the set names no verification pose: its k-fold held-out figure.
+  // The bundle converged and the set names no verification pose: its k-fold held-out figure (the pose-noise
+  // solve's folds when it is the result).
   std::optional<CrossValidationReport> cross_validation;
   // The bundle converged on a set of several scenes sharing point ids: where each lies against the first.
   std::vector<SceneMove> scene_moves;
@@ -158,6 +168,7 @@ struct CalibrationReport {
   double seconds_acceptance = 0, seconds_total = 0;
 
   bool accepted() const { return verdict == Verdict::kAccepted; }
+  bool PoseNoiseIsTheResult() const { return pose_noise.has_value() && pose_noise->ok; }
   // A model is written: accepted, or converged and passing what could be checked without a held-out test.
   bool has_model_verdict() const { return verdict == Verdict::kAccepted || verdict == Verdict::kUntested; }
   // The chosen method's held-out verification (3-D error of the check distances), before and after.

@@ -16,36 +16,44 @@ std::vector<int> ShuffledPoses(const ObservationSet& obs, std::uint64_t seed) {
   return poses;
 }
 
-// One fold: the bundle without `held_out`, started from the whole solve, and its prediction of them.
-CrossValidationFold RunFold(const ObservationSet& obs, const BundleStageReport& full, const BundleStageOptions& options,
-                            const std::vector<int>& held_out) {
+// One fold: `run` on the set without `held_out` (made verification poses), and its figure of them.
+CrossValidationFold RunFold(const ObservationSet& obs, const std::vector<int>& held_out, const FoldRunner& run) {
   CrossValidationFold fold;
   ObservationSet train = obs;
   for (int p : held_out) {
     train.poses[p].role = PoseRole::kVerification;
     fold.held_out.push_back(obs.poses[p].id);
   }
-  const bundle::BundleReport b = bundle::RunBundleAdjustment(train, full.bundle.rho, full.bundle.fx_px, options.bundle);
-  fold.outcome = b.outcome;
-  if (b.outcome != bundle::Outcome::kConverged) {
-    fold.message = b.message;
+  const FoldFit fit = run(train);
+  fold.outcome = fit.outcome;
+  if (fit.outcome != bundle::Outcome::kConverged) {
+    fold.message = fit.message;
     return fold;
   }
+  if (!fit.heldout.ok) {
+    fold.message = fit.heldout.message;
+    return fold;
+  }
+  fold.figure = fit.heldout.overall;
+  return fold;
+}
+
+// The bundle on a fold's training set, started from the whole solve, predicting the fold at the stated noise.
+FoldFit FitBundle(const ObservationSet& train, const BundleStageReport& full, const BundleStageOptions& options) {
+  FoldFit fit;
+  const bundle::BundleReport b = bundle::RunBundleAdjustment(train, full.bundle.rho, full.bundle.fx_px, options.bundle);
+  fit.outcome = b.outcome;
+  fit.message = b.message;
+  if (b.outcome != bundle::Outcome::kConverged) return fit;
   double noise = 0;
   int noise_dof = 0;
-  const HeldOutReprojection h = HeldOutReprojectionOfBundle(train, b, &noise, &noise_dof, obs.pixel_noise_px);
-  if (!h.ok) {
-    fold.message = h.message;
-    return fold;
-  }
-  fold.figure = h.overall;
-  return fold;
+  fit.heldout = HeldOutReprojectionOfBundle(train, b, &noise, &noise_dof, train.pixel_noise_px);
+  return fit;
 }
 
 }  // namespace
 
-CrossValidationReport CrossValidate(const ObservationSet& obs, const BundleStageReport& full,
-                                    const BundleStageOptions& options, int folds, std::uint64_t seed) {
+CrossValidationReport CrossValidateWith(const ObservationSet& obs, int folds, std::uint64_t seed, const FoldRunner& run) {
   CrossValidationReport report;
   report.folds = folds;
   report.seed = seed;
@@ -72,7 +80,7 @@ CrossValidationReport CrossValidate(const ObservationSet& obs, const BundleStage
     std::vector<int> held_out;
     for (size_t k = f; k < poses.size(); k += folds) held_out.push_back(poses[k]);
     std::sort(held_out.begin(), held_out.end());
-    report.per_fold.push_back(RunFold(obs, full, options, held_out));
+    report.per_fold.push_back(RunFold(obs, held_out, run));
     const HeldOutFigure& figure = report.per_fold.back().figure;
     if (figure.num_residuals > 0) {
       sum2 += figure.rms_px * figure.rms_px * figure.num_residuals;
@@ -92,12 +100,20 @@ CrossValidationReport CrossValidate(const ObservationSet& obs, const BundleStage
   } else {
     pooled = HeldOutFigure();
   }
+  report.message = "held-out RMS over " + std::to_string(folds) + " folds";
+  return report;
+}
+
+CrossValidationReport CrossValidate(const ObservationSet& obs, const BundleStageReport& full,
+                                    const BundleStageOptions& options, int folds, std::uint64_t seed) {
+  CrossValidationReport report = CrossValidateWith(
+      obs, folds, seed, [&](const ObservationSet& train) { return FitBundle(train, full, options); });
+  if (!report.ran) return report;
   const double depth = MedianCameraToDotDistance(obs, full.fit_geometry, full.bundle.dots_in_base);
   if (std::isfinite(depth) && full.bundle.fx_px > 0) {
     report.mm_per_px = depth * 1e3 / full.bundle.fx_px;
-    report.rms_mm = pooled.rms_px * report.mm_per_px;
+    report.rms_mm = report.pooled.rms_px * report.mm_per_px;
   }
-  report.message = "held-out RMS over " + std::to_string(folds) + " folds";
   return report;
 }
 

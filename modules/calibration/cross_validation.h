@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,20 @@ struct CrossValidationReport {
   // Every fold's figure summed: predicted detections, RMS per coordinate, chi-square, dof, its 95 % limit, p.
   HeldOutFigure pooled;
 };
+
+// One fold's fit on `train` (the set with the fold's poses made verification poses) and its prediction of them:
+// the fit's outcome and message, and when it converged the held-out reprojection of the fold's poses.
+struct FoldFit {
+  bundle::Outcome outcome = bundle::Outcome::kNotRun;
+  std::string message;
+  HeldOutReprojection heldout;
+};
+using FoldRunner = std::function<FoldFit(const ObservationSet& train)>;
+
+// The folds of a k-fold cross-validation, each run by `run`, pooled (mm_per_px and rms_mm left NaN: the caller
+// knows the scene's depth). Not run, as below, with verification poses, folds < 2 or too few poses.
+CrossValidationReport CrossValidateWith(const ObservationSet& observations, int folds, std::uint64_t seed,
+                                        const FoldRunner& run);
 
 // k-fold cross-validation of `full` (the bundle stage of the whole set, converged): fold f holds out every
 // k-th pose of the seeded order from f on. Not run (ran false, with the reason) when the set has

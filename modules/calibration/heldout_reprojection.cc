@@ -237,6 +237,29 @@ Eigen::Matrix<double, 2, 6> PoseErrorRows(const Rigid3& cam_from_base, const Eig
   return rows;
 }
 
+// The recorded flange pose's noise (base_from_flange * Exp(delta), per axis s_t, s_r in the flange frame) as
+// the camera motion of PoseErrorRows, scaled: e = A delta with, for flange_from_cam = (R, t), the rotation
+// R^T w and the translation R^T (v + w x t) (up to a sign that the covariance does not see). Returns
+// d(pixel)/d(delta) diag(s_t, s_r).
+Eigen::Matrix<double, 2, 6> FlangePoseErrorRows(const Rigid3& cam_from_base, const Rigid3& flange_from_cam,
+                                                const Eigen::Vector3d& p_base, const Matrix23& jd, double translation_sd,
+                                                double rotation_sd) {
+  const Eigen::Matrix3d rt = flange_from_cam.rotation.transpose();
+  Eigen::Matrix<double, 6, 6> a = Eigen::Matrix<double, 6, 6>::Zero();
+  a.topLeftCorner<3, 3>() = rt * translation_sd;
+  a.topRightCorner<3, 3>() = -rt * Skew<double>(flange_from_cam.translation) * rotation_sd;
+  a.bottomRightCorner<3, 3>() = rt * rotation_sd;
+  return PoseErrorRows(cam_from_base, p_base, jd, 1.0, 1.0) * a;
+}
+
+// The camera in the frame of the flange whose recorded pose carries the noise: points_from_cam of the flange's
+// points (eye-to-hand), or base_from_flange^-1 * base_from_cam (eye-in-hand).
+Rigid3 FlangeFromCamAt(const PredictionModel& model, const PoseFrames& frames, const PoseObservation& pose) {
+  const Rigid3 points_from_cam = frames.cam_from_base.Inverse();
+  if (model.robot.mount == CameraMount::kEyeToHand || !pose.base_from_flange) return points_from_cam;
+  return pose.base_from_flange->Inverse() * points_from_cam;
+}
+
 // The square root of the parameters' covariance (Sigma = L L^T; semi-definite allowed).
 Eigen::MatrixXd CovarianceRoot(const Eigen::MatrixXd& covariance) {
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(0.5 * (covariance + covariance.transpose()));
@@ -314,6 +337,7 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
   for (size_t index = 0; index < verification.size(); ++index) {
     const PoseObservation& pose = obs.poses[verification[index]];
     const PoseFrames frames = projector.Frames(pose);
+    const Rigid3 flange_from_cam = model.pose_error_at_flange ? FlangeFromCamAt(model, frames, pose) : Rigid3();
     const int first = static_cast<int>(residuals.rows.size());
     for (const auto& [id, pixel] : pose.dots_px) {
       const auto d = info.find(id);
@@ -330,7 +354,11 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
       if (width > 0) {
         g.setZero();
         if (nt > 0) g.leftCols(nt).noalias() = (jt - jd * d->second.k) * theta_root;
-        if (pose_error) {
+        if (pose_error && model.pose_error_at_flange) {
+          g.middleCols<6>(nt + 6 * static_cast<int>(index)) =
+              FlangePoseErrorRows(frames.cam_from_base, flange_from_cam, dots_in_base.at(id), jd,
+                                  model.pose_translation_m, model.pose_rotation_rad);
+        } else if (pose_error) {
           g.middleCols<6>(nt + 6 * static_cast<int>(index)) =
               PoseErrorRows(frames.cam_from_base, dots_in_base.at(id), jd, model.pose_translation_m, model.pose_rotation_rad);
         }

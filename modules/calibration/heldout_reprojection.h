@@ -67,6 +67,10 @@ struct PredictionModel {
   // Each verification image's own camera pose error (bundle/error_model.h), per axis in the camera frame:
   // C gains J_e diag(s_t^2 I, s_r^2 I) J_e^T over the dots of that image. 0: none.
   double pose_translation_m = 0, pose_rotation_rad = 0;
+  // True: the two sizes above are the recorded flange pose's noise instead (bundle/pose_noise_bundle.h:
+  // base_from_flange * Exp(delta), delta per axis in the flange frame), carried to the camera through the
+  // hand-eye transform: J_e A diag(s_t^2 I, s_r^2 I) A^T J_e^T with A the adjoint of cam_from_flange.
+  bool pose_error_at_flange = false;
 };
 
 // One detection beside the model's prediction of it (for plots of the residuals over the image).

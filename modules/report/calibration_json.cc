@@ -167,13 +167,13 @@ json HeldOutModelJson(const calibration::HeldOutReprojection& h) {
           {"poses", poses}};
 }
 
-// The bundle's held-out reprojection; null when it was not computed (no converged rho, no verification pose).
-json HeldOutJson(const ObservationSet& obs, const calibration::BundleStageReport& stage) {
-  const calibration::HeldOutReprojection& c = stage.heldout;
-  const calibration::HeldOutReprojection& n = stage.heldout_nominal;
+// A held-out reprojection (the bundle's, or the pose-noise solve's: `at_stated` its overall figure at the stated
+// noise) beside the nominal model's; null when it was not computed (no converged rho, no verification pose).
+json HeldOutJson(const ObservationSet& obs, const calibration::HeldOutReprojection& c,
+                 const calibration::HeldOutFigure& at_stated, const calibration::HeldOutReprojection& n) {
   if (!c.ok && c.overall.num_residuals == 0 && c.poses.empty() && c.message.empty()) return nullptr;
   json calibrated = HeldOutModelJson(c);
-  calibrated["overall_at_stated_noise"] = c.ok ? HeldOutFigureJson(stage.heldout_at_stated_noise) : json();
+  calibrated["overall_at_stated_noise"] = c.ok ? HeldOutFigureJson(at_stated) : json();
   calibrated["m_per_px"] = Finite(c.mm_per_px * 1e-3);  // SI keys (the cross-validation's mm keys predate the rule)
   calibrated["rms_m"] = Finite(c.rms_mm * 1e-3);
   const bool compare = c.ok && n.ok;
@@ -186,7 +186,7 @@ json HeldOutJson(const ObservationSet& obs, const calibration::BundleStageReport
           {"noise_px", Finite(c.noise_px)},
           {"noise_source", c.noise_source},
           {"stated_noise_px", obs.pixel_noise_px},
-          {"test_passed", c.ok ? json(stage.heldout_at_stated_noise.test_passed) : json()},
+          {"test_passed", c.ok ? json(at_stated.test_passed) : json()},
           {"beats_nominal", compare ? json(c.overall.rms_px < n.overall.rms_px) : json()},
           {"calibrated_model", calibrated},
           {"nominal_model", HeldOutModelJson(n)}};
@@ -328,7 +328,7 @@ json BundleSectionJson(const ObservationSet& obs, const calibration::BundleStage
           {"parameters", ParametersJson(obs, b.rho, b.stddev, b.free_indices, "value", true)},
           {"verification", VerificationJson(obs, stage.verification_nominal, stage.verification)},
           {"predicted_3d_error", PredictedErrorJson(stage.predicted_error)},
-          {"heldout_reprojection", HeldOutJson(obs, stage)},
+          {"heldout_reprojection", HeldOutJson(obs, stage.heldout, stage.heldout_at_stated_noise, stage.heldout_nominal)},
           {"plot_data", BundlePlotDataJson(obs, stage)}};
 }
 
@@ -451,6 +451,9 @@ json HandEyeJson(const calibration::CalibrationReport& report) {
                                                                      n.intrinsics_stddev)
                                                     : json()},
                        {"rms_reprojection_px", n.rms_reprojection_px},
+                       {"is_the_result", report.PoseNoiseIsTheResult()},
+                       {"fx_px", n.intrinsics[kFx]},
+                       {"variance_factor", Finite(n.variance_factor)},
                        {"pose_ids", n.pose_ids},
                        {"correction_translation_m", n.correction_translation_m},
                        {"correction_rotation_rad", n.correction_rotation_rad}};
@@ -524,6 +527,15 @@ json CalibrationReportJson(const ObservationSet& obs, const calibration::Calibra
   j["verification"] = field("verification");
   j["predicted_3d_error"] = field("predicted_3d_error");
   j["heldout_reprojection"] = field("heldout_reprojection");
+  if (report.PoseNoiseIsTheResult() && report.bundle) {
+    // The pose-noise solve is the model written: the top level, the held-out test and the plots are its.
+    j["fx_px"] = report.pose_noise->intrinsics[kFx];
+    if (report.pose_noise_heldout) {
+      j["heldout_reprojection"] = HeldOutJson(obs, *report.pose_noise_heldout, report.pose_noise_heldout->overall,
+                                              report.bundle->heldout_nominal);
+    }
+    methods["bundle"]["plot_data"] = PoseNoisePlotDataJson(obs, report);
+  }
   j["cross_validation"] = report.cross_validation ? CrossValidationJson(*report.cross_validation) : json();
   json moves = json::array();
   for (const calibration::SceneMove& m : report.scene_moves) {

@@ -30,6 +30,37 @@ json CorrelationJson(const ObservationSet& obs, const bundle::BundleReport& b) {
   return {{"names", names}, {"matrix", matrix}};
 }
 
+// The correlations of the pose-noise solve's covariance: the camera correction (cam.tx .. cam.rz), then the
+// estimated intrinsics.
+json PoseNoiseCorrelationJson(const ObservationSet& obs, const bundle::PoseNoiseReport& n) {
+  const int size = static_cast<int>(n.covariance.rows());
+  if (size == 0) return nullptr;
+  const KinematicParameters params(obs.robot.num_joints());
+  json names = json::array();
+  for (int k = 0; k < 6; ++k) names.push_back(params.name(params.CamOffset() + k));
+  for (int i : EstimatedIntrinsics(n.intrinsics_estimated)) names.push_back(IntrinsicName(i));
+  if (static_cast<int>(names.size()) != size) return nullptr;
+  const Eigen::VectorXd sd = n.covariance.diagonal().cwiseSqrt();
+  json matrix = json::array();
+  for (int r = 0; r < size; ++r) {
+    json row = json::array();
+    for (int c = 0; c < size; ++c) row.push_back(Finite(n.covariance(r, c) / (sd[r] * sd[c])));
+    matrix.push_back(row);
+  }
+  return {{"names", names}, {"matrix", matrix}};
+}
+
+json CamerasJson(const calibration::FitGeometry& g) {
+  json cameras = json::array();
+  for (const calibration::CameraPose& c : g.camera_poses) {
+    cameras.push_back({{"pose", c.pose_id},
+                       {"role", PoseRoleName(c.role)},
+                       {"xyz_m", Vector(c.base_from_cam.translation)},
+                       {"rotvec_rad", Vector(LogSO3(c.base_from_cam.rotation))}});
+  }
+  return cameras;
+}
+
 }  // namespace
 
 json ResidualsJson(const std::vector<calibration::ObservedResidual>& residuals) {
@@ -46,13 +77,7 @@ json ResidualsJson(const std::vector<calibration::ObservedResidual>& residuals) 
 json BundlePlotDataJson(const ObservationSet& obs, const calibration::BundleStageReport& stage) {
   const calibration::FitGeometry& g = stage.fit_geometry;
   if (g.camera_poses.empty()) return nullptr;
-  json cameras = json::array();
-  for (const calibration::CameraPose& c : g.camera_poses) {
-    cameras.push_back({{"pose", c.pose_id},
-                       {"role", PoseRoleName(c.role)},
-                       {"xyz_m", Vector(c.base_from_cam.translation)},
-                       {"rotvec_rad", Vector(LogSO3(c.base_from_cam.rotation))}});
-  }
+  const json cameras = CamerasJson(g);
   json dots = json::array();
   for (const auto& [id, p] : stage.bundle.dots_in_base) dots.push_back({{"dot", id}, {"xyz_m", Vector(p)}});
   return {{"description", "for report.html's figures: camera_poses_from_model, the calibrated model's base_from_cam at every "
@@ -67,6 +92,27 @@ json BundlePlotDataJson(const ObservationSet& obs, const calibration::BundleStag
           {"identification_residuals", ResidualsJson(g.identification_residuals)},
           {"heldout_residuals", ResidualsJson(stage.heldout.residuals)},
           {"correlation", CorrelationJson(obs, stage.bundle)}};
+}
+
+json PoseNoisePlotDataJson(const ObservationSet& obs, const calibration::CalibrationReport& report) {
+  const calibration::FitGeometry& g = report.pose_noise_fit_geometry;
+  if (!report.PoseNoiseIsTheResult() || g.camera_poses.empty()) return nullptr;
+  json dots = json::array();
+  for (const auto& [id, p] : report.pose_noise->dots) dots.push_back({{"dot", id}, {"xyz_m", Vector(p)}});
+  return {{"description", "for report.html's figures, from the pose-noise solve (the model written): "
+                          "camera_poses_from_model, its base_from_cam at every pose (the recorded flange pose times its "
+                          "hand-eye transform, not the corrected flange pose), its dots, every identification detection "
+                          "of its final fit (at the corrected flange poses) and every held-out detection with its "
+                          "residual (detection - prediction, px), and the correlations of its hand-eye correction and "
+                          "estimated intrinsics"},
+          {"image", {{"width_px", obs.camera.width_px}, {"height_px", obs.camera.height_px}}},
+          {"camera_poses_from_model", CamerasJson(g)},
+          {"dots_in_base", dots},
+          {"identification_residuals", ResidualsJson(g.identification_residuals)},
+          {"heldout_residuals",
+           ResidualsJson(report.pose_noise_heldout ? report.pose_noise_heldout->residuals
+                                                   : std::vector<calibration::ObservedResidual>())},
+          {"correlation", PoseNoiseCorrelationJson(obs, *report.pose_noise)}};
 }
 
 }  // namespace selfcal::report

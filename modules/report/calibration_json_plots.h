@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "calibration/bundle_stage.h"
+#include "calibration/calibrate.h"
 #include "observations/observation_set.h"
 
 namespace selfcal::report {
@@ -15,5 +16,10 @@ namespace selfcal::report {
 nlohmann::json ResidualsJson(const std::vector<calibration::ObservedResidual>& residuals);
 
 nlohmann::json BundlePlotDataJson(const ObservationSet& observations, const calibration::BundleStageReport& stage);
+
+// The same keys from a flange-pose set's pose-noise solve when it is the result (CalibrationReport::
+// PoseNoiseIsTheResult): its camera poses, dots, residuals and the correlations of its hand-eye correction and
+// estimated intrinsics.
+nlohmann::json PoseNoisePlotDataJson(const ObservationSet& observations, const calibration::CalibrationReport& report);
 
 }  // namespace selfcal::report

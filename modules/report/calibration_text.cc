@@ -67,8 +67,8 @@ void PrintPaperSummary(const calibration::PaperPipelineReport& r, bool bundle_fo
 // The held-out reprojection: overall for both models, and the verification poses above their own 95 %
 // limit at the bundle's noise estimate, as figures: the verdict's test is the acceptance's, at the stated
 // noise (acceptance.h), and at 95 % one pose in twenty of a correct model lies above its limit.
-void PrintHeldOut(const calibration::BundleStageReport& stage, std::ostream& out) {
-  const calibration::HeldOutReprojection& c = stage.heldout;
+void PrintHeldOut(const calibration::HeldOutReprojection& c, const calibration::HeldOutReprojection& n,
+                  const char* noise_label, std::ostream& out) {
   if (!c.ok) {
     if (!c.message.empty()) out << "  held-out reprojection: not computed (" << c.message << ")\n";
     return;
@@ -77,11 +77,10 @@ void PrintHeldOut(const calibration::BundleStageReport& stage, std::ostream& out
   out << std::fixed << std::setprecision(3) << "  held-out reprojection on " << c.poses.size() << " verification poses, "
       << f.num_residuals << " dots: RMS " << f.rms_px << " px per coordinate";
   if (std::isfinite(c.rms_mm)) out << " (" << c.rms_mm << " mm at the scene)";
-  out << "\n    at the bundle's noise estimate " << c.noise_px << " px: chi-square " << std::setprecision(1)
+  out << "\n    at " << noise_label << " " << c.noise_px << " px: chi-square " << std::setprecision(1)
       << f.chi_square << " for " << f.dof << " dof, 95 % limit " << f.chi_square_limit
       << (f.noise_dof > 0 ? " (F test)" : "") << (f.test_passed ? ": within" : ": above") << "\n";
   if (!c.prediction_uncertainty) out << "    (the parameters' uncertainty is not in the test: " << c.message << ")\n";
-  const calibration::HeldOutReprojection& n = stage.heldout_nominal;
   if (n.ok) {
     out << std::setprecision(3) << "    nominal model on the same images: RMS " << n.overall.rms_px << " px ("
         << n.overall.num_residuals << " dots); the calibrated model " << (f.rms_px < n.overall.rms_px ? "beats" : "does not beat")
@@ -142,7 +141,10 @@ void PrintWeakDirections(const bundle::BundleReport& b, std::ostream& out) {
   }
 }
 
-void PrintBundleSummary(const calibration::BundleStageReport& stage, bool flange_poses, std::ostream& out) {
+// `heldout`: the held-out reprojection to print (the stage's, or the pose-noise solve's when that is the result:
+// printed after it, then).
+void PrintBundleSummary(const calibration::BundleStageReport& stage, bool flange_poses,
+                        const calibration::HeldOutReprojection* heldout, std::ostream& out) {
   const bundle::BundleReport& b = stage.bundle;
   out << (flange_poses ? "hand-eye bundle adjustment (recorded flange poses): " : "kinematic bundle adjustment: ")
       << bundle::OutcomeName(b.outcome);
@@ -185,7 +187,7 @@ void PrintBundleSummary(const calibration::BundleStageReport& stage, bool flange
         << " mm, verification pixels " << stage.predicted_error.rms_pixels_std_m * kMm << " mm)\n";
     out.unsetf(std::ios::floatfield);
   }
-  PrintHeldOut(stage, out);
+  if (heldout != nullptr) PrintHeldOut(*heldout, stage.heldout_nominal, "the bundle's noise estimate", out);
   out << "  time: " << std::fixed << std::setprecision(1) << b.seconds * 1e3 << " ms solve, "
       << stage.seconds_verification * 1e3 << " ms distances, " << stage.seconds_heldout * 1e3 << " ms held-out, "
       << stage.seconds_fit_geometry * 1e3 << " ms fit geometry, " << stage.seconds_predicted_error * 1e3
@@ -193,6 +195,25 @@ void PrintBundleSummary(const calibration::BundleStageReport& stage, bool flange
   out.unsetf(std::ios::floatfield);
 }
 
+
+// The pose-noise solve of a flange-pose set when it is the result: the figures the model written carries.
+void PrintPoseNoiseResult(const calibration::CalibrationReport& report, std::ostream& out) {
+  const bundle::PoseNoiseReport& n = *report.pose_noise;
+  out << "the model written is the pose-noise solve's (flange pose noise " << std::setprecision(3)
+      << report.pose_noise_translation_m * kMm << " mm / " << RadToDeg(report.pose_noise_rotation_rad)
+      << " deg per axis): f_x = " << std::fixed << std::setprecision(3) << n.intrinsics[kFx];
+  if (n.intrinsics_estimated[kFx]) {
+    out << " +- " << n.intrinsics_stddev[kFx] << " px";
+  } else {
+    out << " px (held)";
+  }
+  out << ", reprojection RMS " << std::setprecision(4) << n.rms_reprojection_px << " px at the corrected flange poses\n";
+  out.unsetf(std::ios::floatfield);
+  if (report.pose_noise_heldout && report.bundle) {
+    PrintHeldOut(*report.pose_noise_heldout, report.bundle->heldout_nominal,
+                 "the stated pixel noise (with the flange pose noise)", out);
+  }
+}
 
 }  // namespace
 
@@ -269,7 +290,10 @@ void PrintSummaryLines(const calibration::CalibrationReport& report, std::ostrea
   }
   if (report.bundle) {
     out << "\n";
-    PrintBundleSummary(*report.bundle, report.hand_eye_start.has_value(), out);
+    const bool pose_noise = report.PoseNoiseIsTheResult();
+    PrintBundleSummary(*report.bundle, report.hand_eye_start.has_value(), pose_noise ? nullptr : &report.bundle->heldout,
+                       out);
+    if (pose_noise) PrintPoseNoiseResult(report, out);
     if (report.cross_validation) PrintCrossValidation(*report.cross_validation, out);
     for (const calibration::SceneMove& m : report.scene_moves) {
       out << "  scene `" << m.scene << "` against `" << m.relative_to << "`: its " << m.shared_points
@@ -320,6 +344,9 @@ std::string VerdictHeadline(const calibration::CalibrationReport& report) {
   std::string line = calibration::VerdictName(report.verdict);
   const calibration::HeldOutReprojection* heldout = nullptr;
   if (report.bundle && report.bundle->heldout.ok) heldout = &report.bundle->heldout;
+  if (report.PoseNoiseIsTheResult()) {
+    heldout = report.pose_noise_heldout && report.pose_noise_heldout->ok ? &*report.pose_noise_heldout : nullptr;
+  }
   if (report.method == calibration::Method::kPaper && report.paper_heldout && report.paper_heldout->calibrated.ok) {
     heldout = &report.paper_heldout->calibrated;
   }

@@ -1,6 +1,7 @@
 #include "report/calibration_report.h"
 
 #include <iomanip>
+#include <random>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -217,6 +218,52 @@ TEST(CalibrationReport, PlanarViewsCarryTheirNormalMotionAndUnresolvedRival) {
       EXPECT_EQ(v.at("rival").at("translation_plane_distances").size(), 3u);
     }
   }
+}
+
+// A flange-pose set with 1 mm / 0.05 deg of flange pose noise, stated: the pose-noise solve is the model written,
+// and report.json's top-level f_x, hand-eye transform, held-out figure and plot dots, and the text summary's f_x
+// and headline, are that solve's, not the exact-pose bundle's (whose f_x differs).
+TEST(CalibrationReport, AFlangePoseSetsOutputsAllComeFromThePoseNoiseSolve) {
+  const sim::SimResult world = testing::PumaArcWorld(0.2, 3, 7);
+  ObservationSet obs = testing::AsFlangePoseSet(world);
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  for (PoseObservation& pose : obs.poses) {
+    const double v[6] = {1e-3 * gauss(rng), 1e-3 * gauss(rng), 1e-3 * gauss(rng),
+                         8.7e-4 * gauss(rng), 8.7e-4 * gauss(rng), 8.7e-4 * gauss(rng)};
+    *pose.base_from_flange = *pose.base_from_flange * RigidFromTranslationRotvec(v);
+  }
+  obs.flange_translation_sigma_m = 1e-3;
+  obs.flange_rotation_sigma_rad = 8.7e-4;
+  const calibration::CalibrationReport report = calibration::Calibrate(obs, {});
+  ASSERT_TRUE(report.PoseNoiseIsTheResult() && report.model.has_value()) << report.message;
+  ASSERT_TRUE(report.pose_noise_heldout.has_value() && report.pose_noise_heldout->ok);
+  const bundle::PoseNoiseReport& n = *report.pose_noise;
+  const nlohmann::json j = CalibrationReportJson(obs, report, {});
+  const double fx = j.at("fx_px").get<double>();
+  EXPECT_EQ(fx, report.model->camera.fx_px);
+  EXPECT_EQ(fx, n.intrinsics[kFx]);
+  EXPECT_EQ(j.at("hand_eye").at("pose_noise").at("fx_px").get<double>(), fx);
+  EXPECT_TRUE(j.at("hand_eye").at("pose_noise").at("is_the_result").get<bool>());
+  EXPECT_NE(j.at("methods").at("bundle").at("fx_px").get<double>(), fx);  // the exact-pose solve's, a record
+  const nlohmann::json& xyz = j.at("hand_eye").at("flange_from_cam").at("xyz_m");
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(xyz.at(k).get<double>(), n.flange_from_cam.translation[k]) << k;
+  EXPECT_EQ(j.at("heldout_reprojection").at("calibrated_model").at("overall").at("rms_px").get<double>(),
+            report.pose_noise_heldout->overall.rms_px);
+  EXPECT_EQ(j.at("heldout_reprojection").at("test_passed").get<bool>(), report.pose_noise_heldout->overall.test_passed);
+  const nlohmann::json& dots = j.at("methods").at("bundle").at("plot_data").at("dots_in_base");
+  ASSERT_EQ(dots.size(), n.dots.size());
+  const int first = dots.at(0).at("dot").get<int>();
+  EXPECT_EQ(dots.at(0).at("xyz_m").at(0).get<double>(), n.dots.at(first).x());
+  std::ostringstream text;
+  PrintCalibrationSummary(obs, report, text);
+  std::ostringstream fx_text;
+  fx_text << std::fixed << std::setprecision(3) << fx;
+  EXPECT_NE(text.str().find("pose-noise solve's"), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("f_x = " + fx_text.str()), std::string::npos) << text.str();
+  std::ostringstream rms;
+  rms << std::fixed << std::setprecision(3) << report.pose_noise_heldout->overall.rms_px;
+  EXPECT_NE(VerdictHeadline(report).find("held-out " + rms.str() + " px"), std::string::npos) << VerdictHeadline(report);
 }
 
 // The paper's Table 2 comes from the literature table, as printed there.
