@@ -72,10 +72,13 @@ nlohmann::json BundleCellJson(const simulation::StudyCell& c) {
                                {"fraction", Finite(c.BundleCoverage())}}},
           {"parameters_rms_error_over_bound", BundleParametersJson(c)},
           {"parameter_abs_error", {{"description", "|estimate - truth| of every free parameter, pooled over the "
-                                                   "runs whose gauge is the truth's (noise 0 included)"},
+                                                   "runs whose gauge is the truth's (runs_in_truths_gauge; noise 0 "
+                                                   "included)"},
                                    {"length_mm", StatJson(c.bundle_length_error_mm)},
                                    {"angle_deg", StatJson(c.bundle_angle_error_deg)}}},
           {"weak_held_runs", c.bundle_weak_held},
+          {"runs_with_weak_held", c.bundle_runs_weak_held},
+          {"runs_in_truths_gauge", c.bundle_runs_in_truths_gauge},
           {"seconds_per_solve", StatJson(c.bundle_seconds)}};
 }
 }  // namespace

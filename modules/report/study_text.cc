@@ -178,11 +178,13 @@ void PrintBundleAgainstBound(const simulation::StudyReport& study, std::ostream&
     if (c.bundle_weak_held.empty()) continue;
     std::string held;
     for (const auto& [name, runs] : c.bundle_weak_held) {
-      held += (held.empty() ? "" : ", ") + name + " in " + std::to_string(runs) + " of " + std::to_string(c.bundle_runs);
+      held += (held.empty() ? "" : ", ") + name + " " + std::to_string(runs);
     }
     std::snprintf(line, sizeof(line),
-                  "%-10s %-6.2f weak parameters held at the description (its error is then in the others'): %s\n",
-                  c.trajectory.c_str(), c.noise_px, held.c_str());
+                  "%-10s %-6.2f %d of %d runs held weak parameters at the description (%s): left out of the coverage "
+                  "and the per-parameter ratios, %d runs scored\n",
+                  c.trajectory.c_str(), c.noise_px, c.bundle_runs_weak_held, c.bundle_runs, held.c_str(),
+                  c.bundle_runs_in_truths_gauge);
     out << line;
   }
   for (const simulation::StudyCell& c : study.cells) {

@@ -87,6 +87,8 @@ void StudyCell::Append(const StudyCell& later) {
   for (const auto& [name, stat] : later.bundle_parameter_error) AppendStat(&bundle_parameter_error[name], stat);
   for (const auto& [name, stat] : later.bundle_parameter_bound) AppendStat(&bundle_parameter_bound[name], stat);
   for (const auto& [name, count] : later.bundle_weak_held) bundle_weak_held[name] += count;
+  bundle_runs_weak_held += later.bundle_runs_weak_held;
+  bundle_runs_in_truths_gauge += later.bundle_runs_in_truths_gauge;
 }
 
 namespace {
@@ -229,21 +231,21 @@ bundle::CramerRaoReport BundleBound(const sim::SimResult& world, const Observati
   return bundle::BundleCramerRao(geometry, truth, sigma_px, options);
 }
 
-// Whether the truth is in the bundle's gauge: every entry it held fixed equal to the truth's, apart from the
-// weak parameters it held at the description (BundleReport::weak): identifiable, so the truth moved them,
-// and holding them is the bundle's choice, whose bias the free parameters' errors then carry. If so, adds
-// each free parameter's |error| to the cell; counts the weak parameters held either way.
+// Whether the truth is in the bundle's gauge: every entry it held fixed equal to the truth's. A weak
+// parameter held at the description (BundleReport::weak) is not: the truth moved it, and the bias of holding
+// it goes into the free parameters, beyond their sigmas and bound (the run is counted in bundle_weak_held).
+// If so, adds each free parameter's |error| to the cell.
 bool ScoreAgainstTheTruth(const bundle::BundleReport& b, const sim::SimTruth& truth, const KinematicParameters& params,
                           StudyCell* cell) {
   bool gauge_is_truths = true;
   for (int i = 0; i < b.rho.size() && gauge_is_truths; ++i) {
     const bool free = std::find(b.free_indices.begin(), b.free_indices.end(), i) != b.free_indices.end();
-    const bool weak = std::any_of(b.weak.begin(), b.weak.end(),
-                                  [&](const bundle::WeakParameter& w) { return w.name == params.name(i); });
-    if (!free && !weak && b.rho[i] != truth.rho_true[i]) gauge_is_truths = false;
+    if (!free && b.rho[i] != truth.rho_true[i]) gauge_is_truths = false;
   }
   for (const bundle::WeakParameter& w : b.weak) ++cell->bundle_weak_held[w.name];
+  if (!b.weak.empty()) ++cell->bundle_runs_weak_held;
   if (!gauge_is_truths) return false;
+  ++cell->bundle_runs_in_truths_gauge;
   for (int i : b.free_indices) {
     const double error = std::abs(b.rho[i] - truth.rho_true[i]);
     if (params.kind(i) == ParameterKind::kLength) {

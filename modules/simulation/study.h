@@ -124,7 +124,7 @@ struct StudyCell {
   Stat bundle_predicted3d_mm, bundle_predicted3d_parameters_mm, bundle_predicted3d_pixels_mm;
   Stat bundle_bound3d_mm, bundle_bound3d_parameters_mm;
   // (d) Coverage, pooled over runs: free parameters and f_x whose truth lies within +-2 reported sigma of
-  // the estimate (runs with noise > 0 whose gauge is the truth's, weak parameters held apart: (h)).
+  // the estimate (runs with noise > 0 whose gauge is the truth's: (h)).
   int bundle_intervals = 0, bundle_covered = 0;
   double BundleCoverage() const { return bundle_intervals > 0 ? static_cast<double>(bundle_covered) / bundle_intervals : std::nan(""); }
   // (f) Per free parameter (by name, mm or deg): the bundle's error against the truth (same-gauge runs) and
@@ -136,8 +136,10 @@ struct StudyCell {
   // gauge is the truth's, at every noise level (0 included: the zero-noise row's exactness is their max).
   Stat bundle_length_error_mm, bundle_angle_error_deg;
   // (h) Weak parameters the bundle held at the robot description's value (BundleReport::weak), by name: in
-  // how many runs. The truth moved them; the scoring above takes them as the bundle's model error.
+  // how many runs, and the runs that held any. The truth moved them: such a run's gauge is not the truth's,
+  // and (d), (f), (g) leave it out. bundle_runs_in_truths_gauge: the converged runs they score.
   std::map<std::string, int> bundle_weak_held;
+  int bundle_runs_weak_held = 0, bundle_runs_in_truths_gauge = 0;
 
   // Adds the runs of `later` (the same trajectory and level) after this cell's: counts summed, samples
   // appended in order, failure messages kept up to the first few. Merging the cells of single runs in
