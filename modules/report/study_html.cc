@@ -35,8 +35,10 @@ void SettingsTable(const json& s, Page* page) {
   if (hidden.is_object()) {
     for (const auto& [key, value] : hidden.items()) t.Row({"hidden error: " + key, Text(value)});
   }
-  t.Row({"identifiable parameters (paper)", Text(At(s, {"identifiable_parameters"}))});
-  t.Row({"fixed parameters (paper)", Text(At(s, {"fixed_parameters"}))});
+  if (At(s, {"paper_pipeline_applies"}) != false) {
+    t.Row({"identifiable parameters (paper)", Text(At(s, {"identifiable_parameters"}))});
+    t.Row({"fixed parameters (paper)", Text(At(s, {"fixed_parameters"}))});
+  }
   t.Row({"free parameters (bundle)", Text(At(s, {"bundle_free_parameters"}))});
   t.Row({"fixed parameters (bundle)", Text(At(s, {"bundle_fixed_parameters"}))});
   t.Row({"total time (s)", Text(At(s, {"seconds_total"}))});

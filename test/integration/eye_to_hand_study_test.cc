@@ -130,6 +130,7 @@ TEST_F(EyeToHandStudyTest, ReportRendersTheStudy) {
   EXPECT_TRUE(Contains(page, "eye_to_hand")) << page.substr(0, 2000);
   EXPECT_TRUE(Contains(page, "kinematic bundle adjustment"));
   EXPECT_FALSE(Contains(page, "paper pipeline, true scale"));
+  EXPECT_FALSE(Contains(page, "identifiable parameters (paper)"));
 }
 
 TEST(EyeToHandStudy, OptionsWithoutAnEyeToHandMeaningAreRefused) {
