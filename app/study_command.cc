@@ -6,6 +6,7 @@
 #include "app/cli_util.h"
 #include "app/output_options.h"
 #include "app/commands.h"
+#include "app/run_configuration.h"
 #include "report/study_report.h"
 #include "io/report_json.h"
 #include "io/robot_config.h"
@@ -28,15 +29,63 @@ struct StudyArgs {
   bool flat_sheet = false;
   bool rendered = false;
   int jobs = 0;
+  std::string configuration = "eye_in_hand";
 };
+
+// The robot (in the simulated cell of --configuration) and the trajectories of a study, or why not.
+Status LoadStudyInputs(const StudyArgs& args, RobotModel* robot, std::vector<simulation::TrajectorySpec>* trajectories) {
+  Result<CameraMount> mount = ParseConfiguration(args.configuration);
+  if (!mount.ok()) return mount.status();
+  if (*mount == CameraMount::kEyeToHand && (args.flat_sheet || args.rendered)) {
+    return Status::Error(ErrorCode::kInvalidInput,
+                         std::string("--configuration eye_to_hand: ") + (args.flat_sheet ? "--flat-sheet" : "--rendered") +
+                             " is not available there (the simulated eye-to-hand cell is a plate of point dots on the flange)");
+  }
+  Result<RobotModel> config = io::LoadRobotModel(ResolveDataPath(args.robot));
+  if (!config.ok()) return config.status();
+  Result<RobotModel> cell = RobotInSimulatedCell(*config, args.robot, *mount);
+  if (!cell.ok()) return cell.status();
+  *robot = *cell;
+  std::vector<std::string> specs = args.trajectories;
+  if (specs.empty() && *mount == CameraMount::kEyeToHand) {
+    // No eye-to-hand trajectory is shipped: the start `simulate` and `plan` take (EyeToHandStart).
+    Result<std::vector<Eigen::VectorXd>> start = EyeToHandStart(*robot, args.robot, 25);
+    if (!start.ok()) return start.status();
+    trajectories->push_back({"e2h-start", *start});
+    return Status::Ok();
+  }
+  if (specs.empty()) {
+    Result<std::string> shipped = TrajectoryForRobot("", robot->name, args.robot);
+    if (!shipped.ok()) return shipped.status();
+    specs.push_back("initial=" + *shipped);
+  }
+  for (const std::string& spec : specs) {
+    const size_t eq = spec.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      return Status::Error(ErrorCode::kInvalidInput, "--trajectory `" + spec + "`: expected NAME=FILE");
+    }
+    const std::string path = spec.substr(eq + 1);
+    Result<io::TrajectoryFile> file = io::LoadTrajectoryFileForRobot(ResolveDataPath(path), *robot, args.robot);
+    if (!file.ok()) return file.status();
+    if (file->planned_for && file->planned_for->configuration != *mount) {
+      return Status::Error(ErrorCode::kInvalidInput, "--trajectory " + path + " was planned for configuration " +
+                                                         CameraMountName(file->planned_for->configuration) +
+                                                         ", this study is " + args.configuration + " (--configuration)");
+    }
+    trajectories->push_back({spec.substr(0, eq), file->poses});
+  }
+  return Status::Ok();
+}
 }  // namespace
 
 Command AddStudyCommand(CLI::App& app) {
   auto args = std::make_shared<StudyArgs>();
   CLI::App* cmd = app.add_subcommand("study", "Monte Carlo: the paper's Table 2 and Fig. 6 on the simulator");
   AddRobotOption(cmd, &args->robot);
+  AddConfigurationOption(cmd, &args->configuration);
   cmd->add_option("--trajectory", args->trajectories,
-                  "NAME=FILE, repeatable (each for the robot); default: initial=config/trajectories/initial_<robot name>.yaml");
+                  "NAME=FILE, repeatable (each for the robot); default: initial=config/trajectories/initial_<robot name>.yaml "
+                  "(eye_to_hand: e2h-start=the 25-pose eye-to-hand start of plan and simulate)");
   cmd->add_option("--runs", args->runs, "Runs per cell")->check(CLI::Range(1, 100000));
   cmd->add_option("--noise-px", args->noise, "Pixel noise levels (std, px)")->delimiter(',');
   cmd->add_option("--seed", args->seed, "Base seed");
@@ -55,25 +104,9 @@ Command AddStudyCommand(CLI::App& app) {
   cmd->add_flag("--bound-sweep", args->bound_sweep,
                 "Also sweep the two-view Cramer-Rao bound over field of view, depth spread and baseline");
   return [args]() {
-    Result<RobotModel> robot = io::LoadRobotModel(ResolveDataPath(args->robot));
-    if (!robot.ok()) return Fail(robot.status());
+    RobotModel robot;
     std::vector<simulation::TrajectorySpec> trajectories;
-    std::vector<std::string> specs = args->trajectories;
-    if (specs.empty()) {
-      Result<std::string> shipped = TrajectoryForRobot("", robot->name, args->robot);
-      if (!shipped.ok()) return Fail(shipped.status());
-      specs.push_back("initial=" + *shipped);
-    }
-    for (const std::string& spec : specs) {
-      const size_t eq = spec.find('=');
-      if (eq == std::string::npos || eq == 0) {
-        return Fail(Status::Error(ErrorCode::kInvalidInput, "--trajectory `" + spec + "`: expected NAME=FILE"));
-      }
-      Result<io::TrajectoryFile> file =
-          io::LoadTrajectoryFileForRobot(ResolveDataPath(spec.substr(eq + 1)), *robot, args->robot);
-      if (!file.ok()) return Fail(file.status());
-      trajectories.push_back({spec.substr(0, eq), file->poses});
-    }
+    if (Status s = LoadStudyInputs(*args, &robot, &trajectories); !s.ok()) return Fail(s);
     for (double n : args->noise) {
       if (!(n >= 0 && n < 10)) return Fail(Status::Error(ErrorCode::kInvalidInput, "--noise-px: " + std::to_string(n) + " is not in [0, 10)"));
     }
@@ -94,7 +127,7 @@ Command AddStudyCommand(CLI::App& app) {
       options.rendered_levels = {{"img-0", 0, 0, 0.01}, {"img-I", 2, 0, 0.01}, {"img-II", 5, 0, 0.02},
                                  {"img-II-blur", 5, 1.0, 0.02}};
     }
-    const simulation::StudyReport study = simulation::RunStudy(*robot, trajectories, options);
+    const simulation::StudyReport study = simulation::RunStudy(robot, trajectories, options);
     report::PrintStudyTables(study, std::cout);
     nlohmann::json json = report::StudyJson(study, options);
     if (args->bound_sweep) {

@@ -13,7 +13,7 @@
 #include "planning/pose_twists.h"
 #include "planning/view_geometry.h"
 #include "sim/sim_world.h"
-#include "sim/trajectory_generator.h"
+#include "support/sim_worlds.h"
 #include "support/test_robots.h"
 
 namespace selfcal::planning {
@@ -27,24 +27,16 @@ struct EyeToHandWorld {
 // The PUMA 560 in the simulated eye-to-hand cell, the simulator's plate as the scene.
 EyeToHandWorld MakeEyeToHandWorld() {
   EyeToHandWorld w;
-  RobotModel robot = testing::Puma560();
-  const std::vector<double> home_deg = {0, 20, -200, 0, 45, 0};
-  Eigen::VectorXd home(6);
-  for (int j = 0; j < 6; ++j) home[j] = DegToRad(home_deg[j]);
-  robot.mount = CameraMount::kEyeToHand;
-  robot.base_from_cam = sim::DefaultFixedCamera(robot, home);
-  sim::EyeToHandTrajectoryOptions options;
-  options.home_joints_deg = home_deg;
-  const sim::GeneratedTrajectory t = sim::MakeEyeToHandTrajectory(robot, options);
-  EXPECT_TRUE(t.ok) << t.message;
-  const sim::SimResult world = sim::Simulate(robot, t.joints, sim::SimOptions());
+  const testing::EyeToHandCell cell = testing::PumaEyeToHandCell();
+  const RobotModel& robot = cell.robot;
+  const sim::SimResult world = sim::Simulate(robot, cell.start, sim::SimOptions());
   EXPECT_TRUE(world.ok) << world.message;
   w.problem.robot = robot;
   w.problem.camera = world.observations.camera;
   w.problem.scene = Scene::FromDots(world.truth.dots_in_base);
   w.problem.constraints.image_margin_px = 2.0;
   w.problem.constraints.max_fx_stddev_rel = 0.01;  // as `plan --configuration eye_to_hand`: a small plate
-  w.start = t.joints;
+  w.start = cell.start;
   return w;
 }
 

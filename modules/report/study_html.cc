@@ -30,23 +30,38 @@ void SettingsTable(const json& s, Page* page) {
   t.Row({"runs per cell", Text(At(s, {"runs_per_cell"}))});
   t.Row({"seed", Text(At(s, {"seed"}))});
   t.Row({"flat dot sheet", Text(At(s, {"flat_sheet"}))});
+  if (!At(s, {"configuration"}).is_null()) t.Row({"configuration", Text(At(s, {"configuration"}))});
   const json& hidden = At(s, {"hidden_errors"});
   if (hidden.is_object()) {
     for (const auto& [key, value] : hidden.items()) t.Row({"hidden error: " + key, Text(value)});
   }
-  t.Row({"identifiable parameters (paper)", Text(At(s, {"identifiable_parameters"}))});
-  t.Row({"fixed parameters (paper)", Text(At(s, {"fixed_parameters"}))});
+  if (At(s, {"paper_pipeline_applies"}) != false) {
+    t.Row({"identifiable parameters (paper)", Text(At(s, {"identifiable_parameters"}))});
+    t.Row({"fixed parameters (paper)", Text(At(s, {"fixed_parameters"}))});
+  }
   t.Row({"free parameters (bundle)", Text(At(s, {"bundle_free_parameters"}))});
   t.Row({"fixed parameters (bundle)", Text(At(s, {"bundle_fixed_parameters"}))});
   t.Row({"total time (s)", Text(At(s, {"seconds_total"}))});
   page->Add(t);
 }
 
-void Table2(const json& cells, const json& paper, Page* page) {
+// paper_rows false (eye-to-hand: the paper pipeline not run): the bundle adjustment's rows only.
+void Table2(const json& cells, const json& paper, bool paper_rows, Page* page) {
   page->Heading(2, "Table 2: pose measurement errors (mean \u00b1 SD over pose pairs and runs)", "table2");
   Table t({"cell", "method", "position (mm)", "orientation (1e-4 rad)", "f_x (px)", "runs (failed)"});
   for (const json& c : cells) {
     const std::string runs = Text(At(c, {"runs"})) + " (" + Text(At(c, {"runs_failed"})) + ")";
+    const json& b = At(c, {"kinematic_bundle", "relative_pose_identification"});
+    auto bundle_row = [&]() {
+      if (b.is_null()) return;
+      t.Row({Cell(c), "kinematic bundle adjustment", MeanSd(At(b, {"position_mm"})),
+             MeanSd(At(b, {"orientation_1e4rad"})), MeanSd(At(b, {"fx_px"})),
+             Text(At(c, {"kinematic_bundle", "runs"})) + " (" + Text(At(c, {"kinematic_bundle", "runs_failed"})) + ")"});
+    };
+    if (!paper_rows) {
+      bundle_row();
+      continue;
+    }
     const json& p = At(c, {"paper_pipeline"});
     t.Row({Cell(c), "paper pipeline", MeanSd(At(p, {"position_mm"})), MeanSd(At(p, {"orientation_1e4rad"})),
            MeanSd(At(p, {"fx_px"})), runs});
@@ -60,14 +75,10 @@ void Table2(const json& cells, const json& paper, Page* page) {
       t.Row({Cell(c), "Cramer-Rao bound, f_x unknown (RMS)", Rms(At(u, {"position_mm_rms"})),
              Rms(At(u, {"orientation_1e4rad_rms"})), Rms(At(u, {"fx_px_rms"})), ""});
     }
-    const json& b = At(c, {"kinematic_bundle", "relative_pose_identification"});
-    if (!b.is_null()) {
-      t.Row({Cell(c), "kinematic bundle adjustment", MeanSd(At(b, {"position_mm"})),
-             MeanSd(At(b, {"orientation_1e4rad"})), MeanSd(At(b, {"fx_px"})),
-             Text(At(c, {"kinematic_bundle", "runs"})) + " (" + Text(At(c, {"kinematic_bundle", "runs_failed"})) + ")"});
-    }
+    bundle_row();
   }
   page->Add(t);
+  if (!paper_rows) return;
   Table lit({"trajectory", "noise (px)", "position (mm)", "orientation (1e-4 rad)", "f_x (px)"});
   for (const json& row : paper) {
     auto pair = [&](const char* key) {
@@ -163,9 +174,15 @@ std::string StudyReportHtml(const json& s, const std::string& plotly_js) {
                    "completed.",
                    "note");
   }
+  const bool paper_rows = At(s, {"paper_pipeline_applies"}) != false;
+  if (!paper_rows) {
+    page.Paragraph("Configuration " + Text(At(s, {"configuration"})) + ": the paper pipeline's rows are left out; it is " +
+                       Text(At(s, {"paper_pipeline_note"})),
+                   "note");
+  }
   SettingsTable(s, &page);
   const json& cells = At(s, {"cells"}).is_array() ? At(s, {"cells"}) : json::array();
-  Table2(cells, At(s, {"paper_table2"}).is_array() ? At(s, {"paper_table2"}) : json::array(), &page);
+  Table2(cells, At(s, {"paper_table2"}).is_array() ? At(s, {"paper_table2"}) : json::array(), paper_rows, &page);
   Fig6(cells, &page);
   BoundSweep(At(s, {"bound_sweep"}), &page);
   Failures(cells, &page);

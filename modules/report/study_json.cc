@@ -71,6 +71,14 @@ nlohmann::json BundleCellJson(const simulation::StudyCell& c) {
                                {"covered", c.bundle_covered},
                                {"fraction", Finite(c.BundleCoverage())}}},
           {"parameters_rms_error_over_bound", BundleParametersJson(c)},
+          {"parameter_abs_error", {{"description", "|estimate - truth| of every free parameter, pooled over the "
+                                                   "runs whose gauge is the truth's (runs_in_truths_gauge; noise 0 "
+                                                   "included)"},
+                                   {"length_mm", StatJson(c.bundle_length_error_mm)},
+                                   {"angle_deg", StatJson(c.bundle_angle_error_deg)}}},
+          {"weak_held_runs", c.bundle_weak_held},
+          {"runs_with_weak_held", c.bundle_runs_weak_held},
+          {"runs_in_truths_gauge", c.bundle_runs_in_truths_gauge},
           {"seconds_per_solve", StatJson(c.bundle_seconds)}};
 }
 }  // namespace
@@ -91,6 +99,9 @@ nlohmann::json StudyJson(const simulation::StudyReport& study, const simulation:
   j["identifiable_parameters"] = study.identifiable_parameters;
   j["fixed_parameters"] = study.fixed_parameters;
   j["flat_sheet"] = study.flat_sheet;
+  j["configuration"] = CameraMountName(study.configuration);
+  j["paper_pipeline_applies"] = study.paper_pipeline_note.empty();
+  j["paper_pipeline_note"] = study.paper_pipeline_note.empty() ? nlohmann::json(nullptr) : nlohmann::json(study.paper_pipeline_note);
   j["bundle_free_parameters"] = study.bundle_free_parameters;
   j["bundle_fixed_parameters"] = study.bundle_fixed_parameters;
   nlohmann::json table2 = nlohmann::json::array();

@@ -77,7 +77,7 @@ void StudyCell::Append(const StudyCell& later) {
       &StudyCell::bundle_bound_pose_position_mm, &StudyCell::bundle_bound_pose_orientation_1e4rad,
       &StudyCell::bundle_predicted3d_mm, &StudyCell::bundle_predicted3d_parameters_mm,
       &StudyCell::bundle_predicted3d_pixels_mm, &StudyCell::bundle_bound3d_mm, &StudyCell::bundle_bound3d_parameters_mm,
-      &StudyCell::bundle_seconds};
+      &StudyCell::bundle_seconds, &StudyCell::bundle_length_error_mm, &StudyCell::bundle_angle_error_deg};
   for (Stat StudyCell::*stat : stats) AppendStat(&(this->*stat), later.*stat);
   bundle_runs += later.bundle_runs;
   bundle_runs_failed += later.bundle_runs_failed;
@@ -86,6 +86,9 @@ void StudyCell::Append(const StudyCell& later) {
   bundle_covered += later.bundle_covered;
   for (const auto& [name, stat] : later.bundle_parameter_error) AppendStat(&bundle_parameter_error[name], stat);
   for (const auto& [name, stat] : later.bundle_parameter_bound) AppendStat(&bundle_parameter_bound[name], stat);
+  for (const auto& [name, count] : later.bundle_weak_held) bundle_weak_held[name] += count;
+  bundle_runs_weak_held += later.bundle_runs_weak_held;
+  bundle_runs_in_truths_gauge += later.bundle_runs_in_truths_gauge;
 }
 
 namespace {
@@ -228,6 +231,32 @@ bundle::CramerRaoReport BundleBound(const sim::SimResult& world, const Observati
   return bundle::BundleCramerRao(geometry, truth, sigma_px, options);
 }
 
+// Whether the truth is in the bundle's gauge: every entry it held fixed equal to the truth's. A weak
+// parameter held at the description (BundleReport::weak) is not: the truth moved it, and the bias of holding
+// it goes into the free parameters, beyond their sigmas and bound (the run is counted in bundle_weak_held).
+// If so, adds each free parameter's |error| to the cell.
+bool ScoreAgainstTheTruth(const bundle::BundleReport& b, const sim::SimTruth& truth, const KinematicParameters& params,
+                          StudyCell* cell) {
+  bool gauge_is_truths = true;
+  for (int i = 0; i < b.rho.size() && gauge_is_truths; ++i) {
+    const bool free = std::find(b.free_indices.begin(), b.free_indices.end(), i) != b.free_indices.end();
+    if (!free && b.rho[i] != truth.rho_true[i]) gauge_is_truths = false;
+  }
+  for (const bundle::WeakParameter& w : b.weak) ++cell->bundle_weak_held[w.name];
+  if (!b.weak.empty()) ++cell->bundle_runs_weak_held;
+  if (!gauge_is_truths) return false;
+  ++cell->bundle_runs_in_truths_gauge;
+  for (int i : b.free_indices) {
+    const double error = std::abs(b.rho[i] - truth.rho_true[i]);
+    if (params.kind(i) == ParameterKind::kLength) {
+      cell->bundle_length_error_mm.Add(kMm * error);
+    } else {
+      cell->bundle_angle_error_deg.Add(RadToDeg(error));
+    }
+  }
+  return true;
+}
+
 // Runs the bundle stage on one observation set and scores it against the truth; adds to the cell.
 void ScoreBundle(const sim::SimResult& world, const ObservationSet& obs, const calibration::PaperPipelineReport& paper,
                  const StudyOptions& options, StudyCell* cell, RunHeader* study) {
@@ -271,6 +300,8 @@ void ScoreBundle(const sim::SimResult& world, const ObservationSet& obs, const c
   for (const calibration::DistanceCheck& c : stage.verification.checks) {
     if (c.ok) cell->bundle_error3d_mm.Add(kMm * c.error_m);
   }
+  const KinematicParameters params(obs.robot.num_joints());
+  const bool gauge_is_truths = ScoreAgainstTheTruth(b, truth, params, cell);
   if (cell->noise_px <= 0) return;  // no noise: no sigma to cover with, no bound
   if (stage.predicted_error.ok) {
     for (const calibration::PredictedDistanceError& e : stage.predicted_error.distances) {
@@ -280,13 +311,8 @@ void ScoreBundle(const sim::SimResult& world, const ObservationSet& obs, const c
       cell->bundle_predicted3d_pixels_mm.Add(kMm * e.pixels_std_m);
     }
   }
-  // Coverage needs the truth in the bundle's gauge: every entry it held fixed equal to the truth's.
-  bool same_gauge = b.covariance_available;
-  for (int i = 0; i < b.rho.size() && same_gauge; ++i) {
-    const bool free = std::find(b.free_indices.begin(), b.free_indices.end(), i) != b.free_indices.end();
-    if (!free && b.rho[i] != truth.rho_true[i]) same_gauge = false;
-  }
-  const KinematicParameters params(robot.num_joints());
+  // Coverage needs the truth in the bundle's gauge, and the bundle's sigmas.
+  const bool same_gauge = b.covariance_available && gauge_is_truths;
   auto in_report_units = [&](int i, double v) { return params.kind(i) == ParameterKind::kLength ? kMm * v : RadToDeg(v); };
   if (same_gauge) {
     for (int i : b.free_indices) {
@@ -398,7 +424,9 @@ RunResult RunOne(const RobotModel& nominal, const TrajectorySpec& trajectory, co
     }
     calibration::PaperPipelineReport report = calibration::RunPaperPipeline(obs, options.pipeline);
     bool score_paper = true;
-    if (report.outcome != calibration::Outcome::kSuccess) {
+    if (nominal.mount == CameraMount::kEyeToHand && report.outcome == calibration::Outcome::kNotRun) {
+      score_paper = false;  // not a failure: the paper's method does not apply (StudyReport::paper_pipeline_note)
+    } else if (report.outcome != calibration::Outcome::kSuccess) {
       ++cell.runs_failed;
       cell.failures.push_back(std::string(calibration::OutcomeName(report.outcome)) + ": " + report.message);
       score_paper = !report.measurements.empty() && report.calibrated_rho.size() > 0;
@@ -462,6 +490,8 @@ StudyReport RunStudy(const RobotModel& nominal, const std::vector<TrajectorySpec
   const auto start = std::chrono::steady_clock::now();
   StudyReport study;
   study.flat_sheet = options.sim.flat_sheet;
+  study.configuration = nominal.mount;
+  if (nominal.mount == CameraMount::kEyeToHand) study.paper_pipeline_note = calibration::kPaperNotEyeToHand;
   ProgressScope progress(options.progress, static_cast<int64_t>(trajectories.size()) * options.runs, "study runs");
   std::mutex progress_mutex;
   RunHeader header;

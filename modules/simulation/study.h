@@ -5,6 +5,12 @@
 // Cramer-Rao bound (bundle::BundleCramerRao), with the coverage of its reported sigmas. With
 // sim.flat_sheet the dots lie on one plane: the paper pipeline fails there (its rows count only the runs
 // it completed) while the bundle adjustment starts from the nominal model.
+//
+// Eye-to-hand (the nominal model's mount, kinematics/robot_model.h): the simulated cell of sim/sim_world.h,
+// a camera fixed in the base frame and a plate of dots on the flange, every truth and relative pose in the
+// points' frame (PointsFromCam). The paper pipeline is not run there (it assumes the camera on the flange:
+// calibration::kPaperNotEyeToHand, StudyReport::paper_pipeline_note); its rows stay empty and count no
+// failure, and the bundle starts from the nominal arm with the fixed camera from the images.
 #pragma once
 
 #include <cmath>
@@ -118,7 +124,7 @@ struct StudyCell {
   Stat bundle_predicted3d_mm, bundle_predicted3d_parameters_mm, bundle_predicted3d_pixels_mm;
   Stat bundle_bound3d_mm, bundle_bound3d_parameters_mm;
   // (d) Coverage, pooled over runs: free parameters and f_x whose truth lies within +-2 reported sigma of
-  // the estimate (runs with noise > 0 whose gauge is the truth's).
+  // the estimate (runs with noise > 0 whose gauge is the truth's: (h)).
   int bundle_intervals = 0, bundle_covered = 0;
   double BundleCoverage() const { return bundle_intervals > 0 ? static_cast<double>(bundle_covered) / bundle_intervals : std::nan(""); }
   // (f) Per free parameter (by name, mm or deg): the bundle's error against the truth (same-gauge runs) and
@@ -126,6 +132,14 @@ struct StudyCell {
   std::map<std::string, Stat> bundle_parameter_error, bundle_parameter_bound;
   // (e) Wall time of one bundle solve (the screen's refits included).
   Stat bundle_seconds;
+  // (g) |estimate - truth| of every free length (mm) and angle (deg) parameter, pooled over the runs whose
+  // gauge is the truth's, at every noise level (0 included: the zero-noise row's exactness is their max).
+  Stat bundle_length_error_mm, bundle_angle_error_deg;
+  // (h) Weak parameters the bundle held at the robot description's value (BundleReport::weak), by name: in
+  // how many runs, and the runs that held any. The truth moved them: such a run's gauge is not the truth's,
+  // and (d), (f), (g) leave it out. bundle_runs_in_truths_gauge: the converged runs they score.
+  std::map<std::string, int> bundle_weak_held;
+  int bundle_runs_weak_held = 0, bundle_runs_in_truths_gauge = 0;
 
   // Adds the runs of `later` (the same trajectory and level) after this cell's: counts summed, samples
   // appended in order, failure messages kept up to the first few. Merging the cells of single runs in
@@ -140,6 +154,9 @@ struct StudyReport {
   int bundle_free_parameters = 0;  // kinematic, f_x not counted
   std::vector<std::string> bundle_fixed_parameters;
   bool flat_sheet = false;
+  CameraMount configuration = CameraMount::kEyeInHand;  // the nominal model's mount
+  // Empty when the paper pipeline ran; otherwise why it was not run (eye-to-hand), and its rows are empty.
+  std::string paper_pipeline_note;
   double seconds_total = 0;
 };
 

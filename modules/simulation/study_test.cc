@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "sim/trajectory_generator.h"
+#include "support/sim_worlds.h"
 #include "support/test_robots.h"
 
 namespace selfcal::simulation {
@@ -79,12 +80,60 @@ TEST(Study, CellAppendKeepsRunOrder) {
   b.bundle_parameter_error["a2"].values = {6};
   a.failures = {"f1", "f2", "f3", "f4"};
   b.failures = {"g1", "g2"};
+  a.bundle_weak_held["j3.beta"] = 1;
+  b.bundle_weak_held["j3.beta"] = 2;
+  b.bundle_weak_held["j5.alpha"] = 1;
+  a.bundle_runs_weak_held = 1;
+  b.bundle_runs_weak_held = 2;
+  a.bundle_runs_in_truths_gauge = 1;
+  b.bundle_runs_in_truths_gauge = 1;
+  b.bundle_length_error_mm.values = {7};
   a.Append(b);
+  EXPECT_EQ(a.bundle_weak_held, (std::map<std::string, int>{{"j3.beta", 3}, {"j5.alpha", 1}}));
+  EXPECT_EQ(a.bundle_runs_weak_held, 3);
+  EXPECT_EQ(a.bundle_runs_in_truths_gauge, 2);
+  EXPECT_EQ(a.bundle_length_error_mm.values, (std::vector<double>{7}));
   EXPECT_EQ(a.runs, 5);
   EXPECT_EQ(a.position_mm.values, (std::vector<double>{1, 2, 3}));
   EXPECT_EQ(a.bundle_parameter_error["d1"].values, (std::vector<double>{4, 5}));
   EXPECT_EQ(a.bundle_parameter_error["a2"].values, (std::vector<double>{6}));
   EXPECT_EQ(a.failures, (std::vector<std::string>{"f1", "f2", "f3", "f4", "g1"}));
+}
+
+// The PUMA 560's eye-to-hand cell (sim_world.h) on its eye-to-hand start, two runs: no paper pipeline rows and
+// no failure counted for them; no noise gives the truth back; at 0.5 px the bundle holds j3.beta at the
+// description in both runs (its std from these poses is beyond 0.5 deg), so neither run is scored against
+// the truth parameter by parameter, while the relative poses are.
+TEST(Study, EyeToHandLeavesThePaperOutAndCountsTheWeakHeld) {
+  const testing::EyeToHandCell cell = testing::PumaEyeToHandCell();
+  ASSERT_EQ(cell.start.size(), 25u);
+  StudyOptions options;
+  options.runs = 2;
+  options.noise_levels_px = {0.0, 0.5};
+  options.jobs = 2;
+  const StudyReport study = RunStudy(cell.robot, {{"start", cell.start}}, options);
+  EXPECT_EQ(study.configuration, CameraMount::kEyeToHand);
+  EXPECT_FALSE(study.paper_pipeline_note.empty());
+  EXPECT_EQ(study.identifiable_parameters, 0);
+  EXPECT_EQ(study.bundle_free_parameters, 24);
+  ASSERT_EQ(study.cells.size(), 2u);
+  for (const StudyCell& c : study.cells) {
+    EXPECT_EQ(c.runs_failed, 0) << c.noise_px;
+    EXPECT_EQ(c.position_mm.count(), 0);
+    EXPECT_EQ(c.bundle_runs_failed, 0) << c.noise_px;
+  }
+  const StudyCell& exact = study.cells[0];
+  EXPECT_EQ(exact.bundle_runs_in_truths_gauge, 2);
+  EXPECT_LT(exact.bundle_length_error_mm.Max(), 1e-6);
+  EXPECT_LT(exact.bundle_angle_error_deg.Max(), RadToDeg(1e-9));
+  const StudyCell& noisy = study.cells[1];
+  EXPECT_EQ(noisy.bundle_weak_held.count("j3.beta") ? noisy.bundle_weak_held.at("j3.beta") : 0, 2);
+  EXPECT_EQ(noisy.bundle_runs_weak_held, 2);
+  EXPECT_EQ(noisy.bundle_runs_in_truths_gauge, 0);
+  EXPECT_EQ(noisy.bundle_intervals, 0);
+  EXPECT_TRUE(noisy.bundle_parameter_error.empty());
+  EXPECT_EQ(noisy.bundle_position_mm.count(), 2 * 14);  // 15 identification poses, the first the reference
+  EXPECT_GT(noisy.bundle_bound_position_mm.count(), 0);
 }
 
 }  // namespace

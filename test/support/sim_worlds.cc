@@ -27,6 +27,22 @@ sim::SimResult PumaArcWorld(const sim::SimOptions& options) {
   return world;
 }
 
+EyeToHandCell PumaEyeToHandCell() {
+  EyeToHandCell cell;
+  cell.robot = Puma560();
+  const std::vector<double> home_deg = {0, 20, -200, 0, 45, 0};
+  Eigen::VectorXd home(6);
+  for (int j = 0; j < 6; ++j) home[j] = DegToRad(home_deg[j]);
+  cell.robot.mount = CameraMount::kEyeToHand;
+  cell.robot.base_from_cam = sim::DefaultFixedCamera(cell.robot, home);
+  sim::EyeToHandTrajectoryOptions options;
+  options.home_joints_deg = home_deg;
+  const sim::GeneratedTrajectory t = sim::MakeEyeToHandTrajectory(cell.robot, options);
+  EXPECT_TRUE(t.ok) << t.message;
+  cell.start = t.joints;
+  return cell;
+}
+
 ObservationSet AsFlangePoseSet(const sim::SimResult& world) {
   ObservationSet obs = world.observations;
   obs.robot = FlangePoseModel(Rigid3());
