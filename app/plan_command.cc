@@ -52,6 +52,11 @@ std::string Fixed(double v, int digits) {
 }
 
 void PrintCheck(const planning::PlanCheck& check, std::ostream& out) {
+  for (const BarelyMovingJoint& j : check.barely_moving) {
+    out << "  warning: joint " << j.joint << " barely moves (" << Fixed(RadToDeg(j.range_rad), 1)
+        << " deg over the identification poses): the parameters beside it are hard to tell apart, and calibrate "
+           "holds those the data determine worse than their tolerance at the robot description's value\n";
+  }
   if (check.image_motion.empty()) {  // the robot-level checks only
     out << "  max joint travel " << Fixed(RadToDeg(check.max_joint_travel_rad), 1) << " deg\n";
     std::istringstream lines(check.Summary());

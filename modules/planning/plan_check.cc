@@ -453,6 +453,9 @@ PlanCheck CheckPlanFor(const RobotModel* robot, const PlanSubject& plan, const C
   if (check.problems.empty()) {
     CheckJointLimits(EffectiveLimits(robot, controller, n), margin, plan.poses, &check);
     CheckJointTravel(travel, plan.poses, n, &check);
+    const int m = static_cast<int>(plan.poses.size());
+    const int identify = plan.num_identification_poses > 0 ? std::min(plan.num_identification_poses, m) : std::min(m, 15);
+    check.barely_moving = BarelyMovingJoints({plan.poses.begin(), plan.poses.begin() + identify});
   }
   if (check.problems.empty() && plan.planned_for && robot != nullptr) {
     PlanningProblem problem;

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "kinematics/joint_motion.h"
 #include "planning/observability.h"
 #include "planning/plan_problem.h"
 
@@ -70,6 +71,9 @@ struct PlanCheck {
   // The observability report of the identification poses at constraints.pixel_noise_px (planning/observability.h),
   // made by the scene checks (ok false when they did not run).
   ObservabilityReport observability;
+  // Joints that barely move over the identification poses (CheckPlanFor): a warning, not a problem; the
+  // parameters beside such a joint are hard to tell apart, and calibrate holds the poorly determined ones.
+  std::vector<BarelyMovingJoint> barely_moving;
   std::string Summary() const;      // one line per problem, or "plan ok"
 };
 
