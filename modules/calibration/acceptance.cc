@@ -103,9 +103,9 @@ AcceptanceCheck CrossValidationTest(const AcceptanceInputs& in) {
   check.status = f.test_passed ? CheckStatus::kPassed : CheckStatus::kFailed;
   check.sentence =
       Format("with each of %.0f folds of the identification poses left out in turn, the model fitted to the others "
-             "predicts them at %.3g px RMS; with the stated pixel noise of %.3g px and the estimated pose error that "
-             "is ",
+             "predicts them at %.3g px RMS; with the stated pixel noise of %.3g px and ",
              cv->folds_tested, f.rms_px, in.stated_noise_px) +
+      cv->pose_error + " that is " +
       ChiSquareClause(f, "the model does not predict poses it was not fitted to");
   if (cv->folds_tested < cv->folds) {
     check.sentence += Format(" (%.0f of the %.0f folds did not converge or predicted nothing)",

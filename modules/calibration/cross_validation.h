@@ -33,6 +33,8 @@ struct CrossValidationReport {
   int folds = 0;
   std::uint64_t seed = 0;
   std::vector<CrossValidationFold> per_fold;
+  // The pose error the folds' prediction carries beside the pixel noise, in words (the acceptance sentence).
+  std::string pose_error = "the estimated pose error";
   double mm_per_px = NAN;        // at the scene: median camera-to-dot distance / f_x
   double rms_mm = NAN;           // pooled.rms_px * mm_per_px
   int folds_passed = 0;          // folds whose held-out test passed at the stated noise

@@ -1,7 +1,9 @@
 #include "calibration/pose_noise_result.h"
 
 #include <cmath>
+#include <iomanip>
 #include <set>
+#include <sstream>
 #include <utility>
 
 #include "camera/camera.h"
@@ -84,6 +86,10 @@ CrossValidationReport CrossValidatePoseNoise(const ObservationSet& obs, const bu
     report.rms_mm = report.pooled.rms_px * report.mm_per_px;
   }
   report.message += ", each fold's pose-noise solve at the flange pose noise of the whole set";
+  std::ostringstream words;
+  words << std::setprecision(3) << "the flange pose noise of " << noise.translation_sigma_m * 1e3 << " mm / "
+        << noise.rotation_sigma_rad * 180 / M_PI << " deg per axis";
+  report.pose_error = words.str();
   return report;
 }
 

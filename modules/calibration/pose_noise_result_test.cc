@@ -150,6 +150,12 @@ TEST(PoseNoiseResult, CrossValidationFoldsRefitThePoseNoiseSolve) {
   EXPECT_TRUE(cv.pooled.test_passed) << cv.pooled.chi_square << " > " << cv.pooled.chi_square_limit;
   EXPECT_GT(cv.mm_per_px, 0);
   EXPECT_EQ(report.verdict, Verdict::kAccepted) << report.message;
+  // The verdict's sentence names the pose error the folds carried: the flange pose noise, not the camera's.
+  bool named = false;
+  for (const AcceptanceCheck& c : report.acceptance.checks) {
+    named = named || (c.name == "cross_validation_test" && c.sentence.find("and the flange pose noise of ") != std::string::npos);
+  }
+  EXPECT_TRUE(named) << cv.pose_error;
 }
 
 // Eye-to-hand (the camera fixed, the dots on the flange: the flange pose noise reaches the camera through
