@@ -27,7 +27,7 @@ using testing::WriteFile;
 
 int RunSelfcal(const std::string& arguments, std::string* output) { return testing::RunSelfcal(arguments, output); }
 
-bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using testing::Contains;
 
 // Replaces the recorded input `name` of the session copy at `session` and its size and SHA-256 in
 // session.json, as if it had been recorded so.

@@ -27,7 +27,7 @@ using testing::WriteFile;
 // Runs the selfcal binary with arguments; returns its exit code, stdout and stderr in *output.
 int RunSelfcal(const std::string& arguments, std::string* output) { return testing::RunSelfcal(arguments, output); }
 
-bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using testing::Contains;
 
 // One recorded session (simulated arm, default plan, seed 1) shared by the tests, each of which works on
 // its own copy.

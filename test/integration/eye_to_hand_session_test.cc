@@ -22,7 +22,7 @@ namespace fs = std::filesystem;
 using testing::ReadFile;
 using testing::RunSelfcal;
 
-bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using testing::Contains;
 
 class EyeToHandSessionTest : public ::testing::Test {
  protected:

@@ -21,7 +21,7 @@ using nlohmann::json;
 using testing::ReadFile;
 using testing::RunSelfcal;
 
-bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using testing::Contains;
 
 constexpr const char* kStudy =
     "study --configuration eye_to_hand --robot config/robots/puma560.yaml --runs 3 --noise-px 0,0.2 --seed 5 ";

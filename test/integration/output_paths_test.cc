@@ -28,7 +28,7 @@ using testing::ReadFile;
 using testing::TreeState;
 using testing::WriteFile;
 
-bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using testing::Contains;
 
 struct Output {
   int code = -1;

@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 using testing::ReadFile;
 using testing::RunSelfcal;
 
-bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using testing::Contains;
 
 // The JSON payloads of a session's journal, in order (J1 <length> <crc> <payload>).
 std::vector<nlohmann::json> JournalRecords(const fs::path& session) {

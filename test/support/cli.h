@@ -13,6 +13,9 @@
 
 namespace selfcal::testing {
 
+// Whether a command's output (or any text) contains `part`.
+inline bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
 // `selfcal arguments` in the test's working directory; stderr folded into stdout, which goes to *output
 // when given. Returns the exit code (-1 when it did not exit normally).
 inline int RunSelfcal(const std::string& arguments, std::string* output = nullptr) {
