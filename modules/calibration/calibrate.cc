@@ -277,7 +277,7 @@ CalibratedModel ModelOf(const CalibrationReport& report, const ObservationSet& o
     model.intrinsics_estimated = kFocalLengthOnly;
     model.method_description = "paper pipeline";
   }
-  if (report.pose_noise && report.pose_noise->ok) {
+  if (report.PoseNoiseIsTheResult()) {
     if (eye_to_hand) {
       model.robot.base_from_cam = report.pose_noise->base_from_cam;
       model.base_from_cam_stddev = report.pose_noise->stddev;
@@ -297,6 +297,8 @@ CalibratedModel ModelOf(const CalibrationReport& report, const ObservationSet& o
     }
     model.method_description += report.pose_noise_estimated ? ", flange poses with their noise estimated from the residuals"
                                                             : ", flange poses with their stated noise";
+  } else if (report.model_choice && report.model_choice->made) {
+    model.method_description += ", flange poses as recorded (cross-validated better than with a per-image flange noise)";
   }
   return model;
 }
@@ -363,13 +365,25 @@ CalibrationReport CalibrateSteps(const ObservationSet& observations, const Calib
     ObservationSet noise_set;
     bundle::PoseNoiseOptions noise;
     if (flange_poses) CheckFlangePoses(observations, obs, options, &report, &noise_set, &noise);
-    if (report.bundle->bundle.outcome == bundle::Outcome::kConverged &&
-        obs.PosesWithRole(PoseRole::kVerification).empty()) {
+    const bool converged = report.bundle->bundle.outcome == bundle::Outcome::kConverged;
+    const bool verification = !obs.PosesWithRole(PoseRole::kVerification).empty();
+    const int folds = options.cross_validation_folds;
+    const std::uint64_t seed = options.paper.two_view.seed;
+    if (converged && report.PoseNoiseIsTheResult() && report.pose_noise_estimated &&
+        report.flange_scale_yardsticks == 0 && folds >= 2) {
+      CrossValidationReport exact_cv, noise_cv;
+      report.model_choice = ChooseFlangeModel(obs, *report.bundle, stage_options, noise_set, *report.pose_noise, noise,
+                                              folds, seed, &exact_cv, &noise_cv);
+      if (!report.PoseNoiseIsTheResult()) {  // the exact-pose solve predicts better: it is the result
+        report.pose_noise_heldout.reset();
+        report.pose_noise_fit_geometry = FitGeometry();
+      }
+      if (!verification) report.cross_validation = report.PoseNoiseIsTheResult() ? noise_cv : exact_cv;
+    } else if (converged && !verification) {
       report.cross_validation =
           report.PoseNoiseIsTheResult()
-              ? CrossValidatePoseNoise(noise_set, *report.pose_noise, noise, options.cross_validation_folds,
-                                       options.paper.two_view.seed)
-              : CrossValidate(obs, *report.bundle, stage_options, options.cross_validation_folds, options.paper.two_view.seed);
+              ? CrossValidatePoseNoise(noise_set, *report.pose_noise, noise, folds, seed)
+              : CrossValidate(obs, *report.bundle, stage_options, folds, seed);
     }
     progress.Advance();
   }

@@ -46,6 +46,7 @@
 #include "calibration/acceptance.h"
 #include "calibration/bundle_stage.h"
 #include "calibration/cross_validation.h"
+#include "calibration/model_choice.h"
 #include "calibration/hand_eye_start.h"
 #include "bundle/pose_noise_bundle.h"
 #include "calibration/motion_check.h"
@@ -149,6 +150,9 @@ struct CalibrationReport {
   // identification residuals of its fit (the report's plots).
   std::optional<HeldOutReprojection> pose_noise_heldout;
   FitGeometry pose_noise_fit_geometry;
+  // The noise estimated, not stated: which of the exact-pose and the pose-noise solves predicts identification
+  // poses it never saw better (model_choice.h); the exact-pose one is the result when it does.
+  std::optional<ModelChoice> model_choice;
   // A flange-pose set: how many yardsticks constrained the scale beside the flange translations (0: the
   // flange translations alone; the yardsticks were checks).
   int flange_scale_yardsticks = 0;
@@ -168,7 +172,9 @@ struct CalibrationReport {
   double seconds_acceptance = 0, seconds_total = 0;
 
   bool accepted() const { return verdict == Verdict::kAccepted; }
-  bool PoseNoiseIsTheResult() const { return pose_noise.has_value() && pose_noise->ok; }
+  bool PoseNoiseIsTheResult() const {
+    return pose_noise.has_value() && pose_noise->ok && (!model_choice || model_choice->pose_noise_chosen);
+  }
   // A model is written: accepted, or converged and passing what could be checked without a held-out test.
   bool has_model_verdict() const { return verdict == Verdict::kAccepted || verdict == Verdict::kUntested; }
   // The chosen method's held-out verification (3-D error of the check distances), before and after.

@@ -197,5 +197,73 @@ TEST(PoseNoiseResult, EyeToHandHeldOutChiSquareMatchesItsDistribution) {
   EXPECT_GE(passed, 9);
 }
 
+// The flange pose noise not stated (estimated from the residuals): which solve is the result is decided by
+// cross-validating both on the identification poses, and everything written comes from the one with the lower
+// held-out RMS (model_choice.h). Without verification poses its cross-validation is the report's. (The arc's
+// yardstick left out: a yardstick that scales the pose-noise solve keeps it the result.)
+TEST(ModelChoice, AnEstimatedNoiseIsDecidedByCrossValidationAndTheWinnerIsWritten) {
+  for (const std::uint64_t seed : {7u, 8u}) {
+    NoisyFlangeWorld w = MakeNoisyFlangeWorld(seed);
+    w.observations.yardsticks.clear();
+    w.observations.flange_translation_sigma_m = 0;
+    w.observations.flange_rotation_sigma_rad = 0;
+    for (PoseObservation& pose : w.observations.poses) pose.role = PoseRole::kIdentification;
+    const CalibrationReport report = Calibrate(w.observations, CalibrateOptions());
+    ASSERT_TRUE(report.pose_noise.has_value() && report.pose_noise->ok)
+        << seed << ": " << report.message << " / " << report.bundle->bundle.error_model.message << " "
+        << report.bundle->bundle.error_model.pose_translation_m << " " << report.bundle->bundle.error_model.pose_rotation_rad;
+    ASSERT_TRUE(report.model_choice.has_value() && report.model_choice->made) << seed;
+    const ModelChoice& c = *report.model_choice;
+    EXPECT_EQ(c.pose_noise_chosen, c.pose_noise_rms_px <= c.exact_pose_rms_px) << seed;
+    EXPECT_EQ(report.PoseNoiseIsTheResult(), c.pose_noise_chosen) << seed;
+    ASSERT_TRUE(report.cross_validation.has_value()) << seed;
+    EXPECT_EQ(report.cross_validation->pooled.rms_px, std::min(c.pose_noise_rms_px, c.exact_pose_rms_px)) << seed;
+    ASSERT_TRUE(report.model.has_value()) << seed << ": " << report.message;
+    const Rigid3& written = report.model->robot.flange_from_cam;
+    const Rigid3& winner = c.pose_noise_chosen ? report.pose_noise->flange_from_cam
+                                               : report.bundle->calibrated_robot.flange_from_cam;
+    EXPECT_EQ(written.translation, winner.translation) << seed;
+    EXPECT_EQ(report.model->camera.fx_px, c.pose_noise_chosen ? report.pose_noise->intrinsics[kFx]
+                                                              : report.bundle->calibrated_camera.fx_px)
+        << seed;
+    EXPECT_EQ(report.pose_noise_fit_geometry.camera_poses.empty(), !c.pose_noise_chosen) << seed;
+    std::printf("seed %d: exact-pose %.3f px, pose-noise %.3f px cross-validated\n", static_cast<int>(seed),
+                c.exact_pose_rms_px, c.pose_noise_rms_px);
+  }
+}
+
+// With verification poses the choice still cross-validates the identification poses only: the verification
+// images stay the verdict's test, and the pose-noise solve's held-out figure exists exactly when it is the result.
+TEST(ModelChoice, VerificationPosesStayTheTestTheChoiceNeverSaw) {
+  NoisyFlangeWorld w = MakeNoisyFlangeWorld(7);
+  w.observations.yardsticks.clear();
+  w.observations.flange_translation_sigma_m = 0;
+  w.observations.flange_rotation_sigma_rad = 0;
+  ASSERT_FALSE(w.observations.PosesWithRole(PoseRole::kVerification).empty());
+  const CalibrationReport report = Calibrate(w.observations, CalibrateOptions());
+  ASSERT_TRUE(report.model_choice.has_value() && report.model_choice->made) << report.message;
+  EXPECT_FALSE(report.cross_validation.has_value());
+  EXPECT_EQ(report.pose_noise_heldout.has_value(), report.model_choice->pose_noise_chosen);
+  EXPECT_TRUE(report.acceptance.HeldOutTested()) << report.message;
+}
+
+// A stated noise is the user's model, and a yardstick that scales the pose-noise solve is a model the
+// exact-pose solve lacks: no choice, the pose-noise solve is the result.
+TEST(ModelChoice, AStatedNoiseOrAYardstickScaleIsNotSecondGuessed) {
+  const NoisyFlangeWorld stated = MakeNoisyFlangeWorld(7);
+  const CalibrationReport report = Calibrate(stated.observations, CalibrateOptions());
+  EXPECT_FALSE(report.model_choice.has_value());
+  EXPECT_TRUE(report.PoseNoiseIsTheResult()) << report.message;
+  NoisyFlangeWorld scaled = MakeNoisyFlangeWorld(7);
+  ASSERT_FALSE(scaled.observations.yardsticks.empty());
+  scaled.observations.flange_translation_sigma_m = 0;
+  scaled.observations.flange_rotation_sigma_rad = 0;
+  const CalibrationReport by_yardstick = Calibrate(scaled.observations, CalibrateOptions());
+  ASSERT_TRUE(by_yardstick.pose_noise.has_value() && by_yardstick.pose_noise->ok) << by_yardstick.message;
+  EXPECT_GT(by_yardstick.flange_scale_yardsticks, 0);
+  EXPECT_FALSE(by_yardstick.model_choice.has_value());
+  EXPECT_TRUE(by_yardstick.PoseNoiseIsTheResult());
+}
+
 }  // namespace
 }  // namespace selfcal::calibration

@@ -102,6 +102,13 @@ json WeakJson(const bundle::BundleReport& b) {
   return {{"held", held}, {"barely_moving_joints", joints}};
 }
 
+json ModelChoiceJson(const std::optional<calibration::ModelChoice>& c) {
+  if (!c) return json();
+  return {{"made", c->made}, {"message", c->message}, {"folds", c->folds}, {"seed", c->seed},
+          {"exact_pose_rms_px", Finite(c->exact_pose_rms_px)}, {"pose_noise_rms_px", Finite(c->pose_noise_rms_px)},
+          {"pose_noise_chosen", c->pose_noise_chosen}};
+}
+
 json ErrorModelJson(const bundle::ErrorModel& m) {
   return {{"estimated", m.estimated},
           {"message", m.message},
@@ -456,7 +463,8 @@ json HandEyeJson(const calibration::CalibrationReport& report) {
                        {"variance_factor", Finite(n.variance_factor)},
                        {"pose_ids", n.pose_ids},
                        {"correction_translation_m", n.correction_translation_m},
-                       {"correction_rotation_rad", n.correction_rotation_rad}};
+                       {"correction_rotation_rad", n.correction_rotation_rad},
+                       {"model_choice", ModelChoiceJson(report.model_choice)}};
   }
   return j;
 }

@@ -281,6 +281,21 @@ void PrintCrossValidation(const calibration::CrossValidationReport& cv, std::ost
 
 namespace {
 
+// Which flange-pose solve is the result, and the held-out figures that chose it.
+void PrintModelChoice(const calibration::ModelChoice& c, std::ostream& out) {
+  out << "  the result: ";
+  if (!c.made) {
+    out << "the pose-noise solve (the choice by cross-validation " << c.message << ")\n";
+    return;
+  }
+  out << std::fixed << std::setprecision(3)
+      << (c.pose_noise_chosen ? "the pose-noise solve" : "the exact-pose solve (flange poses as recorded)")
+      << ": cross-validated on the identification poses (" << c.folds << " folds, seed " << c.seed
+      << "), the exact-pose solve predicts them at " << c.exact_pose_rms_px << " px, the pose-noise solve at "
+      << c.pose_noise_rms_px << " px\n";
+  out.unsetf(std::ios::floatfield);
+}
+
 void PrintSummaryLines(const calibration::CalibrationReport& report, std::ostream& out) {
   if (report.hand_eye_start) {
     PrintHandEye(report, out);
@@ -295,6 +310,7 @@ void PrintSummaryLines(const calibration::CalibrationReport& report, std::ostrea
                        out);
     if (pose_noise) PrintPoseNoiseResult(report, out);
     if (report.cross_validation) PrintCrossValidation(*report.cross_validation, out);
+    if (report.model_choice) PrintModelChoice(*report.model_choice, out);
     for (const calibration::SceneMove& m : report.scene_moves) {
       out << "  scene `" << m.scene << "` against `" << m.relative_to << "`: its " << m.shared_points
           << " points lie " << std::fixed << std::setprecision(2) << m.displacement_rms_m * 1e3 << " mm RMS from the first's (largest "
