@@ -264,7 +264,7 @@ Status AravisCamera::Impl::TimedOut(double not_before_s, double timeout_s) {
   if (const std::string e = Take(&error); !e.empty()) return Disconnected("the camera stopped answering (" + e + ")");
   std::ostringstream why;
   why.precision(6);
-  why << std::fixed << Who() << ": no frame exposed at or after " << not_before_s << " s arrived within " << timeout_s
+  why << std::fixed << Who() << ": no frame " << ExposedAtOrAfterWords(not_before_s) << "arrived within " << timeout_s
       << " s (" << (triggered ? "software trigger" : "free-running") << ", " << sequence << " frames returned since Open)";
   return CaptureFailure(CaptureError::kTimeout, why.str());
 }
@@ -348,7 +348,7 @@ Status AravisCamera::Open() {
   m.LockControls();
   if (Status s = m.StartStream(); !s.ok()) return fail(s);
   m.open = true;
-  Result<Frame> test = Grab(-1e300, m.options.open_timeout_s);  // pre-flight test frame (V1, V3)
+  Result<Frame> test = Grab(kAnyFrame, m.options.open_timeout_s);  // pre-flight test frame (V1, V3)
   if (!test.ok() && CaptureErrorOf(test.status()) != CaptureError::kBadFrame) return fail(test.status());
   return Status::Ok();
 }

@@ -127,5 +127,12 @@ TEST(FrameChecks, OptionsValidateListsEveryProblem) {
   EXPECT_TRUE(Contains(problems, "min_laplacian_variance = -1"));
 }
 
+// A timeout's words: the settle time it waited for, or none for the pre-flight frame of Open (any frame), whose
+// bound of -1e300 was printed in full digits.
+TEST(FrameSourceWords, ATimeoutNamesTheSettleTimeOrNothingForAnyFrame) {
+  EXPECT_EQ(ExposedAtOrAfterWords(kAnyFrame), "");
+  EXPECT_EQ(ExposedAtOrAfterWords(12.5), "exposed at or after 12.500000 s ");
+}
+
 }  // namespace
 }  // namespace selfcal::capture

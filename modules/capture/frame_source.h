@@ -26,6 +26,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <string>
 
 #include <visp3/core/vpImage.h>
@@ -98,5 +99,16 @@ class FrameSource {
 
   virtual void Close() = 0;
 };
+
+// `not_before_s` for any frame at all (a camera's pre-flight test frame at Open).
+constexpr double kAnyFrame = -1e300;
+
+// A Grab's time condition in a message: "exposed at or after T s ", or nothing for kAnyFrame.
+inline std::string ExposedAtOrAfterWords(double not_before_s) {
+  if (not_before_s <= kAnyFrame) return "";
+  char text[64];
+  std::snprintf(text, sizeof(text), "exposed at or after %.6f s ", not_before_s);
+  return text;
+}
 
 }  // namespace selfcal::capture

@@ -415,7 +415,7 @@ Status V4l2Camera::Open() {
   m.reader = std::thread([&m] { m.ReadLoop(); });
   // Pre-flight test frame (V1, V3) and its clock (V5).
   const double asked_at = MonotonicNowS();
-  Result<Frame> test = Grab(-1e300, m.options.open_timeout_s);
+  Result<Frame> test = Grab(kAnyFrame, m.options.open_timeout_s);
   // A dark or flat first frame (kBadFrame) is common while the sensor settles; format and clock are
   // what the pre-flight checks.
   if (!test.ok() && CaptureErrorOf(test.status()) != CaptureError::kBadFrame) return fail(test.status());
@@ -462,8 +462,8 @@ Result<Frame> V4l2Camera::Grab(double not_before_s, double timeout_s) {
           !m.failure) {
         std::ostringstream why;
         why.precision(6);
-        why << std::fixed << "camera " << m.options.device << ": no frame exposed at or after " << not_before_s
-            << " s arrived within " << timeout_s << " s (" << m.received << " frames received since Open";
+        why << std::fixed << "camera " << m.options.device << ": no frame " << ExposedAtOrAfterWords(not_before_s)
+            << "arrived within " << timeout_s << " s (" << m.received << " frames received since Open";
         if (m.latest.sequence >= 0) why << ", the newest exposed at " << m.latest.exposure_time_s << " s";
         why << ")";
         return CaptureFailure(CaptureError::kTimeout, why.str());

@@ -154,6 +154,14 @@ void ParseConfiguration(const json& j, JsonFields* fields, RobotModel* robot) {
   const json* rotation = fields->Get(*c, at, "rotation");
   if (translation == nullptr || rotation == nullptr) return;
   bool ok = Numbers(*translation, at.Member("translation_m"), 3, fields, t);
+  for (int k = 0; ok && k < 3; ++k) {
+    if (std::abs(t[k]) > io::kMaxTranslationM) {
+      fields->Add(at.Member("translation_m").Element(k), "`base_from_cam.translation_m` " + ShortNumber(t[k]) +
+                                                             " m is beyond the " + ShortNumber(io::kMaxTranslationM) +
+                                                             " m a camera of an arm's cell can be from its base");
+      ok = false;
+    }
+  }
   if (!rotation->is_array() || rotation->size() != 3) {
     fields->Add(at.Member("rotation"), "`base_from_cam.rotation` must be 3 rows of 3 numbers");
     return;

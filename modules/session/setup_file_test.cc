@@ -59,6 +59,10 @@ TEST(SetupFile, ConfigurationRefusalsNameTheKeyAndLine) {
   nlohmann::json reflection = j;
   reflection["base_from_cam"]["rotation"][0] = {-1, 0, 0};
   EXPECT_NE(refusal(reflection).find("not a rotation"), std::string::npos) << refusal(reflection);
+  nlohmann::json far = j;  // mm typed as m: a camera 1200 m from the base
+  far["base_from_cam"]["translation_m"][2] = 1200.0;
+  EXPECT_NE(refusal(far).find("`base_from_cam.translation_m` 1200 m is beyond the 10 m"), std::string::npos)
+      << refusal(far);
   nlohmann::json in_hand = j;
   in_hand["configuration"] = "eye_in_hand";
   const std::string message = refusal(in_hand);
