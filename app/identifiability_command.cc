@@ -44,9 +44,9 @@ Command AddIdentifiabilityCommand(CLI::App& app) {
     const Eigen::VectorXd rho = KinematicParameters::Nominal(*robot);
     std::cout << "robot " << robot->name << ", " << poses.size() << " poses, measurements cam_1_from_cam_i\n";
     for (const BarelyMovingJoint& j : BarelyMovingJoints(poses)) {
-      std::cout << "warning: joint " << j.joint << " barely moves (" << RadToDeg(j.range_rad)
-                << " deg over these poses): the parameters beside it are hard to tell apart, and calibrate holds "
-                   "those the data determine worse than their tolerance at the robot description's value\n";
+      std::cout << "warning: " << BarelyMovesSentence(j, "these poses")
+                << ", and calibrate holds those the data determine worse than their tolerance at the robot "
+                   "description's value\n";
     }
     identification::IdentifiabilityOptions options;
     Print("metric relative poses", identification::AnalyzeIdentifiability(*robot, rho, poses, 0, options));

@@ -9,6 +9,7 @@
 #include "app/cli_output.h"
 #include "app/cli_util.h"
 #include "app/output_options.h"
+#include "kinematics/joint_motion.h"
 #include "app/run_configuration.h"
 #include "app/commands.h"
 #include "io/robot_config.h"
@@ -53,9 +54,9 @@ std::string Fixed(double v, int digits) {
 
 void PrintCheck(const planning::PlanCheck& check, std::ostream& out) {
   for (const BarelyMovingJoint& j : check.barely_moving) {
-    out << "  warning: joint " << j.joint << " barely moves (" << Fixed(RadToDeg(j.range_rad), 1)
-        << " deg over the identification poses): the parameters beside it are hard to tell apart, and calibrate "
-           "holds those the data determine worse than their tolerance at the robot description's value\n";
+    out << "  warning: " << BarelyMovesSentence(j, "the identification poses")
+        << ", and calibrate holds those the data determine worse than their tolerance at the robot description's "
+           "value\n";
   }
   if (check.image_motion.empty()) {  // the robot-level checks only
     out << "  max joint travel " << Fixed(RadToDeg(check.max_joint_travel_rad), 1) << " deg\n";

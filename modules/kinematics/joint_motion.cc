@@ -1,6 +1,7 @@
 #include "kinematics/joint_motion.h"
 
 #include <algorithm>
+#include <cstdio>
 
 namespace selfcal {
 
@@ -17,6 +18,13 @@ std::vector<BarelyMovingJoint> BarelyMovingJoints(const std::vector<Eigen::Vecto
     if (hi - lo < threshold_rad) out.push_back({static_cast<int>(j) + 1, hi - lo});
   }
   return out;
+}
+
+std::string BarelyMovesSentence(const BarelyMovingJoint& joint, const std::string& poses) {
+  char degrees[32];
+  std::snprintf(degrees, sizeof(degrees), "%.1f", joint.range_rad * 180.0 / 3.14159265358979323846);
+  return "joint " + std::to_string(joint.joint) + " barely moves (" + degrees + " deg over " + poses +
+         "): the parameters beside it are hard to tell apart";
 }
 
 }  // namespace selfcal

@@ -3,6 +3,7 @@
 // `identifiability` warns of it from the poses alone).
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -20,5 +21,9 @@ struct BarelyMovingJoint {
 // size); none for an empty list.
 std::vector<BarelyMovingJoint> BarelyMovingJoints(const std::vector<Eigen::VectorXd>& joints,
                                                   double threshold_rad = kBarelyMovingRad);
+
+// The one sentence every command says of it: "joint 3 barely moves (0.5 deg over `poses`): the parameters
+// beside it are hard to tell apart" (degrees to one decimal).
+std::string BarelyMovesSentence(const BarelyMovingJoint& joint, const std::string& poses);
 
 }  // namespace selfcal

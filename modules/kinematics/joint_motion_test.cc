@@ -22,5 +22,12 @@ TEST(BarelyMovingJoints, NamesTheJointsThatMoveLessThanTheThreshold) {
   EXPECT_TRUE(BarelyMovingJoints({}).empty());
 }
 
+// identifiability, plan --check and calibrate say it in the same words and digits.
+TEST(JointMotion, OneSentenceForEveryCommand) {
+  EXPECT_EQ(BarelyMovesSentence({3, 0.5 * 3.14159265358979323846 / 180}, "the identification poses"),
+            "joint 3 barely moves (0.5 deg over the identification poses): the parameters beside it are hard to tell "
+            "apart");
+}
+
 }  // namespace
 }  // namespace selfcal

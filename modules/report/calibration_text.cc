@@ -4,6 +4,7 @@
 #include <sstream>
 #include <string>
 
+#include "kinematics/joint_motion.h"
 #include "report/calibration_report.h"
 
 namespace selfcal::report {
@@ -127,9 +128,7 @@ void PrintLensSummary(const bundle::BundleReport& b, std::ostream& out) {
 // The joints that barely move and the parameters held because the data determine them too poorly.
 void PrintWeakDirections(const bundle::BundleReport& b, std::ostream& out) {
   for (const BarelyMovingJoint& j : b.barely_moving) {
-    out << "  joint " << j.joint << " barely moves (" << std::fixed << std::setprecision(1) << RadToDeg(j.range_rad)
-        << " deg over the identification poses): the parameters beside it are hard to tell apart\n";
-    out.unsetf(std::ios::floatfield);
+    out << "  " << BarelyMovesSentence(j, "the identification poses") << "\n";
   }
   for (const bundle::WeakParameter& w : b.weak) {
     const double scale = w.length ? kMm : RadToDeg(1.0);
