@@ -386,6 +386,11 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   options.progress = Progress();
   calibration::CalibrationReport report = calibration::Calibrate(loaded->observations, options);
   report::PrintCalibrationSummary(loaded->observations, report, std::cout);
+  // Inconsistent observations or options found during the solve (a verification pose no identification pose
+  // can predict, a scale asked of yardsticks the set lacks): exit 2 like any bad input, and nothing written.
+  if (report.verdict == calibration::Verdict::kInvalidInput) {
+    return Fail(Status::Error(ErrorCode::kInvalidInput, report.message));
+  }
   if (Status s = CheckCameraOutputs(request, report); !s.ok()) return Fail(s);
   if (Status s = EnsureDirectory(request.out_dir); !s.ok()) return Fail(s);
   if (from_session) {
