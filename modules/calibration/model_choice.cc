@@ -1,11 +1,27 @@
 #include "calibration/model_choice.h"
 
-#include <algorithm>
-#include <utility>
+#include <cmath>
+#include <string>
 
 #include "calibration/pose_noise_result.h"
 
 namespace selfcal::calibration {
+
+namespace {
+
+// A cross-validation's pooled held-out RMS when every fold gave one, else NaN and *why says what it lacked.
+double CompleteFigure(const CrossValidationReport& cv, std::string* why) {
+  if (!cv.ran) {
+    *why = cv.message;
+  } else if (cv.folds_tested < cv.folds || cv.pooled.num_residuals == 0) {
+    *why = std::to_string(cv.folds_tested) + " of " + std::to_string(cv.folds) + " folds gave a figure";
+  } else {
+    return cv.pooled.rms_px;
+  }
+  return NAN;
+}
+
+}  // namespace
 
 ObservationSet IdentificationPosesOnly(const ObservationSet& obs) {
   ObservationSet out = obs;
@@ -26,16 +42,12 @@ ModelChoice ChooseFlangeModel(const ObservationSet& exact_set, const BundleStage
   choice.seed = seed;
   *exact_cv = CrossValidate(IdentificationPosesOnly(exact_set), stage, stage_options, folds, seed);
   *noise_cv = CrossValidatePoseNoise(IdentificationPosesOnly(noise_set), solve, noise, folds, seed);
-  const auto figure = [](const CrossValidationReport& cv) {
-    return cv.ran && cv.pooled.num_residuals > 0 && cv.folds_tested == cv.folds ? cv.pooled.rms_px : NAN;
-  };
-  choice.exact_pose_rms_px = figure(*exact_cv);
-  choice.pose_noise_rms_px = figure(*noise_cv);
-  if (!std::isfinite(choice.exact_pose_rms_px) || !std::isfinite(choice.pose_noise_rms_px)) {
-    choice.message = "not made: " + std::string(!std::isfinite(choice.exact_pose_rms_px)
-                                                    ? "the exact-pose solve's cross-validation: " + exact_cv->message
-                                                    : "the pose-noise solve's cross-validation: " + noise_cv->message) +
-                     " (the pose-noise solve is the result)";
+  std::string exact_why, noise_why;
+  choice.exact_pose_rms_px = CompleteFigure(*exact_cv, &exact_why);
+  choice.pose_noise_rms_px = CompleteFigure(*noise_cv, &noise_why);
+  if (!exact_why.empty() || !noise_why.empty()) {
+    choice.message = !exact_why.empty() ? "the exact-pose solve's cross-validation: " + exact_why
+                                        : "the pose-noise solve's cross-validation: " + noise_why;
     return choice;
   }
   choice.made = true;

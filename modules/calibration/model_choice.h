@@ -24,7 +24,7 @@ namespace selfcal::calibration {
 
 struct ModelChoice {
   bool made = false;        // both cross-validations gave a figure; else the pose-noise solve stays the result
-  std::string message;      // why not made
+  std::string message;      // why not made: which cross-validation gave no figure, and why
   int folds = 0;
   std::uint64_t seed = 0;
   double exact_pose_rms_px = NAN, pose_noise_rms_px = NAN;  // pooled held-out RMS per coordinate

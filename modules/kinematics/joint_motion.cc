@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "geometry/rigid3.h"
+
 namespace selfcal {
 
 std::vector<BarelyMovingJoint> BarelyMovingJoints(const std::vector<Eigen::VectorXd>& joints, double threshold_rad) {
@@ -22,7 +24,7 @@ std::vector<BarelyMovingJoint> BarelyMovingJoints(const std::vector<Eigen::Vecto
 
 std::string BarelyMovesSentence(const BarelyMovingJoint& joint, const std::string& poses) {
   char degrees[32];
-  std::snprintf(degrees, sizeof(degrees), "%.1f", joint.range_rad * 180.0 / 3.14159265358979323846);
+  std::snprintf(degrees, sizeof(degrees), "%.1f", RadToDeg(joint.range_rad));
   return "joint " + std::to_string(joint.joint) + " barely moves (" + degrees + " deg over " + poses +
          "): the parameters beside it are hard to tell apart";
 }

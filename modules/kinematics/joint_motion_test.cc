@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "geometry/rigid3.h"
+
 namespace selfcal {
 namespace {
 
@@ -24,7 +26,7 @@ TEST(BarelyMovingJoints, NamesTheJointsThatMoveLessThanTheThreshold) {
 
 // identifiability, plan --check and calibrate say it in the same words and digits.
 TEST(JointMotion, OneSentenceForEveryCommand) {
-  EXPECT_EQ(BarelyMovesSentence({3, 0.5 * 3.14159265358979323846 / 180}, "the identification poses"),
+  EXPECT_EQ(BarelyMovesSentence({3, DegToRad(0.5)}, "the identification poses"),
             "joint 3 barely moves (0.5 deg over the identification poses): the parameters beside it are hard to tell "
             "apart");
 }

@@ -284,7 +284,7 @@ namespace {
 void PrintModelChoice(const calibration::ModelChoice& c, std::ostream& out) {
   out << "  the result: ";
   if (!c.made) {
-    out << "the pose-noise solve (the choice by cross-validation " << c.message << ")\n";
+    out << "the pose-noise solve (not chosen by cross-validation: " << c.message << ")\n";
     return;
   }
   out << std::fixed << std::setprecision(3)
