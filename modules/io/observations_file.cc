@@ -2,10 +2,10 @@
 
 #include <climits>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <sstream>
 
+#include "base/short_number.h"
 #include "io/atomic_file.h"
 #include "io/camera_file.h"
 #include "io/plausible_limits.h"
@@ -20,12 +20,6 @@ namespace {
 
 const Range kPixel = Range::Closed(-1e5, 1e5);
 
-std::string Short(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.6g", v);
-  return buffer;
-}
-
 std::string DirectoryOf(const std::string& path) {
   const size_t slash = path.find_last_of('/');
   return slash == std::string::npos ? "." : path.substr(0, slash == 0 ? 1 : slash);
@@ -36,7 +30,7 @@ std::string DirectoryOf(const std::string& path) {
 std::string PixelProblem(const CameraIntrinsics& camera, const Eigen::Vector2d& uv) {
   if (InImage(camera, uv, 0.0)) return "";
   return "lies outside the " + std::to_string(camera.width_px) + "x" + std::to_string(camera.height_px) +
-         " image (u in [-0.5, " + Short(camera.width_px - 0.5) + "], v in [-0.5, " + Short(camera.height_px - 0.5) + "])";
+         " image (u in [-0.5, " + ShortNumber(camera.width_px - 0.5) + "], v in [-0.5, " + ShortNumber(camera.height_px - 0.5) + "])";
 }
 
 }  // namespace
@@ -199,7 +193,7 @@ bool ReadDots(const yaml::YamlNode& node, const std::string& name, const CameraI
     }
     if (camera) {
       if (const std::string p = PixelProblem(*camera, uv); !p.empty()) {
-        problems->Add("dot " + std::to_string(id) + " at (" + Short(uv.x()) + ", " + Short(uv.y()) + ") px in `" +
+        problems->Add("dot " + std::to_string(id) + " at (" + ShortNumber(uv.x()) + ", " + ShortNumber(uv.y()) + ") px in `" +
                       item_name + "` at " + problems->At(item.line) + " " + p);
         ok = false;
       }
@@ -514,7 +508,7 @@ Status SaveObservations(const ObservationSet& set, const std::string& path) {
       out << "    base_from_flange: " << TransformYaml(*pose.base_from_flange, TransformStyle::kExact) << "\n";
     } else {
       out << "    joints_rad: " << YamlNumberList(pose.joints_rad) << "\n    # joints_deg (rounded): [";
-      for (int j = 0; j < pose.joints_rad.size(); ++j) out << (j ? ", " : "") << Short(RadToDeg(pose.joints_rad[j]));
+      for (int j = 0; j < pose.joints_rad.size(); ++j) out << (j ? ", " : "") << ShortNumber(RadToDeg(pose.joints_rad[j]));
       out << "]\n";
     }
     out << "    dots:" << (pose.dots_px.empty() ? " []\n" : "\n");

@@ -2,7 +2,6 @@
 
 #include <cctype>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <sstream>
@@ -11,6 +10,7 @@
 #include <Eigen/Geometry>
 
 #include "base/atomic_file.h"
+#include "base/short_number.h"
 #include "io/plausible_limits.h"
 #include "io/transform_yaml.h"
 #include "io/yaml_schema.h"
@@ -22,12 +22,6 @@ namespace selfcal::io {
 namespace {
 
 const Range kTranslation = Range::Closed(-kMaxTranslationM, kMaxTranslationM);
-
-std::string Short(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.6g", v);
-  return buffer;
-}
 
 // Form (a): x, y, z (m) and the unit quaternion qx, qy, qz, qw.
 bool ReadRosPose(MapReader* root, Problems* problems, Rigid3* out) {
@@ -41,7 +35,7 @@ bool ReadRosPose(MapReader* root, Problems* problems, Rigid3* out) {
   const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
   if (!(std::abs(norm - 1.0) <= kQuaternionNormTolerance)) {
     problems->Add("the quaternion (qx, qy, qz, qw) at " + problems->At(root->KeyLine("qx")) + " has norm " +
-                  Short(norm) + ", not 1 (within " + Short(kQuaternionNormTolerance) + ")");
+                  ShortNumber(norm) + ", not 1 (within " + ShortNumber(kQuaternionNormTolerance) + ")");
     return false;
   }
   const Eigen::Quaterniond quaternion(q[3] / norm, q[0] / norm, q[1] / norm, q[2] / norm);
@@ -84,7 +78,7 @@ bool ReadVispPose(MapReader* root, Problems* problems, Rigid3* out) {
   const Eigen::Vector3d theta_u(v[3], v[4], v[5]);
   if (theta_u.norm() > 2 * kPi) {
     problems->Add("the theta-u rotation `data[3..5]` at " + problems->At(data->line) + " has angle " +
-                  Short(theta_u.norm()) + " rad, more than 2 pi");
+                  ShortNumber(theta_u.norm()) + " rad, more than 2 pi");
     return false;
   }
   *out = Rigid3(ExpSO3<double>(theta_u), Eigen::Vector3d(v[0], v[1], v[2]));

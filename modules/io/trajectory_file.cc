@@ -1,9 +1,9 @@
 #include "io/trajectory_file.h"
 
 #include <cmath>
-#include <cstdio>
 #include <sstream>
 
+#include "base/short_number.h"
 #include "io/atomic_file.h"
 #include "io/observations_file.h"
 #include "io/transform_yaml.h"
@@ -14,12 +14,6 @@
 namespace selfcal::io {
 
 namespace {
-
-std::string Short(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.6g", v);
-  return buffer;
-}
 
 // A list of points `key` ([x, y, z] in mm) of the map.
 bool ReadPointsMm(MapReader* map, const std::string& key, bool required, Problems* problems,
@@ -214,8 +208,8 @@ Result<TrajectoryFile> Load(const std::string& path, int num_joints, const Robot
         const JointLimits& l = robot->limits[j];
         if (pose[j] < l.min_rad || pose[j] > l.max_rad) {
           problems.Add("pose " + std::to_string(i) + " (`" + name + "` at " + problems.At(row.items[j].line) +
-                       "): joint " + std::to_string(j + 1) + " = " + Short(RadToDeg(pose[j])) + " deg is outside its limits [" +
-                       Short(RadToDeg(l.min_rad)) + ", " + Short(RadToDeg(l.max_rad)) + "] deg");
+                       "): joint " + std::to_string(j + 1) + " = " + ShortNumber(RadToDeg(pose[j])) + " deg is outside its limits [" +
+                       ShortNumber(RadToDeg(l.min_rad)) + ", " + ShortNumber(RadToDeg(l.max_rad)) + "] deg");
         }
       }
       poses.push_back(pose);
@@ -310,7 +304,7 @@ Status SaveTrajectoryFile(const TrajectoryFile& file, const std::string& path) {
   out << "poses_rad:" << (poses_rad.empty() ? " []\n" : "\n");
   for (size_t i = 0; i < poses_rad.size(); ++i) {
     out << "  - " << YamlNumberList(poses_rad[i]) << "  # " << i << ": [";
-    for (int j = 0; j < poses_rad[i].size(); ++j) out << (j ? ", " : "") << Short(RadToDeg(poses_rad[i][j]));
+    for (int j = 0; j < poses_rad[i].size(); ++j) out << (j ? ", " : "") << ShortNumber(RadToDeg(poses_rad[i][j]));
     out << "] deg\n";
   }
   return WriteFileAtomically(path, out.str());

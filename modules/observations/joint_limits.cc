@@ -1,17 +1,8 @@
 #include "observations/joint_limits.h"
 
-#include <cstdio>
+#include "base/short_number.h"
 
 namespace selfcal {
-namespace {
-
-std::string Short(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.6g", v);
-  return buffer;
-}
-
-}  // namespace
 
 std::vector<std::string> PosesOutsideJointLimits(const ObservationSet& set) {
   std::vector<std::string> out;
@@ -24,7 +15,7 @@ std::vector<std::string> PosesOutsideJointLimits(const ObservationSet& set) {
       const double q = pose.joints_rad[j];
       if (q >= l.min_rad - kJointLimitReadingToleranceRad && q <= l.max_rad + kJointLimitReadingToleranceRad) continue;
       joints += (joints.empty() ? "" : ", ") + std::string("joint ") + std::to_string(j + 1) + " = " +
-                Short(RadToDeg(q)) + " deg outside [" + Short(RadToDeg(l.min_rad)) + ", " + Short(RadToDeg(l.max_rad)) +
+                ShortNumber(RadToDeg(q)) + " deg outside [" + ShortNumber(RadToDeg(l.min_rad)) + ", " + ShortNumber(RadToDeg(l.max_rad)) +
                 "] deg";
     }
     if (!joints.empty()) {

@@ -1,13 +1,13 @@
 #include "session/setup_file.h"
 
 #include <cmath>
-#include <cstdio>
 #include <optional>
 #include <set>
 #include <utility>
 
 #include <nlohmann/json.hpp>
 
+#include "base/short_number.h"
 #include "io/plausible_limits.h"
 #include "session/json_fields.h"
 
@@ -73,12 +73,6 @@ void ParseCamera(const json& j, JsonFields* fields, CameraIntrinsics* camera) {
   fields->GetDouble(*c, at, "cx_px", &camera->cx_px);
   fields->GetDouble(*c, at, "cy_px", &camera->cy_px);
   fields->GetDouble(*c, at, "k1", &camera->k1);
-}
-
-std::string ShortNumber(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.6g", v);
-  return buffer;
 }
 
 // yardsticks or check_distances: [{dot_a, dot_b, length_m}], each length in [1 mm, 100 m] as in observations
