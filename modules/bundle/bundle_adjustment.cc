@@ -18,6 +18,7 @@
 #include "bundle/weak_holding.h"
 #include "identification/identifiability.h"
 #include "identification/triangulation.h"
+#include "kinematics/joint_motion.h"
 
 namespace selfcal::bundle {
 
@@ -329,6 +330,15 @@ void RecordSolution(const BundleData& data, const BundleState& state, BundleRepo
   report->rms_reprojection_px = report->num_observations > 0 ? std::sqrt(sum2 / report->num_observations) : 0.0;
 }
 
+// A joint set's CameraMotionPerJoint of every identification pose at `state`, the joint component's shape
+// (error_model.h); empty for a flange-pose set.
+std::vector<Eigen::MatrixXd> JointMotions(const BundleData& data, const BundleState& state) {
+  std::vector<Eigen::MatrixXd> motions;
+  if (!data.base_from_flange.empty() || data.robot.num_joints() == 0) return motions;
+  for (const Eigen::VectorXd& q : data.joints) motions.push_back(CameraMotionPerJoint(data.robot, state.rho, q));
+  return motions;
+}
+
 // Covariance of the free globals at the solution, dots as nuisance (K8), scaled by the residual
 // variance 2 cost / dof; the standard deviations and correlations from it.
 void EstimateCovariance(const BundleData& data, const BundleState& state, const std::vector<int>& free,
@@ -355,11 +365,13 @@ void EstimateCovariance(const BundleData& data, const BundleState& state, const 
     const double s2 = 2.0 * final_cost / dof;
     report->covariance_free = s2 * covariance;
     if (options.estimate_pose_error) {
+      const std::vector<Eigen::MatrixXd> motions = JointMotions(data, state);
       report->error_model = internal::EstimateErrorModel(reduced, columns.size(), pose_errors.gradient,
-                                                         pose_errors.residual_sq, dof, data.sigma_px);
+                                                         pose_errors.residual_sq, dof, data.sigma_px,
+                                                         Eigen::VectorXd(), motions);
       if (report->error_model.estimated) {
         report->covariance_free = internal::ModelCovariance(reduced, columns.size(), covariance, report->error_model,
-                                                            data.sigma_px, &report->covariance_pose_part);
+                                                            data.sigma_px, &report->covariance_pose_part, motions);
       }
     }
     report->covariance_available = true;
@@ -420,16 +432,17 @@ void TestHeldParameters(const BundleData& data, const BundleState& state, const 
   // The error model of the fit with the held parameters freed (one linear step): a wrong held value leaves a
   // pose error behind that would otherwise be taken as the cell's noise and hide it.
   ErrorModel freed = report->error_model;
+  const std::vector<Eigen::MatrixXd> motions = JointMotions(data, state);
   if (options.estimate_pose_error) {
     Eigen::VectorXd global_gradient = Eigen::VectorXd::Zero(columns.size());
     global_gradient.tail(gradient.size()) = gradient;
     freed = internal::EstimateErrorModel(permuted, columns.size(), pose.gradient, pose.residual_sq,
                                          report->residual_dof - static_cast<int>(gradient.size()), data.sigma_px,
-                                         global_gradient);
+                                         global_gradient, motions);
     if (!freed.estimated) freed = report->error_model;
   }
   report->held_values =
-      internal::TestHeldValues(permuted, num_free, names, gradient, norm_sq, freed, data.sigma_px, s * s);
+      internal::TestHeldValues(permuted, num_free, names, gradient, norm_sq, freed, data.sigma_px, s * s, motions);
   report->held_values.decisive =
       options.free_parameters.empty() &&
       std::find(options.held_parameters.begin(), options.held_parameters.end(), "kinematics") == options.held_parameters.end();

@@ -6,7 +6,20 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
-namespace selfcal::bundle::internal {
+namespace selfcal::bundle {
+
+Eigen::Matrix<double, 6, 6> PoseErrorCovariance(double translation_m, double rotation_rad, double joint_rad,
+                                                const Eigen::MatrixXd& camera_motion_per_joint) {
+  const auto variance = [](double sd) { return sd > 0 ? sd * sd : 0.0; };
+  Eigen::Matrix<double, 6, 6> theta = Eigen::Matrix<double, 6, 6>::Zero();
+  theta.diagonal() << Eigen::Vector3d::Constant(variance(translation_m)), Eigen::Vector3d::Constant(variance(rotation_rad));
+  if (joint_rad > 0 && camera_motion_per_joint.rows() == 6) {
+    theta += variance(joint_rad) * camera_motion_per_joint * camera_motion_per_joint.transpose();
+  }
+  return theta;
+}
+
+namespace internal {
 
 namespace {
 
@@ -30,92 +43,142 @@ bool InverseSpd(const Eigen::MatrixXd& s, Eigen::MatrixXd* inverse) {
   return inverse->allFinite();
 }
 
-// Theta's diagonal over `num_columns` pose columns (v, omega per pose): the model's variances.
-Eigen::VectorXd PoseVariances(const ErrorModel& model, int num_columns) {
-  Eigen::VectorXd theta(num_columns);
-  for (int c = 0; c < num_columns; ++c) {
-    const double sd = c % 6 < 3 ? model.pose_translation_m : model.pose_rotation_rad;
-    theta[c] = sd * sd;
+// The joint component's columns beside the pose columns, pose i's pose columns times A_i, and their
+// gradient; false (nothing added) when joint_motion does not hold one 6 x n matrix per pose.
+bool AddJointColumns(const Eigen::MatrixXd& reduced, int num_global, const Eigen::VectorXd& gradient,
+                     const std::vector<Eigen::MatrixXd>& joint_motion, Eigen::MatrixXd* work, Eigen::VectorXd* work_gradient) {
+  const int num_poses = (static_cast<int>(reduced.cols()) - num_global) / 6;
+  if (static_cast<int>(joint_motion.size()) != num_poses || num_poses == 0) return false;
+  const Eigen::Index n = joint_motion.front().cols();
+  for (const Eigen::MatrixXd& a : joint_motion) {
+    if (a.rows() != 6 || a.cols() != n || !a.allFinite()) return false;
   }
-  return theta;
+  if (n == 0) return false;
+  const Eigen::Index width = reduced.cols();
+  work->resize(reduced.rows(), width + n * num_poses);
+  work->leftCols(width) = reduced;
+  work_gradient->resize(width - num_global + n * num_poses);
+  work_gradient->head(width - num_global) = gradient;
+  for (int i = 0; i < num_poses; ++i) {
+    work->middleCols(width + n * i, n) = reduced.middleCols(num_global + 6 * i, 6) * joint_motion[i];
+    work_gradient->segment(width - num_global + n * i, n) = joint_motion[i].transpose() * gradient.segment<6>(6 * i);
+  }
+  return true;
+}
+
+// The pose part S_ge Theta S_eg of a covariance from cross = the columns' products with the pose columns,
+// Theta_i per pose (6 columns each).
+Eigen::MatrixXd PosePart(const Eigen::MatrixXd& cross, const ErrorModel& model,
+                         const std::vector<Eigen::MatrixXd>& joint_motion) {
+  const int num_poses = static_cast<int>(cross.cols()) / 6;
+  const bool joints = static_cast<int>(joint_motion.size()) == num_poses;
+  Eigen::MatrixXd part = Eigen::MatrixXd::Zero(cross.rows(), cross.rows());
+  for (int i = 0; i < num_poses; ++i) {
+    const Eigen::Matrix<double, 6, 6> theta = PoseErrorCovariance(
+        model.pose_translation_m, model.pose_rotation_rad, joints ? model.joint_rad : 0.0,
+        joints ? joint_motion[i] : Eigen::MatrixXd());
+    part.noalias() += cross.middleCols<6>(6 * i) * theta * cross.middleCols<6>(6 * i).transpose();
+  }
+  return part;
 }
 
 }  // namespace
 
 ErrorModel EstimateErrorModel(const Eigen::MatrixXd& reduced, int num_global, const Eigen::VectorXd& gradient,
-                              double residual_sq, int dof, double sigma_px, const Eigen::VectorXd& global_gradient) {
+                              double residual_sq, int dof, double sigma_px, const Eigen::VectorXd& global_gradient,
+                              const std::vector<Eigen::MatrixXd>& joint_motion) {
   ErrorModel model;
-  const int width = static_cast<int>(reduced.cols());
-  const int num_poses = (width - num_global) / 6;
+  const int num_poses = (static_cast<int>(reduced.cols()) - num_global) / 6;
   if (num_poses < 2 || dof <= 0 || gradient.size() != 6 * num_poses || !(residual_sq > 0)) {
     model.message = "no redundancy to estimate a pose error from";
     return model;
   }
-  const Eigen::MatrixXd normal = reduced.transpose() * reduced;
-  // Variances: pixels in units of sigma_px^2, translations m^2, rotations rad^2 (starts: the residuals'
-  // own pixel variance, 0.1 mm and 0.01 deg).
-  double var_px = residual_sq / dof, var_t = 1e-8, var_r = 3e-8;
-  const double floor_t = kTranslationFloorM * kTranslationFloorM, floor_r = kRotationFloorRad * kRotationFloorRad;
+  // Unknowns after the globals: 6 per pose (group 0 translation, 1 rotation), then a joint set's n per pose
+  // (group 2).
+  Eigen::MatrixXd work;
+  Eigen::VectorXd work_gradient;
+  const bool joints = AddJointColumns(reduced, num_global, gradient, joint_motion, &work, &work_gradient);
+  const Eigen::MatrixXd& columns = joints ? work : reduced;
+  const Eigen::VectorXd& extra_gradient = joints ? work_gradient : gradient;
+  const int width = static_cast<int>(columns.cols()), num_extra = width - num_global;
+  std::vector<int> group(num_extra);
+  for (int c = 0; c < num_extra; ++c) group[c] = c >= 6 * num_poses ? 2 : c % 6 < 3 ? 0 : 1;
+  const Eigen::MatrixXd normal = columns.transpose() * columns;
+  // Variances: pixels in units of sigma_px^2, translations m^2, rotations and joints rad^2 (starts: the
+  // residuals' own pixel variance, 0.1 mm, 0.01 deg, 0.01 deg).
+  double var_px = residual_sq / dof;
+  double var[3] = {1e-8, 3e-8, 3e-8};
+  const double floor[3] = {kTranslationFloorM * kTranslationFloorM, kRotationFloorRad * kRotationFloorRad,
+                           kRotationFloorRad * kRotationFloorRad};
+  const int num_groups = joints ? 3 : 2;
+  double red[3] = {0, 0, 0};
   Eigen::MatrixXd s, inverse;
   for (model.iterations = 1; model.iterations <= kMaxIterations; ++model.iterations) {
     const double w = 1.0 / var_px;
     s = w * normal;
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(width);
-    rhs.tail(6 * num_poses) = w * gradient;
+    rhs.tail(num_extra) = w * extra_gradient;
     if (global_gradient.size() == num_global) rhs.head(num_global) = w * global_gradient;
-    for (int i = 0; i < num_poses; ++i) {
-      for (int k = 0; k < 6; ++k) s(num_global + 6 * i + k, num_global + 6 * i + k) += 1.0 / (k < 3 ? var_t : var_r);
-    }
+    for (int c = 0; c < num_extra; ++c) s(num_global + c, num_global + c) += 1.0 / var[group[c]];
     if (!InverseSpd(s, &inverse)) {
       model.message = "the pose-error normal matrix is not positive definite";
       return model;
     }
     const Eigen::VectorXd step = inverse * rhs;
-    double sum_t = 0, sum_r = 0, trace_t = 0, trace_r = 0;
-    for (int i = 0; i < num_poses; ++i) {
-      for (int k = 0; k < 6; ++k) {
-        const int c = num_global + 6 * i + k;
-        (k < 3 ? sum_t : sum_r) += step[c] * step[c];
-        (k < 3 ? trace_t : trace_r) += inverse(c, c);
-      }
+    double sum[3] = {0, 0, 0}, trace[3] = {0, 0, 0}, count[3] = {0, 0, 0};
+    for (int c = 0; c < num_extra; ++c) {
+      const int k = num_global + c;
+      sum[group[c]] += step[k] * step[k];
+      trace[group[c]] += inverse(k, k);
+      count[group[c]] += 1;
     }
-    const double energy_px = w * residual_sq - step.dot(rhs) - sum_t / var_t - sum_r / var_r;
-    const double red_t = 3.0 * num_poses - trace_t / var_t, red_r = 3.0 * num_poses - trace_r / var_r;
-    const double red_px = dof - red_t - red_r;
+    double energy_px = w * residual_sq - step.dot(rhs), red_px = dof;
+    for (int g = 0; g < num_groups; ++g) {
+      energy_px -= sum[g] / var[g];
+      red[g] = count[g] - trace[g] / var[g];
+      red_px -= red[g];
+    }
     model.pixel_redundancy = red_px;
-    model.translation_redundancy = red_t;
-    model.rotation_redundancy = red_r;
     if (!(red_px > 0) || !(energy_px > 0)) {
       model.message = "the pixel residuals have no redundancy left beside the pose errors";
       return model;
     }
     const double new_px = var_px * energy_px / red_px;
-    // A component whose redundancy has fallen far below one is absent (it only drifts further towards zero,
-    // iteration after iteration): held at its floor from then on.
-    const bool freeze = model.iterations >= kFreezeAfter;
-    const double new_t = red_t > (freeze ? kFreezeRedundancy : 1e-9) ? std::max(sum_t / red_t, floor_t) : floor_t;
-    const double new_r = red_r > (freeze ? kFreezeRedundancy : 1e-9) ? std::max(sum_r / red_r, floor_r) : floor_r;
     const auto settled = [](double a, double b, double floor) {
       return (a <= floor && b <= floor) || std::abs(std::sqrt(a) - std::sqrt(b)) <= kRelativeTolerance * std::sqrt(b);
     };
-    const bool done = settled(new_px, var_px, 0) && settled(new_t, var_t, floor_t) && settled(new_r, var_r, floor_r);
+    bool done = settled(new_px, var_px, 0);
     var_px = new_px;
-    var_t = new_t;
-    var_r = new_r;
+    // A component whose redundancy has fallen far below one is absent (it only drifts further towards zero,
+    // iteration after iteration): held at its floor from then on.
+    const bool freeze = model.iterations >= kFreezeAfter;
+    for (int g = 0; g < num_groups; ++g) {
+      const double next = red[g] > (freeze ? kFreezeRedundancy : 1e-9) ? std::max(sum[g] / red[g], floor[g]) : floor[g];
+      done = done && settled(next, var[g], floor[g]);
+      var[g] = next;
+    }
     if (done) break;
   }
   model.iterations = std::min(model.iterations, kMaxIterations);
   model.estimated = true;
   model.pixel_px = sigma_px * std::sqrt(var_px);
+  model.translation_redundancy = red[0];
+  model.rotation_redundancy = red[1];
   // A component resting on less than one degree of freedom is not seen in the data (without pose error the
   // iteration drifts towards zero with redundancies of a few hundredths): absent.
-  model.pose_translation_m = var_t > floor_t && model.translation_redundancy >= kMinRedundancy ? std::sqrt(var_t) : 0.0;
-  model.pose_rotation_rad = var_r > floor_r && model.rotation_redundancy >= kMinRedundancy ? std::sqrt(var_r) : 0.0;
+  const auto size = [&](int g) { return var[g] > floor[g] && red[g] >= kMinRedundancy ? std::sqrt(var[g]) : 0.0; };
+  model.pose_translation_m = size(0);
+  model.pose_rotation_rad = size(1);
+  if (joints) {
+    model.joint_redundancy = red[2];
+    model.joint_rad = size(2);
+  }
   return model;
 }
 
 Eigen::MatrixXd ModelCovariance(const Eigen::MatrixXd& reduced, int num_global, const Eigen::MatrixXd& inverse,
-                                const ErrorModel& model, double sigma_px, Eigen::MatrixXd* pose_part) {
+                                const ErrorModel& model, double sigma_px, Eigen::MatrixXd* pose_part,
+                                const std::vector<Eigen::MatrixXd>& joint_motion) {
   const double ratio = model.pixel_px / sigma_px;
   Eigen::MatrixXd covariance = ratio * ratio * inverse;
   const int num_pose_columns = static_cast<int>(reduced.cols()) - num_global;
@@ -123,14 +186,14 @@ Eigen::MatrixXd ModelCovariance(const Eigen::MatrixXd& reduced, int num_global, 
   if (num_pose_columns <= 0) return covariance;
   const Eigen::MatrixXd cross =
       inverse * (reduced.leftCols(num_global).transpose() * reduced.rightCols(num_pose_columns));
-  *pose_part = cross * PoseVariances(model, num_pose_columns).asDiagonal() * cross.transpose();
+  *pose_part = PosePart(cross, model, joint_motion);
   covariance += *pose_part;
   return covariance;
 }
 
 HeldValueTest TestHeldValues(const Eigen::MatrixXd& reduced, int num_free, const std::vector<std::string>& names,
                              const Eigen::VectorXd& gradient, const Eigen::VectorXd& norm_sq, const ErrorModel& model,
-                             double sigma_px, double pixel_variance) {
+                             double sigma_px, double pixel_variance, const std::vector<Eigen::MatrixXd>& joint_motion) {
   HeldValueTest test;
   const int num_held = static_cast<int>(names.size());
   const int num_pose = static_cast<int>(reduced.cols()) - num_free - num_held;
@@ -148,7 +211,7 @@ HeldValueTest TestHeldValues(const Eigen::MatrixXd& reduced, int num_free, const
   const Eigen::MatrixXd s_he = rest.topRightCorner(num_held, num_pose);
   const double var_px = model.estimated ? (model.pixel_px / sigma_px) * (model.pixel_px / sigma_px) : pixel_variance;
   Eigen::MatrixXd covariance = var_px * s_hh;
-  if (model.estimated && num_pose > 0) covariance += s_he * PoseVariances(model, num_pose).asDiagonal() * s_he.transpose();
+  if (model.estimated && num_pose > 0) covariance += PosePart(s_he, model, joint_motion);
   // A held column in the span of the free ones and the dots (the gauge's, or one the poses cannot see)
   // carries no information: left out.
   // (Its squared norm after the eliminations is then ~1e-15 of its norm before them.)
@@ -187,4 +250,5 @@ HeldValueTest TestHeldValues(const Eigen::MatrixXd& reduced, int num_free, const
   return test;
 }
 
-}  // namespace selfcal::bundle::internal
+}  // namespace internal
+}  // namespace selfcal::bundle

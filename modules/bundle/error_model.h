@@ -25,6 +25,13 @@
 // s_px the estimated pixel noise over the stated one. A pose error moves every dot of an image
 // together, so n dots of one image are not n independent measurements: the pixel-only covariance was
 // 3-50 times too small on real recordings.
+//
+// A joint set's images carry a third component beside the two isotropic ones: the joint readings' noise,
+// dq_i ~ N(0, s_q^2 I) per image, which moves the camera by A_i dq_i (kinematics/joint_motion.h,
+// CameraMotionPerJoint). Its shape changes with the configuration (a reading error of the first joint moves
+// a camera far from the base by much more than one of the last), which the isotropic camera-frame
+// components cannot take: it enters as n more unknowns per image, columns J_e A_i, under the same iteration,
+// and Theta_i = diag(s_t^2 I, s_r^2 I) + s_q^2 A_i A_i^T.
 #pragma once
 
 #include <cmath>
@@ -41,8 +48,9 @@ struct ErrorModel {
   double pixel_px = NAN;               // per coordinate
   double pose_translation_m = NAN;     // per axis, camera frame, per image
   double pose_rotation_rad = NAN;      // per axis (rotation vector)
+  double joint_rad = NAN;              // per joint reading (a joint set's; NaN: not modelled)
   // Redundancy numbers (the degrees of freedom each component's estimate rests on).
-  double pixel_redundancy = NAN, translation_redundancy = NAN, rotation_redundancy = NAN;
+  double pixel_redundancy = NAN, translation_redundancy = NAN, rotation_redundancy = NAN, joint_redundancy = NAN;
   int iterations = 0;
 };
 
@@ -63,6 +71,11 @@ struct HeldValueTest {
   bool decisive = true;
 };
 
+// Theta_i above: the covariance of one image's camera motion e = (v, omega) given the components' sizes
+// (non-positive or NaN: absent) and, for a joint set, the image's CameraMotionPerJoint (6 x n; empty: none).
+Eigen::Matrix<double, 6, 6> PoseErrorCovariance(double translation_m, double rotation_rad, double joint_rad,
+                                                const Eigen::MatrixXd& camera_motion_per_joint);
+
 namespace internal {
 
 // reduced: the reduced Jacobian with the pose columns (bundle_problem.h, whitened by sigma_px: the
@@ -70,14 +83,17 @@ namespace internal {
 // residuals (pixel coordinates and yardsticks) minus unknowns (globals and dots).
 // global_gradient (optional): J^T r of the global columns, for columns that are not at their optimum (held
 // ones taken as free: the error model of the fit with them freed, one linear step away).
+// joint_motion: a joint set's CameraMotionPerJoint per pose (the joint component); empty: none.
 ErrorModel EstimateErrorModel(const Eigen::MatrixXd& reduced, int num_global, const Eigen::VectorXd& gradient,
                               double residual_sq, int dof, double sigma_px,
-                              const Eigen::VectorXd& global_gradient = Eigen::VectorXd());
+                              const Eigen::VectorXd& global_gradient = Eigen::VectorXd(),
+                              const std::vector<Eigen::MatrixXd>& joint_motion = {});
 
 // The globals' covariance under `model` (above), given inverse = S^-1 of the globals' reduced matrix
 // (CovarianceFromJacobian of reduced's first num_global columns); *pose_part: its pose-error term.
 Eigen::MatrixXd ModelCovariance(const Eigen::MatrixXd& reduced, int num_global, const Eigen::MatrixXd& inverse,
-                                const ErrorModel& model, double sigma_px, Eigen::MatrixXd* pose_part);
+                                const ErrorModel& model, double sigma_px, Eigen::MatrixXd* pose_part,
+                                const std::vector<Eigen::MatrixXd>& joint_motion = {});
 
 // reduced: the reduced Jacobian with pose columns over [free globals (num_free) | held (num_held)]; names:
 // the held columns'; gradient, norm_sq: J^T r and the squared norms (before the dots' elimination) of the held
@@ -85,7 +101,8 @@ Eigen::MatrixXd ModelCovariance(const Eigen::MatrixXd& reduced, int num_global, 
 // was estimated).
 HeldValueTest TestHeldValues(const Eigen::MatrixXd& reduced, int num_free, const std::vector<std::string>& names,
                              const Eigen::VectorXd& gradient, const Eigen::VectorXd& norm_sq, const ErrorModel& model,
-                             double sigma_px, double pixel_variance);
+                             double sigma_px, double pixel_variance,
+                             const std::vector<Eigen::MatrixXd>& joint_motion = {});
 
 }  // namespace internal
 }  // namespace selfcal::bundle

@@ -63,11 +63,18 @@ TEST(ErrorModel, FindsAJointReadingNoiseAndItsSigmasCoverTheTruth) {
     const BundleReport model = Solve(world, true), pixel = Solve(world, false);
     ASSERT_EQ(model.outcome, Outcome::kConverged) << seed << ": " << model.message;
     ASSERT_TRUE(model.error_model.estimated) << model.error_model.message;
-    // 0.01 deg at the joints moves the camera by ~0.1 mm and ~0.015 deg (lever ~0.6 m).
-    EXPECT_GT(model.error_model.pose_translation_m, 2e-5) << seed;
-    EXPECT_LT(model.error_model.pose_translation_m, 5e-4) << seed;
-    EXPECT_GT(model.error_model.pose_rotation_rad, 5e-5) << seed;
-    EXPECT_LT(model.error_model.pose_rotation_rad, 1e-3) << seed;
+    // The joint component takes most of it (0.01 deg at the joints moves the camera by ~0.1 mm and ~0.015 deg,
+    // lever ~0.6 m, but by each configuration's own lever arms). The isotropic components can take a share:
+    // over 8 worlds the joint estimate was 0.0048-0.0117 deg (redundancy 15-38) and the isotropic ones up to
+    // 0.065 mm / 0.009 deg, each smaller than the whole joint noise's camera motion.
+    std::cout << "[ figure ] seed " << seed << ": joint readings " << model.error_model.joint_rad * 180 / M_PI
+              << " deg (redundancy " << model.error_model.joint_redundancy << "), camera "
+              << model.error_model.pose_translation_m * 1e3 << " mm / " << model.error_model.pose_rotation_rad * 180 / M_PI
+              << " deg\n";
+    EXPECT_GT(model.error_model.joint_rad * 180 / M_PI, 0.004) << seed;
+    EXPECT_LT(model.error_model.joint_rad * 180 / M_PI, 0.016) << seed;
+    EXPECT_LT(model.error_model.pose_translation_m, 1e-4) << seed;
+    EXPECT_LT(model.error_model.pose_rotation_rad * 180 / M_PI, 0.015) << seed;
     model_inside += Covered(model, world).first;
     pixel_inside += Covered(pixel, world).first;
     total += Covered(model, world).second;

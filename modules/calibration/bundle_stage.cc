@@ -126,10 +126,18 @@ HeldOutReprojection HeldOutReprojectionOfBundle(const ObservationSet& obs, const
       const double ratio = (*noise_px / fitted_px) * (*noise_px / fitted_px);
       calibrated.covariance = ratio * (b.covariance_free - pose_part) + pose_part;
     }
+    if (b.covariance_pose_part.rows() == b.covariance_free.rows()) calibrated.covariance_pose_part = b.covariance_pose_part;
+  }
+  // A weak parameter is the description's value, as true as its manufacturing tolerance says.
+  const KinematicParameters names(obs.robot.num_joints());
+  for (const bundle::WeakParameter& w : b.weak) {
+    const int index = names.IndexOf(w.name);
+    if (index >= 0 && w.tolerance > 0) calibrated.held_prior.emplace_back(index, w.tolerance);
   }
   if (model) {
     calibrated.pose_translation_m = b.error_model.pose_translation_m;
     calibrated.pose_rotation_rad = b.error_model.pose_rotation_rad;
+    calibrated.joint_rad = b.error_model.joint_rad > 0 ? b.error_model.joint_rad : 0.0;
   }
   ExcludedObservations excluded;
   for (const bundle::RemovedObservation& o : b.removed) excluded.insert({o.pose_id, o.dot_id});
@@ -137,7 +145,8 @@ HeldOutReprojection HeldOutReprojectionOfBundle(const ObservationSet& obs, const
   heldout.noise_source = at_noise_px > 0 ? "the stated pixel noise"
                          : estimated    ? "the bundle's estimate from its identification residuals"
                                         : "the stated pixel noise (the bundle has no redundancy to estimate it)";
-  if (model && (b.error_model.pose_translation_m > 0 || b.error_model.pose_rotation_rad > 0)) {
+  if (model && (b.error_model.pose_translation_m > 0 || b.error_model.pose_rotation_rad > 0 ||
+                b.error_model.joint_rad > 0)) {
     heldout.noise_source += ", with each image's pose error as estimated";
   }
   return heldout;

@@ -58,8 +58,8 @@ TEST(Calibrate, NoModelWithoutAnAcceptedVerdict) {
   EXPECT_FALSE(report.message.empty());
 }
 
-// A wrong model the calibration may not correct: f_x held 2 % off the truth. The solve converges, the
-// held-out test at the stated (true) noise fails, and the verdict refuses the model, saying why. The
+// A wrong model the calibration may not correct: f_x held 2 % off the truth. The solve converges, and the
+// verdict refuses the model, saying why. The
 // same sets with f_x free are accepted (the held-out test passes at 95 %: 3 of 3 with probability 0.86,
 // so the bound asks for 2).
 TEST(Calibrate, AWrongFocalLengthHeldFixedIsRejected) {
@@ -77,8 +77,14 @@ TEST(Calibrate, AWrongFocalLengthHeldFixedIsRejected) {
     EXPECT_EQ(report.verdict, Verdict::kRejected) << seed << ": " << report.message;
     EXPECT_FALSE(report.model.has_value());
     ASSERT_FALSE(report.acceptance.Reasons().empty());
-    EXPECT_NE(report.acceptance.Reasons()[0].find("does not explain images it was not fitted to"), std::string::npos)
-        << report.acceptance.Reasons()[0];
+    // Refused by the score test of the held f_x, and by the held-out test where the weak joint parameters,
+    // held with their manufacturing tolerance in the test's covariance, cannot take the error up (measured:
+    // seed 21 by both, 22 and 23 by the score test alone).
+    bool named = false;
+    for (const std::string& reason : report.acceptance.Reasons()) {
+      named = named || reason.find("the images disagree with a held value, most with fx") != std::string::npos;
+    }
+    EXPECT_TRUE(named) << report.acceptance.Reasons()[0];
   }
   EXPECT_GE(correct_accepted, 2);
 }

@@ -5,8 +5,10 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
+#include "bundle/error_model.h"
 #include "geometry/rigid3.h"
 #include "identification/triangulation.h"
+#include "kinematics/joint_motion.h"
 
 namespace selfcal::calibration {
 
@@ -23,6 +25,7 @@ using Matrix23 = Eigen::Matrix<double, 2, 3>;
 struct PoseFrames {
   Rigid3 cam_from_base;
   std::vector<Rigid3> plus, minus;  // per free rho entry
+  std::vector<Rigid3> held_plus, held_minus;  // per PredictionModel::held_prior entry
 };
 
 // Projections of the model and their derivatives by central differences.
@@ -40,6 +43,13 @@ class Projector {
   PoseFrames Frames(const PoseObservation& q) const {
     PoseFrames f;
     f.cam_from_base = PointsFromCamAt(model_.robot, model_.rho, q).Inverse();
+    for (const auto& [index, sd] : model_.held_prior) {
+      Eigen::VectorXd rho = model_.rho;
+      rho[index] += kStepRho;
+      f.held_plus.push_back(PointsFromCamAt(model_.robot, rho, q).Inverse());
+      rho[index] -= 2 * kStepRho;
+      f.held_minus.push_back(PointsFromCamAt(model_.robot, rho, q).Inverse());
+    }
     if (!with_parameters_) return f;
     for (int index : model_.free_indices) {
       Eigen::VectorXd rho = model_.rho;
@@ -51,12 +61,18 @@ class Projector {
     return f;
   }
 
-  // The pixel of p_in_base, d(pixel)/d(p) and d(pixel)/d(theta); false when behind the camera at any step.
-  bool Project(const PoseFrames& f, const Eigen::Vector3d& p, Eigen::Vector2d* uv, Matrix23* jd,
-               Eigen::MatrixXd* jt) const {
+  // The pixel of p_in_base, d(pixel)/d(p), d(pixel)/d(theta) and d(pixel)/d(held prior entry), each by its
+  // sd (jh); false when behind the camera at any step.
+  bool Project(const PoseFrames& f, const Eigen::Vector3d& p, Eigen::Vector2d* uv, Matrix23* jd, Eigen::MatrixXd* jt,
+               Eigen::MatrixXd* jh) const {
     const IntrinsicsVector& in = intrinsics_;
     if (!Pixel(f.cam_from_base, in, p, uv)) return false;
     Eigen::Vector2d a, b;
+    jh->resize(2, static_cast<Eigen::Index>(f.held_plus.size()));
+    for (size_t k = 0; k < f.held_plus.size(); ++k) {
+      if (!Pixel(f.held_plus[k], in, p, &a) || !Pixel(f.held_minus[k], in, p, &b)) return false;
+      jh->col(static_cast<Eigen::Index>(k)) = (a - b) / (2 * kStepRho) * model_.held_prior[k].second;
+    }
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d h = Eigen::Vector3d::Unit(k) * kStepDot;
       if (!Pixel(f.cam_from_base, in, p + h, &a) || !Pixel(f.cam_from_base, in, p - h, &b)) return false;
@@ -92,6 +108,60 @@ class Projector {
   int num_theta_ = 0;
 };
 
+// The rows of one dot's prediction error in the 6 columns of its image's camera motion (v, omega in the
+// camera frame): d uv / d p_cam = jd R^T (jd = d uv / d p_base, p_cam = R p_base + t), d p_cam / d v = I,
+// d p_cam / d omega = -[p_cam]x.
+Eigen::Matrix<double, 2, 6> PoseErrorRows(const Rigid3& cam_from_base, const Eigen::Vector3d& p_base, const Matrix23& jd) {
+  return jd * cam_from_base.rotation.transpose() * SmallMotionJacobian(cam_from_base * p_base);
+}
+
+// The recorded flange pose's noise (base_from_flange * Exp(delta), per axis s_t, s_r in the flange frame) as
+// the camera motion of PoseErrorRows: e = A diag(s_t, s_r) z with, for flange_from_cam = (R, t), the rotation
+// R^T w and the translation R^T (v + w x t) (up to a sign that the covariance does not see).
+Eigen::Matrix<double, 6, 6> FlangePoseMotion(const Rigid3& flange_from_cam, double translation_sd, double rotation_sd) {
+  const Eigen::Matrix3d rt = flange_from_cam.rotation.transpose();
+  Eigen::Matrix<double, 6, 6> a = Eigen::Matrix<double, 6, 6>::Zero();
+  a.topLeftCorner<3, 3>() = rt * translation_sd;
+  a.topRightCorner<3, 3>() = -rt * Skew<double>(flange_from_cam.translation) * rotation_sd;
+  a.bottomRightCorner<3, 3>() = rt * rotation_sd;
+  return a;
+}
+
+// The camera in the frame of the flange whose recorded pose carries the noise: points_from_cam of the flange's
+// points (eye-to-hand), or base_from_flange^-1 * base_from_cam (eye-in-hand).
+Rigid3 FlangeFromCamAt(const PredictionModel& model, const PoseFrames& frames, const PoseObservation& pose) {
+  const Rigid3 points_from_cam = frames.cam_from_base.Inverse();
+  if (model.robot.mount == CameraMount::kEyeToHand || !pose.base_from_flange) return points_from_cam;
+  return pose.base_from_flange->Inverse() * points_from_cam;
+}
+
+bool HasPoseError(const PredictionModel& model) {
+  return model.pose_translation_m > 0 || model.pose_rotation_rad > 0 || model.joint_rad > 0;
+}
+
+// The bundle's pixel-only estimate with an estimated pose error (not the pose-noise solve, whose estimator
+// weighs the pose errors itself): the identification images' pose errors moved its parameters and dots, and
+// the prediction carries that (PoseEffects).
+bool CarriesIdentificationPoseErrors(const PredictionModel& model) {
+  return HasPoseError(model) && !model.pose_error_at_flange;
+}
+
+// M with e = M z, z ~ N(0, I): the camera motion of `pose`'s pose error under `model` (Theta = M M^T;
+// bundle/error_model.h), a joint set's joint-reading noise through the pose's CameraMotionPerJoint, or the
+// flange pose noise carried to the camera.
+Eigen::Matrix<double, 6, 6> PoseErrorRootAt(const PredictionModel& model, const PoseFrames& frames,
+                                            const PoseObservation& pose) {
+  if (model.pose_error_at_flange) {
+    return FlangePoseMotion(FlangeFromCamAt(model, frames, pose), model.pose_translation_m, model.pose_rotation_rad);
+  }
+  const bool joints = model.joint_rad > 0 && !pose.base_from_flange && pose.joints_rad.size() > 0;
+  const Eigen::Matrix<double, 6, 6> theta = bundle::PoseErrorCovariance(
+      model.pose_translation_m, model.pose_rotation_rad, joints ? model.joint_rad : 0.0,
+      joints ? Eigen::MatrixXd(CameraMotionPerJoint(model.robot, model.rho, pose.joints_rad)) : Eigen::MatrixXd());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(theta);
+  return eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+}
+
 // What the identification images say about one dot: H_dd and H_dtheta (sigma = 1), and from them the
 // square root of H_dd^-1 and K = H_dd^-1 H_dtheta.
 struct DotInformation {
@@ -102,27 +172,59 @@ struct DotInformation {
   Eigen::Matrix3d sqrt_inverse = Eigen::Matrix3d::Zero();
   Eigen::MatrixXd k;
   int column = -1;  // index of its block among the usable dots
+  // With a pose error: J_d^T J_e M of each identification image that sees it (image index among the
+  // identification poses, 3 x 6), and from them its error per unit of those images' pose errors, with the
+  // parameters' share (3 x 6 per identification image; PoseEffects).
+  std::vector<std::pair<int, Eigen::Matrix<double, 3, 6>>> hde;
+  Eigen::MatrixXd pose_effect;
+  // With a prior on held parameters: J_d^T J_h (3 x held), and the dot's error per unit of their errors
+  // (HeldEffects).
+  Eigen::MatrixXd hdh, held_effect;
 };
 
-std::map<int, DotInformation> IdentificationInformation(const ObservationSet& obs, const Projector& projector,
+// hte (with a pose error): J_theta^T J_e M per identification image (theta x 6); hth: J_theta^T J_h of the
+// held parameters with a prior (theta x held).
+std::map<int, DotInformation> IdentificationInformation(const ObservationSet& obs, const PredictionModel& model,
+                                                        const Projector& projector,
                                                         const std::map<int, Eigen::Vector3d>& dots,
-                                                        const ExcludedObservations& excluded) {
+                                                        const ExcludedObservations& excluded,
+                                                        std::vector<Eigen::MatrixXd>* hte, Eigen::MatrixXd* hth) {
   std::map<int, DotInformation> info;
-  for (const auto& [id, p] : dots) info[id].hdt = Eigen::MatrixXd::Zero(3, projector.num_theta());
-  for (int i : obs.PosesWithRole(PoseRole::kIdentification)) {
-    const PoseObservation& pose = obs.poses[i];
+  const Eigen::Index nh = static_cast<Eigen::Index>(model.held_prior.size());
+  for (const auto& [id, p] : dots) {
+    info[id].hdt = Eigen::MatrixXd::Zero(3, projector.num_theta());
+    info[id].hdh = Eigen::MatrixXd::Zero(3, nh);
+  }
+  const std::vector<int> identification = obs.PosesWithRole(PoseRole::kIdentification);
+  hte->clear();
+  *hth = Eigen::MatrixXd::Zero(projector.num_theta(), nh);
+  for (size_t index = 0; index < identification.size(); ++index) {
+    const PoseObservation& pose = obs.poses[identification[index]];
     const PoseFrames frames = projector.Frames(pose);
+    const bool pose_error = CarriesIdentificationPoseErrors(model);
+    const Eigen::Matrix<double, 6, 6> root =
+        pose_error ? PoseErrorRootAt(model, frames, pose) : Eigen::Matrix<double, 6, 6>::Zero();
+    if (pose_error) hte->push_back(Eigen::MatrixXd::Zero(projector.num_theta(), 6));
     for (const auto& [id, pixel] : pose.dots_px) {
       const auto dot = dots.find(id);
       if (dot == dots.end() || excluded.count({pose.id, id}) > 0) continue;
       Eigen::Vector2d uv;
       Matrix23 jd;
-      Eigen::MatrixXd jt;
-      if (!projector.Project(frames, dot->second, &uv, &jd, &jt)) continue;
+      Eigen::MatrixXd jt, jh;
+      if (!projector.Project(frames, dot->second, &uv, &jd, &jt, &jh)) continue;
       DotInformation& d = info[id];
       d.hdd += jd.transpose() * jd;
       d.hdt += jd.transpose() * jt;
+      if (nh > 0) {
+        d.hdh.noalias() += jd.transpose() * jh;
+        hth->noalias() += jt.transpose() * jh;
+      }
       ++d.views;
+      if (pose_error) {
+        const Eigen::Matrix<double, 2, 6> je = PoseErrorRows(frames.cam_from_base, dot->second, jd) * root;
+        d.hde.emplace_back(static_cast<int>(index), jd.transpose() * je);
+        hte->back().noalias() += jt.transpose() * je;
+      }
     }
   }
   for (auto& [id, d] : info) {
@@ -134,6 +236,59 @@ std::map<int, DotInformation> IdentificationInformation(const ObservationSet& ob
     d.k = eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().asDiagonal() * eigen.eigenvectors().transpose() * d.hdt;
   }
   return info;
+}
+
+// S^-1 of the fit (the parameters' normal matrix with the dots eliminated, unit weights): the pixel part of
+// their covariance over noise_px^2.
+Eigen::MatrixXd FitInverse(const PredictionModel& model, double noise_px) {
+  const Eigen::Index nt = model.covariance.rows();
+  const bool split = model.covariance_pose_part.rows() == nt && model.covariance_pose_part.cols() == nt;
+  const Eigen::MatrixXd pixel_part = split ? Eigen::MatrixXd(model.covariance - model.covariance_pose_part) : model.covariance;
+  return pixel_part / (noise_px * noise_px);
+}
+
+// The held parameters' errors (PredictionModel::held_prior, per unit sd) carried into the estimates: the fit
+// absorbs the identification residuals' share J_h dh into dtheta = S^-1 (H_th - sum_j K_j^T H_dh_j) and each
+// dot's H_dd^-1 H_dh_j - K_j dtheta (DotInformation::held_effect). Returns dtheta (theta x held).
+Eigen::MatrixXd HeldEffects(const PredictionModel& model, double noise_px, int nt, const Eigen::MatrixXd& hth,
+                            std::map<int, DotInformation>* info) {
+  Eigen::MatrixXd c = hth;
+  for (const auto& [id, d] : *info) {
+    if (d.usable && nt > 0) c.noalias() -= d.k.transpose() * d.hdh;
+  }
+  const Eigen::MatrixXd dtheta = nt > 0 ? Eigen::MatrixXd(FitInverse(model, noise_px) * c) : Eigen::MatrixXd::Zero(0, hth.cols());
+  for (auto& [id, d] : *info) {
+    if (!d.usable) continue;
+    d.held_effect = d.sqrt_inverse * d.sqrt_inverse.transpose() * d.hdh;
+    if (nt > 0) d.held_effect.noalias() -= d.k * dtheta;
+  }
+  return dtheta;
+}
+
+// The identification images' pose errors carried into the estimates, as the least-squares fit carries them:
+// per identification image i, c_i = H_te_i - sum_j K_j^T H_de_ji (the dots eliminated), the parameters'
+// error dtheta_i = S^-1 c_i (S^-1: the pixel part of their covariance over noise_px^2) and each dot's error
+// H_dd^-1 H_de_ji - K_j dtheta_i (DotInformation::pose_effect), all per unit z of that image's pose error.
+// Returns dtheta (theta x 6 per identification image).
+Eigen::MatrixXd PoseEffects(const PredictionModel& model, double noise_px, int nt, const std::vector<Eigen::MatrixXd>& hte,
+                            std::map<int, DotInformation>* info) {
+  const int width = 6 * static_cast<int>(hte.size());
+  Eigen::MatrixXd c = Eigen::MatrixXd::Zero(nt, width);
+  for (size_t i = 0; i < hte.size(); ++i) c.middleCols<6>(6 * static_cast<Eigen::Index>(i)) = hte[i];
+  for (const auto& [id, d] : *info) {
+    if (!d.usable || nt == 0) continue;
+    for (const auto& [i, h] : d.hde) c.middleCols<6>(6 * i).noalias() -= d.k.transpose() * h;
+  }
+  Eigen::MatrixXd dtheta = Eigen::MatrixXd::Zero(nt, width);
+  if (nt > 0) dtheta = FitInverse(model, noise_px) * c;
+  for (auto& [id, d] : *info) {
+    if (!d.usable) continue;
+    const Eigen::Matrix3d hdd_inverse = d.sqrt_inverse * d.sqrt_inverse.transpose();
+    d.pose_effect = Eigen::MatrixXd::Zero(3, width);
+    for (const auto& [i, h] : d.hde) d.pose_effect.middleCols<6>(6 * i) = hdd_inverse * h;
+    if (nt > 0) d.pose_effect.noalias() -= d.k * dtheta;
+  }
+  return dtheta;
 }
 
 // One verification residual: detection - prediction, and its rows of U (C = sigma^2 I + U U^T, U in px):
@@ -226,40 +381,6 @@ HeldOutFigure FigureOf(const std::string& pose_id, int begin, int end, const Res
   return f;
 }
 
-// The rows of one dot's prediction error in the 6 columns of its image's camera motion (v, omega in the
-// camera frame), scaled by the pose error's standard deviations: d uv / d p_cam = jd R^T (jd = d uv / d
-// p_base, p_cam = R p_base + t), d p_cam / d v = I, d p_cam / d omega = -[p_cam]x.
-Eigen::Matrix<double, 2, 6> PoseErrorRows(const Rigid3& cam_from_base, const Eigen::Vector3d& p_base,
-                                          const Matrix23& jd, double translation_sd, double rotation_sd) {
-  Eigen::Matrix<double, 2, 6> rows = jd * cam_from_base.rotation.transpose() * SmallMotionJacobian(cam_from_base * p_base);
-  rows.leftCols<3>() *= translation_sd;
-  rows.rightCols<3>() *= rotation_sd;
-  return rows;
-}
-
-// The recorded flange pose's noise (base_from_flange * Exp(delta), per axis s_t, s_r in the flange frame) as
-// the camera motion of PoseErrorRows, scaled: e = A delta with, for flange_from_cam = (R, t), the rotation
-// R^T w and the translation R^T (v + w x t) (up to a sign that the covariance does not see). Returns
-// d(pixel)/d(delta) diag(s_t, s_r).
-Eigen::Matrix<double, 2, 6> FlangePoseErrorRows(const Rigid3& cam_from_base, const Rigid3& flange_from_cam,
-                                                const Eigen::Vector3d& p_base, const Matrix23& jd, double translation_sd,
-                                                double rotation_sd) {
-  const Eigen::Matrix3d rt = flange_from_cam.rotation.transpose();
-  Eigen::Matrix<double, 6, 6> a = Eigen::Matrix<double, 6, 6>::Zero();
-  a.topLeftCorner<3, 3>() = rt * translation_sd;
-  a.topRightCorner<3, 3>() = -rt * Skew<double>(flange_from_cam.translation) * rotation_sd;
-  a.bottomRightCorner<3, 3>() = rt * rotation_sd;
-  return PoseErrorRows(cam_from_base, p_base, jd, 1.0, 1.0) * a;
-}
-
-// The camera in the frame of the flange whose recorded pose carries the noise: points_from_cam of the flange's
-// points (eye-to-hand), or base_from_flange^-1 * base_from_cam (eye-in-hand).
-Rigid3 FlangeFromCamAt(const PredictionModel& model, const PoseFrames& frames, const PoseObservation& pose) {
-  const Rigid3 points_from_cam = frames.cam_from_base.Inverse();
-  if (model.robot.mount == CameraMount::kEyeToHand || !pose.base_from_flange) return points_from_cam;
-  return pose.base_from_flange->Inverse() * points_from_cam;
-}
-
 // The square root of the parameters' covariance (Sigma = L L^T; semi-definite allowed).
 Eigen::MatrixXd CovarianceRoot(const Eigen::MatrixXd& covariance) {
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(0.5 * (covariance + covariance.transpose()));
@@ -319,17 +440,32 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
   }
   const Projector projector(model);
   report.prediction_uncertainty = projector.with_parameters();
-  std::map<int, DotInformation> info = IdentificationInformation(obs, projector, dots_in_base, excluded);
+  std::vector<Eigen::MatrixXd> hte;
+  Eigen::MatrixXd hth;
+  std::map<int, DotInformation> info =
+      IdentificationInformation(obs, model, projector, dots_in_base, excluded, &hte, &hth);
   const int nt = projector.num_theta();
-  const Eigen::MatrixXd theta_root = nt > 0 ? CovarianceRoot(model.covariance) : Eigen::MatrixXd();
+  // U's columns: the parameters' (their pixel part when the identification images' pose errors enter
+  // explicitly), 6 per verification image (its own pose error, zero outside its rows), 6 per identification
+  // image (its pose error as carried into the parameters and dots), one per held parameter with a prior (its
+  // error, directly and as carried into the parameters and dots).
+  const bool carried = CarriesIdentificationPoseErrors(model);
+  const Eigen::MatrixXd dtheta = carried ? PoseEffects(model, noise_px, nt, hte, &info) : Eigen::MatrixXd();
+  const Eigen::MatrixXd dtheta_held = HeldEffects(model, noise_px, nt, hth, &info);
+  const int nh = static_cast<int>(model.held_prior.size());
+  const bool split = carried && model.covariance_pose_part.rows() == nt && model.covariance_pose_part.cols() == nt;
+  const Eigen::MatrixXd theta_root =
+      nt > 0 ? CovarianceRoot(split ? Eigen::MatrixXd(model.covariance - model.covariance_pose_part) : model.covariance)
+             : Eigen::MatrixXd();
   int num_dots = 0;
   for (auto& [id, d] : info) {
     if (d.usable) d.column = num_dots++;
   }
-  // With a pose error, 6 more columns of U per verification image, zero outside its rows.
   const std::vector<int> verification = obs.PosesWithRole(PoseRole::kVerification);
-  const bool pose_error = model.pose_translation_m > 0 || model.pose_rotation_rad > 0;
-  const int width = nt + (pose_error ? 6 * static_cast<int>(verification.size()) : 0);
+  const bool pose_error = HasPoseError(model);
+  const int identification_column = nt + (pose_error ? 6 * static_cast<int>(verification.size()) : 0);
+  const int held_column = identification_column + static_cast<int>(dtheta.cols());
+  const int width = held_column + nh;
   Residuals residuals;
   residuals.num_theta = width;
   std::vector<int> first_row_of_pose;  // per report.poses entry, and one past the end
@@ -337,14 +473,15 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
   for (size_t index = 0; index < verification.size(); ++index) {
     const PoseObservation& pose = obs.poses[verification[index]];
     const PoseFrames frames = projector.Frames(pose);
-    const Rigid3 flange_from_cam = model.pose_error_at_flange ? FlangeFromCamAt(model, frames, pose) : Rigid3();
+    const Eigen::Matrix<double, 6, 6> pose_root =
+        pose_error ? PoseErrorRootAt(model, frames, pose) : Eigen::Matrix<double, 6, 6>::Zero();
     const int first = static_cast<int>(residuals.rows.size());
     for (const auto& [id, pixel] : pose.dots_px) {
       const auto d = info.find(id);
       Eigen::Vector2d uv;
       Matrix23 jd;
-      Eigen::MatrixXd jt;
-      if (d == info.end() || !d->second.usable || !projector.Project(frames, dots_in_base.at(id), &uv, &jd, &jt)) {
+      Eigen::MatrixXd jt, jh;
+      if (d == info.end() || !d->second.usable || !projector.Project(frames, dots_in_base.at(id), &uv, &jd, &jt, &jh)) {
         ++report.num_not_predicted;
         continue;
       }
@@ -354,13 +491,17 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
       if (width > 0) {
         g.setZero();
         if (nt > 0) g.leftCols(nt).noalias() = (jt - jd * d->second.k) * theta_root;
-        if (pose_error && model.pose_error_at_flange) {
+        if (pose_error) {
           g.middleCols<6>(nt + 6 * static_cast<int>(index)) =
-              FlangePoseErrorRows(frames.cam_from_base, flange_from_cam, dots_in_base.at(id), jd,
-                                  model.pose_translation_m, model.pose_rotation_rad);
-        } else if (pose_error) {
-          g.middleCols<6>(nt + 6 * static_cast<int>(index)) =
-              PoseErrorRows(frames.cam_from_base, dots_in_base.at(id), jd, model.pose_translation_m, model.pose_rotation_rad);
+              PoseErrorRows(frames.cam_from_base, dots_in_base.at(id), jd) * pose_root;
+        }
+        if (dtheta.cols() > 0) {
+          g.middleCols(identification_column, dtheta.cols()).noalias() = jd * d->second.pose_effect;
+          if (nt > 0) g.middleCols(identification_column, dtheta.cols()).noalias() += jt * dtheta;
+        }
+        if (nh > 0) {
+          g.rightCols(nh) = jh - jd * d->second.held_effect;
+          if (nt > 0) g.rightCols(nh).noalias() -= jt * dtheta_held;
         }
         for (int i = 0; i < 2; ++i) {
           for (int c = 0; c < width; ++c) residuals.g.push_back(g(i, c));
@@ -421,37 +562,6 @@ std::map<int, Eigen::Vector3d> TriangulateIdentificationDots(const ObservationSe
     if (t.ok) dots[id] = t.point;
   }
   return dots;
-}
-
-namespace {
-
-// P(F > f) for F ~ F(d1, d2) (d2 = 0: infinite, i.e. chi-square(d1) / d1), Paulson's approximation:
-// z = ((1 - b) f^(1/3) - (1 - a)) / sqrt(b f^(2/3) + a), a = 2 / (9 d1), b = 2 / (9 d2), standard normal.
-double FUpperTail(double f, int d1, int d2) {
-  const double a = 2.0 / (9.0 * d1), b = d2 > 0 ? 2.0 / (9.0 * d2) : 0.0;
-  const double c = std::cbrt(f);
-  const double z = ((1 - b) * c - (1 - a)) / std::sqrt(b * c * c + a);
-  return 0.5 * std::erfc(z / std::sqrt(2.0));
-}
-
-}  // namespace
-
-double ChiSquareQuantile(double p, int dof, int noise_dof) {
-  if (dof <= 0 || noise_dof < 0 || !(p > 0 && p < 1)) return NAN;
-  // Bisection on the decreasing upper tail, in f = x / dof.
-  double lo = 0, hi = 1;
-  while (FUpperTail(hi, dof, noise_dof) > 1 - p && hi < 1e12) hi *= 2;
-  for (int iteration = 0; iteration < 200 && hi - lo > 1e-13 * hi; ++iteration) {
-    const double mid = 0.5 * (lo + hi);
-    (FUpperTail(mid, dof, noise_dof) > 1 - p ? lo : hi) = mid;
-  }
-  return dof * 0.5 * (lo + hi);
-}
-
-double ChiSquareUpperTail(double x, int dof, int noise_dof) {
-  if (dof <= 0 || noise_dof < 0 || !std::isfinite(x)) return NAN;
-  if (x <= 0) return 1.0;
-  return FUpperTail(x / dof, dof, noise_dof);
 }
 
 }  // namespace selfcal::calibration

@@ -8,6 +8,8 @@
 
 #include <Eigen/Core>
 
+#include "kinematics/robot_model.h"
+
 namespace selfcal {
 
 inline constexpr double kBarelyMovingRad = 0.0349065850398866;  // 2 deg
@@ -25,5 +27,12 @@ std::vector<BarelyMovingJoint> BarelyMovingJoints(const std::vector<Eigen::Vecto
 // The one sentence every command says of it: "joint 3 barely moves (0.5 deg over `poses`): the parameters
 // beside it are hard to tell apart" (degrees to one decimal).
 std::string BarelyMovesSentence(const BarelyMovingJoint& joint, const std::string& poses);
+
+// How each joint's reading moves the camera against the unknown points (PointsFromCam) at joints `q`:
+// column k is the small motion e = (v, omega) of the camera in its own frame (p_cam -> p_cam + omega x p_cam
+// + v; m and rad) per unit (rad) of joint k, by central differences. A reading's error dq moves the camera by
+// A dq: the shape of a joint set's per-image pose error (bundle/error_model.h).
+Eigen::Matrix<double, 6, Eigen::Dynamic> CameraMotionPerJoint(const RobotModel& robot, const Eigen::VectorXd& rho,
+                                                              const Eigen::VectorXd& q);
 
 }  // namespace selfcal

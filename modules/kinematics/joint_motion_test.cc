@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "geometry/rigid3.h"
+#include "support/test_robots.h"
 
 namespace selfcal {
 namespace {
@@ -29,6 +30,28 @@ TEST(JointMotion, OneSentenceForEveryCommand) {
   EXPECT_EQ(BarelyMovesSentence({3, DegToRad(0.5)}, "the identification poses"),
             "joint 3 barely moves (0.5 deg over the identification poses): the parameters beside it are hard to tell "
             "apart");
+}
+
+// A small change dq of the readings moves a point in the camera's frame by SmallMotionJacobian(p_cam) A dq, in
+// both mounts (eye-to-hand: the points ride on the flange, the camera is fixed); the second-order remainder
+// at |dq| ~ 1e-4 rad is ~1e-8 of a metre-sized lever, far below the tolerance.
+TEST(JointMotion, CameraMotionPerJointIsTheFirstOrderMotionOfThePoints) {
+  RobotModel eye_to_hand = testing::Puma560();
+  eye_to_hand.mount = CameraMount::kEyeToHand;
+  eye_to_hand.base_from_cam = Rigid3(RotZ(0.3) * RotX(2.8), Eigen::Vector3d(0.9, -0.1, 0.6));
+  for (const RobotModel& robot : {testing::Puma560(), eye_to_hand}) {
+    const Eigen::VectorXd rho = KinematicParameters::Nominal(robot);
+    const Eigen::VectorXd q = (Eigen::VectorXd(6) << 0.1, -0.4, 0.5, 0.7, -0.3, 0.2).finished();
+    const Eigen::VectorXd dq = (Eigen::VectorXd(6) << 1e-4, -2e-4, 1.5e-4, -1e-4, 2e-4, 1e-4).finished();
+    const Eigen::Matrix<double, 6, Eigen::Dynamic> a = CameraMotionPerJoint(robot, rho, q);
+    ASSERT_EQ(a.cols(), 6);
+    const Eigen::Vector3d p(0.4, 0.2, 0.3);  // in the points' frame
+    const Eigen::Vector3d before = PointsFromCam(robot, rho, q).Inverse() * p;
+    const Eigen::Vector3d after = PointsFromCam(robot, rho, q + dq).Inverse() * p;
+    const Eigen::Vector3d predicted = SmallMotionJacobian(before) * (a * dq);
+    EXPECT_GT(predicted.norm(), 2e-5);
+    EXPECT_LT((after - before - predicted).norm(), 1e-3 * predicted.norm() + 1e-9);
+  }
 }
 
 }  // namespace

@@ -115,9 +115,11 @@ json ErrorModelJson(const bundle::ErrorModel& m) {
           {"pixel_noise_px", Finite(m.pixel_px)},
           {"pose_translation_m", Finite(m.pose_translation_m)},
           {"pose_rotation_rad", Finite(m.pose_rotation_rad)},
+          {"joint_rad", Finite(m.joint_rad)},
           {"redundancy", {{"pixel", Finite(m.pixel_redundancy)},
                           {"translation", Finite(m.translation_redundancy)},
-                          {"rotation", Finite(m.rotation_redundancy)}}},
+                          {"rotation", Finite(m.rotation_redundancy)},
+                          {"joint", Finite(m.joint_redundancy)}}},
           {"iterations", m.iterations}};
 }
 

@@ -172,7 +172,9 @@ void PrintBundleSummary(const calibration::BundleStageReport& stage, bool flange
   if (b.error_model.estimated) {
     out << "  error model from the residuals (the sigmas' model): pixel noise " << std::setprecision(3)
         << b.error_model.pixel_px << " px, camera pose per image " << b.error_model.pose_translation_m * kMm << " mm / "
-        << RadToDeg(b.error_model.pose_rotation_rad) << " deg per axis\n";
+        << RadToDeg(b.error_model.pose_rotation_rad) << " deg per axis";
+    if (b.error_model.joint_rad >= 0) out << ", joint readings " << RadToDeg(b.error_model.joint_rad) << " deg";
+    out << "\n";
   }
   PrintLensSummary(b, out);
   if (stage.verification.num_ok > 0) {
