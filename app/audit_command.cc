@@ -67,7 +67,7 @@ Command AddAuditCommand(CLI::App& app) {
   auto args = std::make_shared<AuditArgs>();
   CLI::App* cmd = app.add_subcommand(
       "audit", "Score a simulated session's dot identities against the simulator's hidden truth (reads only)");
-  cmd->add_option("session", args->session, "Session directory recorded with --camera sim (--robot sim or any other robot)")->required();
+  cmd->add_option("session", args->session, "Session directory recorded with --camera sim (--backend sim or any other robot)")->required();
   AddOutputOption(cmd, "--json", &args->json, OutputKind::kFile, "Write the audit as JSON to this file (outside the session)");
   cmd->add_option("--gate-px", args->gate_px, "A name farther than this from its dot's true projection is wrong")
       ->check(CLI::Range(0.1, 50.0));

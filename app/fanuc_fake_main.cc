@@ -1,5 +1,5 @@
 // selfcal-fanuc-fake: a loopback fake of a FANUC controller's Remote Motion Interface (robot/fanuc_fake.h)
-// on 127.0.0.1, with faults on request. For testing and rehearsing `selfcal run --robot fanuc` without an
+// on 127.0.0.1, with faults on request. For testing and rehearsing `selfcal run --backend fanuc` without an
 // arm; not a simulator of a FANUC's motion or safety system (docs/fanuc.md). Prints its connect port on
 // the first line of stdout, then every packet it receives; SIGINT and SIGTERM stop it (exit 0) after a last
 // line with the motion instructions and aborts counted.

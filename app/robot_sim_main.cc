@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   app.add_option("--start-at-plan", args.start_at_plan,
                  "Start at the first pose of this trajectory file (the plan a rehearsal runs: `selfcal run "
-                 "--robot network --camera sim`)")
+                 "--backend network --camera sim`)")
       ->excludes("--initial-joints-deg");
   app.add_option("--serial", args.serial, "Serial reported in HELLO (default sim-<seed>)");
   app.add_option("--calibration-id", args.calibration_id, "Calibration id reported in HELLO");

@@ -1,9 +1,13 @@
 // The command line of `selfcal run` (RunSettings, session_command.h): every value checked here, before
 // anything is read, connected or written.
+#include <algorithm>
+#include <iostream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "app/camera_options.h"
+#include "app/cli_util.h"
 #include "app/commands.h"
 #include "app/identify_options.h"
 #include "app/output_options.h"
@@ -12,8 +16,38 @@
 
 namespace selfcal::app {
 
+namespace {
+
+const std::vector<std::string> kRobotBackends = {"sim", "network", "manual", "ur", "fanuc"};
+
+// `run --robot X`: a robot config as in every other command, or, for a backend name, --backend's old spelling
+// (said on stderr). Refused when it repeats what --backend or --robot-config already says.
+Status ResolveRobotWord(const std::string& word, bool backend_given, bool config_given, RunSettings* a) {
+  if (word.empty()) return Status::Ok();
+  const bool is_backend = std::find(kRobotBackends.begin(), kRobotBackends.end(), word) != kRobotBackends.end();
+  if (is_backend && backend_given) {
+    return Status::Error(ErrorCode::kInvalidInput, "--robot " + word + " and --backend " + a->robot_backend +
+                                                       " both name the backend: give --backend only");
+  }
+  if (!is_backend && config_given) {
+    return Status::Error(ErrorCode::kInvalidInput, "--robot " + word + " and --robot-config " + a->robot_config +
+                                                       " both name the robot config: give one");
+  }
+  if (is_backend) {
+    std::cerr << "note: --robot " << word << " is the old spelling of --backend " << word
+              << " (--robot names the robot config, as in the other commands)\n";
+    a->robot_backend = word;
+  } else {
+    a->robot_config = word;
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 Command AddRunCommand(CLI::App& app) {
   auto a = std::make_shared<RunSettings>();
+  auto robot_word = std::make_shared<std::string>();
   CLI::App* cmd = app.add_subcommand("run", "Drive a robot through a plan and record a session directory");
   AddOutputOption(cmd, "--session", &a->session, OutputKind::kSessionDirectory,
                   "Session directory (created, never overwritten, never inside another session)")->required();
@@ -34,13 +68,17 @@ Command AddRunCommand(CLI::App& app) {
                   "--resume: visit poses skipped for too few dots, not settled, a bad frame or reading again, at "
                   "most N more times each (0: never)")
       ->check(CLI::Range(0, 100));
-  cmd->add_option("--robot-config", a->robot_config, "Nominal robot config");
+  CLI::Option* config = cmd->add_option("--robot-config", a->robot_config, "Nominal robot config (the same as --robot PATH)");
   AddConfigurationOption(cmd, &a->configuration);
   cmd->add_option("--plan", a->plan, "Plan (trajectory file); default: config/trajectories/initial_<robot name>.yaml");
   cmd->add_option("--setup", a->setup,
-                  "Camera, yardstick and checks (docs/session-format.md); refused with --robot sim, whose cell makes "
-                  "its own");
-  cmd->add_option("--robot", a->robot_backend, "Robot backend")->check(CLI::IsMember({"sim", "network", "manual", "ur", "fanuc"}));
+                  "Camera, yardstick and checks (docs/session-format.md); refused with --backend sim, whose cell "
+                  "makes its own");
+  CLI::Option* backend = cmd->add_option("--backend", a->robot_backend, "Robot backend (default sim)")
+                             ->check(CLI::IsMember(kRobotBackends));
+  cmd->add_option("--robot", *robot_word,
+                  "Nominal robot config, as in the other commands; a backend name here (sim, network, manual, ur, "
+                  "fanuc) is --backend's old spelling, still taken with a note");
   cmd->add_option("--address", a->address,
                   "network backend: HOST:PORT (docs/robot-protocol.md); ur: the controller's HOST "
                   "(docs/universal-robots.md); fanuc: HOST[:PORT], PORT the RMI connect port (default 16001, "
@@ -83,7 +121,11 @@ Command AddRunCommand(CLI::App& app) {
   fault("--fault-stale-read", &a->fault_stale_reads, "joint reading #n is stale");
   fault("--fault-nan-read", &a->fault_nan_reads, "joint reading #n has a NaN");
   fault("--fault-short-read", &a->fault_short_reads, "joint reading #n misses a joint");
-  return [a]() { return RunFromSettings(*a); };
+  return [a, robot_word, backend, config]() {
+    const Status resolved = ResolveRobotWord(*robot_word, backend->count() > 0, config->count() > 0, a.get());
+    if (!resolved.ok()) return Fail(resolved);
+    return RunFromSettings(*a);
+  };
 }
 
 }  // namespace selfcal::app

@@ -169,11 +169,11 @@ Status CheckRunSettings(RunSettings* a) {
   const bool sim_camera = a->camera_backend == "sim";  // with any robot: it renders the joints the robot reports
   if (sim_robot && !sim_camera) {
     return Status::Error(ErrorCode::kInvalidInput,
-                         "--robot sim needs --camera sim: the simulated arm moves only in the simulated cell");
+                         "--backend sim needs --camera sim: the simulated arm moves only in the simulated cell");
   }
   if (sim_camera && !a->setup.empty()) {
     return Status::Error(ErrorCode::kInvalidInput,
-                         "--setup " + a->setup + " does not apply to --camera sim (nor --robot sim): the simulated "
+                         "--setup " + a->setup + " does not apply to --camera sim (nor --backend sim): the simulated "
                          "cell makes its own setup (camera, yardstick, checks); leave --setup out, or use a real camera");
   }
   if (!sim_camera && a->setup.empty()) {

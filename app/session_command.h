@@ -29,7 +29,7 @@ struct RunSettings {
   std::string setup;  // required unless --camera sim
   std::string robot_backend = "sim";
   std::string address = "127.0.0.1:5700";
-  std::vector<int> ur_ports;  // --robot ur: RTDE, secondary, Dashboard ports; empty: a controller's
+  std::vector<int> ur_ports;  // --backend ur: RTDE, secondary, Dashboard ports; empty: a controller's
   std::string camera_backend = "sim";
   std::string device = "/dev/video0";
   CameraMode camera_mode;  // --camera-width-px, ..., and aravis' camera id

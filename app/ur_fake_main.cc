@@ -1,6 +1,6 @@
 // selfcal-ur-fake: a loopback fake of a Universal Robots controller (robot/ur_fake.h): RTDE, the secondary
 // interface and the Dashboard server on 127.0.0.1, with faults on request. For testing and rehearsing
-// `selfcal run --robot ur` without an arm; not a simulator of a UR's motion or safety system
+// `selfcal run --backend ur` without an arm; not a simulator of a UR's motion or safety system
 // (docs/universal-robots.md). Prints its three ports on the first line of stdout, then every line it
 // receives; SIGINT and SIGTERM stop it (exit 0) after a last line with the motion and stop commands counted.
 #include <atomic>

@@ -60,8 +60,8 @@ Result<std::unique_ptr<robot::Robot>> MakeVendorRobot(const RunSettings& a, cons
   if (a.address == RunSettings().address) {
     return Status::Error(ErrorCode::kInvalidInput,
                          a.robot_backend == "ur"
-                             ? "--robot ur needs --address HOST, the controller's (docs/universal-robots.md)"
-                             : "--robot fanuc needs --address HOST[:PORT], the controller's (docs/fanuc.md)");
+                             ? "--backend ur needs --address HOST, the controller's (docs/universal-robots.md)"
+                             : "--backend fanuc needs --address HOST[:PORT], the controller's (docs/fanuc.md)");
   }
   if (a.robot_backend == "ur") {
     Result<robot::UrRobotOptions> ur = robot::UrRunOptions(a.address, a.ur_ports, position_limits);
@@ -69,7 +69,7 @@ Result<std::unique_ptr<robot::Robot>> MakeVendorRobot(const RunSettings& a, cons
     ur.value().log = log;
     return std::unique_ptr<robot::Robot>(std::make_unique<robot::UrRobot>(a.address, *ur));
   }
-  if (!a.ur_ports.empty()) return Status::Error(ErrorCode::kInvalidInput, "--ur-ports applies to --robot ur only");
+  if (!a.ur_ports.empty()) return Status::Error(ErrorCode::kInvalidInput, "--ur-ports applies to --backend ur only");
   std::string host;
   Result<robot::FanucRobotOptions> fanuc = robot::FanucRunOptions(a.address, position_limits, &host);
   if (!fanuc.ok()) return fanuc.status();

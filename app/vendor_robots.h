@@ -1,5 +1,5 @@
-// The robots driven through a vendor's own interface, for `selfcal run`: --robot ur (Universal Robots'
-// RTDE, secondary interface and Dashboard server, docs/universal-robots.md) and --robot fanuc (FANUC's
+// The robots driven through a vendor's own interface, for `selfcal run`: --backend ur (Universal Robots'
+// RTDE, secondary interface and Dashboard server, docs/universal-robots.md) and --backend fanuc (FANUC's
 // Remote Motion Interface, docs/fanuc.md); the confirmation, limits and port every run backend shares.
 #pragma once
 

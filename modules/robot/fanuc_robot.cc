@@ -52,7 +52,7 @@ Result<FanucRobotOptions> FanucRunOptions(const std::string& address, JointLimit
     options.connect_port = digits ? std::stoi(port) : -1;
   }
   if (host->empty() || options.connect_port < 1 || options.connect_port > 65535) {
-    return Status::Error(ErrorCode::kInvalidInput, "--address \"" + address + "\": --robot fanuc takes the controller's "
+    return Status::Error(ErrorCode::kInvalidInput, "--address \"" + address + "\": --backend fanuc takes the controller's "
                                                    "HOST or HOST:PORT (PORT the RMI connect port, 16001 by default)");
   }
   position_limits.max_velocity_rad_s =

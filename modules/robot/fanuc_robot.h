@@ -1,4 +1,4 @@
-// The FANUC backend (`selfcal run --robot fanuc --address HOST[:PORT]`, docs/fanuc.md): a `Robot` that
+// The FANUC backend (`selfcal run --backend fanuc --address HOST[:PORT]`, docs/fanuc.md): a `Robot` that
 // speaks FANUC's Remote Motion Interface (fanuc_protocol.h), the controller's RMI option, no program of
 // ours on the robot's side. One TCP connection: FRC_Connect on the connect port (16001) names the port
 // of the session; on it every call is a command and its answer (FRC_GetStatus, FRC_ReadJointAngles,
@@ -45,7 +45,7 @@ struct FanucRobotOptions {
 // least the time it takes; the velocity scaling is the percentage sent.
 inline constexpr double kFanucJointSpeedLimit_rad_s = 1.0471975511965976;
 
-// The options of `selfcal run --robot fanuc`: `address` HOST or HOST:PORT (the connect port, 16001 by
+// The options of `selfcal run --backend fanuc`: `address` HOST or HOST:PORT (the connect port, 16001 by
 // default; another for the loopback fake), *host receives HOST; the robot config's position limits with
 // kFanucJointSpeedLimit_rad_s. kInvalidInput naming the option.
 Result<FanucRobotOptions> FanucRunOptions(const std::string& address, JointLimits position_limits, std::string* host);

@@ -51,7 +51,7 @@ Result<UrRobotOptions> UrRunOptions(const std::string& host, const std::vector<i
   const size_t colon = host.find(':');
   const bool host_port = colon != std::string::npos && host.find(':', colon + 1) == std::string::npos;
   if (host.empty() || host_port) {
-    return Status::Error(ErrorCode::kInvalidInput, "--address \"" + host + "\": --robot ur takes the controller's HOST "
+    return Status::Error(ErrorCode::kInvalidInput, "--address \"" + host + "\": --backend ur takes the controller's HOST "
                                                    "alone (its ports are UR's; --ur-ports for the loopback fake)");
   }
   if (!ports.empty() && ports.size() != 3) {

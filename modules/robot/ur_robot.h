@@ -1,4 +1,4 @@
-// The Universal Robots backend (`selfcal run --robot ur --address HOST`, docs/universal-robots.md): a
+// The Universal Robots backend (`selfcal run --backend ur --address HOST`, docs/universal-robots.md): a
 // `Robot` that speaks a UR controller's own interfaces (ur_protocol.h), no program on the robot's side:
 //   - RTDE (30004): the joints, joint speeds, runtime state, safety and robot status bits, streamed at
 //     rtde_frequency_hz and read as it comes by a thread of this object; every reading is the newest
@@ -58,7 +58,7 @@ struct UrRobotOptions {
 // datasheets (the base and shoulder of the larger arms); the velocity scaling is a fraction of it.
 inline constexpr double kUrJointSpeedLimit_rad_s = 2.0943951023931953;
 
-// The options of `selfcal run --robot ur`: `host` a host name or address (empty, or HOST:PORT, refused:
+// The options of `selfcal run --backend ur`: `host` a host name or address (empty, or HOST:PORT, refused:
 // the ports are UR's), `ports` none (a controller's) or the RTDE, secondary and Dashboard ports (the
 // loopback fake's), the robot config's position limits with kUrJointSpeedLimit_rad_s. kInvalidInput
 // naming the option.

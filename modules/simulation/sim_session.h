@@ -14,9 +14,9 @@
 // A simulated cell for sessions: the simulated world (hidden robot errors, hand-eye, f_x, spaced dots),
 // a SimulatedRobot moving the true arm on a simulated clock, and the rendered SimulatedCamera looking
 // through the true kinematics at the arm's true joints at every exposure, so that RunSession runs on it
-// exactly as on hardware (issue 6; `selfcal simulate` and `selfcal run --robot sim --camera sim`).
+// exactly as on hardware (issue 6; `selfcal simulate` and `selfcal run --backend sim --camera sim`).
 //
-// With any other robot (`selfcal run --robot network|manual|... --camera sim`, a rehearsal without a
+// With any other robot (`selfcal run --backend network|manual|... --camera sim`, a rehearsal without a
 // camera), FollowReportedJoints makes the same cell's camera follow that robot instead: each frame renders
 // the cell's world at the joints the robot reports when the frame is delivered, in real time.
 //

@@ -151,7 +151,7 @@ TEST(AravisCli, RunHaltsWhenTheGigECameraVanishesAndResumesWhenItIsBack) {
   ASSERT_GT(port, 0) << "selfcal-robot-sim did not print its port";
   pid_t camera = Spawn({kFakeGvCamera, "-i", "127.0.0.1"});
   ASSERT_TRUE(WaitForFakeCamera()) << kFakeGvCamera << " did not take GVCP's port";
-  const std::string run = "run --session " + session + " --plan " + plan + " --robot network --address 127.0.0.1:" +
+  const std::string run = "run --session " + session + " --plan " + plan + " --backend network --address 127.0.0.1:" +
                           std::to_string(port) + " --camera aravis:127.0.0.1 --setup " + setup + " --live-view off";
   std::string output;
   std::atomic<int> code{-1};

@@ -51,7 +51,7 @@ class AuditSessionTest : public ::testing::Test {
     fs::remove_all(*root_);
     fs::create_directories(*root_);
     WriteShortPlan(*root_ / "plan.yaml", 6, 4);
-    run_code_ = RunSelfcal("run --robot sim --camera sim --seed 2 --plan " + (*root_ / "plan.yaml").string() +
+    run_code_ = RunSelfcal("run --backend sim --camera sim --seed 2 --plan " + (*root_ / "plan.yaml").string() +
                                " --session " + (*root_ / "s").string(),
                            &run_output_);
   }

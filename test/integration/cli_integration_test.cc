@@ -298,7 +298,7 @@ TEST(Cli, PlanCheckAndRunPreflightAgreeOnEveryShippedTrajectory) {
       const std::string config = "config/robots/" + robot + ".yaml";
       std::string check_out, run_out;
       const int check = RunSelfcal("plan --robot " + config + " --check " + e.path().string(), &check_out);
-      const int run = RunSelfcal("run --robot sim --camera sim --dry-run --robot-config " + config + " --session " +
+      const int run = RunSelfcal("run --backend sim --camera sim --dry-run --robot-config " + config + " --session " +
                                      (dir / (name + "-" + robot)).string() + " --plan " + e.path().string(),
                                  &run_out);
       EXPECT_EQ(check, run) << name << " on " << robot << "\n" << check_out << "\n" << run_out;
@@ -385,6 +385,27 @@ TEST(CliSession, DryRunPrintsThePreviewAndCreatesNothing) {  // R1, F8
   EXPECT_TRUE(fs::exists(fs::path(session) / "session.json"));
 }
 
+// `run --robot` means the robot config, as in every other command; a backend name there is --backend's old
+// spelling, still taken with a note; said twice (with --backend or --robot-config) it is refused before anything.
+TEST(CliSession, RunRobotIsTheConfigAndTheOldBackendSpellingIsStillTaken) {
+  const fs::path dir = FreshDir("run_robot_word");
+  const std::string session = (dir / "s").string();
+  const std::string puma = std::string(SELFCAL_SOURCE_DIR) + "/config/robots/puma560.yaml";
+  std::string output;
+  ASSERT_EQ(RunSelfcal("run --dry-run --robot sim --camera sim --session " + session + " --seed 3", &output), 0) << output;
+  EXPECT_NE(output.find("--robot sim is the old spelling of --backend sim"), std::string::npos) << output;
+  EXPECT_NE(output.find("dry run: nothing moved"), std::string::npos) << output;
+  ASSERT_EQ(RunSelfcal("run --dry-run --robot " + puma + " --backend sim --camera sim --session " + session + " --seed 3",
+                       &output), 0) << output;
+  EXPECT_EQ(output.find("old spelling"), std::string::npos) << output;
+  EXPECT_EQ(RunSelfcal("run --dry-run --robot sim --backend network --session " + session, &output), 2) << output;
+  EXPECT_NE(output.find("both name the backend"), std::string::npos) << output;
+  EXPECT_EQ(RunSelfcal("run --dry-run --robot " + puma + " --robot-config " + puma + " --session " + session, &output), 2)
+      << output;
+  EXPECT_NE(output.find("both name the robot config"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(session));
+}
+
 // selfcal name-dots on a recorded frame: the annotated PNG, a setup that `run --setup` accepts with the
 // reference identifier, and a yardstick id that was not detected refused naming it.
 TEST(CliNameDots, NamesARecordedFrameWritesThePngAndASetupThatRunAccepts) {
@@ -434,7 +455,7 @@ TEST(CliNameDots, NamesARecordedFrameWritesThePngAndASetupThatRunAccepts) {
   // run takes it with the reference identifier; it only stops at the camera this machine does not have.
   const fs::path joints = dir / "joints.txt";
   std::ofstream(joints) << "0 0 0 0 0 0\n";
-  const std::string run = "run --robot manual --camera v4l2 --device " + (dir / "no-video").string() + " --setup " +
+  const std::string run = "run --backend manual --camera v4l2 --device " + (dir / "no-video").string() + " --setup " +
                           setup + " --identify reference --session " + (dir / "s").string();
   EXPECT_EQ(RunSelfcal(run + " < " + joints.string(), &output), 4) << output;
   EXPECT_NE(output.find("opening the camera"), std::string::npos) << output;
@@ -442,7 +463,7 @@ TEST(CliNameDots, NamesARecordedFrameWritesThePngAndASetupThatRunAccepts) {
   nlohmann::json bare = written;
   bare.erase("reference_dots");
   std::ofstream(dir / "bare.json") << bare.dump(2);
-  EXPECT_EQ(RunSelfcal("run --robot manual --camera v4l2 --setup " + (dir / "bare.json").string() +
+  EXPECT_EQ(RunSelfcal("run --backend manual --camera v4l2 --setup " + (dir / "bare.json").string() +
                            " --identify reference --session " + (dir / "s2").string() + " < " + joints.string(), &output),
             2)
       << output;

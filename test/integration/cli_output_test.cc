@@ -193,7 +193,7 @@ TEST(CliJson, RunCountsTheSamplesOfTheSessionItWrote) {
   const fs::path dir = FreshDir("cli_json", "run");
   WriteShortPlan(dir / "plan.yaml", 6, 4);
   const fs::path session = dir / "session";
-  const Output r = RunSplit("run --robot sim --camera sim --seed 2 --json --plan " + (dir / "plan.yaml").string() +
+  const Output r = RunSplit("run --backend sim --camera sim --seed 2 --json --plan " + (dir / "plan.yaml").string() +
                                 " --session " + session.string(),
                             dir);
   ASSERT_EQ(r.code, 0) << r.err;

@@ -221,7 +221,7 @@ TEST(CompensateChain, RecordedJointsOutsideTheLimitsAreCalibratedWithAWarningBut
       << output;
   EXPECT_TRUE(fs::exists(dir / "cal" / "calibrated_model.yaml"));
   // run refuses the same poses as a plan on this robot.
-  const int run = testing::RunSelfcal("run --robot sim --camera sim --dry-run --robot-config " + narrow + " --session " +
+  const int run = testing::RunSelfcal("run --backend sim --camera sim --dry-run --robot-config " + narrow + " --session " +
                                           (dir / "session").string() + " --plan " + kSource +
                                           "/config/trajectories/initial_puma560.yaml",
                                       &output);

@@ -1,6 +1,6 @@
 // The simulated eye-to-hand cell end to end, as a user runs it (docs/planning.md, docs/session-format.md):
 // `selfcal plan --configuration eye_to_hand` chooses poses that keep the flange's plate in the fixed
-// camera's view, `selfcal run --robot sim --camera sim --configuration eye_to_hand` records every pose with
+// camera's view, `selfcal run --backend sim --camera sim --configuration eye_to_hand` records every pose with
 // every dot named, `selfcal audit` scores the names against the hidden truth (none wrong), the session
 // records its configuration; `run --resume` in the other configuration is refused with nothing written.
 #include <unistd.h>
@@ -32,7 +32,7 @@ class EyeToHandSessionTest : public ::testing::Test {
                                 (*root_ / "plan.yaml").string(),
                             &plan_output_);
     if (plan_code_ != 0) return;
-    run_code_ = RunSelfcal("run --robot sim --camera sim --configuration eye_to_hand --live-view off --seed 3 --plan " +
+    run_code_ = RunSelfcal("run --backend sim --camera sim --configuration eye_to_hand --live-view off --seed 3 --plan " +
                                (*root_ / "plan.yaml").string() + " --session " + (*root_ / "s").string(),
                            &run_output_);
   }
@@ -90,7 +90,7 @@ TEST_F(EyeToHandSessionTest, ResumeInTheOtherConfigurationIsRefusedAndChangesNot
   const fs::path session = *root_ / "s";
   const auto before = testing::TreeState(session);
   std::string output;
-  const int code = RunSelfcal("run --robot sim --camera sim --configuration eye_in_hand --live-view off --seed 3 --plan " +
+  const int code = RunSelfcal("run --backend sim --camera sim --configuration eye_in_hand --live-view off --seed 3 --plan " +
                                   (*root_ / "plan.yaml").string() + " --session " + session.string() + " --resume",
                               &output);
   EXPECT_EQ(code, 2) << output;

@@ -1,4 +1,4 @@
-// `selfcal run --robot fanuc` against the selfcal-fanuc-fake binary on loopback (docs/fanuc.md), as a user
+// `selfcal run --backend fanuc` against the selfcal-fanuc-fake binary on loopback (docs/fanuc.md), as a user
 // meets it, with the simulated camera following the joints the fake reports: a dry run shows the
 // controller's identity and sends no instruction; the whole default plan (25 poses) is recorded and
 // `calibrate` accepts it; each state a person must clear (servos off, the teach pendant enabled) refuses the
@@ -51,10 +51,10 @@ class FanucFake {
   testing::LoopbackFake process_;
 };
 
-// `run --robot fanuc --camera sim` at full speed; the operator types the serial (the address) to arm.
+// `run --backend fanuc --camera sim` at full speed; the operator types the serial (the address) to arm.
 int FanucRun(const fs::path& dir, const std::string& address, const std::string& tail, std::string* output) {
   std::ofstream(dir / "answer") << address << "\n";
-  return testing::RunSelfcalInSource("run --session " + (dir / "s").string() + " --robot fanuc --address " + address +
+  return testing::RunSelfcalInSource("run --session " + (dir / "s").string() + " --backend fanuc --address " + address +
                                          " --camera sim --velocity-scaling 1 --live-view off " + tail + " < " +
                                          (dir / "answer").string() + " 2>&1",
                                      output);
@@ -142,11 +142,11 @@ TEST(FanucFakeBinary, EachFaultDuringAMoveHaltsTheRunAndNoInstructionFollows) {
 TEST(FanucFakeBinary, BadAddressesAreUsageErrorsAndNoControllerIsAHardwareHalt) {
   const fs::path dir = testing::FreshDir("fanucfake", "address");
   std::string output;
-  EXPECT_EQ(testing::RunSelfcalInSource("run --session " + (dir / "s").string() + " --robot fanuc --camera sim 2>&1", &output), 2)
+  EXPECT_EQ(testing::RunSelfcalInSource("run --session " + (dir / "s").string() + " --backend fanuc --camera sim 2>&1", &output), 2)
       << output;
-  EXPECT_TRUE(Has(output, "--robot fanuc needs --address HOST[:PORT]")) << output;
+  EXPECT_TRUE(Has(output, "--backend fanuc needs --address HOST[:PORT]")) << output;
   EXPECT_EQ(FanucRun(dir, "127.0.0.1:99999", "", &output), 2) << output;
-  EXPECT_TRUE(Has(output, "--robot fanuc takes the controller's HOST or HOST:PORT")) << output;
+  EXPECT_TRUE(Has(output, "--backend fanuc takes the controller's HOST or HOST:PORT")) << output;
   EXPECT_EQ(FanucRun(dir, "127.0.0.1:1", "", &output), 4) << output;  // nothing listens on port 1
   EXPECT_TRUE(Has(output, "nothing was sent to the arm")) << output;
   EXPECT_FALSE(fs::exists(dir / "s"));

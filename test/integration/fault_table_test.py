@@ -5,8 +5,8 @@ scripts/reference-robot-server (docs/robot-protocol.md), on loopback, with `--ca
   fault_table_test.py ur-session SELFCAL UR_FAKE SOURCE_DIR
   fault_table_test.py ur:FAULT|reference:FAULT SELFCAL UR_FAKE SOURCE_DIR
 
-ur-session: `run --robot ur` of the default plan (25 poses, seed 1) against the UR fake (the operator types the
-  serial), then `calibrate`: accepted, and the figures equal those of the same plan and seed on `--robot sim`
+ur-session: `run --backend ur` of the default plan (25 poses, seed 1) against the UR fake (the operator types the
+  serial), then `calibrate`: accepted, and the figures equal those of the same plan and seed on `--backend sim`
   (rehearsal_test.compare_with_simulated: every free parameter and f_x within 4 combined standard deviations,
   the same free set, check distances below 0.5 mm RMS); the journal records the controller's identity (model,
   serial, factory calibration id) and session.json names the session.

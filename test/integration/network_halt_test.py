@@ -4,10 +4,10 @@
   network_halt_test.py never-settle|unconfirmed SELFCAL SELFCAL_ROBOT_SIM SELFCAL_UR_FAKE SOURCE_DIR
 
 never-settle: selfcal-robot-sim whose arm keeps moving after move 2 (`--never-settle-move 2`: every joint
-  reads 0.05 rad/s): `run --robot network --camera sim` halts at that pose (exit 4, the journal's halt names
+  reads 0.05 rad/s): `run --backend network --camera sim` halts at that pose (exit 4, the journal's halt names
   it), the controller has accepted 3 MOVEs and no other, the 2 samples before it are kept, and nothing
   says "complete".
-unconfirmed: selfcal-ur-fake (a real arm to selfcal) and `run --robot ur --camera sim` with nothing typed
+unconfirmed: selfcal-ur-fake (a real arm to selfcal) and `run --backend ur --camera sim` with nothing typed
   at the confirmation (stdin empty): exit 2 (the operator's refusal, troubleshooting.md), no session
   created, 0 motion commands at the controller.
 """

@@ -7,7 +7,7 @@ Modes (each a ctest of its own):
   protocol    raw requests: JOINTS before HELLO refused, a second client refused while the first goes on,
               bad MOVEs refused, and a connection reset (RST) by the client mid-move: the arm at rest within
               one control cycle (from the server's log), and still there for the next client.
-  session     selfcal run --robot network --camera sim: the default plan (25 poses) recorded while a second
+  session     selfcal run --backend network --camera sim: the default plan (25 poses) recorded while a second
               client is refused mid-session, calibrate accepts it.
   kill        selfcal SIGKILLed mid-move: the arm at rest within one control cycle of the server noticing,
               measured from the kill.

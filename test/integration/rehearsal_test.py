@@ -3,14 +3,14 @@
 
   rehearsal_test.py dry-run|session SELFCAL SELFCAL_ROBOT_SIM SOURCE_DIR
 
-dry-run: with selfcal-robot-sim on a free port, `run --robot network --dry-run` needs no camera: with
+dry-run: with selfcal-robot-sim on a free port, `run --backend network --dry-run` needs no camera: with
   `--camera v4l2 --device` naming no device it prints the preview and exits 0 (it used to halt opening the
   camera), and with `--camera sim` (the simulated camera following the network robot) likewise; nothing is
   created and no MOVE reaches the server.
-session: selfcal-robot-sim (started at the default plan's first pose) plus `run --robot network --camera
+session: selfcal-robot-sim (started at the default plan's first pose) plus `run --backend network --camera
   sim` records the whole default plan (25 poses), `audit` finds its identities right against the cell
   rebuilt from its inputs (the world that rendered it), `calibrate` accepts it, and its figures equal those of
-  the same plan and seed on `--robot sim` within the statistics: every free parameter and f_x within 4
+  the same plan and seed on `--backend sim` within the statistics: every free parameter and f_x within 4
   combined standard deviations (sqrt(s1^2 + s2^2): the two sessions' images carry different pixel noise,
   their frames being numbered differently), the same free set, and both check-distance RMS below 0.5 mm.
 """
@@ -135,7 +135,7 @@ def whole_session(selfcal, robot_sim, src, tmp, failures):
 
 def compare_with_simulated(selfcal, src, tmp, session, label, failures):
     """Calibrates `session` (a seed-1 run of the default plan with --camera sim on robot backend `label`) and
-    the same plan and seed on `--robot sim`: both accepted, 25 samples, the same free set, every free
+    the same plan and seed on `--backend sim`: both accepted, 25 samples, the same free set, every free
     parameter and f_x within 4 combined standard deviations, both check-distance RMS below 0.5 mm. Returns
     `session`'s report (None when a step failed)."""
     simulated = os.path.join(tmp, "simulated")

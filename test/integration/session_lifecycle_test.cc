@@ -54,7 +54,7 @@ TEST(SessionLifecycle, BadAddressLeavesNothingAndIsRefusedFirst) {
   ASSERT_EQ(RunSelfcal("run --session " + (dir / "sim").string() + " --seed 3", &output), 0) << output;
   const std::string setup = (dir / "sim" / "inputs" / "setup.json").string();
   for (const std::string address : {"nohostport", "localhost:abc", "127.0.0.1:abc", "localhost:70000"}) {
-    EXPECT_EQ(RunSelfcal("run --session " + session + " --robot network --camera v4l2 --setup " + setup +
+    EXPECT_EQ(RunSelfcal("run --session " + session + " --backend network --camera v4l2 --setup " + setup +
                              " --address " + address,
                          &output),
               2)
@@ -63,7 +63,7 @@ TEST(SessionLifecycle, BadAddressLeavesNothingAndIsRefusedFirst) {
     EXPECT_FALSE(fs::exists(session)) << address;
   }
   // A robot that does not answer: nothing sent, nothing created, and the message says so.
-  EXPECT_EQ(RunSelfcal("run --session " + session + " --robot network --camera v4l2 --setup " + setup +
+  EXPECT_EQ(RunSelfcal("run --session " + session + " --backend network --camera v4l2 --setup " + setup +
                            " --address 127.0.0.1:1",
                        &output),
             4)
@@ -162,7 +162,7 @@ TEST(SessionLifecycle, ANetworkResumeOnAnotherPortIsNotAChangedInput) {
   run["device"] = "/dev/video0";
   run["velocity_scaling"] = 0.1;
   std::ofstream(cut / "inputs" / "run.json") << run.dump(2) << "\n";
-  const std::string command = "run --resume --session " + cut.string() + " --robot network --camera v4l2 --setup " +
+  const std::string command = "run --resume --session " + cut.string() + " --backend network --camera v4l2 --setup " +
                               (dir / "clean" / "inputs" / "setup.json").string() + " --seed 3 --address 127.0.0.1:1";
   EXPECT_EQ(RunSelfcal(command, &output), 4) << output;
   EXPECT_FALSE(Has(output, "other inputs")) << output;

@@ -1,4 +1,4 @@
-// `selfcal run --robot ur` against the selfcal-ur-fake binary on loopback (docs/universal-robots.md), as a
+// `selfcal run --backend ur` against the selfcal-ur-fake binary on loopback (docs/universal-robots.md), as a
 // user meets it: a controller that connects is identified (model, serial, the factory calibration's
 // checksums) and, without a camera here, the run halts before any motion command; each state a person must
 // clear at the controller (remote control off, a protective stop, a program running) and a wrong answer to the RTDE recipe
@@ -61,7 +61,7 @@ std::string SetupFile(const fs::path& dir) {
 }
 
 std::string UrRun(const fs::path& session, const std::string& setup, const std::string& tail) {
-  return "run --session " + session.string() + " --robot ur --robot-config config/robots/ur5e.yaml --camera v4l2 "
+  return "run --session " + session.string() + " --backend ur --robot-config config/robots/ur5e.yaml --camera v4l2 "
          "--device /dev/selfcal-no-such-camera --setup " + setup + " " + tail + " 2>&1";
 }
 
@@ -126,7 +126,7 @@ TEST(UrFakeBinary, BadAddressesAreUsageErrorsAndNoControllerIsAHardwareHalt) {
   const std::string setup = SetupFile(dir);
   std::string output;
   EXPECT_EQ(testing::RunSelfcalInSource(UrRun(dir / "s", setup, ""), &output), 2) << output;
-  EXPECT_TRUE(Has(output, "--robot ur needs --address HOST")) << output;
+  EXPECT_TRUE(Has(output, "--backend ur needs --address HOST")) << output;
   EXPECT_EQ(testing::RunSelfcalInSource(UrRun(dir / "s", setup, "--address 127.0.0.1:30004"), &output), 2) << output;
   EXPECT_TRUE(Has(output, "takes the controller's HOST alone")) << output;
   EXPECT_EQ(testing::RunSelfcalInSource(UrRun(dir / "s", setup, "--address 127.0.0.1 --ur-ports 1,2"), &output), 2)
