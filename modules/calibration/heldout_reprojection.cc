@@ -141,7 +141,7 @@ bool HasPoseError(const PredictionModel& model) {
 
 // The bundle's pixel-only estimate with an estimated pose error (not the pose-noise solve, whose estimator
 // weighs the pose errors itself): the identification images' pose errors moved its parameters and dots, and
-// the prediction carries that (PoseEffects).
+// the prediction carries that (CarriedEffects).
 bool CarriesIdentificationPoseErrors(const PredictionModel& model) {
   return HasPoseError(model) && !model.pose_error_at_flange;
 }
@@ -172,39 +172,39 @@ struct DotInformation {
   Eigen::Matrix3d sqrt_inverse = Eigen::Matrix3d::Zero();
   Eigen::MatrixXd k;
   int column = -1;  // index of its block among the usable dots
-  // With a pose error: J_d^T J_e M of each identification image that sees it (image index among the
-  // identification poses, 3 x 6), and from them its error per unit of those images' pose errors, with the
-  // parameters' share (3 x 6 per identification image; PoseEffects).
-  std::vector<std::pair<int, Eigen::Matrix<double, 3, 6>>> hde;
-  Eigen::MatrixXd pose_effect;
-  // With a prior on held parameters: J_d^T J_h (3 x held), and the dot's error per unit of their errors
-  // (HeldEffects).
+  // With a pose error: J_d^T J_e M (3 x 6 per identification image, in the order of the identification
+  // poses; zero for an image that does not see it), and from it the dot's error per unit of those images' pose
+  // errors, with the parameters' share (CarriedEffects).
+  Eigen::MatrixXd hde, pose_effect;
+  // With a prior on held parameters: J_d^T J_h (3 x held), and the dot's error per unit of their errors.
   Eigen::MatrixXd hdh, held_effect;
 };
 
-// hte (with a pose error): J_theta^T J_e M per identification image (theta x 6); hth: J_theta^T J_h of the
+// hte (with a pose error): J_theta^T J_e M (theta x 6 per identification image); hth: J_theta^T J_h of the
 // held parameters with a prior (theta x held).
 std::map<int, DotInformation> IdentificationInformation(const ObservationSet& obs, const PredictionModel& model,
                                                         const Projector& projector,
                                                         const std::map<int, Eigen::Vector3d>& dots,
-                                                        const ExcludedObservations& excluded,
-                                                        std::vector<Eigen::MatrixXd>* hte, Eigen::MatrixXd* hth) {
+                                                        const ExcludedObservations& excluded, Eigen::MatrixXd* hte,
+                                                        Eigen::MatrixXd* hth) {
   std::map<int, DotInformation> info;
-  const Eigen::Index nh = static_cast<Eigen::Index>(model.held_prior.size());
-  for (const auto& [id, p] : dots) {
-    info[id].hdt = Eigen::MatrixXd::Zero(3, projector.num_theta());
-    info[id].hdh = Eigen::MatrixXd::Zero(3, nh);
-  }
   const std::vector<int> identification = obs.PosesWithRole(PoseRole::kIdentification);
-  hte->clear();
-  *hth = Eigen::MatrixXd::Zero(projector.num_theta(), nh);
+  const bool pose_error = CarriesIdentificationPoseErrors(model);
+  const Eigen::Index nt = projector.num_theta(), nh = static_cast<Eigen::Index>(model.held_prior.size());
+  const Eigen::Index ne = pose_error ? 6 * static_cast<Eigen::Index>(identification.size()) : 0;
+  for (const auto& [id, p] : dots) {
+    info[id].hdt = Eigen::MatrixXd::Zero(3, nt);
+    info[id].hdh = Eigen::MatrixXd::Zero(3, nh);
+    info[id].hde = Eigen::MatrixXd::Zero(3, ne);
+  }
+  *hte = Eigen::MatrixXd::Zero(nt, ne);
+  *hth = Eigen::MatrixXd::Zero(nt, nh);
   for (size_t index = 0; index < identification.size(); ++index) {
     const PoseObservation& pose = obs.poses[identification[index]];
     const PoseFrames frames = projector.Frames(pose);
-    const bool pose_error = CarriesIdentificationPoseErrors(model);
     const Eigen::Matrix<double, 6, 6> root =
         pose_error ? PoseErrorRootAt(model, frames, pose) : Eigen::Matrix<double, 6, 6>::Zero();
-    if (pose_error) hte->push_back(Eigen::MatrixXd::Zero(projector.num_theta(), 6));
+    const Eigen::Index column = 6 * static_cast<Eigen::Index>(index);
     for (const auto& [id, pixel] : pose.dots_px) {
       const auto dot = dots.find(id);
       if (dot == dots.end() || excluded.count({pose.id, id}) > 0) continue;
@@ -222,8 +222,8 @@ std::map<int, DotInformation> IdentificationInformation(const ObservationSet& ob
       ++d.views;
       if (pose_error) {
         const Eigen::Matrix<double, 2, 6> je = PoseErrorRows(frames.cam_from_base, dot->second, jd) * root;
-        d.hde.emplace_back(static_cast<int>(index), jd.transpose() * je);
-        hte->back().noalias() += jt.transpose() * je;
+        d.hde.middleCols<6>(column).noalias() += jd.transpose() * je;
+        hte->middleCols<6>(column).noalias() += jt.transpose() * je;
       }
     }
   }
@@ -238,55 +238,35 @@ std::map<int, DotInformation> IdentificationInformation(const ObservationSet& ob
   return info;
 }
 
-// S^-1 of the fit (the parameters' normal matrix with the dots eliminated, unit weights): the pixel part of
-// their covariance over noise_px^2.
-Eigen::MatrixXd FitInverse(const PredictionModel& model, double noise_px) {
+// The parameters' covariance without its pose part (PredictionModel::covariance_pose_part): the fit's own
+// S^-1 times noise_px^2.
+Eigen::MatrixXd PixelPart(const PredictionModel& model) {
   const Eigen::Index nt = model.covariance.rows();
   const bool split = model.covariance_pose_part.rows() == nt && model.covariance_pose_part.cols() == nt;
-  const Eigen::MatrixXd pixel_part = split ? Eigen::MatrixXd(model.covariance - model.covariance_pose_part) : model.covariance;
-  return pixel_part / (noise_px * noise_px);
+  return split ? Eigen::MatrixXd(model.covariance - model.covariance_pose_part) : model.covariance;
 }
 
-// The held parameters' errors (PredictionModel::held_prior, per unit sd) carried into the estimates: the fit
-// absorbs the identification residuals' share J_h dh into dtheta = S^-1 (H_th - sum_j K_j^T H_dh_j) and each
-// dot's H_dd^-1 H_dh_j - K_j dtheta (DotInformation::held_effect). Returns dtheta (theta x held).
-Eigen::MatrixXd HeldEffects(const PredictionModel& model, double noise_px, int nt, const Eigen::MatrixXd& hth,
-                            std::map<int, DotInformation>* info) {
-  Eigen::MatrixXd c = hth;
-  for (const auto& [id, d] : *info) {
-    if (d.usable && nt > 0) c.noalias() -= d.k.transpose() * d.hdh;
+// An error source the least-squares fit absorbed, carried into the estimates: with h_theta = J_theta^T J_E and
+// each dot's h_dot = J_d^T J_E (per unit of the source's columns), the parameters' error
+// dtheta = S^-1 (h_theta - sum_j K_j^T h_dot_j) (S^-1 = PixelPart / noise_px^2, the dots eliminated) and each
+// dot's H_dd^-1 h_dot_j - K_j dtheta (into its `effect`). Returns dtheta (theta x the source's columns). The
+// sources: the identification images' pose errors (hde, pose_effect) and the held parameters' errors about
+// the description (hdh, held_effect).
+Eigen::MatrixXd CarriedEffects(const PredictionModel& model, double noise_px, int nt, const Eigen::MatrixXd& h_theta,
+                               Eigen::MatrixXd DotInformation::*h_dot, Eigen::MatrixXd DotInformation::*effect,
+                               std::map<int, DotInformation>* info) {
+  Eigen::MatrixXd dtheta = Eigen::MatrixXd::Zero(nt, h_theta.cols());
+  if (nt > 0) {
+    Eigen::MatrixXd c = h_theta;
+    for (const auto& [id, d] : *info) {
+      if (d.usable) c.noalias() -= d.k.transpose() * (d.*h_dot);
+    }
+    dtheta = PixelPart(model) / (noise_px * noise_px) * c;
   }
-  const Eigen::MatrixXd dtheta = nt > 0 ? Eigen::MatrixXd(FitInverse(model, noise_px) * c) : Eigen::MatrixXd::Zero(0, hth.cols());
   for (auto& [id, d] : *info) {
     if (!d.usable) continue;
-    d.held_effect = d.sqrt_inverse * d.sqrt_inverse.transpose() * d.hdh;
-    if (nt > 0) d.held_effect.noalias() -= d.k * dtheta;
-  }
-  return dtheta;
-}
-
-// The identification images' pose errors carried into the estimates, as the least-squares fit carries them:
-// per identification image i, c_i = H_te_i - sum_j K_j^T H_de_ji (the dots eliminated), the parameters'
-// error dtheta_i = S^-1 c_i (S^-1: the pixel part of their covariance over noise_px^2) and each dot's error
-// H_dd^-1 H_de_ji - K_j dtheta_i (DotInformation::pose_effect), all per unit z of that image's pose error.
-// Returns dtheta (theta x 6 per identification image).
-Eigen::MatrixXd PoseEffects(const PredictionModel& model, double noise_px, int nt, const std::vector<Eigen::MatrixXd>& hte,
-                            std::map<int, DotInformation>* info) {
-  const int width = 6 * static_cast<int>(hte.size());
-  Eigen::MatrixXd c = Eigen::MatrixXd::Zero(nt, width);
-  for (size_t i = 0; i < hte.size(); ++i) c.middleCols<6>(6 * static_cast<Eigen::Index>(i)) = hte[i];
-  for (const auto& [id, d] : *info) {
-    if (!d.usable || nt == 0) continue;
-    for (const auto& [i, h] : d.hde) c.middleCols<6>(6 * i).noalias() -= d.k.transpose() * h;
-  }
-  Eigen::MatrixXd dtheta = Eigen::MatrixXd::Zero(nt, width);
-  if (nt > 0) dtheta = FitInverse(model, noise_px) * c;
-  for (auto& [id, d] : *info) {
-    if (!d.usable) continue;
-    const Eigen::Matrix3d hdd_inverse = d.sqrt_inverse * d.sqrt_inverse.transpose();
-    d.pose_effect = Eigen::MatrixXd::Zero(3, width);
-    for (const auto& [i, h] : d.hde) d.pose_effect.middleCols<6>(6 * i) = hdd_inverse * h;
-    if (nt > 0) d.pose_effect.noalias() -= d.k * dtheta;
+    d.*effect = d.sqrt_inverse * d.sqrt_inverse.transpose() * (d.*h_dot);
+    if (nt > 0) (d.*effect).noalias() -= d.k * dtheta;
   }
   return dtheta;
 }
@@ -440,8 +420,7 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
   }
   const Projector projector(model);
   report.prediction_uncertainty = projector.with_parameters();
-  std::vector<Eigen::MatrixXd> hte;
-  Eigen::MatrixXd hth;
+  Eigen::MatrixXd hte, hth;
   std::map<int, DotInformation> info =
       IdentificationInformation(obs, model, projector, dots_in_base, excluded, &hte, &hth);
   const int nt = projector.num_theta();
@@ -450,13 +429,13 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
   // image (its pose error as carried into the parameters and dots), one per held parameter with a prior (its
   // error, directly and as carried into the parameters and dots).
   const bool carried = CarriesIdentificationPoseErrors(model);
-  const Eigen::MatrixXd dtheta = carried ? PoseEffects(model, noise_px, nt, hte, &info) : Eigen::MatrixXd();
-  const Eigen::MatrixXd dtheta_held = HeldEffects(model, noise_px, nt, hth, &info);
+  const Eigen::MatrixXd dtheta = CarriedEffects(model, noise_px, nt, hte, &DotInformation::hde,
+                                                &DotInformation::pose_effect, &info);
+  const Eigen::MatrixXd dtheta_held = CarriedEffects(model, noise_px, nt, hth, &DotInformation::hdh,
+                                                     &DotInformation::held_effect, &info);
   const int nh = static_cast<int>(model.held_prior.size());
-  const bool split = carried && model.covariance_pose_part.rows() == nt && model.covariance_pose_part.cols() == nt;
   const Eigen::MatrixXd theta_root =
-      nt > 0 ? CovarianceRoot(split ? Eigen::MatrixXd(model.covariance - model.covariance_pose_part) : model.covariance)
-             : Eigen::MatrixXd();
+      nt > 0 ? CovarianceRoot(carried ? PixelPart(model) : model.covariance) : Eigen::MatrixXd();
   int num_dots = 0;
   for (auto& [id, d] : info) {
     if (d.usable) d.column = num_dots++;
