@@ -499,6 +499,7 @@ BundleReport RunBundleAdjustment(const ObservationSet& observations, const Eigen
     return finish(Outcome::kScaleUnresolved,
                   "no yardstick has both ends seen (and triangulable) in two or more identification poses");
   }
+  if (!data.yardsticks.empty()) report.yardstick_sigma_m = options.yardstick_sigma_m;
   if (data.observations.empty()) {
     return finish(Outcome::kDegenerate, "no dot could be placed: each of the " +
                                             std::to_string(report.dropped_dots.size()) +

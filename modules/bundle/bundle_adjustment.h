@@ -173,6 +173,7 @@ struct BundleReport {
   IntrinsicsVector intrinsics{};
   IntrinsicsMask intrinsics_estimated{};
   std::map<int, Eigen::Vector3d> dots_in_base;  // every dot that entered the solve (flange frame eye-to-hand)
+  double yardstick_sigma_m = 0;                 // BundleOptions::yardstick_sigma_m when a yardstick entered it
   std::vector<int> free_indices;              // kinematic, in rho order
   std::vector<std::string> free_names, fixed_names;  // fixed: by the rank analysis and by request
   std::vector<std::string> held_names;        // held by request (BundleOptions::held_parameters, free_parameters)

@@ -117,6 +117,7 @@ HeldOutReprojection HeldOutReprojectionOfBundle(const ObservationSet& obs, const
   calibrated.camera = WithIntrinsics(obs.camera, b.intrinsics);
   calibrated.free_indices = b.free_indices;
   calibrated.intrinsics_estimated = b.intrinsics_estimated;
+  calibrated.yardstick_sigma_m = b.yardstick_sigma_m;
   if (b.covariance_available) {
     calibrated.covariance = b.covariance_free;
     if (*noise_px != fitted_px) {  // the pixel part scales with the pixel variance, the pose part does not

@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "bundle/error_model.h"
+#include "calibration/heldout_dot_groups.h"
 #include "geometry/rigid3.h"
 #include "identification/triangulation.h"
 #include "kinematics/joint_motion.h"
@@ -178,7 +179,25 @@ struct DotInformation {
   Eigen::MatrixXd hde, pose_effect;
   // With a prior on held parameters: J_d^T J_h (3 x held), and the dot's error per unit of their errors.
   Eigen::MatrixXd hdh, held_effect;
+  int group = -1, slot = -1;  // its DotGroup and place in it (heldout_dot_groups.h); -1: solved alone
 };
+using DotInformationMap = std::map<int, DotInformation>;
+
+// out_j = (H^-1 X)_j for every usable dot j: H_dd^-1 X_j for a dot solved alone, the rows of H_GG^-1 X_G of
+// a group of dots joined by yardsticks (the fit solved them together).
+void SolveDots(const std::vector<DotGroup>& groups, Eigen::MatrixXd DotInformation::*x,
+               Eigen::MatrixXd DotInformation::*out, DotInformationMap* info) {
+  for (auto& [id, d] : *info) {
+    if (d.usable && d.group < 0) d.*out = d.sqrt_inverse * d.sqrt_inverse.transpose() * (d.*x);
+  }
+  for (const DotGroup& g : groups) {
+    const Eigen::Index cols = (info->at(g.ids[0]).*x).cols();
+    Eigen::MatrixXd stacked(3 * static_cast<Eigen::Index>(g.ids.size()), cols);
+    for (size_t j = 0; j < g.ids.size(); ++j) stacked.middleRows<3>(3 * static_cast<Eigen::Index>(j)) = info->at(g.ids[j]).*x;
+    const Eigen::MatrixXd solved = g.inverse * stacked;
+    for (size_t j = 0; j < g.ids.size(); ++j) info->at(g.ids[j]).*out = solved.middleRows<3>(3 * static_cast<Eigen::Index>(j));
+  }
+}
 
 // hte (with a pose error): J_theta^T J_e M (theta x 6 per identification image); hth: J_theta^T J_h of the
 // held parameters with a prior (theta x held).
@@ -186,7 +205,7 @@ std::map<int, DotInformation> IdentificationInformation(const ObservationSet& ob
                                                         const Projector& projector,
                                                         const std::map<int, Eigen::Vector3d>& dots,
                                                         const ExcludedObservations& excluded, Eigen::MatrixXd* hte,
-                                                        Eigen::MatrixXd* hth) {
+                                                        Eigen::MatrixXd* hth, std::vector<DotGroup>* groups) {
   std::map<int, DotInformation> info;
   const std::vector<int> identification = obs.PosesWithRole(PoseRole::kIdentification);
   const bool pose_error = CarriesIdentificationPoseErrors(model);
@@ -233,8 +252,19 @@ std::map<int, DotInformation> IdentificationInformation(const ObservationSet& ob
     if (eigen.info() != Eigen::Success || !(eigen.eigenvalues().minCoeff() > 1e-12 * eigen.eigenvalues().maxCoeff())) continue;
     d.usable = true;
     d.sqrt_inverse = eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().cwiseSqrt().asDiagonal();
-    d.k = eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().asDiagonal() * eigen.eigenvectors().transpose() * d.hdt;
   }
+  std::map<int, Eigen::Matrix3d> usable_hdd;
+  for (const auto& [id, d] : info) {
+    if (d.usable) usable_hdd[id] = d.hdd;
+  }
+  *groups = YardstickDotGroups(obs.yardsticks, model.yardstick_sigma_m, obs.pixel_noise_px, usable_hdd, dots);
+  for (size_t g = 0; g < groups->size(); ++g) {
+    for (size_t j = 0; j < (*groups)[g].ids.size(); ++j) {
+      info[(*groups)[g].ids[j]].group = static_cast<int>(g);
+      info[(*groups)[g].ids[j]].slot = static_cast<int>(j);
+    }
+  }
+  SolveDots(*groups, &DotInformation::hdt, &DotInformation::k, &info);
   return info;
 }
 
@@ -254,7 +284,7 @@ Eigen::MatrixXd PixelPart(const PredictionModel& model) {
 // the description (hdh, held_effect).
 Eigen::MatrixXd CarriedEffects(const PredictionModel& model, double noise_px, int nt, const Eigen::MatrixXd& h_theta,
                                Eigen::MatrixXd DotInformation::*h_dot, Eigen::MatrixXd DotInformation::*effect,
-                               std::map<int, DotInformation>* info) {
+                               const std::vector<DotGroup>& groups, DotInformationMap* info) {
   Eigen::MatrixXd dtheta = Eigen::MatrixXd::Zero(nt, h_theta.cols());
   if (nt > 0) {
     Eigen::MatrixXd c = h_theta;
@@ -263,10 +293,9 @@ Eigen::MatrixXd CarriedEffects(const PredictionModel& model, double noise_px, in
     }
     dtheta = PixelPart(model) / (noise_px * noise_px) * c;
   }
+  SolveDots(groups, h_dot, effect, info);
   for (auto& [id, d] : *info) {
-    if (!d.usable) continue;
-    d.*effect = d.sqrt_inverse * d.sqrt_inverse.transpose() * (d.*h_dot);
-    if (nt > 0) (d.*effect).noalias() -= d.k * dtheta;
+    if (d.usable && nt > 0) (d.*effect).noalias() -= d.k * dtheta;
   }
   return dtheta;
 }
@@ -421,8 +450,9 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
   const Projector projector(model);
   report.prediction_uncertainty = projector.with_parameters();
   Eigen::MatrixXd hte, hth;
+  std::vector<DotGroup> groups;
   std::map<int, DotInformation> info =
-      IdentificationInformation(obs, model, projector, dots_in_base, excluded, &hte, &hth);
+      IdentificationInformation(obs, model, projector, dots_in_base, excluded, &hte, &hth, &groups);
   const int nt = projector.num_theta();
   // U's columns: the parameters' (their pixel part when the identification images' pose errors enter
   // explicitly), 6 per verification image (its own pose error, zero outside its rows), 6 per identification
@@ -430,9 +460,9 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
   // error, directly and as carried into the parameters and dots).
   const bool carried = CarriesIdentificationPoseErrors(model);
   const Eigen::MatrixXd dtheta = CarriedEffects(model, noise_px, nt, hte, &DotInformation::hde,
-                                                &DotInformation::pose_effect, &info);
+                                                &DotInformation::pose_effect, groups, &info);
   const Eigen::MatrixXd dtheta_held = CarriedEffects(model, noise_px, nt, hth, &DotInformation::hdh,
-                                                     &DotInformation::held_effect, &info);
+                                                     &DotInformation::held_effect, groups, &info);
   const int nh = static_cast<int>(model.held_prior.size());
   const Eigen::MatrixXd theta_root =
       nt > 0 ? CovarianceRoot(carried ? PixelPart(model) : model.covariance) : Eigen::MatrixXd();

@@ -87,6 +87,9 @@ struct PredictionModel {
   // base_from_flange * Exp(delta), delta per axis in the flange frame), carried to the camera through the
   // hand-eye transform: J_e A diag(s_t^2 I, s_r^2 I) A^T J_e^T with A the adjoint of cam_from_flange.
   bool pose_error_at_flange = false;
+  // The yardsticks' standard deviation in the fit (bundle/bundle_adjustment.h; 0: the fit had none, or the
+  // model was not fitted): their two dots were solved together, and so are they here.
+  double yardstick_sigma_m = 0;
 };
 
 // One detection beside the model's prediction of it (for plots of the residuals over the image).
