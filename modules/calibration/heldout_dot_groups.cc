@@ -1,7 +1,5 @@
 #include "calibration/heldout_dot_groups.h"
 
-#include <numeric>
-
 #include <Eigen/Cholesky>
 
 namespace selfcal::calibration {

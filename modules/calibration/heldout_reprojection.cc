@@ -179,7 +179,7 @@ struct DotInformation {
   Eigen::MatrixXd hde, pose_effect;
   // With a prior on held parameters: J_d^T J_h (3 x held), and the dot's error per unit of their errors.
   Eigen::MatrixXd hdh, held_effect;
-  int group = -1, slot = -1;  // its DotGroup and place in it (heldout_dot_groups.h); -1: solved alone
+  bool grouped = false;  // joined by a yardstick to another dot: solved in its DotGroup (heldout_dot_groups.h)
 };
 using DotInformationMap = std::map<int, DotInformation>;
 
@@ -188,7 +188,7 @@ using DotInformationMap = std::map<int, DotInformation>;
 void SolveDots(const std::vector<DotGroup>& groups, Eigen::MatrixXd DotInformation::*x,
                Eigen::MatrixXd DotInformation::*out, DotInformationMap* info) {
   for (auto& [id, d] : *info) {
-    if (d.usable && d.group < 0) d.*out = d.sqrt_inverse * d.sqrt_inverse.transpose() * (d.*x);
+    if (d.usable && !d.grouped) d.*out = d.sqrt_inverse * d.sqrt_inverse.transpose() * (d.*x);
   }
   for (const DotGroup& g : groups) {
     const Eigen::Index cols = (info->at(g.ids[0]).*x).cols();
@@ -258,11 +258,8 @@ std::map<int, DotInformation> IdentificationInformation(const ObservationSet& ob
     if (d.usable) usable_hdd[id] = d.hdd;
   }
   *groups = YardstickDotGroups(obs.yardsticks, model.yardstick_sigma_m, obs.pixel_noise_px, usable_hdd, dots);
-  for (size_t g = 0; g < groups->size(); ++g) {
-    for (size_t j = 0; j < (*groups)[g].ids.size(); ++j) {
-      info[(*groups)[g].ids[j]].group = static_cast<int>(g);
-      info[(*groups)[g].ids[j]].slot = static_cast<int>(j);
-    }
+  for (const DotGroup& g : *groups) {
+    for (int id : g.ids) info[id].grouped = true;
   }
   SolveDots(*groups, &DotInformation::hdt, &DotInformation::k, &info);
   return info;
