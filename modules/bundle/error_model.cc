@@ -82,6 +82,57 @@ Eigen::MatrixXd PosePart(const Eigen::MatrixXd& cross, const ErrorModel& model,
   return part;
 }
 
+// ErrorModel::relative_covariance from the last iteration's normal matrix s (pixel weight w on `normal`, the
+// priors 1 / var[g] on the extra columns) and its inverse q; rows: residual rows with the dots eliminated.
+// With W = Sigma^-1 - Sigma^-1 A q A^T Sigma^-1 over the pixels and the pose errors' pseudo-observations,
+// every trace reduces to the unknowns' space: M = w normal,
+//   S_pp = w^2 (rows - 2 tr(q M) + tr(q M q M)),   S_pg = w p_g^2 tr(q_g. M q_.g),
+//   S_gg = p_g^2 (n_g - 2 p_g tr(q_gg) + p_g^2 |q_gg|^2),   S_gh = p_g^2 p_h^2 |q_gh|^2.
+Eigen::Matrix4d RelativeVarianceCovariance(const Eigen::MatrixXd& normal, int num_global, const std::vector<int>& group,
+                                           double var_px, const double var[3], const bool active[3], double rows,
+                                           const Eigen::MatrixXd& q) {
+  const double w = 1.0 / var_px;
+  const Eigen::MatrixXd m = w * normal;
+  const Eigen::MatrixXd qm = q * m;
+  std::vector<int> members[3];
+  for (size_t c = 0; c < group.size(); ++c) members[group[c]].push_back(num_global + static_cast<int>(c));
+  const auto block = [&](const Eigen::MatrixXd& a, int g, int h) {
+    Eigen::MatrixXd b(members[g].size(), members[h].size());
+    for (size_t i = 0; i < members[g].size(); ++i) {
+      for (size_t j = 0; j < members[h].size(); ++j) b(i, j) = a(members[g][i], members[h][j]);
+    }
+    return b;
+  };
+  Eigen::Matrix4d s = Eigen::Matrix4d::Zero();
+  s(0, 0) = w * w * (rows - 2 * qm.trace() + (qm * qm).trace());
+  const Eigen::MatrixXd qmq = qm * q;
+  std::vector<int> used = {0};
+  for (int g = 0; g < 3; ++g) {
+    if (!active[g] || members[g].empty()) continue;
+    const double p = 1.0 / var[g];
+    s(0, g + 1) = s(g + 1, 0) = w * p * p * block(qmq, g, g).trace();
+    const Eigen::MatrixXd qgg = block(q, g, g);
+    s(g + 1, g + 1) = p * p * (members[g].size() - 2 * p * qgg.trace() + p * p * qgg.squaredNorm());
+    for (int h : used) {
+      if (h == 0) continue;
+      s(g + 1, h) = s(h, g + 1) = p * p * std::pow(1.0 / var[h - 1], 2) * block(q, g, h - 1).squaredNorm();
+    }
+    used.push_back(g + 1);
+  }
+  const double value[4] = {var_px, var[0], var[1], var[2]};
+  Eigen::MatrixXd sub(used.size(), used.size());
+  for (size_t i = 0; i < used.size(); ++i) {
+    for (size_t j = 0; j < used.size(); ++j) sub(i, j) = s(used[i], used[j]) * value[used[i]] * value[used[j]];
+  }
+  Eigen::MatrixXd inverse;
+  Eigen::Matrix4d relative = Eigen::Matrix4d::Zero();
+  if (!InverseSpd(sub, &inverse)) return relative;
+  for (size_t i = 0; i < used.size(); ++i) {
+    for (size_t j = 0; j < used.size(); ++j) relative(used[i], used[j]) = 2 * inverse(i, j);
+  }
+  return relative;
+}
+
 }  // namespace
 
 ErrorModel EstimateErrorModel(const Eigen::MatrixXd& reduced, int num_global, const Eigen::VectorXd& gradient,
@@ -161,6 +212,12 @@ ErrorModel EstimateErrorModel(const Eigen::MatrixXd& reduced, int num_global, co
   }
   model.iterations = std::min(model.iterations, kMaxIterations);
   model.estimated = true;
+  {
+    bool active[3];
+    for (int g = 0; g < 3; ++g) active[g] = g < num_groups && var[g] > floor[g] && red[g] >= kMinRedundancy;
+    model.relative_covariance = RelativeVarianceCovariance(normal, num_global, group, var_px, var, active,
+                                                           static_cast<double>(dof) + num_global, inverse);
+  }
   model.pixel_px = sigma_px * std::sqrt(var_px);
   model.translation_redundancy = red[0];
   model.rotation_redundancy = red[1];

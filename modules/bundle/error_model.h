@@ -51,6 +51,12 @@ struct ErrorModel {
   double joint_rad = NAN;              // per joint reading (a joint set's; NaN: not modelled)
   // Redundancy numbers (the degrees of freedom each component's estimate rests on).
   double pixel_redundancy = NAN, translation_redundancy = NAN, rotation_redundancy = NAN, joint_redundancy = NAN;
+  // How precisely the data give the variances: the covariance of the estimated variances, each relative to
+  // its value, over (pixel, translation, rotation, joint), zero rows and columns for an absent or unmodelled
+  // component (Koch 3.6: D(sigma^2) = 2 S^-1, S_kl = tr(W V_k W V_l), at the estimate). A component's
+  // redundancy alone promises 2 / r_k on the diagonal; the components share residuals (a reading error of
+  // the last joints and the pixel noise look alike in a few images), so the joint estimate is less precise.
+  Eigen::Matrix4d relative_covariance = Eigen::Matrix4d::Zero();
   int iterations = 0;
 };
 

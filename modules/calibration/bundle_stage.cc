@@ -139,6 +139,12 @@ HeldOutReprojection HeldOutReprojectionOfBundle(const ObservationSet& obs, const
     calibrated.pose_translation_m = b.error_model.pose_translation_m;
     calibrated.pose_rotation_rad = b.error_model.pose_rotation_rad;
     calibrated.joint_rad = b.error_model.joint_rad > 0 ? b.error_model.joint_rad : 0.0;
+    // The estimated sizes are only as good as the residuals they came from; a stated pixel noise is known.
+    calibrated.relative_variance_covariance = b.error_model.relative_covariance;
+    if (at_noise_px > 0) {
+      calibrated.relative_variance_covariance.row(0).setZero();
+      calibrated.relative_variance_covariance.col(0).setZero();
+    }
   }
   ExcludedObservations excluded;
   for (const bundle::RemovedObservation& o : b.removed) excluded.insert({o.pose_id, o.dot_id});

@@ -72,7 +72,7 @@ CrossValidationReport CrossValidateWith(const ObservationSet& obs, int folds, st
     return report;
   }
   report.ran = true;
-  double sum2 = 0;
+  double sum2 = 0, scatter = 0;  // scatter: sum over folds of share^2 / pose_noise_dof
   HeldOutFigure& pooled = report.pooled;
   pooled.chi_square = 0;
   pooled.max_px = 0;
@@ -89,13 +89,20 @@ CrossValidationReport CrossValidateWith(const ObservationSet& obs, int folds, st
       pooled.num_residuals += figure.num_residuals;
       pooled.dof += figure.dof;
       pooled.chi_square += figure.chi_square;
+      pooled.pose_share += figure.pose_share;
+      if (figure.pose_noise_dof > 0) scatter += figure.pose_share * figure.pose_share / figure.pose_noise_dof;
       pooled.max_px = std::max(pooled.max_px, figure.max_px);
     }
   }
   if (pooled.num_residuals > 0) {
     pooled.rms_px = std::sqrt(sum2 / pooled.num_residuals);
-    pooled.chi_square_limit = ChiSquareQuantile(kHeldOutTestLevel, pooled.dof);
-    pooled.p_value = ChiSquareUpperTail(pooled.chi_square, pooled.dof);
+    // Each fold's pose part scaled by its own estimate's scatter, taken as independent between folds (they
+    // share most of their data: a pooled estimate is no better than that, so this errs towards refusing).
+    pooled.pose_noise_dof =
+        scatter > 0 ? static_cast<int>(std::lround(std::min(pooled.pose_share * pooled.pose_share / scatter, 1e8))) : 0;
+    pooled.chi_square_limit =
+        ChiSquareQuantile(kHeldOutTestLevel, pooled.dof, 0, pooled.pose_share, pooled.pose_noise_dof);
+    pooled.p_value = ChiSquareUpperTail(pooled.chi_square, pooled.dof, 0, pooled.pose_share, pooled.pose_noise_dof);
     pooled.test_passed = pooled.chi_square <= pooled.chi_square_limit;
   } else {
     pooled = HeldOutFigure();

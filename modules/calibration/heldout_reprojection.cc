@@ -4,8 +4,10 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 
 #include "bundle/error_model.h"
+#include "calibration/heldout_chi_square.h"
 #include "calibration/heldout_dot_groups.h"
 #include "geometry/rigid3.h"
 #include "identification/triangulation.h"
@@ -163,6 +165,45 @@ Eigen::Matrix<double, 6, 6> PoseErrorRootAt(const PredictionModel& model, const 
   return eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
 }
 
+// PoseErrorRootAt's model with one component's size only (translation, rotation, joint), for VarianceBlockAt.
+std::vector<PredictionModel> ComponentModels(const PredictionModel& model) {
+  std::vector<PredictionModel> parts(3, model);
+  parts[0].pose_rotation_rad = parts[0].joint_rad = 0;
+  parts[1].pose_translation_m = parts[1].joint_rad = 0;
+  parts[2].pose_translation_m = parts[2].pose_rotation_rad = 0;
+  return parts;
+}
+
+// One image's pose-error columns (root R from `column`) split by component: E_k = R^+ Theta_k R^+T
+// (heldout_chi_square.h).
+VarianceBlock VarianceBlockAt(const std::vector<PredictionModel>& components, const PoseFrames& frames,
+                              const PoseObservation& pose, const Eigen::Matrix<double, 6, 6>& root, int column) {
+  VarianceBlock b;
+  b.column = column;
+  Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<double, 6, 6>> decomposition;
+  decomposition.setThreshold(1e-9);
+  decomposition.compute(root);
+  const Eigen::Matrix<double, 6, 6> inverse = decomposition.pseudoInverse();
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Matrix<double, 6, 6> part = PoseErrorRootAt(components[k], frames, pose);
+    b.e[k] = inverse * part * part.transpose() * inverse.transpose();
+  }
+  return b;
+}
+
+// The identification images' carried pose-error columns (6 each from first_column, in their order) by
+// component.
+void AddIdentificationBlocks(const ObservationSet& obs, const PredictionModel& model,
+                             const std::vector<PredictionModel>& components, int first_column, VarianceParts* parts) {
+  const std::vector<int> identification = obs.PosesWithRole(PoseRole::kIdentification);
+  for (size_t index = 0; index < identification.size(); ++index) {
+    const PoseObservation& pose = obs.poses[identification[index]];
+    const PoseFrames camera_frame;  // a camera-frame pose error (the carried kind) does not look at the frames
+    parts->blocks.push_back(VarianceBlockAt(components, camera_frame, pose, PoseErrorRootAt(model, camera_frame, pose),
+                                            first_column + 6 * static_cast<int>(index)));
+  }
+}
+
 // What the identification images say about one dot: H_dd and H_dtheta (sigma = 1), and from them the
 // square root of H_dd^-1 and K = H_dd^-1 H_dtheta.
 struct DotInformation {
@@ -297,76 +338,8 @@ Eigen::MatrixXd CarriedEffects(const PredictionModel& model, double noise_px, in
   return dtheta;
 }
 
-// One verification residual: detection - prediction, and its rows of U (C = sigma^2 I + U U^T, U in px):
-// U = [G | D] with G (2 x theta) dense, its two rows at 2 k and 2 k + 1 of Residuals::g for residual k,
-// and D zero except the 2 x 3 block of its dot.
-struct Residual {
-  int slot = -1;  // index into HeldOutReprojection::poses
-  Eigen::Vector2d r = Eigen::Vector2d::Zero();
-  Eigen::Matrix<double, 2, 3> d = Eigen::Matrix<double, 2, 3>::Zero();
-  int dot = -1;                                // index of its dot's block
-};
-using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-struct Residuals {
-  int num_theta = 0;
-  std::vector<Residual> rows;
-  std::vector<double> g;  // 2 x num_theta per residual, row by row
-};
-
-// r^T C^-1 r over the residuals [begin, end), C = sigma^2 I + U U^T, by the Woodbury identity:
-// (r^T r - b^T M^-1 b) / sigma^2 with M = U^T U + sigma^2 I and b = U^T r. M's dot part is block
-// diagonal (3 x 3 per dot), so M^-1 b comes from the Schur complement on the theta block:
-// O(residuals x theta^2 + theta^3), not O(dots^3) (the dense M had 3 x dots + theta rows); G^T G is one
-// symmetric rank update over the range's rows, the dots' correction one product over the dots.
-double ChiSquareOf(int begin, int end, const Residuals& residuals, int num_dots, double sigma) {
-  if (begin >= end) return 0;
-  const int nt = residuals.num_theta;
-  const double s2 = sigma * sigma;
-  const Eigen::Map<const RowMajor> g_rows(residuals.g.data() + static_cast<size_t>(2 * nt) * begin, 2 * (end - begin), nt);
-  std::vector<Eigen::Matrix3d> mdd(num_dots, Eigen::Matrix3d::Zero());
-  RowMajor mdt = RowMajor::Zero(3 * num_dots, nt);  // D_j^T G, 3 x theta per dot
-  std::vector<Eigen::Vector3d> bd(num_dots, Eigen::Vector3d::Zero());
-  std::vector<bool> seen(num_dots, false);
-  Eigen::MatrixXd mtt = Eigen::MatrixXd::Zero(nt, nt);
-  Eigen::VectorXd bt = Eigen::VectorXd::Zero(nt);
-  Eigen::VectorXd r_rows(2 * (end - begin));
-  double rr = 0;
-  for (int k = begin; k < end; ++k) {
-    const Residual& e = residuals.rows[k];
-    seen[e.dot] = true;
-    mdd[e.dot] += e.d.transpose() * e.d;
-    mdt.middleRows<3>(3 * e.dot).noalias() += e.d.transpose().lazyProduct(g_rows.middleRows<2>(2 * (k - begin)));
-    bd[e.dot] += e.d.transpose() * e.r;
-    r_rows.segment<2>(2 * (k - begin)) = e.r;
-    rr += e.r.squaredNorm();
-  }
-  if (nt > 0) {
-    mtt.selfadjointView<Eigen::Lower>().rankUpdate(g_rows.transpose());
-    bt.noalias() = g_rows.transpose() * r_rows;
-  }
-  mtt.diagonal().array() += s2;
-  double quadratic = 0;  // b^T M^-1 b
-  RowMajor k_all = RowMajor::Zero(3 * num_dots, nt);  // M_dd^-1 M_dt per dot
-  Eigen::VectorXd y_all = Eigen::VectorXd::Zero(3 * num_dots);
-  for (int j = 0; j < num_dots; ++j) {
-    if (!seen[j]) continue;
-    mdd[j].diagonal().array() += s2;
-    const Eigen::LDLT<Eigen::Matrix3d> block(mdd[j]);
-    k_all.middleRows<3>(3 * j) = block.solve(mdt.middleRows<3>(3 * j));
-    const Eigen::Vector3d y = block.solve(bd[j]);
-    y_all.segment<3>(3 * j) = y;
-    quadratic += bd[j].dot(y);
-  }
-  if (nt > 0) {
-    mtt.triangularView<Eigen::Lower>() -= mdt.transpose() * k_all;
-    bt.noalias() -= mdt.transpose() * y_all;
-    quadratic += bt.dot(mtt.selfadjointView<Eigen::Lower>().ldlt().solve(bt));
-  }
-  return (rr - quadratic) / s2;
-}
-
 HeldOutFigure FigureOf(const std::string& pose_id, int begin, int end, const Residuals& residuals, int num_dots,
-                       double sigma, int noise_dof) {
+                       double sigma, int noise_dof, const PredictionModel& model, const VarianceParts& parts) {
   HeldOutFigure f;
   f.pose_id = pose_id;
   f.noise_dof = noise_dof;
@@ -380,9 +353,17 @@ HeldOutFigure FigureOf(const std::string& pose_id, int begin, int end, const Res
   }
   f.rms_px = std::sqrt(sum2 / f.dof);
   f.max_px = worst;
-  f.chi_square = ChiSquareOf(begin, end, residuals, num_dots, sigma);
-  f.chi_square_limit = ChiSquareQuantile(kHeldOutTestLevel, f.dof, noise_dof);
-  f.p_value = ChiSquareUpperTail(f.chi_square, f.dof, noise_dof);
+  const bool estimated = !model.relative_variance_covariance.isZero(0);
+  const ChiSquare chi_square = ChiSquareOf(begin, end, residuals, num_dots, sigma, estimated ? &parts : nullptr);
+  if (estimated) {
+    const double pixel = model.relative_variance_covariance(0, 0);
+    if (pixel > 0) f.noise_dof = static_cast<int>(std::lround(std::min(2.0 / pixel, 1e8)));
+    f.pose_share = chi_square.share[0] + chi_square.share[1] + chi_square.share[2];
+    f.pose_noise_dof = PoseNoiseDof(chi_square, model.relative_variance_covariance);
+  }
+  f.chi_square = chi_square.value;
+  f.chi_square_limit = ChiSquareQuantile(kHeldOutTestLevel, f.dof, f.noise_dof, f.pose_share, f.pose_noise_dof);
+  f.p_value = ChiSquareUpperTail(f.chi_square, f.dof, f.noise_dof, f.pose_share, f.pose_noise_dof);
   f.test_passed = f.chi_square <= f.chi_square_limit;
   return f;
 }
@@ -472,6 +453,12 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
   const int identification_column = nt + (pose_error ? 6 * static_cast<int>(verification.size()) : 0);
   const int held_column = identification_column + static_cast<int>(dtheta.cols());
   const int width = held_column + nh;
+  VarianceParts parts;
+  parts.first_held = held_column;
+  parts.num_held = nh;
+  const bool variances = pose_error && !model.relative_variance_covariance.isZero(0);
+  const std::vector<PredictionModel> components = variances ? ComponentModels(model) : std::vector<PredictionModel>();
+  if (variances && carried) AddIdentificationBlocks(obs, model, components, identification_column, &parts);
   Residuals residuals;
   residuals.num_theta = width;
   std::vector<int> first_row_of_pose;  // per report.poses entry, and one past the end
@@ -481,6 +468,7 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
     const PoseFrames frames = projector.Frames(pose);
     const Eigen::Matrix<double, 6, 6> pose_root =
         pose_error ? PoseErrorRootAt(model, frames, pose) : Eigen::Matrix<double, 6, 6>::Zero();
+    if (variances) parts.blocks.push_back(VarianceBlockAt(components, frames, pose, pose_root, nt + 6 * static_cast<int>(index)));
     const int first = static_cast<int>(residuals.rows.size());
     for (const auto& [id, pixel] : pose.dots_px) {
       const auto d = info.find(id);
@@ -535,9 +523,10 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
   ScreenGrossErrors(noise_px, &residuals, &first_row_of_pose, &report.residuals, &report.gross_errors);
   for (size_t s = 0; s < report.poses.size(); ++s) {
     report.poses[s] = FigureOf(report.poses[s].pose_id, first_row_of_pose[s], first_row_of_pose[s + 1], residuals,
-                               num_dots, noise_px, noise_dof);
+                               num_dots, noise_px, noise_dof, model, parts);
   }
-  report.overall = FigureOf("", 0, static_cast<int>(residuals.rows.size()), residuals, num_dots, noise_px, noise_dof);
+  report.overall = FigureOf("", 0, static_cast<int>(residuals.rows.size()), residuals, num_dots, noise_px, noise_dof,
+                            model, parts);
   report.ok = true;
   return report;
 }

@@ -90,6 +90,10 @@ struct PredictionModel {
   // The yardsticks' standard deviation in the fit (bundle/bundle_adjustment.h; 0: the fit had none, or the
   // model was not fitted): their two dots were solved together, and so are they here.
   double yardstick_sigma_m = 0;
+  // How well the fit's residuals gave the variances in C (bundle::ErrorModel::relative_covariance over
+  // pixel, translation, rotation, joint; zero rows: stated, taken as known). Non-zero: the test's F
+  // distribution takes its noise degrees of freedom from it (heldout_chi_square.h), not from noise_dof.
+  Eigen::Matrix4d relative_variance_covariance = Eigen::Matrix4d::Zero();
 };
 
 // One detection beside the model's prediction of it (for plots of the residuals over the image).
@@ -109,7 +113,11 @@ struct HeldOutFigure {
   double max_px = NAN;        // largest 2-D error
   double chi_square = NAN;    // r^T C^-1 r
   int noise_dof = 0;          // the noise's degrees of freedom when it was estimated, 0 when taken as known
-  double chi_square_limit = NAN;  // kHeldOutTestLevel quantile of the statistic (chi-square, or dof F(dof, noise_dof))
+  // The part of the statistic that the images' estimated pose errors make, tr(C^-1 C_pose) (of dof), and the
+  // degrees of freedom of their size's estimate (0: none, or taken as known; heldout_chi_square.h).
+  double pose_share = 0;
+  int pose_noise_dof = 0;
+  double chi_square_limit = NAN;  // kHeldOutTestLevel quantile of the statistic (ChiSquareQuantile)
   double p_value = NAN;       // probability of a larger statistic with a correct model
   bool test_passed = false;   // chi_square <= chi_square_limit
 };
@@ -160,8 +168,12 @@ HeldOutReprojection NominalHeldOutReprojection(const ObservationSet& observation
 
 // The distribution of the statistic X with `dof` degrees of freedom: chi-square (noise_dof = 0,
 // Wilson-Hilferty) or dof F(dof, noise_dof) (Paulson): the quantile at probability p (0 < p < 1), and the
-// upper tail P(X > x).
-double ChiSquareQuantile(double p, int dof, int noise_dof = 0);
-double ChiSquareUpperTail(double x, int dof, int noise_dof = 0);
+// upper tail P(X > x). With a pose part (pose_share of the dof, its size estimated from pose_noise_dof degrees
+// of freedom), X = lambda_p (chi-square of dof - pose_share) + lambda_e (chi-square of pose_share), lambda_e
+// the true size over the estimate, pose_noise_dof / chi-square(pose_noise_dof) (the estimate's sampling
+// distribution, as for the pixel noise's lambda_p in F): moment-matched to a scaled chi-square for each
+// lambda_e and averaged over a grid of them.
+double ChiSquareQuantile(double p, int dof, int noise_dof = 0, double pose_share = 0, int pose_noise_dof = 0);
+double ChiSquareUpperTail(double x, int dof, int noise_dof = 0, double pose_share = 0, int pose_noise_dof = 0);
 
 }  // namespace selfcal::calibration

@@ -1,6 +1,8 @@
 // The held-out test's quantiles and tails (heldout_reprojection.h): chi-square, or dof x F(dof, noise_dof)
-// when the noise was estimated.
+// when the noise was estimated, averaged over the estimated pose error's size.
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "calibration/heldout_reprojection.h"
 
@@ -10,31 +12,69 @@ namespace {
 
 // P(F > f) for F ~ F(d1, d2) (d2 = 0: infinite, i.e. chi-square(d1) / d1), Paulson's approximation:
 // z = ((1 - b) f^(1/3) - (1 - a)) / sqrt(b f^(2/3) + a), a = 2 / (9 d1), b = 2 / (9 d2), standard normal.
-double FUpperTail(double f, int d1, int d2) {
+double FUpperTail(double f, double d1, int d2) {
   const double a = 2.0 / (9.0 * d1), b = d2 > 0 ? 2.0 / (9.0 * d2) : 0.0;
   const double c = std::cbrt(f);
   const double z = ((1 - b) * c - (1 - a)) / std::sqrt(b * c * c + a);
   return 0.5 * std::erfc(z / std::sqrt(2.0));
 }
 
+// lambda = nu / chi-square(nu) over a grid of u = log chi-square(nu), whose density is proportional to
+// exp(nu u / 2 - e^u / 2), with the grid's normalised weights.
+struct ScaleDraws {
+  std::vector<double> scale, weight;
+};
+ScaleDraws DrawsOfTheEstimate(int nu) {
+  constexpr int kPoints = 600;
+  const double lo = std::log(1e-7 * nu), hi = std::log(nu + 40 * std::sqrt(2.0 * nu) + 40);
+  const auto log_density = [nu](double u) { return 0.5 * nu * u - 0.5 * std::exp(u); };
+  const double top = log_density(std::log(static_cast<double>(nu)));  // the mode
+  ScaleDraws d;
+  double total = 0;
+  for (int i = 0; i < kPoints; ++i) {
+    const double u = lo + (hi - lo) * (i + 0.5) / kPoints;
+    d.scale.push_back(nu * std::exp(-u));
+    d.weight.push_back(std::exp(log_density(u) - top));
+    total += d.weight.back();
+  }
+  for (double& w : d.weight) w /= total;
+  return d;
+}
+
+// P(X > x) for X of ChiSquareQuantile's comment, in f = x / dof.
+double UpperTail(double f, int dof, int noise_dof, double pose_share, int pose_noise_dof) {
+  const double share = std::clamp(pose_share, 0.0, static_cast<double>(dof));
+  if (!(share > 0) || pose_noise_dof <= 0) return FUpperTail(f, dof, noise_dof);
+  const ScaleDraws draws = DrawsOfTheEstimate(pose_noise_dof);
+  const double rest = dof - share;
+  double tail = 0;
+  for (size_t i = 0; i < draws.scale.size(); ++i) {
+    const double lambda = draws.scale[i];
+    const double mean = rest + lambda * share, variance = 2 * (rest + lambda * lambda * share);
+    const double k = 2 * mean * mean / variance;  // X ~ mean chi-square(k) / k
+    tail += draws.weight[i] * FUpperTail(f * dof / mean, k, noise_dof);
+  }
+  return tail;
+}
+
 }  // namespace
 
-double ChiSquareQuantile(double p, int dof, int noise_dof) {
+double ChiSquareQuantile(double p, int dof, int noise_dof, double pose_share, int pose_noise_dof) {
   if (dof <= 0 || noise_dof < 0 || !(p > 0 && p < 1)) return NAN;
   // Bisection on the decreasing upper tail, in f = x / dof.
   double lo = 0, hi = 1;
-  while (FUpperTail(hi, dof, noise_dof) > 1 - p && hi < 1e12) hi *= 2;
-  for (int iteration = 0; iteration < 200 && hi - lo > 1e-13 * hi; ++iteration) {
+  while (UpperTail(hi, dof, noise_dof, pose_share, pose_noise_dof) > 1 - p && hi < 1e12) hi *= 2;
+  for (int iteration = 0; iteration < 200 && hi - lo > 1e-10 * hi; ++iteration) {
     const double mid = 0.5 * (lo + hi);
-    (FUpperTail(mid, dof, noise_dof) > 1 - p ? lo : hi) = mid;
+    (UpperTail(mid, dof, noise_dof, pose_share, pose_noise_dof) > 1 - p ? lo : hi) = mid;
   }
   return dof * 0.5 * (lo + hi);
 }
 
-double ChiSquareUpperTail(double x, int dof, int noise_dof) {
+double ChiSquareUpperTail(double x, int dof, int noise_dof, double pose_share, int pose_noise_dof) {
   if (dof <= 0 || noise_dof < 0 || !std::isfinite(x)) return NAN;
   if (x <= 0) return 1.0;
-  return FUpperTail(x / dof, dof, noise_dof);
+  return UpperTail(x / dof, dof, noise_dof, pose_share, pose_noise_dof);
 }
 
 }  // namespace selfcal::calibration

@@ -120,6 +120,10 @@ json ErrorModelJson(const bundle::ErrorModel& m) {
                           {"translation", Finite(m.translation_redundancy)},
                           {"rotation", Finite(m.rotation_redundancy)},
                           {"joint", Finite(m.joint_redundancy)}}},
+          {"relative_variance_sd", {{"pixel", std::sqrt(m.relative_covariance(0, 0))},
+                                    {"translation", std::sqrt(m.relative_covariance(1, 1))},
+                                    {"rotation", std::sqrt(m.relative_covariance(2, 2))},
+                                    {"joint", std::sqrt(m.relative_covariance(3, 3))}}},
           {"iterations", m.iterations}};
 }
 
@@ -157,6 +161,8 @@ json HeldOutFigureJson(const calibration::HeldOutFigure& f) {
             {"max_px", any ? Finite(f.max_px) : json()},
             {"chi_square", any ? Finite(f.chi_square) : json()},
             {"noise_dof", f.noise_dof},
+            {"pose_share", f.pose_share},
+            {"pose_noise_dof", f.pose_noise_dof},
             {"chi_square_limit", any ? Finite(f.chi_square_limit) : json()},
             {"p_value", any ? Finite(f.p_value) : json()},
             {"test_passed", any ? json(f.test_passed) : json()}};
