@@ -10,7 +10,10 @@ namespace {
 
 std::atomic<bool> g_stop{false};  // set by the signal handler only
 
+std::atomic<int> g_acknowledgements{0};  // likewise
+
 extern "C" void OnStopSignal(int) { g_stop.store(true); }
+extern "C" void OnAcknowledgeSignal(int) { g_acknowledgements.fetch_add(1); }
 
 }  // namespace
 
@@ -32,6 +35,14 @@ const std::atomic<bool>& StopOnSignals() {
   ::sigaction(SIGINT, &action, nullptr);
   ::sigaction(SIGTERM, &action, nullptr);
   return g_stop;
+}
+
+const std::atomic<int>& CountAcknowledgements() {
+  struct sigaction action {};
+  action.sa_handler = OnAcknowledgeSignal;
+  sigemptyset(&action.sa_mask);
+  ::sigaction(SIGUSR1, &action, nullptr);
+  return g_acknowledgements;
 }
 
 }  // namespace selfcal::app

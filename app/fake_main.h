@@ -17,4 +17,7 @@ std::optional<int> ParseFakeCommandLine(CLI::App& app, int argc, char** argv);
 // From now on SIGINT and SIGTERM only set the returned flag (the fake then stops, exit 0).
 const std::atomic<bool>& StopOnSignals();
 
+// From now on each SIGUSR1 adds one to the returned count: a person's acknowledgement at the controller.
+const std::atomic<int>& CountAcknowledgements();
+
 }  // namespace selfcal::app

@@ -2,7 +2,8 @@
 // on 127.0.0.1, with faults on request. For testing and rehearsing `selfcal run --backend fanuc` without an
 // arm; not a simulator of a FANUC's motion or safety system (docs/fanuc.md). Prints its connect port on
 // the first line of stdout, then every packet it receives; SIGINT and SIGTERM stop it (exit 0) after a last
-// line with the motion instructions and aborts counted.
+// line with the motion instructions and aborts counted; SIGUSR1 is ABORT ALL and RESET at the teach pendant
+// (the RMI program ended, an alarm cleared, the servos on again).
 #include <atomic>
 #include <iostream>
 #include <optional>
@@ -48,9 +49,10 @@ int main(int argc, char** argv) {
     return static_cast<int>(selfcal::app::ExitCodeFor(fake.status().code()));
   }
   const std::atomic<bool>& stop = selfcal::app::StopOnSignals();
+  const std::atomic<int>& pendant_resets = selfcal::app::CountAcknowledgements();
   std::cout << "listening on 127.0.0.1:" << fake->connect_port() << " (session port " << fake->session_port() << ")"
             << std::endl;
-  fake.value().Serve(stop, [](const std::string& line) { std::cout << line << std::endl; });
+  fake.value().Serve(stop, [](const std::string& line) { std::cout << line << std::endl; }, &pendant_resets);
   std::cout << "stopped; motion commands " << fake->motion_commands() << ", stop commands " << fake->stop_commands()
             << std::endl;
   return 0;

@@ -170,10 +170,21 @@ void FanucFakeController::ServeSession(const Log& log) {
   }
 }
 
-void FanucFakeController::Serve(const std::atomic<bool>& stop, const Log& log) {
+void FanucFakeController::ResetAtPendant(const Log& log) {
+  status_.servo_ready = 1;
+  status_.rmi_motion_status = 0;
+  Say(log, "pendant: ABORT ALL and RESET: the RMI program ended, the alarm cleared, the servos on");
+}
+
+void FanucFakeController::Serve(const std::atomic<bool>& stop, const Log& log, const std::atomic<int>* pendant_resets) {
   MonotonicClock clock;
   double next_s = clock.Now();
+  int resets = pendant_resets != nullptr ? pendant_resets->load() : 0;
   while (!stop.load()) {
+    if (pendant_resets != nullptr && pendant_resets->load() != resets) {
+      resets = pendant_resets->load();
+      ResetAtPendant(log);
+    }
     AcceptNewest(&connect_, &connect_client_);
     AcceptNewest(&session_, &session_client_);
     ServeConnect(log);

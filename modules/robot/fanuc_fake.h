@@ -44,7 +44,13 @@ class FanucFakeController {
   int session_port() const { return session_.port(); }
 
   // Serves until `stop` is set, in steps of 8 ms. `log` gets every received packet and what the fake does.
-  void Serve(const std::atomic<bool>& stop, const std::function<void(const std::string&)>& log);
+  // Each increase of *pendant_resets is a person pressing RESET at the teach pendant (ResetAtPendant).
+  void Serve(const std::atomic<bool>& stop, const std::function<void(const std::string&)>& log,
+             const std::atomic<int>* pendant_resets = nullptr);
+
+  // ABORT ALL and RESET at the pendant: the RMI program ended (RMIMotionStatus 0: a client must initialise
+  // it again), an alarm cleared, the servos on again (ServoReady 1). Nothing moves.
+  void ResetAtPendant(const std::function<void(const std::string&)>& log);
 
   // Read after Serve() returned.
   int motion_commands() const { return motion_commands_; }

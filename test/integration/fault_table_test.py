@@ -1,9 +1,10 @@
 #!/usr/bin/python3
-"""Whole sessions and the fault table against the fakes: selfcal-ur-fake (docs/universal-robots.md) and
-scripts/reference-robot-server (docs/robot-protocol.md), on loopback, with `--camera sim`.
+"""Whole sessions and the fault table against the fakes: selfcal-ur-fake (docs/universal-robots.md),
+scripts/reference-robot-server (docs/robot-protocol.md) and selfcal-fanuc-fake (docs/fanuc.md), on loopback,
+with `--camera sim`.
 
   fault_table_test.py ur-session SELFCAL UR_FAKE SOURCE_DIR
-  fault_table_test.py ur:FAULT|reference:FAULT SELFCAL UR_FAKE SOURCE_DIR
+  fault_table_test.py ur:FAULT|reference:FAULT|fanuc:FAULT SELFCAL UR_FAKE SOURCE_DIR [FANUC_FAKE]
 
 ur-session: `run --backend ur` of the default plan (25 poses, seed 1) against the UR fake (the operator types the
   serial), then `calibrate`: accepted, and the figures equal those of the same plan and seed on `--backend sim`
@@ -14,7 +15,8 @@ BACKEND:FAULT: one row of the fault table. The fault is injected during move #2 
   run must halt with exit 4 (a killed selfcal: SIGKILL) and a message naming the cause, say truthfully
   whether its stop command reached the controller (counted there), send no motion command after the
   faulted one, and have recorded the samples of poses p00 and p01; then the fault is cleared as a person would (UR: the Dashboard's `unlock protective stop`; reference server: SIGUSR1, the
-  acknowledgement at the controller; a server that ended: started again) and `run --resume` (the same command)
+  acknowledgement at the controller; a server that ended: started again; FANUC: SIGUSR1, RESET at the
+  teach pendant) and `run --resume` (the same command)
   completes the session: 25 samples, the samples recorded before the fault unchanged (none lost), and
   `calibrate` accepts it. The row is printed in the table's form (docs/universal-robots.md,
   docs/robot-protocol.md).
@@ -41,10 +43,11 @@ FAULT_MOVE = 2
 UR_SERIAL = "20235500001"
 
 
-class UrFake:
-    """selfcal-ur-fake at the plan's first pose on free ports; its stdout collected line by line."""
+class LoopbackFake:
+    """A fake controller binary at the plan's first pose on free ports; its stdout collected line by line.
+    `pattern` reads its ports from its first line (self.ports)."""
 
-    def __init__(self, binary, src, extra=()):
+    def __init__(self, binary, src, extra, pattern):
         with open(os.path.join(src, PLAN)) as f:
             first = yaml.safe_load(f)["poses_rad"][0]
         start = ",".join(repr(math.degrees(q)) for q in first)
@@ -52,10 +55,10 @@ class UrFake:
                                      stderr=subprocess.STDOUT, text=True)
         reference_server_test.STARTED.append(self.proc)
         line = self.proc.stdout.readline()
-        m = re.match(r"listening on 127.0.0.1 rtde (\d+) secondary (\d+) dashboard (\d+)", line)
+        m = re.match(pattern, line)
         if not m:
-            raise RuntimeError("selfcal-ur-fake did not start: " + line + self.proc.stdout.read())
-        self.rtde, self.secondary, self.dashboard = (int(v) for v in m.groups())
+            raise RuntimeError("%s did not start: %s%s" % (os.path.basename(binary), line, self.proc.stdout.read()))
+        self.ports = [int(v) for v in m.groups()]
         self.lines = []
         self.reader = threading.Thread(target=self._read, daemon=True)
         self.reader.start()
@@ -63,6 +66,28 @@ class UrFake:
     def _read(self):
         for line in self.proc.stdout:
             self.lines.append(line.rstrip("\n"))
+
+    def wait_for_motion_command(self, count, timeout_s=60.0):
+        deadline = time.monotonic() + timeout_s
+        while self.motion_commands() < count:
+            if time.monotonic() > deadline:
+                raise AssertionError("fewer than %d motion commands reached the fake:\n%s" % (count, "\n".join(self.lines)))
+            time.sleep(0.005)
+
+    def stop(self):
+        if self.proc.poll() is None:
+            self.proc.send_signal(signal.SIGTERM)
+        self.proc.wait(timeout=10)
+        self.reader.join(timeout=5)
+        return "\n".join(self.lines)
+
+
+class UrFake(LoopbackFake):
+    """selfcal-ur-fake: RTDE, secondary and Dashboard ports."""
+
+    def __init__(self, binary, src, extra=()):
+        super().__init__(binary, src, extra, r"listening on 127.0.0.1 rtde (\d+) secondary (\d+) dashboard (\d+)")
+        self.rtde, self.secondary, self.dashboard = self.ports
 
     def robot_args(self):
         return ["--robot", "ur", "--address", "127.0.0.1", "--ur-ports",
@@ -74,13 +99,6 @@ class UrFake:
     def stop_commands(self):
         return sum(1 for line in list(self.lines) if line.startswith(("secondary: stopj(", "dashboard: stop")))
 
-    def wait_for_motion_command(self, count, timeout_s=60.0):
-        deadline = time.monotonic() + timeout_s
-        while self.motion_commands() < count:
-            if time.monotonic() > deadline:
-                raise AssertionError("fewer than %d movej reached the fake:\n%s" % (count, "\n".join(self.lines)))
-            time.sleep(0.005)
-
     def dashboard_command(self, line):
         """What a person does at the pendant, through the Dashboard server: one command, its answer."""
         with socket.create_connection(("127.0.0.1", self.dashboard), timeout=2) as sock:
@@ -89,12 +107,27 @@ class UrFake:
             sock.sendall((line + "\n").encode("ascii"))
             return reader.readline().rstrip("\n")
 
-    def stop(self):
-        if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGTERM)
-        self.proc.wait(timeout=10)
-        self.reader.join(timeout=5)
-        return "\n".join(self.lines)
+
+class FanucFake(LoopbackFake):
+    """selfcal-fanuc-fake: its RMI connect port; every packet it received is a `session: ` line."""
+
+    def __init__(self, binary, src, extra=()):
+        super().__init__(binary, src, extra, r"listening on 127.0.0.1:(\d+) ")
+        self.port = self.ports[0]
+        # RMI reports no serial: the operator arms the run by typing the controller's address instead.
+        self.confirmation = "127.0.0.1:%d" % self.port
+
+    def robot_args(self):
+        return ["--backend", "fanuc", "--address", "127.0.0.1:%d" % self.port]
+
+    def _packets(self, name):
+        return sum(1 for line in list(self.lines) if line.startswith("session: ") and '"%s"' % name in line)
+
+    def motion_commands(self):
+        return self._packets("FRC_JointMotionJRep")
+
+    def stop_commands(self):
+        return self._packets("FRC_Abort")
 
 
 class ReferenceServer(reference_server_test.Server):
@@ -118,9 +151,14 @@ def selfcal_args(selfcal, robot, session, extra=()):
                                                     "--live-view", "off", "--session", session] + list(extra)
 
 
+def typed(robot):
+    """What the operator types to arm a real robot: its serial (the UR's), or what the controller asks for."""
+    return getattr(robot, "confirmation", UR_SERIAL)
+
+
 def run(selfcal, src, robot, session, extra=()):
     """A run to its end; the operator types the UR's serial when asked (the reference server is not real)."""
-    p = subprocess.run(selfcal_args(selfcal, robot, session, extra), cwd=src, input=UR_SERIAL + "\n",
+    p = subprocess.run(selfcal_args(selfcal, robot, session, extra), cwd=src, input=typed(robot) + "\n",
                        capture_output=True, text=True, timeout=300)
     return p.returncode, p.stdout + p.stderr
 
@@ -177,12 +215,20 @@ FAULTS = {
     "reference:exception": (["--exception-move", str(FAULT_MOVE)], None, "acknowledge"),
     "reference:terminate": ([], "end the server", "start again"),
     "reference:kill": ([], "kill selfcal", None),
+    "fanuc:drop": (["--drop-move", str(FAULT_MOVE)], None, None),
+    "fanuc:servo-off": (["--servo-off-move", str(FAULT_MOVE)], None, "reset at the pendant"),
+    "fanuc:stall": (["--stall-move", str(FAULT_MOVE)], None, None),
+    "fanuc:wrong-answer": (["--wrong-answer-move", str(FAULT_MOVE)], None, None),
+    "fanuc:kill": ([], "kill selfcal", "reset at the pendant"),  # its RMI session stays open
 }
+FANUC_FAKE = None  # the binary, from the command line
 
 
 def start(kind, options, ur_fake, src):
     if kind.startswith("ur:"):
         return UrFake(ur_fake, src, options)
+    if kind.startswith("fanuc:"):
+        return FanucFake(FANUC_FAKE, src, options)
     return ReferenceServer(src, options)
 
 
@@ -191,7 +237,7 @@ def inject(selfcal, src, robot, session, act):
     an end: SIGTERM to the server); returns its exit code and output."""
     proc = subprocess.Popen(selfcal_args(selfcal, robot, session), cwd=src, stdin=subprocess.PIPE,
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    proc.stdin.write(UR_SERIAL + "\n")
+    proc.stdin.write(typed(robot) + "\n")
     proc.stdin.close()
     robot.wait_for_motion_command(FAULT_MOVE + 1)  # the faulted move under way (a UR fake's takes 0.09 s)
     (proc if act == "kill selfcal" else robot.proc).send_signal(
@@ -224,8 +270,9 @@ def fault_row(kind, selfcal, ur_fake, src, tmp, failures):
                         (kind, sent, FAULT_MOVE + 1))
     if sorted(before) != list(range(FAULT_MOVE)):
         failures.append("%s: samples recorded before the fault: poses %s, expected 0..%d" % (kind, sorted(before), FAULT_MOVE - 1))
-    if clear in ("unlock protective stop", "acknowledge"):  # nothing resumes by itself: refused, nothing moves
-        code_before, out_before = run(selfcal, src, robot, session, ["--resume"])
+    resume = ["--resume"] + (["--take-over-stale-lock"] if act == "kill selfcal" else [])
+    if clear in ("unlock protective stop", "acknowledge", "reset at the pendant"):  # nothing resumes by itself
+        code_before, out_before = run(selfcal, src, robot, session, resume)
         if code_before != 4 or robot.motion_commands() != sent:
             failures.append("%s: a resume before the fault is cleared: exit %d, %d motion commands\n%s" %
                             (kind, code_before, robot.motion_commands() - sent, out_before[-2000:]))
@@ -234,13 +281,12 @@ def fault_row(kind, selfcal, ur_fake, src, tmp, failures):
         answer = robot.dashboard_command(clear)
         if answer != "Protective stop releasing":
             failures.append("%s: `unlock protective stop` answered %r" % (kind, answer))
-    elif clear == "acknowledge":
+    elif clear in ("acknowledge", "reset at the pendant"):
         robot.proc.send_signal(signal.SIGUSR1)
         time.sleep(0.3)
     elif clear == "start again":
         robot.stop()
         robot = start(kind, [], ur_fake, src)
-    resume = ["--resume"] + (["--take-over-stale-lock"] if act == "kill selfcal" else [])
     rcode, rout = run(selfcal, src, robot, session, resume)
     robot.stop()
     after = accepted_samples(session) if os.path.exists(os.path.join(session, "journal.log")) else {}
@@ -262,7 +308,12 @@ def fault_row(kind, selfcal, ur_fake, src, tmp, failures):
 
 
 def main():
+    global FANUC_FAKE
     mode, selfcal, ur_fake, src = sys.argv[1:5]
+    FANUC_FAKE = sys.argv[5] if len(sys.argv) > 5 else None
+    if mode.startswith("fanuc:") and FANUC_FAKE is None:
+        print("usage: fault_table_test.py fanuc:FAULT SELFCAL UR_FAKE SOURCE_DIR FANUC_FAKE", file=sys.stderr)
+        return 2
     if mode == "ur-session":
         body = lambda tmp, failures: ur_session(selfcal, ur_fake, src, tmp, failures)  # noqa: E731
     else:
