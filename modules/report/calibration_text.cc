@@ -80,7 +80,11 @@ void PrintHeldOut(const calibration::HeldOutReprojection& c, const calibration::
   if (std::isfinite(c.rms_mm)) out << " (" << c.rms_mm << " mm at the scene)";
   out << "\n    at " << noise_label << " " << c.noise_px << " px: chi-square " << std::setprecision(1)
       << f.chi_square << " for " << f.dof << " dof, 95 % limit " << f.chi_square_limit
-      << (f.noise_dof > 0 ? " (F test)" : "") << (f.test_passed ? ": within" : ": above") << "\n";
+      << (f.noise_dof > 0 ? " (F test)" : "");
+  if (f.pose_noise_dof > 0) {
+    out << " (pose errors " << f.pose_share << " of the dof, their size estimated from " << f.pose_noise_dof << " dof)";
+  }
+  out << (f.test_passed ? ": within" : ": above") << "\n";
   if (!c.prediction_uncertainty) out << "    (the parameters' uncertainty is not in the test: " << c.message << ")\n";
   if (n.ok) {
     out << std::setprecision(3) << "    nominal model on the same images: RMS " << n.overall.rms_px << " px ("
