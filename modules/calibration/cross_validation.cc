@@ -4,6 +4,8 @@
 #include <cmath>
 #include <random>
 
+#include "calibration/heldout_chi_square.h"
+
 namespace selfcal::calibration {
 
 namespace {
@@ -98,8 +100,7 @@ CrossValidationReport CrossValidateWith(const ObservationSet& obs, int folds, st
     pooled.rms_px = std::sqrt(sum2 / pooled.num_residuals);
     // Each fold's pose part scaled by its own estimate's scatter, taken as independent between folds (they
     // share most of their data: a pooled estimate is no better than that, so this errs towards refusing).
-    pooled.pose_noise_dof =
-        scatter > 0 ? static_cast<int>(std::lround(std::min(pooled.pose_share * pooled.pose_share / scatter, 1e8))) : 0;
+    pooled.pose_noise_dof = DegreesOfFreedomOf(2 * scatter / (pooled.pose_share * pooled.pose_share));
     pooled.chi_square_limit =
         ChiSquareQuantile(kHeldOutTestLevel, pooled.dof, 0, pooled.pose_share, pooled.pose_noise_dof);
     pooled.p_value = ChiSquareUpperTail(pooled.chi_square, pooled.dof, 0, pooled.pose_share, pooled.pose_noise_dof);

@@ -17,7 +17,6 @@ void Shares(const Eigen::LDLT<Eigen::MatrixXd>& ldlt, double s2, const VarianceP
         Eigen::Matrix<double, 6, 6>::Identity() - s2 * inverse.block<6, 6>(b.column, b.column);
     for (int k = 0; k < 3; ++k) result->share[k] += b.e[k].cwiseProduct(seen.transpose()).sum();
   }
-  for (int c = parts.first_held; c < parts.first_held + parts.num_held; ++c) result->share[3] += 1 - s2 * inverse(c, c);
 }
 
 }  // namespace
@@ -80,14 +79,17 @@ ChiSquare ChiSquareOf(int begin, int end, const Residuals& residuals, int num_do
 }
 
 
+int DegreesOfFreedomOf(double relative_variance) {
+  if (!(relative_variance > 0)) return 0;
+  constexpr double kLargest = 1e8;  // beyond this the estimate is as good as known
+  return static_cast<int>(std::lround(std::clamp(2.0 / relative_variance, 1.0, kLargest)));
+}
+
 int PoseNoiseDof(const ChiSquare& chi_square, const Eigen::Matrix4d& relative_covariance) {
   const Eigen::Vector3d s(chi_square.share[0], chi_square.share[1], chi_square.share[2]);
   const double total = s.sum();
   if (!(total > 0)) return 0;
-  const double variance = s.dot(relative_covariance.bottomRightCorner<3, 3>() * s) / (total * total);
-  if (!(variance > 0)) return 0;
-  constexpr double kLargest = 1e8;  // beyond this the size is as good as known
-  return static_cast<int>(std::lround(std::clamp(2.0 / variance, 1.0, kLargest)));
+  return DegreesOfFreedomOf(s.dot(relative_covariance.bottomRightCorner<3, 3>() * s) / (total * total));
 }
 
 }  // namespace selfcal::calibration

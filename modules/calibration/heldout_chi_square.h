@@ -43,20 +43,25 @@ struct VarianceBlock {
 };
 struct VarianceParts {
   std::vector<VarianceBlock> blocks;
-  int first_held = 0, num_held = 0;  // the held parameters' prior columns: stated, not estimated
 };
 
 struct ChiSquare {
   double value = 0;                  // r^T C^-1 r
-  std::array<double, 4> share{};     // tr(C^-1 C_k): translation, rotation, joint, held prior (the rest: pixel)
+  std::array<double, 3> share{};     // tr(C^-1 C_k): translation, rotation, joint
 };
 
 // Over the residuals [begin, end) with `sigma` the pixel noise; parts: fill ChiSquare::share (null: not).
 ChiSquare ChiSquareOf(int begin, int end, const Residuals& residuals, int num_dots, double sigma,
                       const VarianceParts* parts = nullptr);
 
-// The degrees of freedom of the pose part's size: 2 / (s^T V s / (sum s)^2) over the components' shares s,
-// V = relative_covariance's pose block (translation, rotation, joint); 0 (known) when V or s is zero.
+// The degrees of freedom of an estimated variance whose relative variance is `relative_variance`
+// (chi-square: 2 / dof), rounded, at least 1 and at most 1e8 (as good as known); 0 (known) when it is not
+// positive.
+int DegreesOfFreedomOf(double relative_variance);
+
+// The degrees of freedom of the pose part's size: DegreesOfFreedomOf(s^T V s / (sum s)^2) over the
+// components' shares s, V = relative_covariance's pose block (translation, rotation, joint); 0 (known) when
+// V or s is zero.
 int PoseNoiseDof(const ChiSquare& chi_square, const Eigen::Matrix4d& relative_covariance);
 
 }  // namespace selfcal::calibration

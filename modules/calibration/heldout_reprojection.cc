@@ -356,8 +356,8 @@ HeldOutFigure FigureOf(const std::string& pose_id, int begin, int end, const Res
   const bool estimated = !model.relative_variance_covariance.isZero(0);
   const ChiSquare chi_square = ChiSquareOf(begin, end, residuals, num_dots, sigma, estimated ? &parts : nullptr);
   if (estimated) {
-    const double pixel = model.relative_variance_covariance(0, 0);
-    if (pixel > 0) f.noise_dof = static_cast<int>(std::lround(std::min(2.0 / pixel, 1e8)));
+    const int pixel_dof = DegreesOfFreedomOf(model.relative_variance_covariance(0, 0));
+    if (pixel_dof > 0) f.noise_dof = pixel_dof;
     f.pose_share = chi_square.share[0] + chi_square.share[1] + chi_square.share[2];
     f.pose_noise_dof = PoseNoiseDof(chi_square, model.relative_variance_covariance);
   }
@@ -454,8 +454,6 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
   const int held_column = identification_column + static_cast<int>(dtheta.cols());
   const int width = held_column + nh;
   VarianceParts parts;
-  parts.first_held = held_column;
-  parts.num_held = nh;
   const bool variances = pose_error && !model.relative_variance_covariance.isZero(0);
   const std::vector<PredictionModel> components = variances ? ComponentModels(model) : std::vector<PredictionModel>();
   if (variances && carried) AddIdentificationBlocks(obs, model, components, identification_column, &parts);

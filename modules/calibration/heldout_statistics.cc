@@ -41,18 +41,29 @@ ScaleDraws DrawsOfTheEstimate(int nu) {
   return d;
 }
 
-// P(X > x) for X of ChiSquareQuantile's comment, in f = x / dof.
-double UpperTail(double f, int dof, int noise_dof, double pose_share, int pose_noise_dof) {
-  const double share = std::clamp(pose_share, 0.0, static_cast<double>(dof));
-  if (!(share > 0) || pose_noise_dof <= 0) return FUpperTail(f, dof, noise_dof);
-  const ScaleDraws draws = DrawsOfTheEstimate(pose_noise_dof);
-  const double rest = dof - share;
+// The statistic's distribution (ChiSquareQuantile's comment), with the pose part's scale draws made once.
+struct Statistic {
+  int dof = 0, noise_dof = 0;
+  double share = 0;   // the pose part, within [0, dof]; 0: none, or its size known
+  ScaleDraws draws;   // of its size's estimate, when share > 0
+};
+Statistic StatisticOf(int dof, int noise_dof, double pose_share, int pose_noise_dof) {
+  Statistic x{dof, noise_dof, std::clamp(pose_share, 0.0, static_cast<double>(dof)), {}};
+  if (!(x.share > 0) || pose_noise_dof <= 0) x.share = 0;
+  if (x.share > 0) x.draws = DrawsOfTheEstimate(pose_noise_dof);
+  return x;
+}
+
+// P(X > x) in f = x / dof.
+double UpperTail(double f, const Statistic& x) {
+  if (x.share == 0) return FUpperTail(f, x.dof, x.noise_dof);
+  const double rest = x.dof - x.share;
   double tail = 0;
-  for (size_t i = 0; i < draws.scale.size(); ++i) {
-    const double lambda = draws.scale[i];
-    const double mean = rest + lambda * share, variance = 2 * (rest + lambda * lambda * share);
+  for (size_t i = 0; i < x.draws.scale.size(); ++i) {
+    const double lambda = x.draws.scale[i];
+    const double mean = rest + lambda * x.share, variance = 2 * (rest + lambda * lambda * x.share);
     const double k = 2 * mean * mean / variance;  // X ~ mean chi-square(k) / k
-    tail += draws.weight[i] * FUpperTail(f * dof / mean, k, noise_dof);
+    tail += x.draws.weight[i] * FUpperTail(f * x.dof / mean, k, x.noise_dof);
   }
   return tail;
 }
@@ -61,12 +72,13 @@ double UpperTail(double f, int dof, int noise_dof, double pose_share, int pose_n
 
 double ChiSquareQuantile(double p, int dof, int noise_dof, double pose_share, int pose_noise_dof) {
   if (dof <= 0 || noise_dof < 0 || !(p > 0 && p < 1)) return NAN;
+  const Statistic x = StatisticOf(dof, noise_dof, pose_share, pose_noise_dof);
   // Bisection on the decreasing upper tail, in f = x / dof.
   double lo = 0, hi = 1;
-  while (UpperTail(hi, dof, noise_dof, pose_share, pose_noise_dof) > 1 - p && hi < 1e12) hi *= 2;
+  while (UpperTail(hi, x) > 1 - p && hi < 1e12) hi *= 2;
   for (int iteration = 0; iteration < 200 && hi - lo > 1e-10 * hi; ++iteration) {
     const double mid = 0.5 * (lo + hi);
-    (UpperTail(mid, dof, noise_dof, pose_share, pose_noise_dof) > 1 - p ? lo : hi) = mid;
+    (UpperTail(mid, x) > 1 - p ? lo : hi) = mid;
   }
   return dof * 0.5 * (lo + hi);
 }
@@ -74,7 +86,7 @@ double ChiSquareQuantile(double p, int dof, int noise_dof, double pose_share, in
 double ChiSquareUpperTail(double x, int dof, int noise_dof, double pose_share, int pose_noise_dof) {
   if (dof <= 0 || noise_dof < 0 || !std::isfinite(x)) return NAN;
   if (x <= 0) return 1.0;
-  return UpperTail(x / dof, dof, noise_dof, pose_share, pose_noise_dof);
+  return UpperTail(x / dof, StatisticOf(dof, noise_dof, pose_share, pose_noise_dof));
 }
 
 }  // namespace selfcal::calibration
