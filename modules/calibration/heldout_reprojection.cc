@@ -1,6 +1,7 @@
 #include "calibration/heldout_reprojection.h"
 
 #include <algorithm>
+#include <array>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -149,58 +150,65 @@ bool CarriesIdentificationPoseErrors(const PredictionModel& model) {
   return HasPoseError(model) && !model.pose_error_at_flange;
 }
 
-// M with e = M z, z ~ N(0, I): the camera motion of `pose`'s pose error under `model` (Theta = M M^T;
-// bundle/error_model.h), a joint set's joint-reading noise through the pose's CameraMotionPerJoint, or the
-// flange pose noise carried to the camera.
-Eigen::Matrix<double, 6, 6> PoseErrorRootAt(const PredictionModel& model, const PoseFrames& frames,
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+// Theta_k, the covariance of `pose`'s camera motion from each pose-error component under `model`
+// (translation, rotation, joint reading; bundle/error_model.h): a joint set's joint-reading noise through the
+// pose's CameraMotionPerJoint, or the flange pose noise carried to the camera. Their sum is Theta.
+std::array<Matrix6d, 3> PoseErrorComponents(const PredictionModel& model, const PoseFrames& frames,
                                             const PoseObservation& pose) {
   if (model.pose_error_at_flange) {
-    return FlangePoseMotion(FlangeFromCamAt(model, frames, pose), model.pose_translation_m, model.pose_rotation_rad);
+    const Rigid3 flange_from_cam = FlangeFromCamAt(model, frames, pose);
+    const Matrix6d t = FlangePoseMotion(flange_from_cam, model.pose_translation_m, 0);
+    const Matrix6d r = FlangePoseMotion(flange_from_cam, 0, model.pose_rotation_rad);
+    return {t * t.transpose(), r * r.transpose(), Matrix6d::Zero()};
   }
   const bool joints = model.joint_rad > 0 && !pose.base_from_flange && pose.joints_rad.size() > 0;
-  const Eigen::Matrix<double, 6, 6> theta = bundle::PoseErrorCovariance(
-      model.pose_translation_m, model.pose_rotation_rad, joints ? model.joint_rad : 0.0,
-      joints ? Eigen::MatrixXd(CameraMotionPerJoint(model.robot, model.rho, pose.joints_rad)) : Eigen::MatrixXd());
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(theta);
+  return {bundle::PoseErrorCovariance(model.pose_translation_m, 0, 0, Eigen::MatrixXd()),
+          bundle::PoseErrorCovariance(0, model.pose_rotation_rad, 0, Eigen::MatrixXd()),
+          joints ? bundle::PoseErrorCovariance(0, 0, model.joint_rad,
+                                               CameraMotionPerJoint(model.robot, model.rho, pose.joints_rad))
+                 : Matrix6d::Zero()};
+}
+
+// M with M M^T = theta (symmetric, semi-definite).
+Matrix6d SymmetricRoot(const Matrix6d& theta) {
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(theta);
   return eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
 }
 
-// PoseErrorRootAt's model with one component's size only (translation, rotation, joint), for VarianceBlockAt.
-std::vector<PredictionModel> ComponentModels(const PredictionModel& model) {
-  std::vector<PredictionModel> parts(3, model);
-  parts[0].pose_rotation_rad = parts[0].joint_rad = 0;
-  parts[1].pose_translation_m = parts[1].joint_rad = 0;
-  parts[2].pose_translation_m = parts[2].pose_rotation_rad = 0;
-  return parts;
+Matrix6d SumOf(const std::array<Matrix6d, 3>& theta) { return theta[0] + theta[1] + theta[2]; }
+
+// M with e = M z, z ~ N(0, I): the camera motion of `pose`'s pose error under `model` (Theta = M M^T, the
+// sum of PoseErrorComponents; at the flange, the noise's own axes carried to the camera).
+Matrix6d PoseErrorRootAt(const PredictionModel& model, const PoseFrames& frames, const PoseObservation& pose) {
+  if (model.pose_error_at_flange) {
+    return FlangePoseMotion(FlangeFromCamAt(model, frames, pose), model.pose_translation_m, model.pose_rotation_rad);
+  }
+  return SymmetricRoot(SumOf(PoseErrorComponents(model, frames, pose)));
 }
 
 // One image's pose-error columns (root R from `column`) split by component: E_k = R^+ Theta_k R^+T
 // (heldout_chi_square.h).
-VarianceBlock VarianceBlockAt(const std::vector<PredictionModel>& components, const PoseFrames& frames,
-                              const PoseObservation& pose, const Eigen::Matrix<double, 6, 6>& root, int column) {
+VarianceBlock VarianceBlockAt(const std::array<Matrix6d, 3>& theta, const Matrix6d& root, int column) {
   VarianceBlock b;
   b.column = column;
-  Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<double, 6, 6>> decomposition;
+  Eigen::CompleteOrthogonalDecomposition<Matrix6d> decomposition;
   decomposition.setThreshold(1e-9);
   decomposition.compute(root);
-  const Eigen::Matrix<double, 6, 6> inverse = decomposition.pseudoInverse();
-  for (int k = 0; k < 3; ++k) {
-    const Eigen::Matrix<double, 6, 6> part = PoseErrorRootAt(components[k], frames, pose);
-    b.e[k] = inverse * part * part.transpose() * inverse.transpose();
-  }
+  const Matrix6d inverse = decomposition.pseudoInverse();
+  for (int k = 0; k < 3; ++k) b.e[k] = inverse * theta[k] * inverse.transpose();
   return b;
 }
 
 // The identification images' carried pose-error columns (6 each from first_column, in their order) by
-// component.
-void AddIdentificationBlocks(const ObservationSet& obs, const PredictionModel& model,
-                             const std::vector<PredictionModel>& components, int first_column, VarianceParts* parts) {
+// component; carried errors are the camera frame's, which do not look at the frames.
+void AddIdentificationBlocks(const ObservationSet& obs, const PredictionModel& model, int first_column,
+                             VarianceParts* parts) {
   const std::vector<int> identification = obs.PosesWithRole(PoseRole::kIdentification);
   for (size_t index = 0; index < identification.size(); ++index) {
-    const PoseObservation& pose = obs.poses[identification[index]];
-    const PoseFrames camera_frame;  // a camera-frame pose error (the carried kind) does not look at the frames
-    parts->blocks.push_back(VarianceBlockAt(components, camera_frame, pose, PoseErrorRootAt(model, camera_frame, pose),
-                                            first_column + 6 * static_cast<int>(index)));
+    const std::array<Matrix6d, 3> theta = PoseErrorComponents(model, PoseFrames(), obs.poses[identification[index]]);
+    parts->blocks.push_back(VarianceBlockAt(theta, SymmetricRoot(SumOf(theta)), first_column + 6 * static_cast<int>(index)));
   }
 }
 
@@ -455,8 +463,7 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
   const int width = held_column + nh;
   VarianceParts parts;
   const bool variances = pose_error && !model.relative_variance_covariance.isZero(0);
-  const std::vector<PredictionModel> components = variances ? ComponentModels(model) : std::vector<PredictionModel>();
-  if (variances && carried) AddIdentificationBlocks(obs, model, components, identification_column, &parts);
+  if (variances && carried) AddIdentificationBlocks(obs, model, identification_column, &parts);
   Residuals residuals;
   residuals.num_theta = width;
   std::vector<int> first_row_of_pose;  // per report.poses entry, and one past the end
@@ -466,7 +473,10 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
     const PoseFrames frames = projector.Frames(pose);
     const Eigen::Matrix<double, 6, 6> pose_root =
         pose_error ? PoseErrorRootAt(model, frames, pose) : Eigen::Matrix<double, 6, 6>::Zero();
-    if (variances) parts.blocks.push_back(VarianceBlockAt(components, frames, pose, pose_root, nt + 6 * static_cast<int>(index)));
+    if (variances) {
+      parts.blocks.push_back(
+          VarianceBlockAt(PoseErrorComponents(model, frames, pose), pose_root, nt + 6 * static_cast<int>(index)));
+    }
     const int first = static_cast<int>(residuals.rows.size());
     for (const auto& [id, pixel] : pose.dots_px) {
       const auto d = info.find(id);
