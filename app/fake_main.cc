@@ -15,6 +15,13 @@ std::atomic<int> g_acknowledgements{0};  // likewise
 extern "C" void OnStopSignal(int) { g_stop.store(true); }
 extern "C" void OnAcknowledgeSignal(int) { g_acknowledgements.fetch_add(1); }
 
+void Handle(int signal, void (*handler)(int)) {
+  struct sigaction action {};
+  action.sa_handler = handler;
+  sigemptyset(&action.sa_mask);
+  ::sigaction(signal, &action, nullptr);
+}
+
 }  // namespace
 
 std::optional<int> ParseFakeCommandLine(CLI::App& app, int argc, char** argv) {
@@ -29,19 +36,13 @@ std::optional<int> ParseFakeCommandLine(CLI::App& app, int argc, char** argv) {
 }
 
 const std::atomic<bool>& StopOnSignals() {
-  struct sigaction action {};
-  action.sa_handler = OnStopSignal;
-  sigemptyset(&action.sa_mask);
-  ::sigaction(SIGINT, &action, nullptr);
-  ::sigaction(SIGTERM, &action, nullptr);
+  Handle(SIGINT, OnStopSignal);
+  Handle(SIGTERM, OnStopSignal);
   return g_stop;
 }
 
 const std::atomic<int>& CountAcknowledgements() {
-  struct sigaction action {};
-  action.sa_handler = OnAcknowledgeSignal;
-  sigemptyset(&action.sa_mask);
-  ::sigaction(SIGUSR1, &action, nullptr);
+  Handle(SIGUSR1, OnAcknowledgeSignal);
   return g_acknowledgements;
 }
 
