@@ -10,6 +10,7 @@ function(selfcal_add_module)
   target_include_directories(${target} PUBLIC ${PROJECT_SOURCE_DIR}/modules)
   target_link_libraries(${target} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
   selfcal_set_warnings(${target})
+  selfcal_set_unity(${target})
 endfunction()
 
 # selfcal_add_module_test(NAME <m> SRCS ... [DEPS ...] [LABELS ...])
@@ -49,4 +50,10 @@ function(selfcal_set_warnings target)
   if(SELFCAL_WERROR)
     target_compile_options(${target} PRIVATE -Werror)
   endif()
+endfunction()
+
+# The sources of `target` compiled in batches of up to 16 (SELFCAL_UNITY_BUILD): names at namespace scope
+# in a source's anonymous namespace must then be unique within its module.
+function(selfcal_set_unity target)
+  set_target_properties(${target} PROPERTIES UNITY_BUILD ${SELFCAL_UNITY_BUILD} UNITY_BUILD_BATCH_SIZE 16)
 endfunction()

@@ -22,10 +22,10 @@ std::string DecodeKey(std::string_view raw) {
 
 // One pass over the text in a loop with an explicit stack (a document nested a million deep must not
 // exhaust the call stack): what comes next is a value, a member of an object, or what follows a value.
-class Scanner {
+class JsonScanner {
  public:
   // `lines` null: only the first repeated key is looked for.
-  Scanner(std::string_view text, std::map<std::string, int>* lines, std::optional<JsonDuplicateKey>* duplicate)
+  JsonScanner(std::string_view text, std::map<std::string, int>* lines, std::optional<JsonDuplicateKey>* duplicate)
       : text_(text), lines_(lines), duplicate_(duplicate) {}
 
   void Run() {
@@ -151,12 +151,12 @@ class Scanner {
 
 JsonLines::JsonLines(std::string_view text) {
   lines_[""] = FirstValueLine(text);
-  Scanner(text, &lines_, &duplicate_).Run();
+  JsonScanner(text, &lines_, &duplicate_).Run();
 }
 
 std::optional<JsonDuplicateKey> FindDuplicateJsonKey(std::string_view text) {
   std::optional<JsonDuplicateKey> duplicate;
-  Scanner(text, nullptr, &duplicate).Run();
+  JsonScanner(text, nullptr, &duplicate).Run();
   return duplicate;
 }
 

@@ -33,9 +33,9 @@ size_t Utf8Length(const std::string& text, size_t i) {
   return n;
 }
 
-class Scanner {
+class XmlScanner {
  public:
-  Scanner(const std::string& text, const std::string& name, const XmlScanLimits& limits)
+  XmlScanner(const std::string& text, const std::string& name, const XmlScanLimits& limits)
       : s_(text), name_(name), limits_(limits) {}
 
   Status Run() {
@@ -210,7 +210,7 @@ Status ScanXml(const std::string& text, const std::string& name, const XmlScanLi
                            name + ":" + std::to_string(line) + ": invalid UTF-8 (" + limits.kind + " must be UTF-8)");
     }
   }
-  return Scanner(text, name, limits).Run();
+  return XmlScanner(text, name, limits).Run();
 }
 
 }  // namespace selfcal

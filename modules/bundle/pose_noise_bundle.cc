@@ -18,8 +18,8 @@ namespace {
 
 // x0 is the hand-eye transform: flange_from_cam (eye-in-hand: the points in the base frame) or base_from_cam
 // (eye_to_hand: the points in the flange frame, points_from_cam = (base_from_flange Exp(delta))^-1 x0 Exp(c)).
-struct Reprojection {
-  Reprojection(const Rigid3* base_from_flange, const Rigid3* x0, bool eye_to_hand, Eigen::Vector2d pixel, double sigma)
+struct FlangeReprojection {
+  FlangeReprojection(const Rigid3* base_from_flange, const Rigid3* x0, bool eye_to_hand, Eigen::Vector2d pixel, double sigma)
       : base_from_flange(base_from_flange), x0(x0), eye_to_hand(eye_to_hand), pixel(std::move(pixel)),
         inv_sigma(1.0 / sigma) {}
   template <typename T>
@@ -68,7 +68,7 @@ std::vector<KnownDistance> LengthsAmong(const std::vector<KnownDistance>& yardst
   return out;
 }
 
-struct Obs {
+struct PoseObs {
   int pose = -1;
   int dot = -1;
   Eigen::Vector2d pixel;
@@ -130,7 +130,7 @@ PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
   const bool eye_to_hand = obs.robot.mount == CameraMount::kEyeToHand;
   const std::vector<int> poses = obs.PosesWithRole(PoseRole::kIdentification);
   std::vector<Rigid3> flanges;
-  std::vector<Obs> all;
+  std::vector<PoseObs> all;
   std::map<int, int> views;
   for (size_t i = 0; i < poses.size(); ++i) {
     const PoseObservation& pose = obs.poses[poses[i]];
@@ -159,8 +159,8 @@ PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
     ceres::Problem problem;
     for (size_t k = 0; k < all.size(); ++k) {
       if (!keep[k] || !dots.count(all[k].dot)) continue;
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Reprojection, 2, 6, 6, 3, kNumIntrinsics>(
-                                   new Reprojection(&flanges[all[k].pose], &x0, eye_to_hand, all[k].pixel, sigma)),
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<FlangeReprojection, 2, 6, 6, 3, kNumIntrinsics>(
+                                   new FlangeReprojection(&flanges[all[k].pose], &x0, eye_to_hand, all[k].pixel, sigma)),
                                round == 0 ? new ceres::LossFunctionWrapper(&huber, ceres::DO_NOT_TAKE_OWNERSHIP) : nullptr,
                                deltas[all[k].pose].data(), c.data(), dots[all[k].dot].data(), intrinsics.data());
     }
@@ -178,10 +178,10 @@ PoseNoiseReport RunPoseNoiseBundle(const ObservationSet& obs, const Rigid3& x0,
     summary = internal::SolveWithIntrinsics(&problem, intrinsics.data(), options.intrinsics, options.max_iterations);
     if (internal::SolverFailed(summary, &report.message)) return report;
     std::vector<double> errors;
-    for (const Obs& o : all) {
+    for (const PoseObs& o : all) {
       double r[2] = {NAN, NAN};
       if (dots.count(o.dot)) {
-        Reprojection f(&flanges[o.pose], &x0, eye_to_hand, o.pixel, 1.0);
+        FlangeReprojection f(&flanges[o.pose], &x0, eye_to_hand, o.pixel, 1.0);
         if (!f(deltas[o.pose].data(), c.data(), dots[o.dot].data(), intrinsics.data(), r)) r[0] = NAN;
       }
       errors.push_back(std::hypot(r[0], r[1]));

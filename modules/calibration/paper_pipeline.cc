@@ -22,7 +22,7 @@ const char* OutcomeName(Outcome outcome) {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double SecondsSince(Clock::time_point start) {
+double SecondsSinceStart(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
@@ -240,7 +240,7 @@ bool IdentifyParameters(const ObservationSet& obs, const Eigen::VectorXd& rho_no
     if (reweighted.outcome != identification::Outcome::kConverged) break;  // keep the converged solve
     report->identification = std::move(reweighted);
   }
-  report->seconds_identification = SecondsSince(start_identification);
+  report->seconds_identification = SecondsSinceStart(start_identification);
   if (report->identification.outcome == identification::Outcome::kFailure ||
       report->identification.outcome == identification::Outcome::kInvalidInput) {
     report->outcome = Outcome::kSolverFailure;
@@ -319,7 +319,7 @@ PaperPipelineReport RunPaperPipeline(const ObservationSet& obs, const PaperPipel
   EstimatePairs(obs, id_poses, rho_nominal, nominal_ref_from_base, options, &report);
   SolveAgainWithMeasuredFx(obs, ref, options, &report);
   const Motions motions = UsableMotions(&report);
-  report.seconds_two_view = SecondsSince(start_two_view);
+  report.seconds_two_view = SecondsSinceStart(start_two_view);
   if (static_cast<int>(motions.directions.size()) < options.min_pose_measurements) {
     TooFewMotions(motions.directions.size(), options, &report);
     return report;
@@ -331,7 +331,7 @@ PaperPipelineReport RunPaperPipeline(const ObservationSet& obs, const PaperPipel
   // Steps 3 to 5.
   if (!IdentifyParameters(obs, rho_nominal, all_joints.size(), scaled, options, &report)) return report;
   ScaleAndVerify(obs, id_poses, verification_poses, rho_nominal, options, &report);
-  report.seconds_total = SecondsSince(start);
+  report.seconds_total = SecondsSinceStart(start);
   return report;
 }
 

@@ -143,6 +143,7 @@ struct PoseDifference {
 PoseDifference ComparePoses(const Rigid3& a, const Rigid3& b);
 
 constexpr double kPi = 3.14159265358979323846;
+constexpr double kMmPerM = 1e3;  // reports and configs speak mm (docs/frames-and-units.md)
 constexpr double DegToRad(double deg) { return deg * kPi / 180.0; }
 constexpr double RadToDeg(double rad) { return rad * 180.0 / kPi; }
 

@@ -13,7 +13,6 @@ namespace selfcal::planning::internal {
 namespace {
 
 // Robots up to 7 joints (the Panda); unused derivative slots stay zero.
-constexpr int kMaxJoints = 7;
 using JointJet = ceres::Jet<double, kMaxJoints>;
 using PairJet = ceres::Jet<double, 2 * kMaxJoints>;
 using PointJet = ceres::Jet<double, 3>;  // a camera-frame point's coordinates

@@ -16,7 +16,6 @@ namespace {
 
 // Partials: slots [0, 7) the joints of pose i, [7, 14) those of the reference pose (robots up to 7 joints:
 // the Panda). Unused slots stay zero, so a 6-joint robot's values and gradients are those of 12 slots.
-constexpr int kMaxJoints = 7;
 constexpr int kSlots = 2 * kMaxJoints;
 using Jet = ceres::Jet<double, kSlots>;
 using JetMatrix = Eigen::Matrix<Jet, Eigen::Dynamic, Eigen::Dynamic>;

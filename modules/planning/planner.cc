@@ -21,7 +21,6 @@ namespace selfcal::planning {
 namespace {
 
 // Robots up to 7 joints (the Panda): eq. (39) and its barrier carry the joints in fixed-size Jets.
-constexpr int kMaxJoints = 7;
 
 double Seconds(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -33,6 +33,13 @@
 #include "geometry/rigid3.h"
 #include "kinematics/robot_model.h"
 
+namespace selfcal::planning {
+
+// The most joints the planner differentiates for: its Jets over the joint angles have a fixed size.
+constexpr int kMaxJoints = 7;
+
+}  // namespace selfcal::planning
+
 namespace selfcal::planning::internal {
 
 template <typename T>

@@ -21,10 +21,9 @@ using html::Table;
 using html::Text;
 using nlohmann::json;
 
-constexpr double kMm = 1e3;
 constexpr double kDeg = RadToDeg(1.0);
 
-std::string Mm(const json& v) { return Text(v, 4, kMm); }
+std::string Mm(const json& v) { return Text(v, 4, kMmPerM); }
 std::string Yes(const json& v) { return v.is_boolean() ? (v.get<bool>() ? "yes" : "no") : Text(v); }
 
 // The reasons of a verdict, in whatever form the document gives them: strings, or objects with a
@@ -151,7 +150,7 @@ void ParameterTable(const json& parameters, Page* page) {
   for (const json& row : parameters) {
     const bool length = At(row, {"nominal_m"}).is_number();
     const char* unit = length ? "_m" : "_rad";
-    const double scale = length ? kMm : kDeg;
+    const double scale = length ? kMmPerM : kDeg;
     auto cell = [&](const std::string& key, int digits) { return Text(At(row, {(key + unit).c_str()}), digits, scale); };
     const bool free = At(row, {"free"}) == true;
     std::vector<std::string> cells = {Text(At(row, {"name"})), Yes(At(row, {"free"})), length ? "mm" : "deg",

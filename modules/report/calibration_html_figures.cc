@@ -16,7 +16,6 @@ namespace {
 
 using nlohmann::json;
 
-constexpr double kMm = 1e3;
 constexpr const char* kIdentificationColour = "#1f77b4";
 constexpr const char* kHeldOutColour = "#ff7f0e";
 constexpr const char* kNominalColour = "#8c8c8c";
@@ -65,8 +64,8 @@ json Axis(const std::string& title) { return {{"title", {{"text", title}}}}; }
 void AddSegment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, json* trace) {
   for (const char* k : {"x", "y", "z"}) {
     const int i = k[0] - 'x';
-    (*trace)[k].push_back(a[i] * kMm);
-    (*trace)[k].push_back(b[i] * kMm);
+    (*trace)[k].push_back(a[i] * kMmPerM);
+    (*trace)[k].push_back(b[i] * kMmPerM);
     (*trace)[k].push_back(nullptr);
   }
 }
@@ -89,7 +88,7 @@ void SceneFigure(const json& plot_data, const json& verification, Page* page) {
   dot_trace["text"] = json::array();
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
   for (const auto& [id, p] : dots) {
-    for (int k = 0; k < 3; ++k) dot_trace[std::string(1, char('x' + k))].push_back(p[k] * kMm);
+    for (int k = 0; k < 3; ++k) dot_trace[std::string(1, char('x' + k))].push_back(p[k] * kMmPerM);
     dot_trace["text"].push_back("dot " + std::to_string(id));
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
@@ -125,7 +124,7 @@ void SceneFigure(const json& plot_data, const json& verification, Page* page) {
     for (const Camera& c : cameras) {
       if (c.role != role) continue;
       const Eigen::Vector3d& t = c.base_from_cam.translation;
-      for (int k = 0; k < 3; ++k) centres[std::string(1, char('x' + k))].push_back(t[k] * kMm);
+      for (int k = 0; k < 3; ++k) centres[std::string(1, char('x' + k))].push_back(t[k] * kMmPerM);
       centres["text"].push_back(PlotText("pose " + c.pose));
       AddSegment(t, t + axis_m * c.base_from_cam.rotation.col(2), &axes);
     }
@@ -281,7 +280,7 @@ void CorrectionFigure(const json& parameters, Page* page) {
       const double sd = Number(At(row, {length ? "stddev_m" : "stddev_rad"}));
       if (!std::isfinite(value)) continue;
       json& trace = length ? lengths : angles;
-      const double unit = length ? kMm : RadToDeg(1.0);
+      const double unit = length ? kMmPerM : RadToDeg(1.0);
       trace["x"].push_back(PlotText(Text(At(row, {"name"}))));
       trace["y"].push_back(value * unit);
       trace["error_y"]["array"].push_back(std::isfinite(sd) ? json(sd * unit) : json(nullptr));
@@ -398,10 +397,10 @@ void CheckDistanceFigure(const json& verification, const json& predicted, Page* 
       const json& a = At(c, {"dot_a"});
       const json& b = At(c, {"dot_b"});
       bars["x"].push_back(PlotText(Text(a) + "-" + Text(b)));
-      bars["y"].push_back(Number(At(c, {"error_m"})) * kMm);
+      bars["y"].push_back(Number(At(c, {"error_m"})) * kMmPerM);
       const auto p = a.is_number_integer() && b.is_number_integer() ? predicted_std.find({a.get<int>(), b.get<int>()})
                                                                      : predicted_std.end();
-      errors.push_back(p != predicted_std.end() && std::isfinite(p->second) ? json(p->second * kMm) : json(nullptr));
+      errors.push_back(p != predicted_std.end() && std::isfinite(p->second) ? json(p->second * kMmPerM) : json(nullptr));
     }
     if (std::string(key) == "calibrated_model" && !predicted_std.empty()) {
       bars["error_y"] = {{"type", "data"}, {"array", errors}, {"visible", true}};

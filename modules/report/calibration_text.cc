@@ -11,8 +11,6 @@ namespace selfcal::report {
 
 namespace {
 
-constexpr double kMm = 1e3;  // the text prints mm
-
 // The paper pipeline's outcome, one line: a long message (one clause per pose pair) cut to its first
 // clause and the unused pairs counted by outcome (report.json lists them pair by pair). `bundle_follows`:
 // the bundle ran after it and starts from the nominal model when the paper pipeline did not succeed.
@@ -46,7 +44,7 @@ void PrintPaperSummary(const calibration::PaperPipelineReport& r, bool bundle_fo
   if (r.identification.outcome != identification::Outcome::kNotRun) {
     out << "identification: " << identification::OutcomeName(r.identification.outcome) << ", "
         << r.identification.iterations << " iterations, residual RMS " << std::setprecision(3)
-        << r.identification.rms_position_m * kMm << " mm / " << RadToDeg(r.identification.rms_rotation_rad)
+        << r.identification.rms_position_m * kMmPerM << " mm / " << RadToDeg(r.identification.rms_rotation_rad)
         << " deg\n";
   }
   if (r.yardstick.ok) {
@@ -56,14 +54,13 @@ void PrintPaperSummary(const calibration::PaperPipelineReport& r, bool bundle_fo
   }
   if (r.verification_calibrated.num_ok > 0) {
     out << "3-D error on " << r.verification_calibrated.num_ok << " held-out distances: nominal model "
-        << std::setprecision(3) << r.verification_nominal.rms_error_m * kMm << " mm RMS, calibrated "
-        << r.verification_calibrated.rms_error_m * kMm << " mm RMS (max " << r.verification_calibrated.max_error_m * kMm
+        << std::setprecision(3) << r.verification_nominal.rms_error_m * kMmPerM << " mm RMS, calibrated "
+        << r.verification_calibrated.rms_error_m * kMmPerM << " mm RMS (max " << r.verification_calibrated.max_error_m * kMmPerM
         << " mm)\n";
   }
   out << "time: " << std::setprecision(1) << r.seconds_total * 1e3 << " ms\n";
   out.unsetf(std::ios::floatfield);
 }
-
 
 // The held-out reprojection: overall for both models, and the verification poses above their own 95 %
 // limit at the bundle's noise estimate, as figures: the verdict's test is the acceptance's, at the stated
@@ -135,7 +132,7 @@ void PrintWeakDirections(const bundle::BundleReport& b, std::ostream& out) {
     out << "  " << BarelyMovesSentence(j, "the identification poses") << "\n";
   }
   for (const bundle::WeakParameter& w : b.weak) {
-    const double scale = w.length ? kMm : RadToDeg(1.0);
+    const double scale = w.length ? kMmPerM : RadToDeg(1.0);
     const char* unit = w.length ? " mm" : " deg";
     out << "  held (weak): " << w.name << " at the robot description's value: these poses determine it only to +- "
         << std::setprecision(3) << w.conditional_std * scale << unit
@@ -175,7 +172,7 @@ void PrintBundleSummary(const calibration::BundleStageReport& stage, bool flange
   out.unsetf(std::ios::floatfield);
   if (b.error_model.estimated) {
     out << "  error model from the residuals (the sigmas' model): pixel noise " << std::setprecision(3)
-        << b.error_model.pixel_px << " px, camera pose per image " << b.error_model.pose_translation_m * kMm << " mm / "
+        << b.error_model.pixel_px << " px, camera pose per image " << b.error_model.pose_translation_m * kMmPerM << " mm / "
         << RadToDeg(b.error_model.pose_rotation_rad) << " deg per axis";
     if (b.error_model.joint_rad >= 0) out << ", joint readings " << RadToDeg(b.error_model.joint_rad) << " deg";
     out << "\n";
@@ -183,13 +180,13 @@ void PrintBundleSummary(const calibration::BundleStageReport& stage, bool flange
   PrintLensSummary(b, out);
   if (stage.verification.num_ok > 0) {
     out << "  3-D error on " << stage.verification.num_ok << " held-out distances: nominal model " << std::fixed
-        << std::setprecision(3) << stage.verification_nominal.rms_error_m * kMm << " mm RMS, bundle "
-        << stage.verification.rms_error_m * kMm << " mm RMS (max " << stage.verification.max_error_m * kMm << " mm)\n";
+        << std::setprecision(3) << stage.verification_nominal.rms_error_m * kMmPerM << " mm RMS, bundle "
+        << stage.verification.rms_error_m * kMmPerM << " mm RMS (max " << stage.verification.max_error_m * kMmPerM << " mm)\n";
   }
   if (stage.predicted_error.ok) {
-    out << "  predicted 3-D error (first order): " << std::fixed << std::setprecision(3) << stage.predicted_error.rms_std_m * kMm
-        << " mm RMS (calibrated parameters " << stage.predicted_error.rms_parameters_std_m * kMm
-        << " mm, verification pixels " << stage.predicted_error.rms_pixels_std_m * kMm << " mm)\n";
+    out << "  predicted 3-D error (first order): " << std::fixed << std::setprecision(3) << stage.predicted_error.rms_std_m * kMmPerM
+        << " mm RMS (calibrated parameters " << stage.predicted_error.rms_parameters_std_m * kMmPerM
+        << " mm, verification pixels " << stage.predicted_error.rms_pixels_std_m * kMmPerM << " mm)\n";
     out.unsetf(std::ios::floatfield);
   }
   if (heldout != nullptr) PrintHeldOut(*heldout, stage.heldout_nominal, "the bundle's noise estimate", out);
@@ -200,12 +197,11 @@ void PrintBundleSummary(const calibration::BundleStageReport& stage, bool flange
   out.unsetf(std::ios::floatfield);
 }
 
-
 // The pose-noise solve of a flange-pose set when it is the result: the figures the model written carries.
 void PrintPoseNoiseResult(const calibration::CalibrationReport& report, std::ostream& out) {
   const bundle::PoseNoiseReport& n = *report.pose_noise;
   out << "the model written is the pose-noise solve's (flange pose noise " << std::setprecision(3)
-      << report.pose_noise_translation_m * kMm << " mm / " << RadToDeg(report.pose_noise_rotation_rad)
+      << report.pose_noise_translation_m * kMmPerM << " mm / " << RadToDeg(report.pose_noise_rotation_rad)
       << " deg per axis): f_x = " << std::fixed << std::setprecision(3) << n.intrinsics[kFx];
   if (n.intrinsics_estimated[kFx]) {
     out << " +- " << n.intrinsics_stddev[kFx] << " px";
@@ -237,18 +233,18 @@ void PrintHandEye(const calibration::CalibrationReport& report, std::ostream& ou
   const Rigid3& x = eye_to_hand ? report.model->robot.base_from_cam : report.model->robot.flange_from_cam;
   const Eigen::Vector3d rotvec = LogSO3(x.rotation);
   const Eigen::Matrix<double, 6, 1>& sd = eye_to_hand ? report.model->base_from_cam_stddev : report.model->flange_from_cam_stddev;
-  out << std::fixed << std::setprecision(3) << (eye_to_hand ? "base_from_cam" : "flange_from_cam") << ": translation [" << x.translation.x() * kMm << ", "
-      << x.translation.y() * kMm << ", " << x.translation.z() * kMm << "] mm, rotation vector ["
+  out << std::fixed << std::setprecision(3) << (eye_to_hand ? "base_from_cam" : "flange_from_cam") << ": translation [" << x.translation.x() * kMmPerM << ", "
+      << x.translation.y() * kMmPerM << ", " << x.translation.z() * kMmPerM << "] mm, rotation vector ["
       << RadToDeg(rotvec.x()) << ", " << RadToDeg(rotvec.y()) << ", " << RadToDeg(rotvec.z()) << "] deg";
   if (sd.allFinite()) {
-    out << "; std " << sd[0] * kMm << ", " << sd[1] * kMm << ", " << sd[2] * kMm << " mm, " << RadToDeg(sd[3]) << ", "
+    out << "; std " << sd[0] * kMmPerM << ", " << sd[1] * kMmPerM << ", " << sd[2] * kMmPerM << " mm, " << RadToDeg(sd[3]) << ", "
         << RadToDeg(sd[4]) << ", " << RadToDeg(sd[5]) << " deg (camera frame)";
   }
   out << "\n";
   out.unsetf(std::ios::floatfield);
   if (report.pose_noise) {
     out << "with the flange pose noise " << (report.pose_noise_estimated ? "estimated from the residuals" : "stated")
-        << " (" << report.pose_noise_translation_m * kMm << " mm / " << RadToDeg(report.pose_noise_rotation_rad)
+        << " (" << report.pose_noise_translation_m * kMmPerM << " mm / " << RadToDeg(report.pose_noise_rotation_rad)
         << " deg per axis): " << (report.pose_noise->ok ? "" : "not solved: ")
         << report.pose_noise->message << "\n";
   }

@@ -16,12 +16,9 @@ nlohmann::json StatJson(const simulation::Stat& s) {
 
 double Ratio(double a, double b) { return std::isfinite(a) && std::isfinite(b) && b > 0 ? a / b : NAN; }
 
-
 }  // namespace internal
 
 namespace {
-
-constexpr double kMm = 1e3;  // the study document keeps its mm keys (format version 1)
 
 using internal::Ratio;
 using internal::StatJson;
@@ -91,9 +88,9 @@ nlohmann::json StudyJson(const simulation::StudyReport& study, const simulation:
   j["runs_per_cell"] = options.runs;
   j["seed"] = options.seed;
   j["pixel_noise_note"] = "std per coordinate in px (the paper's N(0, s) read as a std)";
-  j["hidden_errors"] = {{"length_std_mm", options.sim.length_error_std_m * kMm},
+  j["hidden_errors"] = {{"length_std_mm", options.sim.length_error_std_m * kMmPerM},
                         {"angle_std_deg", RadToDeg(options.sim.angle_error_std_rad)},
-                        {"cam_length_std_mm", options.sim.cam_length_error_std_m * kMm},
+                        {"cam_length_std_mm", options.sim.cam_length_error_std_m * kMmPerM},
                         {"cam_angle_std_deg", RadToDeg(options.sim.cam_angle_error_std_rad)},
                         {"fx_relative_std", options.sim.fx_relative_error_std}};
   j["identifiable_parameters"] = study.identifiable_parameters;
@@ -166,16 +163,16 @@ nlohmann::json BoundSweepJson(const std::vector<simulation::BoundPoint>& sweep) 
     rows.push_back({{"fx_observable", p.ok_fx_unknown},
                     {"fx_px", p.setup.fx_px},
                     {"horizontal_fov_deg", p.horizontal_fov_deg},
-                    {"depth_mm", p.setup.depth_m * kMm},
+                    {"depth_mm", p.setup.depth_m * kMmPerM},
                     {"depth_spread_ratio", p.setup.depth_spread_ratio},
-                    {"baseline_mm", p.baseline_m * kMm},
+                    {"baseline_mm", p.baseline_m * kMmPerM},
                     {"num_points", p.setup.num_points},
                     {"sigma_px", p.setup.sigma_px},
                     {"orientation_1e4rad_fx_unknown", p.orientation_rad_fx_unknown * 1e4},
-                    {"position_mm_fx_unknown", p.position_m_fx_unknown * kMm},
+                    {"position_mm_fx_unknown", p.position_m_fx_unknown * kMmPerM},
                     {"fx_px_rms", p.fx_px},
                     {"orientation_1e4rad_fx_known", p.orientation_rad_fx_known * 1e4},
-                    {"position_mm_fx_known", p.position_m_fx_known * kMm}});
+                    {"position_mm_fx_known", p.position_m_fx_known * kMmPerM}});
   }
   return rows;
 }

@@ -11,8 +11,6 @@ namespace selfcal::report {
 
 namespace {
 
-constexpr double kMm = 1e3;  // tables print mm
-
 using internal::Ratio;
 
 // A failure message cut for a table line (the JSON keeps it whole).
@@ -303,7 +301,7 @@ void PrintBoundSweep(const std::vector<simulation::BoundPoint>& sweep, std::ostr
   std::snprintf(line, sizeof(line),
                 "\nTwo-view Cramer-Rao bound (RMS), %d points, sigma %.2f px, depth %.0f mm; paper's Table 2 "
                 "optimal at noise %s: %.2fe-4 rad, %.2f mm, %.2f px\n",
-                sweep.front().setup.num_points, sigma, sweep.front().setup.depth_m * kMm,
+                sweep.front().setup.num_points, sigma, sweep.front().setup.depth_m * kMmPerM,
                 paper.noise_px > 0.35 ? "II" : "I", paper.orientation_1e4rad.mean, paper.position_mm.mean,
                 paper.fx_px.mean);
   out << line;
@@ -312,9 +310,9 @@ void PrintBoundSweep(const std::vector<simulation::BoundPoint>& sweep, std::ostr
   out << line;
   for (const simulation::BoundPoint& p : sweep) {
     std::snprintf(line, sizeof(line), "%7.0f %7.1f %7.2f %9.0f %6d | %12.3f %10.4f %8.3f | %12.3f %10.4f%s\n",
-                  p.setup.fx_px, p.horizontal_fov_deg, p.setup.depth_spread_ratio, p.baseline_m * kMm, p.setup.num_points,
-                  p.orientation_rad_fx_unknown * 1e4, p.position_m_fx_unknown * kMm, p.fx_px,
-                  p.orientation_rad_fx_known * 1e4, p.position_m_fx_known * kMm,
+                  p.setup.fx_px, p.horizontal_fov_deg, p.setup.depth_spread_ratio, p.baseline_m * kMmPerM, p.setup.num_points,
+                  p.orientation_rad_fx_unknown * 1e4, p.position_m_fx_unknown * kMmPerM, p.fx_px,
+                  p.orientation_rad_fx_known * 1e4, p.position_m_fx_known * kMmPerM,
                   p.ok_fx_unknown ? "" : "  (f_x unobservable)");
     out << line;
   }

@@ -16,7 +16,7 @@ std::string Lower(std::string text) {
   return text;
 }
 
-RobotError ErrorOfIo(LineIo outcome) { return outcome == LineIo::kTimeout ? RobotError::kTimeout : RobotError::kDisconnected; }
+RobotError RobotErrorOfIo(LineIo outcome) { return outcome == LineIo::kTimeout ? RobotError::kTimeout : RobotError::kDisconnected; }
 
 std::string Joined(const std::vector<std::string>& parts) {
   std::string text;
@@ -149,7 +149,7 @@ Result<std::string> UrRobot::Dashboard(const std::string& command) {
   std::string reply;
   if (io.ok()) io = dashboard_.ReadLine(&reply, options_.reply_timeout_s);
   if (!io.ok()) {
-    return Broken(ErrorOfIo(io.outcome), "Dashboard server (port " + std::to_string(options_.dashboard_port) +
+    return Broken(RobotErrorOfIo(io.outcome), "Dashboard server (port " + std::to_string(options_.dashboard_port) +
                                              "): no answer to \"" + command + "\": " + io.error);
   }
   return TerminalSafe(reply);
@@ -204,7 +204,7 @@ Status UrRobot::ReadKinematics() {
     if (io.ok() && !size.ok()) return Broken(RobotError::kProtocol, "secondary interface: " + size.status().message());
     if (io.ok()) io = secondary_.ReadBytes(&body, *size - 5, left_s);
     if (!io.ok()) {
-      return Broken(ErrorOfIo(io.outcome), "secondary interface (port " + std::to_string(options_.secondary_port) +
+      return Broken(RobotErrorOfIo(io.outcome), "secondary interface (port " + std::to_string(options_.secondary_port) +
                                                "): no robot state with the kinematics info: " + io.error);
     }
     Result<std::optional<ur::KinematicsInfo>> info = ur::KinematicsInfoOf(header + body);
@@ -224,7 +224,7 @@ Result<ur::RtdePackage> UrRobot::ReadRtdePackage(double timeout_s) {
   if (!size.ok()) return RobotFailure(RobotError::kProtocol, "RTDE: " + size.status().message());
   if (io.ok()) io = rtde_.ReadBytes(&payload, *size - 3, options_.reply_timeout_s);
   if (!io.ok()) {
-    return RobotFailure(ErrorOfIo(io.outcome), "RTDE (port " + std::to_string(options_.rtde_port) + "): " + io.error);
+    return RobotFailure(RobotErrorOfIo(io.outcome), "RTDE (port " + std::to_string(options_.rtde_port) + "): " + io.error);
   }
   return ur::RtdePackage{static_cast<uint8_t>(header[2]), payload};
 }
@@ -233,7 +233,7 @@ Status UrRobot::StartRtde() {
   // Each request and its answer, text messages ('M') skipped.
   const auto ask = [this](const std::string& request, uint8_t type) -> Result<std::string> {
     if (LineIoResult io = rtde_.WriteBytes(request, options_.reply_timeout_s); !io.ok()) {
-      return Broken(ErrorOfIo(io.outcome), "RTDE: " + io.error);
+      return Broken(RobotErrorOfIo(io.outcome), "RTDE: " + io.error);
     }
     while (true) {
       Result<ur::RtdePackage> reply = ReadRtdePackage(options_.reply_timeout_s);
@@ -306,7 +306,7 @@ Status UrRobot::ConnectUnchecked() {
   if (Status s = open(&dashboard_, options_.dashboard_port); !s.ok()) return s;
   std::string greeting;
   if (LineIoResult io = dashboard_.ReadLine(&greeting, options_.reply_timeout_s); !io.ok()) {
-    return RobotFailure(ErrorOfIo(io.outcome), name_ + ": the Dashboard server sent no greeting: " + io.error);
+    return RobotFailure(RobotErrorOfIo(io.outcome), name_ + ": the Dashboard server sent no greeting: " + io.error);
   }
   if (Status s = CheckDashboard(); !s.ok()) return s;
   if (Status s = open(&secondary_, options_.secondary_port); !s.ok()) return s;
@@ -413,7 +413,7 @@ Status UrRobot::StartMove(const Eigen::VectorXd& target_rad, double velocity_sca
   const double velocity = velocity_scaling * options_.limits.max_velocity_rad_s.minCoeff();
   const std::string script = ur::MovejScript(target_rad, options_.acceleration_per_velocity * velocity, velocity);
   if (LineIoResult io = secondary_.WriteLine(script, options_.reply_timeout_s); !io.ok()) {
-    return Broken(ErrorOfIo(io.outcome), "secondary interface: movej not sent: " + io.error);
+    return Broken(RobotErrorOfIo(io.outcome), "secondary interface: movej not sent: " + io.error);
   }
   target_ = target_rad;
   return Status::Ok();

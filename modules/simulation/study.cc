@@ -93,8 +93,6 @@ void StudyCell::Append(const StudyCell& later) {
 
 namespace {
 
-constexpr double kMm = 1e3;
-
 // The report's fields the runs set (the first run's that set them), with whether this run set them.
 struct RunHeader {
   bool paper_set = false, bundle_set = false;
@@ -127,9 +125,9 @@ void ScoreRun(const sim::SimResult& world, const ObservationSet& obs, const cali
     const Rigid3 true_rel = true_ref_from_base * truth.base_from_cam[m.pose_index];  // cam_ref_from_cam_i
     if (m.used) {
       const Eigen::Vector3d t_meas = k_correction * m.measured_cam_ref_from_cam.translation;
-      cell->position_mm.Add(kMm * (t_meas - true_rel.translation).norm());
+      cell->position_mm.Add(kMmPerM * (t_meas - true_rel.translation).norm());
       const Eigen::Vector3d t_true_scale = true_rel.translation.norm() * m.measured_cam_ref_from_cam.translation.normalized();
-      cell->position_true_scale_mm.Add(kMm * (t_true_scale - true_rel.translation).norm());
+      cell->position_true_scale_mm.Add(kMmPerM * (t_true_scale - true_rel.translation).norm());
       cell->orientation_1e4rad.Add(k1e4 * RotationAngle(m.measured_cam_ref_from_cam.rotation.transpose() * true_rel.rotation));
       if (m.two_view.fx_observable) cell->fx_px.Add(std::abs(m.two_view.fx_px - truth.camera_true.fx_px));
       if (first) {
@@ -152,8 +150,8 @@ void ScoreRun(const sim::SimResult& world, const ObservationSet& obs, const cali
         const Eigen::Matrix3d r = cv.rotation.transpose();
         const Eigen::Vector3d dir = -(r * cv.translation_direction).normalized();
         const Eigen::Vector3d t_meas = k_correction * m.nominal_translation.norm() * dir;
-        cell->opencv_position_mm.Add(kMm * (t_meas - true_rel.translation).norm());
-        cell->opencv_position_true_scale_mm.Add(kMm * (true_rel.translation.norm() * dir - true_rel.translation).norm());
+        cell->opencv_position_mm.Add(kMmPerM * (t_meas - true_rel.translation).norm());
+        cell->opencv_position_true_scale_mm.Add(kMmPerM * (true_rel.translation.norm() * dir - true_rel.translation).norm());
         cell->opencv_orientation_1e4rad.Add(k1e4 * RotationAngle(r.transpose() * true_rel.rotation));
       }
     }
@@ -165,7 +163,7 @@ void ScoreRun(const sim::SimResult& world, const ObservationSet& obs, const cali
         if (!bound.ok) continue;
         // Position error of the measurement cam_ref_from_cam_i = -R^T t: with ||t|| exact, its direction
         // error has the same angle as t's (rotation error enters too; the t term dominates).
-        const double position = kMm * true_rel.translation.norm() * bound.translation_dir_rms_rad();
+        const double position = kMmPerM * true_rel.translation.norm() * bound.translation_dir_rms_rad();
         const double orientation = k1e4 * bound.rotation_rms_rad();
         if (fx_unknown) {
           cell->bound_position_mm_fx_unknown.Add(position);
@@ -179,10 +177,10 @@ void ScoreRun(const sim::SimResult& world, const ObservationSet& obs, const cali
     }
   }
   for (const calibration::DistanceCheck& c : report.verification_nominal.checks) {
-    if (c.ok) cell->error3d_nominal_mm.Add(kMm * c.error_m);
+    if (c.ok) cell->error3d_nominal_mm.Add(kMmPerM * c.error_m);
   }
   for (const calibration::DistanceCheck& c : report.verification_calibrated.checks) {
-    if (c.ok) cell->error3d_calibrated_mm.Add(kMm * c.error_m);
+    if (c.ok) cell->error3d_calibrated_mm.Add(kMmPerM * c.error_m);
   }
   const Eigen::VectorXd rho_nominal = KinematicParameters::Nominal(obs.robot);
   const Rigid3 nominal_ref_from_base = PointsFromCam(obs.robot, rho_nominal, obs.poses[ref].joints_rad).Inverse();
@@ -195,8 +193,8 @@ void ScoreRun(const sim::SimResult& world, const ObservationSet& obs, const cali
                                   PointsFromCam(report.calibrated_robot, report.calibrated_rho, obs.poses[v].joints_rad);
     const PoseDifference before = ComparePoses(true_rel, nominal_rel);
     const PoseDifference after = ComparePoses(true_rel, calibrated_rel);
-    cell->pose_position_nominal_mm.Add(kMm * before.position_m);
-    cell->pose_position_calibrated_mm.Add(kMm * after.position_m);
+    cell->pose_position_nominal_mm.Add(kMmPerM * before.position_m);
+    cell->pose_position_calibrated_mm.Add(kMmPerM * after.position_m);
     cell->pose_orientation_nominal_1e4rad.Add(k1e4 * before.rotation_rad);
     cell->pose_orientation_calibrated_1e4rad.Add(k1e4 * after.rotation_rad);
   }
@@ -249,7 +247,7 @@ bool ScoreAgainstTheTruth(const bundle::BundleReport& b, const sim::SimTruth& tr
   for (int i : b.free_indices) {
     const double error = std::abs(b.rho[i] - truth.rho_true[i]);
     if (params.kind(i) == ParameterKind::kLength) {
-      cell->bundle_length_error_mm.Add(kMm * error);
+      cell->bundle_length_error_mm.Add(kMmPerM * error);
     } else {
       cell->bundle_angle_error_deg.Add(RadToDeg(error));
     }
@@ -288,17 +286,17 @@ void ScoreBundle(const sim::SimResult& world, const ObservationSet& obs, const c
   };
   for (size_t k = 1; k < id_poses.size(); ++k) {
     const PoseDifference d = relative_error(id_poses[k]);
-    cell->bundle_position_mm.Add(kMm * d.position_m);
+    cell->bundle_position_mm.Add(kMmPerM * d.position_m);
     cell->bundle_orientation_1e4rad.Add(k1e4 * d.rotation_rad);
   }
   cell->bundle_fx_px.Add(std::abs(b.fx_px - truth.camera_true.fx_px));
   for (int v : obs.PosesWithRole(PoseRole::kVerification)) {
     const PoseDifference d = relative_error(v);
-    cell->bundle_pose_position_mm.Add(kMm * d.position_m);
+    cell->bundle_pose_position_mm.Add(kMmPerM * d.position_m);
     cell->bundle_pose_orientation_1e4rad.Add(k1e4 * d.rotation_rad);
   }
   for (const calibration::DistanceCheck& c : stage.verification.checks) {
-    if (c.ok) cell->bundle_error3d_mm.Add(kMm * c.error_m);
+    if (c.ok) cell->bundle_error3d_mm.Add(kMmPerM * c.error_m);
   }
   const KinematicParameters params(obs.robot.num_joints());
   const bool gauge_is_truths = ScoreAgainstTheTruth(b, truth, params, cell);
@@ -306,14 +304,14 @@ void ScoreBundle(const sim::SimResult& world, const ObservationSet& obs, const c
   if (stage.predicted_error.ok) {
     for (const calibration::PredictedDistanceError& e : stage.predicted_error.distances) {
       if (!e.ok) continue;
-      cell->bundle_predicted3d_mm.Add(kMm * e.std_m);
-      cell->bundle_predicted3d_parameters_mm.Add(kMm * e.parameters_std_m);
-      cell->bundle_predicted3d_pixels_mm.Add(kMm * e.pixels_std_m);
+      cell->bundle_predicted3d_mm.Add(kMmPerM * e.std_m);
+      cell->bundle_predicted3d_parameters_mm.Add(kMmPerM * e.parameters_std_m);
+      cell->bundle_predicted3d_pixels_mm.Add(kMmPerM * e.pixels_std_m);
     }
   }
   // Coverage needs the truth in the bundle's gauge, and the bundle's sigmas.
   const bool same_gauge = b.covariance_available && gauge_is_truths;
-  auto in_report_units = [&](int i, double v) { return params.kind(i) == ParameterKind::kLength ? kMm * v : RadToDeg(v); };
+  auto in_report_units = [&](int i, double v) { return params.kind(i) == ParameterKind::kLength ? kMmPerM * v : RadToDeg(v); };
   if (same_gauge) {
     for (int i : b.free_indices) {
       cell->bundle_parameter_error[params.name(i)].Add(in_report_units(i, b.rho[i] - truth.rho_true[i]));
@@ -332,10 +330,10 @@ void ScoreBundle(const sim::SimResult& world, const ObservationSet& obs, const c
   const size_t first_copy = bound.position_bound_m.size() - static_cast<size_t>(copies);
   for (size_t k = 0; k < bound.position_bound_m.size(); ++k) {
     if (k >= first_copy) {
-      cell->bundle_bound_position_mm.Add(kMm * bound.position_bound_m[k]);
+      cell->bundle_bound_position_mm.Add(kMmPerM * bound.position_bound_m[k]);
       cell->bundle_bound_orientation_1e4rad.Add(k1e4 * bound.orientation_bound_rad[k]);
     } else {
-      cell->bundle_bound_pose_position_mm.Add(kMm * bound.position_bound_m[k]);
+      cell->bundle_bound_pose_position_mm.Add(kMmPerM * bound.position_bound_m[k]);
       cell->bundle_bound_pose_orientation_1e4rad.Add(k1e4 * bound.orientation_bound_rad[k]);
     }
   }
@@ -357,12 +355,11 @@ void ScoreBundle(const sim::SimResult& world, const ObservationSet& obs, const c
                               truth.camera_true.fx_px, bound.free_indices, sigma, cell->noise_px, obs.check_distances);
     for (const calibration::PredictedDistanceError& e : b3d.distances) {
       if (!e.ok) continue;
-      cell->bundle_bound3d_mm.Add(kMm * e.std_m);
-      cell->bundle_bound3d_parameters_mm.Add(kMm * e.parameters_std_m);
+      cell->bundle_bound3d_mm.Add(kMmPerM * e.std_m);
+      cell->bundle_bound3d_parameters_mm.Add(kMmPerM * e.parameters_std_m);
     }
   }
 }
-
 
 // The study's cells of one trajectory, empty: the point rows, then the rendered rows.
 std::vector<StudyCell> EmptyCells(const TrajectorySpec& trajectory, const StudyOptions& options) {

@@ -47,14 +47,14 @@ class RunSets {
 };
 
 // Buffers reused from blob to blob.
-struct Scratch {
+struct WindowScratch {
   std::vector<LabelledRun> runs;
   RunSets sets;
   std::vector<std::uint8_t> dark, near;
 };
 
 // The dark runs of rows y0..y1 within columns x0..x1, labelled 8-connected, in raster order.
-void LabelBoxRuns(const BlobWindow& win, const PixelBox& box, Scratch* scratch) {
+void LabelBoxRuns(const BlobWindow& win, const PixelBox& box, WindowScratch* scratch) {
   std::vector<LabelledRun>& runs = scratch->runs;
   RunSets& sets = scratch->sets;
   runs.clear();
@@ -91,7 +91,7 @@ void LabelBoxRuns(const BlobWindow& win, const PixelBox& box, Scratch* scratch) 
 
 // The root of the set spanning `box` that holds the seed (window coordinates) or, without one, a run of
 // the box's top row; -1 if none.
-int SpanningSet(const PixelBox& box, const std::pair<int, int>* seed, Scratch* scratch) {
+int SpanningSet(const PixelBox& box, const std::pair<int, int>* seed, WindowScratch* scratch) {
   for (const LabelledRun& run : scratch->runs) {
     if (seed != nullptr) {
       if (run.y != seed->second || run.s > seed->first || run.e < seed->first) continue;
@@ -106,7 +106,7 @@ int SpanningSet(const PixelBox& box, const std::pair<int, int>* seed, Scratch* s
 }
 
 // Other: the dark cells left (not the blob's) and every non-blob cell 8-adjacent to one.
-void MarkOthers(BlobWindow* win, Scratch* scratch) {
+void MarkOthers(BlobWindow* win, WindowScratch* scratch) {
   // Byte loops over raw pointers and local bounds (a byte store may alias anything else), so that they
   // vectorise.
   const int w = win->w, h = win->h;
@@ -143,7 +143,7 @@ void MarkOthers(BlobWindow* win, Scratch* scratch) {
 bool ClassifyBlobWindow(const vpImage<unsigned char>& image, int threshold, const PixelBox& bbox, int margin,
                         const std::pair<int, int>* required_seed, BlobWindow* window,
                         std::vector<PixelRun>* blob_runs) {
-  thread_local Scratch scratch;
+  thread_local WindowScratch scratch;
   BlobWindow& win = *window;
   const int width = static_cast<int>(image.getWidth());
   const int height = static_cast<int>(image.getHeight());

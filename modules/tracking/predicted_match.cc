@@ -14,7 +14,7 @@ namespace {
 
 constexpr double kMedianChi2TwoDof = 1.3862943611198906;  // 2 ln 2
 
-double Median(std::vector<double> v) {
+double UpperMedian(std::vector<double> v) {
   if (v.empty()) return 0;
   const size_t mid = v.size() / 2;
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
@@ -26,7 +26,7 @@ double ModelVariance(const std::vector<double>& squared_residuals, int params, c
   const int n = static_cast<int>(squared_residuals.size());
   double var = o.fallback_model_sigma_px * o.fallback_model_sigma_px;
   if (n >= params + 3) {
-    var = Median(squared_residuals) / kMedianChi2TwoDof * static_cast<double>(2 * n) / static_cast<double>(2 * n - params);
+    var = UpperMedian(squared_residuals) / kMedianChi2TwoDof * static_cast<double>(2 * n) / static_cast<double>(2 * n - params);
   }
   return std::max(var, o.min_model_sigma_px * o.min_model_sigma_px);
 }
@@ -57,7 +57,7 @@ PredictionCorrection FitPredictionCorrection(const std::vector<Eigen::Vector2d>&
     du.push_back(observed[k].x() - predicted[k].x());
     dv.push_back(observed[k].y() - predicted[k].y());
   }
-  Eigen::Vector2d t(Median(du), Median(dv));
+  Eigen::Vector2d t(UpperMedian(du), UpperMedian(dv));
   std::vector<size_t> in;
   for (size_t k = 0; k < n; ++k) {
     if ((observed[k] - predicted[k] - t).norm() <= options.inlier_threshold_px) in.push_back(k);
