@@ -144,5 +144,30 @@ TEST(Acceptance, TheYardstickIsCheckedAgainstTheDescriptionsLengths) {
   EXPECT_EQ(Check(AcceptanceOf(in), "yardstick_scale").status, CheckStatus::kNotAvailable);
 }
 
+
+// A held-out statistic far below its distribution (the residuals smaller than the stated noise says: a noise
+// stated 5x too large gives about 1/25 of the degrees of freedom) passes, and the sentence says the test was
+// lenient; one near its degrees of freedom, or above its 0.1 % point, does not say so.
+TEST(Acceptance, AStatisticFarBelowItsDistributionSaysTheTestIsLenient) {
+  HeldOutReprojection held = Figures({0.1, 0.1});
+  HeldOutFigure figure = held.overall;
+  figure.dof = 574;
+  figure.chi_square_limit = ChiSquareQuantile(0.95, figure.dof);
+  figure.test_passed = true;
+  AcceptanceInputs in;
+  in.calibrated = &held;
+  in.test_at_stated_noise = &figure;
+  in.stated_noise_px = 0.5;
+  const double low = ChiSquareQuantile(1e-3, figure.dof);
+  ASSERT_GT(low, 400);  // about 475 at 574 dof
+  for (double chi_square : {574.0 / 25, low - 1.0, low + 1.0, 574.0}) {
+    figure.chi_square = chi_square;
+    figure.p_value = ChiSquareUpperTail(chi_square, figure.dof);
+    const AcceptanceCheck& c = Check(AcceptanceOf(in), "heldout_test");
+    EXPECT_EQ(c.status, CheckStatus::kPassed) << c.sentence;
+    EXPECT_EQ(c.sentence.find("lenient") != std::string::npos, chi_square < low) << chi_square << ": " << c.sentence;
+  }
+}
+
 }  // namespace
 }  // namespace selfcal::calibration
