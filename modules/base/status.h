@@ -62,6 +62,8 @@ class Status {
   Status() = default;  // OK
   static Status Ok() { return Status(); }
   static Status Error(ErrorCode code, std::string message) { return Status(code, std::move(message)); }
+  // A configuration or input error (kInvalidInput): the message names the file, key, line or value.
+  static Status InvalidInput(std::string message) { return Status(ErrorCode::kInvalidInput, std::move(message)); }
 
   bool ok() const { return code_ == ErrorCode::kOk; }
   ErrorCode code() const { return code_; }

@@ -1,4 +1,4 @@
-// Module geometry (ARCHITECTURE.md): Rigid3T<T> (b_from_a), rotations, SO(3) exp/log. Uses Eigen only.
+// Module geometry (ARCHITECTURE.md): Rigid3T<T> (b_from_a), rotations, SO(3) exp/log. Uses Eigen and base (kPi).
 //
 // Rigid transforms and rotations, templated on the scalar so that Ceres Jets flow through them.
 //
@@ -11,6 +11,8 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+
+#include "base/numbers.h"
 
 namespace selfcal {
 
@@ -142,7 +144,6 @@ struct PoseDifference {
 };
 PoseDifference ComparePoses(const Rigid3& a, const Rigid3& b);
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kMmPerM = 1e3;  // reports and configs speak mm (docs/frames-and-units.md)
 constexpr double DegToRad(double deg) { return deg * kPi / 180.0; }
 constexpr double RadToDeg(double rad) { return rad * 180.0 / kPi; }

@@ -4,26 +4,17 @@
 #include <utility>
 
 #include "robot/clock.h"
+#include "robot/fake_support.h"
 #include "robot/fanuc_robot.h"
 
 namespace selfcal::robot {
 namespace {
 
 constexpr double kStep_s = 0.008;
-using Log = std::function<void(const std::string&)>;
+using Log = internal::FakeLog;
 using fanuc::PacketKind;
-
-void Say(const Log& log, const std::string& line) {
-  if (log) log(line);
-}
-
-// A client waiting on `listener` becomes `client`, replacing (closing) the one before; true when it did.
-bool AcceptNewest(TcpListener* listener, LineSocket* client) {
-  std::optional<LineSocket> waiting = listener->Accept(0, 4096);
-  if (!waiting) return false;
-  *client = std::move(*waiting);
-  return true;
-}
+using internal::AcceptNewest;
+using internal::Say;
 
 }  // namespace
 

@@ -13,8 +13,6 @@ namespace {
 
 using fanuc::PacketKind;
 
-RobotError ErrorOfIo(LineIo outcome) { return outcome == LineIo::kTimeout ? RobotError::kTimeout : RobotError::kDisconnected; }
-
 constexpr size_t kMaxPacketBytes = 4096;
 
 LineIoResult Send(LineSocket* socket, const std::string& packet, double timeout_s) {
@@ -117,15 +115,15 @@ Status FanucRobot::Note(const fanuc::Packet& packet) {
 
 Result<fanuc::Packet> FanucRobot::Ask(PacketKind kind, const std::string& name, const std::string& request) {
   if (LineIoResult io = Send(&socket_, request, options_.reply_timeout_s); !io.ok()) {
-    return Broken(ErrorOfIo(io.outcome), "RMI: " + name + " not sent: " + io.error);
+    return Broken(RobotErrorOfIo(io.outcome), "RMI: " + name + " not sent: " + io.error);
   }
   const double deadline_s = clock_.Now() + options_.reply_timeout_s;
   while (true) {
     std::string line;
     const LineIoResult io = socket_.ReadLine(&line, std::max(0.0, deadline_s - clock_.Now()));
     if (!io.ok()) {
-      return Broken(ErrorOfIo(io.outcome), "RMI (port " + std::to_string(session_port_) + "): no answer to " + name +
-                                               ": " + io.error);
+      return Broken(RobotErrorOfIo(io.outcome),
+                    "RMI (port " + std::to_string(session_port_) + "): no answer to " + name + ": " + io.error);
     }
     Result<fanuc::Packet> packet = fanuc::ParsePacket(line);
     if (!packet.ok()) return Broken(RobotError::kProtocol, packet.status().message());
@@ -153,7 +151,7 @@ Result<fanuc::Packet> FanucRobot::SessionPort() {
   std::string line;
   LineIoResult io = Send(&startup, fanuc::SimpleRequest(PacketKind::kCommunication, "FRC_Connect"), options_.reply_timeout_s);
   if (io.ok()) io = startup.ReadLine(&line, options_.reply_timeout_s);
-  if (!io.ok()) return RobotFailure(ErrorOfIo(io.outcome), name_ + ": no answer to FRC_Connect: " + io.error);
+  if (!io.ok()) return RobotFailure(RobotErrorOfIo(io.outcome), name_ + ": no answer to FRC_Connect: " + io.error);
   Result<fanuc::Packet> reply = fanuc::ParsePacket(line);
   if (!reply.ok()) return RobotFailure(RobotError::kProtocol, name_ + ": " + reply.status().message());
   if (reply->name != "FRC_Connect" || reply->error_id != 0 || !reply->port) {
@@ -288,7 +286,7 @@ Status FanucRobot::StartMove(const Eigen::VectorXd& target_rad, double velocity_
   const int sequence = next_sequence_id_++;
   if (LineIoResult io = Send(&socket_, fanuc::JointMotionRequest(sequence, target_rad, percent), options_.reply_timeout_s);
       !io.ok()) {
-    return Broken(ErrorOfIo(io.outcome), "RMI: FRC_JointMotionJRep not sent: " + io.error);
+    return Broken(RobotErrorOfIo(io.outcome), "RMI: FRC_JointMotionJRep not sent: " + io.error);
   }
   pending_sequence_ = sequence;
   pending_answered_ = false;

@@ -50,6 +50,10 @@ bool IsReset(int error) { return error == ECONNRESET || error == EPIPE || error 
 
 }  // namespace
 
+RobotError RobotErrorOfIo(LineIo outcome) {
+  return outcome == LineIo::kTimeout ? RobotError::kTimeout : RobotError::kDisconnected;
+}
+
 LineSocket::LineSocket(int fd, size_t max_line_bytes) : fd_(fd), max_line_bytes_(max_line_bytes) {
   if (fd_ >= 0) {
     ::fcntl(fd_, F_SETFL, ::fcntl(fd_, F_GETFL) | O_NONBLOCK);

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "base/status.h"
+#include "robot/robot.h"
 
 namespace selfcal::robot {
 
@@ -20,6 +21,9 @@ enum class LineIo {
   kTooLong,  // a line longer than the cap: the stream cannot be trusted any more
   kFailed,   // another socket error (see the message)
 };
+
+// The robot failure a failed exchange is: kTimeout for kTimeout, kDisconnected for every other outcome.
+RobotError RobotErrorOfIo(LineIo outcome);
 
 struct LineIoResult {
   LineIo outcome = LineIo::kOk;

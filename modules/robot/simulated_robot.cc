@@ -5,11 +5,11 @@
 #include <limits>
 #include <sstream>
 
+#include "base/numbers.h"
+
 namespace selfcal::robot {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-// Peak of ds/dtau of the quintic time scaling s = 10 tau^3 - 15 tau^4 + 6 tau^5 (at tau = 1/2).
 constexpr double kNeverSettledVelocity_rad_s = 0.05;  // R7 fault: what the restless arm reads on every joint
 constexpr double kSlowSettleFactor = 20;  // R7 fault: the ring-down's time constant times this
 constexpr double kStaleAge_s = 1;         // R8 fault: a stale reading is this much older than the last

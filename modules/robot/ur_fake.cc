@@ -5,29 +5,19 @@
 #include <map>
 #include <utility>
 
+#include "base/numbers.h"
 #include "robot/clock.h"
+#include "robot/fake_support.h"
 
 namespace selfcal::robot {
 namespace {
 
-constexpr double kRtdeStep_s = 0.008;          // the RTDE stream at 125 Hz
+constexpr double kRtdeStep_s = 0.008;        // the RTDE stream at 125 Hz
 constexpr double kRobotStatePeriod_s = 0.1;  // the secondary interface's robot state at 10 Hz
-constexpr double kPiRad = 3.14159265358979323846;
 
-using Log = std::function<void(const std::string&)>;
-
-void SayIfLogged(const Log& log, const std::string& line) {
-  if (log) log(line);
-}
-
-// A client waiting on `listener` becomes `client`, replacing (closing) the one before; true when it did.
-bool AcceptNewest(TcpListener* listener, LineSocket* client, const std::string& greeting) {
-  std::optional<LineSocket> waiting = listener->Accept(0, 4096);
-  if (!waiting) return false;
-  *client = std::move(*waiting);
-  if (!greeting.empty()) client->WriteLine(greeting, 0.5);
-  return true;
-}
+using Log = internal::FakeLog;
+using internal::AcceptNewest;
+using internal::Say;
 
 }  // namespace
 
@@ -37,7 +27,7 @@ ur::KinematicsInfo Ur5eNominalKinematics() {
   info.dh_theta = {0, 0, 0, 0, 0, 0};
   info.dh_a = {0, -0.425, -0.3922, 0, 0, 0};
   info.dh_d = {0.1625, 0, 0, 0.1333, 0.0997, 0.0996};
-  info.dh_alpha = {kPiRad / 2, 0, 0, kPiRad / 2, -kPiRad / 2, 0};
+  info.dh_alpha = {kPi / 2, 0, 0, kPi / 2, -kPi / 2, 0};
   info.calibration_status = 1;
   return info;
 }
@@ -64,7 +54,7 @@ void UrFakeController::DropAll(const Log& log) {
   secondary_client_.Close();
   dashboard_client_.Close();
   streaming_ = false;
-  SayIfLogged(log, "fault: every connection closed during move #" + std::to_string(moves_ - 1));
+  Say(log, "fault: every connection closed during move #" + std::to_string(moves_ - 1));
 }
 
 void UrFakeController::Step(double dt_s, const Log& log) {
@@ -83,9 +73,9 @@ void UrFakeController::Step(double dt_s, const Log& log) {
     if (move == options_.protective_stop_move) {
       state_.safety_status_bits = ur::kSafetyProtectiveStopped;
       state_.runtime_state = 1;
-      SayIfLogged(log, "fault: protective stop half way through move #" + std::to_string(move));
+      Say(log, "fault: protective stop half way through move #" + std::to_string(move));
     } else {
-      SayIfLogged(log, "fault: move #" + std::to_string(move) + " stops half way and never finishes");
+      Say(log, "fault: move #" + std::to_string(move) + " stops half way and never finishes");
     }
     options_.protective_stop_move = options_.stall_move = -1;
     return;
@@ -117,7 +107,7 @@ void UrFakeController::ServeRtde(const Log& log) {
     if (type == ur::kRtdeRequestProtocolVersion) {
       const bool two = payload.size() == 2 && payload[0] == 0 && payload[1] == 2;
       reply = ur::EncodeRtde(type, std::string(1, two ? 1 : 0));
-      SayIfLogged(log, "rtde: protocol version request");
+      Say(log, "rtde: protocol version request");
     } else if (type == ur::kRtdeSetupOutputs && payload.size() >= 8) {
       static const std::map<std::string, std::string> kTypes = {
           {"actual_q", "VECTOR6D"}, {"actual_qd", "VECTOR6D"}, {"runtime_state", "UINT32"},
@@ -132,11 +122,11 @@ void UrFakeController::ServeRtde(const Log& log) {
         at = comma + 1;
       }
       reply = ur::EncodeRtde(type, std::string(1, 1) + types);
-      SayIfLogged(log, "rtde: output recipe " + names + " -> " + types);
+      Say(log, "rtde: output recipe " + names + " -> " + types);
     } else if (type == ur::kRtdeStart || type == ur::kRtdePause) {
       streaming_ = type == ur::kRtdeStart;
       reply = ur::EncodeRtde(type, std::string(1, 1));
-      SayIfLogged(log, streaming_ ? "rtde: start" : "rtde: pause");
+      Say(log, streaming_ ? "rtde: start" : "rtde: pause");
     } else {
       reply = ur::EncodeRtde(ur::kRtdeTextMessage, "unknown package");
     }
@@ -153,7 +143,7 @@ void UrFakeController::ServeSecondary(const Log& log) {
       secondary_client_.Close();
       return;
     }
-    SayIfLogged(log, "secondary: " + line);
+    Say(log, "secondary: " + line);
     double velocity = 0;
     if (line.rfind("stopj(", 0) == 0) {
       ++stop_commands_;
@@ -164,7 +154,7 @@ void UrFakeController::ServeSecondary(const Log& log) {
     if (!q) continue;  // a real controller would raise a script error; the fake ignores it
     ++motion_commands_;
     if (options_.remote_control_off || state_.safety_status_bits != ur::kSafetyNormal) {
-      SayIfLogged(log, "ignored: not in remote control or not in normal safety status");
+      Say(log, "ignored: not in remote control or not in normal safety status");
       continue;
     }
     from_ = state_.q_rad;
@@ -186,7 +176,7 @@ void UrFakeController::ServeDashboard(const Log& log) {
       dashboard_client_.Close();
       return;
     }
-    SayIfLogged(log, "dashboard: " + line);
+    Say(log, "dashboard: " + line);
     std::string reply;
     const bool stopped = state_.safety_status_bits & ur::kSafetyProtectiveStopped;
     if (line == "is in remote control") {
@@ -218,8 +208,8 @@ void UrFakeController::Serve(const std::atomic<bool>& stop, const Log& log) {
   double next_s = clock.Now();
   while (!stop.load()) {
     AcceptNewest(&dashboard_, &dashboard_client_, "Connected: Universal Robots Dashboard Server");
-    AcceptNewest(&secondary_, &secondary_client_, "");
-    if (AcceptNewest(&rtde_, &rtde_client_, "")) streaming_ = false;
+    AcceptNewest(&secondary_, &secondary_client_);
+    if (AcceptNewest(&rtde_, &rtde_client_)) streaming_ = false;
     ServeDashboard(log);
     ServeSecondary(log);
     ServeRtde(log);

@@ -16,8 +16,6 @@ std::string Lower(std::string text) {
   return text;
 }
 
-RobotError RobotErrorOfIo(LineIo outcome) { return outcome == LineIo::kTimeout ? RobotError::kTimeout : RobotError::kDisconnected; }
-
 std::string Joined(const std::vector<std::string>& parts) {
   std::string text;
   for (size_t i = 0; i < parts.size(); ++i) text += (i ? "," : "") + parts[i];

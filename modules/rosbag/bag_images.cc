@@ -16,8 +16,6 @@ constexpr const char* kJointStateType = "sensor_msgs/msg/JointState";
 constexpr const char* kImageType = "sensor_msgs/msg/Image";
 constexpr const char* kCompressedImageType = "sensor_msgs/msg/CompressedImage";
 
-Status Invalid(const std::string& message) { return Status::Error(ErrorCode::kInvalidInput, message); }
-
 std::string Joined(const std::vector<std::string>& names) {
   std::string out;
   for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
@@ -33,16 +31,17 @@ Result<std::string> TopicType(const McapContents& bag, const std::string& path, 
     topics.push_back(channel.topic + " (" + (channel.schema_name.empty() ? "no schema" : channel.schema_name) + ")");
     if (channel.topic != topic) continue;
     if (channel.message_encoding != "cdr") {
-      return Invalid(path + ": topic " + topic + " is encoded `" + channel.message_encoding +
-                     "`, not cdr: not a ROS 2 recording");
+      return Status::InvalidInput(path + ": topic " + topic + " is encoded `" + channel.message_encoding +
+                                  "`, not cdr: not a ROS 2 recording");
     }
     if (std::find(types.begin(), types.end(), channel.schema_name) == types.end()) {
-      return Invalid(path + ": topic " + topic + " holds " + channel.schema_name + ", not " + Joined(types) +
-                     " (" + option + ")");
+      return Status::InvalidInput(path + ": topic " + topic + " holds " + channel.schema_name + ", not " +
+                                  Joined(types) + " (" + option + ")");
     }
     type = channel.schema_name;
   }
-  if (type.empty()) return Invalid(path + ": no topic " + topic + " (" + option + "); the bag holds " + Joined(topics));
+  if (type.empty())
+    return Status::InvalidInput(path + ": no topic " + topic + " (" + option + "); the bag holds " + Joined(topics));
   return type;
 }
 
@@ -56,21 +55,22 @@ Result<Eigen::VectorXd> RobotOrder(const JointStateMessage& m, const std::string
   Eigen::VectorXd q(dof);
   if (joint_names.empty()) {
     if (static_cast<int>(m.position.size()) != dof) {
-      return Invalid(where + ": joint state of " + std::to_string(m.position.size()) + " positions for a robot of " +
-                     std::to_string(dof) + " joints (its config names no joints to pick them by)");
+      return Status::InvalidInput(where + ": joint state of " + std::to_string(m.position.size()) +
+                                  " positions for a robot of " + std::to_string(dof) +
+                                  " joints (its config names no joints to pick them by)");
     }
     for (int j = 0; j < dof; ++j) q[j] = m.position[static_cast<size_t>(j)];
     return q;
   }
   if (m.position.size() != m.name.size()) {
-    return Invalid(where + ": joint state of " + std::to_string(m.name.size()) + " names and " +
-                   std::to_string(m.position.size()) + " positions");
+    return Status::InvalidInput(where + ": joint state of " + std::to_string(m.name.size()) + " names and " +
+                                std::to_string(m.position.size()) + " positions");
   }
   for (int j = 0; j < dof; ++j) {
     auto it = std::find(m.name.begin(), m.name.end(), joint_names[static_cast<size_t>(j)]);
     if (it == m.name.end()) {
-      return Invalid(where + ": joint state without the robot's joint `" + joint_names[static_cast<size_t>(j)] +
-                     "` (it names " + Joined(m.name) + ")");
+      return Status::InvalidInput(where + ": joint state without the robot's joint `" +
+                                  joint_names[static_cast<size_t>(j)] + "` (it names " + Joined(m.name) + ")");
     }
     q[j] = m.position[static_cast<size_t>(it - m.name.begin())];
   }
@@ -88,11 +88,12 @@ Result<std::vector<JointSample>> ReadJoints(const McapContents& bag, const std::
     if (!m.ok()) return m.status();
     Result<Eigen::VectorXd> q = RobotOrder(*m, message.where, dof, joint_names);
     if (!q.ok()) return q.status();
-    if (!q->allFinite()) return Invalid(message.where + ": joint state with a position that is not a finite number");
+    if (!q->allFinite())
+      return Status::InvalidInput(message.where + ": joint state with a position that is not a finite number");
     if (joints.empty()) first_names = m->name;
     joints.push_back({MessageTime(m->stamp, message.log_time_ns), *q});
   }
-  if (joints.empty()) return Invalid(path + ": no message on the joint topic " + options.joint_topic);
+  if (joints.empty()) return Status::InvalidInput(path + ": no message on the joint topic " + options.joint_topic);
   if (joint_names.empty()) {
     notes->push_back(path + ": the robot config names no joints: the joint states' positions are taken in the "
                      "message's order (" + Joined(first_names) + ") as the robot's joints 1 to " + std::to_string(dof));
@@ -183,9 +184,10 @@ Result<BagImages> LoadBagImages(const std::string& bag, const BagOptions& option
     if (!grey.ok()) return grey.status();
     if (!out.images.empty() && (grey->getWidth() != out.images[0].image.getWidth() ||
                                 grey->getHeight() != out.images[0].image.getHeight())) {
-      return Invalid(records[i]->where + ": image of " + std::to_string(grey->getWidth()) + "x" +
-                     std::to_string(grey->getHeight()) + ", the first still image is " +
-                     std::to_string(out.images[0].image.getWidth()) + "x" + std::to_string(out.images[0].image.getHeight()));
+      return Status::InvalidInput(records[i]->where + ": image of " + std::to_string(grey->getWidth()) + "x" +
+                                  std::to_string(grey->getHeight()) + ", the first still image is " +
+                                  std::to_string(out.images[0].image.getWidth()) + "x" +
+                                  std::to_string(out.images[0].image.getHeight()));
     }
     char id[32];
     std::snprintf(id, sizeof(id), "image_%04zu", i);
@@ -200,9 +202,11 @@ Result<BagImages> LoadBagImages(const std::string& bag, const BagOptions& option
     out.inputs.poses.push_back(pose);
   }
   if (out.images.empty()) {
-    return Invalid(bag + ": none of the " + std::to_string(images.size()) + " images on " + options.image_topic +
-                   " was taken while the arm was still (" + std::to_string(out.moving) + " while moving; still: no joint "
-                   "moving more than the tolerance within the window either side, docs/detect.md)");
+    return Status::InvalidInput(bag + ": none of the " + std::to_string(images.size()) + " images on " +
+                                options.image_topic + " was taken while the arm was still (" +
+                                std::to_string(out.moving) +
+                                " while moving; still: no joint "
+                                "moving more than the tolerance within the window either side, docs/detect.md)");
   }
   return out;
 }

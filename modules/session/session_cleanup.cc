@@ -21,8 +21,6 @@ namespace fs = std::filesystem;
 using internal::Join;
 using internal::SystemError;
 
-Status UsageError(const std::string& message) { return Status::Error(ErrorCode::kInvalidInput, message); }
-
 // ".<name>.tmp.XXXXXX": a temporary file of base/atomic_file.h, left by a write cut short.
 bool IsAtomicTemporary(const std::string& name) {
   return name.size() > 1 && name[0] == '.' && name.find(".tmp.") != std::string::npos;
@@ -35,7 +33,7 @@ Result<std::vector<fs::directory_entry>> Entries(const std::string& directory) {
   for (fs::directory_iterator it(directory, error), end; !error && it != end; it.increment(error)) {
     entries.push_back(*it);
   }
-  if (error) return UsageError("cannot list " + directory + ": " + error.message());
+  if (error) return Status::InvalidInput("cannot list " + directory + ": " + error.message());
   std::sort(entries.begin(), entries.end());
   return entries;
 }
@@ -96,7 +94,7 @@ Result<SessionDirInspection> InspectSessionDir(const std::string& path) {
   std::error_code error;
   const fs::file_status status = fs::symlink_status(path, error);
   if (!fs::exists(status)) return out;
-  if (!fs::is_directory(status)) return UsageError(path + " exists and is not a directory");
+  if (!fs::is_directory(status)) return Status::InvalidInput(path + " exists and is not a directory");
   Result<std::vector<fs::directory_entry>> entries = Entries(path);
   if (!entries.ok()) return entries.status();
   if (entries->empty()) {
@@ -152,30 +150,33 @@ std::vector<std::string> DifferingInputs(const SessionDirInspection& inspection,
 
 Status DiscardSession(const std::string& path, bool take_over_stale_lock) {
   Result<SessionDirInspection> inspection = InspectSessionDir(path);
-  if (!inspection.ok()) return UsageError("cannot discard session " + path + ": " + inspection.status().message());
+  if (!inspection.ok())
+    return Status::InvalidInput("cannot discard session " + path + ": " + inspection.status().message());
   const SessionDirInspection& in = *inspection;
-  if (in.state == SessionDirState::kAbsent) return UsageError("cannot discard session " + path + ": no such directory");
+  if (in.state == SessionDirState::kAbsent)
+    return Status::InvalidInput("cannot discard session " + path + ": no such directory");
   if (in.state == SessionDirState::kRecorded) {
-    return UsageError("session " + path + " holds recorded data (" + std::to_string(in.samples) + " accepted samples, " +
-                 std::to_string(in.frames) + " frames, " + std::to_string(in.images) +
-                 " image files): recorded data is never removed; resume it, or calibrate from it");
+    return Status::InvalidInput("session " + path + " holds recorded data (" + std::to_string(in.samples) +
+                                " accepted samples, " + std::to_string(in.frames) + " frames, " +
+                                std::to_string(in.images) +
+                                " image files): recorded data is never removed; resume it, or calibrate from it");
   }
   if (!in.foreign.empty()) {
     std::string list;
     for (const std::string& f : in.foreign) list += (list.empty() ? "" : ", ") + f;
-    return UsageError("cannot discard session " + path + ": it holds entries selfcal did not write (" + list +
-                 "); nothing was removed");
+    return Status::InvalidInput("cannot discard session " + path + ": it holds entries selfcal did not write (" + list +
+                                "); nothing was removed");
   }
   // The lock first: a process still creating or running this session keeps it.
   Result<SessionLock> lock = SessionLock::Acquire(path, false, take_over_stale_lock);
-  if (!lock.ok()) return UsageError("cannot discard session " + path + ": " + lock.status().message());
+  if (!lock.ok()) return Status::InvalidInput("cannot discard session " + path + ": " + lock.status().message());
   Result<std::vector<fs::directory_entry>> entries = Entries(path);
   if (!entries.ok()) return entries.status();
   for (const fs::directory_entry& e : *entries) {
     if (e.path().filename() == kLockFileName) continue;
     std::error_code error;
     fs::remove_all(e.path(), error);
-    if (error) return UsageError("cannot remove " + e.path().string() + ": " + error.message());
+    if (error) return Status::InvalidInput("cannot remove " + e.path().string() + ": " + error.message());
   }
   const std::string lock_file = Join(path, kLockFileName);
   if (::unlink(lock_file.c_str()) != 0 && errno != ENOENT) return SystemError("cannot remove", lock_file, errno);

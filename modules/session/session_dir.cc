@@ -29,8 +29,6 @@ using internal::WithErrnoErrorCode;
 
 constexpr std::size_t kMaxManifestBytes = std::size_t{1} << 20;
 
-Status Usage(const std::string& message) { return Status::Error(ErrorCode::kInvalidInput, message); }
-
 bool ValidUtcTime(const std::string& text) {
   static const std::regex pattern(R"(^(\d{4})-(\d{2})-(\d{2})T(\d{2}):(\d{2}):(\d{2})(\.\d{1,9})?Z$)");
   std::smatch m;
@@ -191,9 +189,9 @@ Result<SessionManifest> ParseManifest(const std::string& text, const std::string
 // Whether `path` is an empty directory; kInvalidInput when it exists but is not a directory.
 Result<bool> IsEmptyDirectory(const std::string& path) {
   std::error_code error;
-  if (!std::filesystem::is_directory(path, error)) return Usage(path + " exists and is not a directory");
+  if (!std::filesystem::is_directory(path, error)) return Status::InvalidInput(path + " exists and is not a directory");
   const bool empty = std::filesystem::is_empty(path, error);
-  if (error) return Usage("cannot list " + path + ": " + error.message());
+  if (error) return Status::InvalidInput("cannot list " + path + ": " + error.message());
   return empty;
 }
 
@@ -230,7 +228,7 @@ Result<std::string> MoveToOrphans(const std::string& session_path, const std::st
     }
     if (errno != EEXIST) return SystemError("cannot move the orphan image " + from + " to", orphans, errno);
   }
-  return Usage("cannot move the orphan image " + from + ": 1000 names in " + orphans + " are taken");
+  return Status::InvalidInput("cannot move the orphan image " + from + ": 1000 names in " + orphans + " are taken");
 }
 
 // Moves the files of images/ that no record names to orphans/ (P2).
@@ -265,7 +263,7 @@ Result<std::vector<std::string>> MoveOrphans(const std::string& session_path,
 
 Result<SessionInput> ReadInputFile(const std::string& name, const std::string& path) {
   Result<std::string> bytes = ReadFileCapped(path, kMaxInputBytes);
-  if (!bytes.ok()) return Usage("cannot read " + path + ": " + bytes.status().message());
+  if (!bytes.ok()) return Status::InvalidInput("cannot read " + path + ": " + bytes.status().message());
   return SessionInput{name, std::move(bytes).value()};
 }
 
@@ -280,11 +278,11 @@ bool IsSessionDirectory(const std::string& path) {
 Status CheckSessionLayout(const std::string& path) {
   std::error_code error;
   if (!std::filesystem::is_directory(Join(path, kImagesDirName), error)) {
-    return Usage("session " + path + " has no " + kImagesDirName + "/ directory");
+    return Status::InvalidInput("session " + path + " has no " + kImagesDirName + "/ directory");
   }
   // Created with the session: a missing journal is lost data, never silently started afresh.
   if (!std::filesystem::exists(std::filesystem::symlink_status(Join(path, kJournalFileName), error))) {
-    return Usage("session " + path + " has no " + kJournalFileName + ": its records are lost");
+    return Status::InvalidInput("session " + path + " has no " + kJournalFileName + ": its records are lost");
   }
   return Status::Ok();
 }
@@ -322,13 +320,14 @@ Result<std::string> ReadRecordedInput(const std::string& session_path, const Inp
   const std::string recorded = "recorded " + std::to_string(digest.bytes) + " bytes, sha256 " + digest.sha256_hex;
   bool missing = false;
   Result<std::string> text = ReadFileCapped(file, kMaxInputBytes, &missing);
-  if (missing) return Usage(file + ": missing, but recorded in " + kManifestFileName + " (" + recorded + ")");
+  if (missing)
+    return Status::InvalidInput(file + ": missing, but recorded in " + kManifestFileName + " (" + recorded + ")");
   if (!text.ok()) return WithErrnoErrorCode(text.status());
   const std::string sha256 = Sha256Hex(*text);
   if (text->size() != digest.bytes || sha256 != digest.sha256_hex) {
-    return Usage(file + ": differs from the size or SHA-256 recorded in " + kManifestFileName + " (" + recorded +
-                 "; found " + std::to_string(text->size()) + " bytes, sha256 " + sha256 +
-                 "): the session's stored input was modified");
+    return Status::InvalidInput(file + ": differs from the size or SHA-256 recorded in " + kManifestFileName + " (" +
+                                recorded + "; found " + std::to_string(text->size()) + " bytes, sha256 " + sha256 +
+                                "): the session's stored input was modified");
   }
   return text;
 }
@@ -363,12 +362,14 @@ Result<SessionManifest> ReadManifest(const std::string& session_path, std::strin
     struct stat st {};
     if (::stat(Join(session_path, kLockFileName).c_str(), &st) == 0 ||
         ::stat(Join(session_path, kInputsDirName).c_str(), &st) == 0) {
-      return Usage("session " + session_path + " was never completely created (its creation was interrupted: no " +
-                   kManifestFileName + "), so nothing was recorded in it: complete it with `selfcal run --resume "
-                   "--session " + session_path + "` (the same options) or remove it with `selfcal session discard " +
-                   session_path + "`");
+      return Status::InvalidInput(
+          "session " + session_path + " was never completely created (its creation was interrupted: no " +
+          kManifestFileName +
+          "), so nothing was recorded in it: complete it with `selfcal run --resume "
+          "--session " +
+          session_path + "` (the same options) or remove it with `selfcal session discard " + session_path + "`");
     }
-    return Usage(session_path + " is not a selfcal session: it has no " + kManifestFileName);
+    return Status::InvalidInput(session_path + " is not a selfcal session: it has no " + kManifestFileName);
   }
   if (!text.ok()) return WithErrnoErrorCode(text.status());
   if (sha256 != nullptr) *sha256 = Sha256Hex(*text);
@@ -398,17 +399,17 @@ Result<Session> CreateSession(const std::string& path, const SessionInputs& inpu
     }
     input_bytes += input.contents.size();
   }
-  if (!problems.empty()) return Usage("cannot create session " + path + ": " + JoinProblems(problems));
+  if (!problems.empty()) return Status::InvalidInput("cannot create session " + path + ": " + JoinProblems(problems));
 
   std::error_code error;
   const bool exists = std::filesystem::exists(std::filesystem::symlink_status(path, error));
   std::string checked_dir = path;
   if (exists) {
     Result<bool> empty = IsEmptyDirectory(path);
-    if (!empty.ok()) return Usage("cannot create session " + path + ": " + empty.status().message());
+    if (!empty.ok()) return Status::InvalidInput("cannot create session " + path + ": " + empty.status().message());
     if (!*empty) {
-      return Usage("session directory " + path +
-                   " exists and is not empty: a session is never overwritten; choose a new directory");
+      return Status::InvalidInput("session directory " + path +
+                                  " exists and is not empty: a session is never overwritten; choose a new directory");
     }
   } else {
     std::filesystem::path normal = std::filesystem::path(path).lexically_normal();
@@ -416,24 +417,26 @@ Result<Session> CreateSession(const std::string& path, const SessionInputs& inpu
     checked_dir = normal.parent_path().string();
     if (checked_dir.empty()) checked_dir = ".";
     if (!std::filesystem::is_directory(checked_dir, error)) {
-      return Usage("cannot create session " + path + ": its parent directory " + checked_dir + " does not exist");
+      return Status::InvalidInput("cannot create session " + path + ": its parent directory " + checked_dir +
+                                  " does not exist");
     }
   }
   if (::access(checked_dir.c_str(), W_OK | X_OK) != 0) {
-    return Usage("cannot create session " + path + ": " + checked_dir + " is not writable");
+    return Status::InvalidInput("cannot create session " + path + ": " + checked_dir + " is not writable");
   }
   Result<std::uint64_t> available = AvailableBytes(checked_dir);
   if (!available.ok()) return available.status();
   const std::uint64_t needed = options.min_free_bytes + input_bytes;
   if (*available < needed) {
-    return Usage("cannot create session " + path + ": only " + std::to_string(*available) +
-                 " bytes are free on the file system of " + checked_dir + ", the session needs " +
-                 std::to_string(needed) + "");
+    return Status::InvalidInput("cannot create session " + path + ": only " + std::to_string(*available) +
+                                " bytes are free on the file system of " + checked_dir + ", the session needs " +
+                                std::to_string(needed) + "");
   }
 
   if (!exists) {
     if (::mkdir(path.c_str(), 0755) != 0) {
-      if (errno == EEXIST) return Usage("session directory " + path + " was created meanwhile by another process");
+      if (errno == EEXIST)
+        return Status::InvalidInput("session directory " + path + " was created meanwhile by another process");
       return SystemError("cannot create session directory", path, errno);
     }
     if (!FsyncDirectory(checked_dir)) return SystemError("cannot fsync directory", checked_dir, errno);
@@ -487,8 +490,8 @@ std::vector<std::string> ChangedInputs(const SessionManifest& manifest, const Se
 }
 
 Status ChangedInputsRefusal(const std::string& path, const std::vector<std::string>& changed) {
-  return Usage("session " + path + " was recorded with other inputs: " + JoinProblems(changed) +
-               "; resume with the same files, or allow changed inputs explicitly");
+  return Status::InvalidInput("session " + path + " was recorded with other inputs: " + JoinProblems(changed) +
+                              "; resume with the same files, or allow changed inputs explicitly");
 }
 
 Result<Session> OpenSession(const std::string& path, const SessionInputs& expected, bool allow_changed_inputs,
@@ -531,16 +534,17 @@ Status Session::WriteRejectedImage(const std::string& name, const std::string& b
 
 Status Session::WriteImageIn(const std::string& directory, const std::string& name, const std::string& bytes) {
   if (!SafeFileName(name)) {
-    return Usage("session " + path_ + ": image name \"" + name + "\" is not a plain file name");
+    return Status::InvalidInput("session " + path_ + ": image name \"" + name + "\" is not a plain file name");
   }
   const std::string file = Join(directory, name);
   struct stat info {};
   if (::lstat(file.c_str(), &info) == 0) {
     Result<std::string> existing = ReadFileCapped(file, bytes.size());
     if (existing.ok() && *existing == bytes) return Status::Ok();  // a retried write
-    return Usage("image " + file +
-                 " exists already with other content: recorded images are never overwritten; give the new frame "
-                 "a new name");
+    return Status::InvalidInput(
+        "image " + file +
+        " exists already with other content: recorded images are never overwritten; give the new frame "
+        "a new name");
   }
   return WithErrnoErrorCode(WriteFileAtomically(file, bytes, Publish::kNoReplace));
 }
@@ -558,7 +562,7 @@ Status Session::CheckFreeSpace(std::uint64_t bytes_needed) const {
 
 Result<std::string> Session::ReadInput(const std::string& name) const {
   const InputDigest* digest = manifest_.FindInput(name);
-  if (digest == nullptr) return Usage("session " + path_ + " has no input \"" + name + "\"");
+  if (digest == nullptr) return Status::InvalidInput("session " + path_ + " has no input \"" + name + "\"");
   return ReadRecordedInput(path_, *digest);
 }
 

@@ -15,8 +15,6 @@ namespace selfcal::simulation {
 
 namespace {
 
-Status Refuse(const std::string& message) { return Status::Error(ErrorCode::kInvalidInput, message); }
-
 // The recorded session's run settings, refused unless its images are the simulated camera's (any robot).
 Result<SimCellOptions> SimulatedRunOptions(const session::SessionSnapshot& snapshot, const std::string& path) {
   Result<std::string> text = snapshot.Input("run.json");
@@ -25,10 +23,11 @@ Result<SimCellOptions> SimulatedRunOptions(const session::SessionSnapshot& snaps
   Result<RunBackends> backends = ReadRunBackends(*text, name);
   if (!backends.ok()) return backends.status();
   if (!backends->rendered()) {  // the simulated camera with any robot: the joints it rendered are recorded
-    return Refuse("session " + path + " was recorded with robot \"" + TerminalSafe(backends->robot) +
-                  "\" and camera \"" + TerminalSafe(backends->camera) + "\" (" + backends->robot_at +
-                  "): only a session recorded with the simulated camera (run --camera sim, with the simulated "
-                  "robot or any other) has a hidden truth to audit against");
+    return Status::InvalidInput(
+        "session " + path + " was recorded with robot \"" + TerminalSafe(backends->robot) + "\" and camera \"" +
+        TerminalSafe(backends->camera) + "\" (" + backends->robot_at +
+        "): only a session recorded with the simulated camera (run --camera sim, with the simulated "
+        "robot or any other) has a hidden truth to audit against");
   }
   return SimCellOptionsFor(*text, name);
 }
@@ -66,9 +65,10 @@ Status CompareSetup(const std::string& rebuilt, const std::string& recorded, con
   } else {
     what = "missing " + key + ", which " + world + " has (" + Quoted(first.value("value", nlohmann::json())) + ")";
   }
-  return Refuse(name + ":" + std::to_string(JsonLines(recorded).Line(pointer)) + ": " + what +
-                ": the world does not reproduce the recorded setup (recorded by another version?); its identities "
-                "cannot be scored");
+  return Status::InvalidInput(
+      name + ":" + std::to_string(JsonLines(recorded).Line(pointer)) + ": " + what +
+      ": the world does not reproduce the recorded setup (recorded by another version?); its identities "
+      "cannot be scored");
 }
 
 // The world `selfcal run` built for this session, rebuilt from its inputs and checked against setup.json.
@@ -79,8 +79,9 @@ Result<SimCell> RebuildWorld(const session::SessionSnapshot& snapshot, const ses
   Result<RobotModel> nominal = io::ParseRobotModelText(*robot_text, path + "/inputs/robot.yaml");
   if (!nominal.ok()) return nominal.status();
   if (!log.plan_complete() || log.plan.empty()) {
-    return Refuse("session " + path + ": the journal holds " + std::to_string(log.plan.size()) + " of " +
-                  std::to_string(log.num_poses) + " planned poses; the world cannot be rebuilt without the plan");
+    return Status::InvalidInput("session " + path + ": the journal holds " + std::to_string(log.plan.size()) + " of " +
+                                std::to_string(log.num_poses) +
+                                " planned poses; the world cannot be rebuilt without the plan");
   }
   Result<std::string> setup = snapshot.Input(session::kSetupFileName);
   if (!setup.ok()) return setup.status();

@@ -31,15 +31,13 @@ const char* YamlNode::KindName() const {
 
 namespace {
 
-Status UsageError(const std::string& message) { return Status::Error(ErrorCode::kInvalidInput, message); }
-
 std::string At(const std::string& name, int line) { return name + ":" + std::to_string(line); }
 
 bool Terse(const YamlRules& rules) { return rules.wording == YamlWording::kSequenceIndex; }
 
 // A refusal located in the file: "<problem> at FILE:LINE", or "FILE:LINE: <problem>" when terse.
 Status Refusal(const YamlRules& rules, const std::string& name, int line, const std::string& problem) {
-  return UsageError(Terse(rules) ? At(name, line) + ": " + problem : problem + " at " + At(name, line));
+  return Status::InvalidInput(Terse(rules) ? At(name, line) + ": " + problem : problem + " at " + At(name, line));
 }
 
 // Decodes one UTF-8 sequence at text[i]; returns its length, or 0 when invalid (overlong, surrogate,
@@ -87,17 +85,19 @@ Status BadCharacter(const YamlRules& rules, const std::string& name, int line, u
                     unsigned code_point) {
   char hex[12];
   std::snprintf(hex, sizeof(hex), "0x%02X", byte);
-  if (Terse(rules)) return UsageError(At(name, line) + ": invalid byte " + hex + " (binary or corrupted file?)");
+  if (Terse(rules))
+    return Status::InvalidInput(At(name, line) + ": invalid byte " + hex + " (binary or corrupted file?)");
   std::string what = "invalid UTF-8 (byte " + std::string(hex) + ")";
   if (decoded) {
     std::snprintf(hex, sizeof(hex), "U+%04X", code_point);
     if (code_point == 0x2028 || code_point == 0x2029) {
-      return UsageError(std::string(code_point == 0x2028 ? "a line" : "a paragraph") + " separator " + hex + " at " +
-                        At(name, line) + ": YAML would read it as a line break that editors do not show; end lines with LF");
+      return Status::InvalidInput(std::string(code_point == 0x2028 ? "a line" : "a paragraph") + " separator " + hex +
+                                  " at " + At(name, line) +
+                                  ": YAML would read it as a line break that editors do not show; end lines with LF");
     }
     what = "control character " + std::string(hex);
   }
-  return UsageError(what + " at " + At(name, line) + "; is this a binary file? selfcal reads UTF-8 YAML");
+  return Status::InvalidInput(what + " at " + At(name, line) + "; is this a binary file? selfcal reads UTF-8 YAML");
 }
 
 // True for the bytes of a printable ASCII character or a tab or LF, which need no further check.
@@ -111,7 +111,8 @@ Status Normalise(const YamlRules& rules, const std::string& name, std::string* t
   std::string& t = *text;
   const auto starts = [&](const char* prefix, size_t n) { return t.size() >= n && std::memcmp(t.data(), prefix, n) == 0; };
   if (!Terse(rules) && (starts("\x00\x00\xFE\xFF", 4) || starts("\xFF\xFE\x00\x00", 4) || starts("\xFE\xFF", 2) || starts("\xFF\xFE", 2))) {
-    return UsageError("a UTF-16 or UTF-32 byte order mark at " + At(name, 1) + ": the file is not UTF-8; save it as UTF-8");
+    return Status::InvalidInput("a UTF-16 or UTF-32 byte order mark at " + At(name, 1) +
+                                ": the file is not UTF-8; save it as UTF-8");
   }
   if (starts("\xEF\xBB\xBF", 3)) t.erase(0, 3);
   bool has_cr = false;
@@ -192,16 +193,16 @@ class EventSource {
   // Why Next() failed: "malformed YAML at FILE:LINE: <libyaml's problem> (<its context>)". A simple key
   // without its `:` is found only on a later line: the message then names the key's line.
   Status Problem(const std::string& name) const {
-    if (!ok_ || parser_.error == YAML_MEMORY_ERROR) return UsageError("out of memory while parsing " + name);
+    if (!ok_ || parser_.error == YAML_MEMORY_ERROR) return Status::InvalidInput("out of memory while parsing " + name);
     const std::string problem = parser_.problem != nullptr ? parser_.problem : "unknown problem";
-    if (parser_.error == YAML_READER_ERROR) return UsageError("malformed YAML in " + name + ": " + problem);
+    if (parser_.error == YAML_READER_ERROR) return Status::InvalidInput("malformed YAML in " + name + ": " + problem);
     const std::string context = parser_.context != nullptr ? parser_.context : "";
     const int context_line = static_cast<int>(parser_.context_mark.line) + 1;
     const int line = context == "while scanning a simple key" ? context_line : ProblemLine();
     std::string message = "malformed YAML at " + At(name, line) + ": " + problem;
     if (!context.empty()) message += " (" + context + (context_line != line ? " at line " + std::to_string(context_line) : "") + ")";
     if (problem.find("tab") == std::string::npos && CharacterAt(text_, parser_.problem_mark) == U'\t') message += "; a tab where YAML wants spaces";
-    return UsageError(message);
+    return Status::InvalidInput(message);
   }
 
  private:
@@ -374,9 +375,8 @@ class TreeBuilder {
 Result<YamlDocument> ParseYamlText(const std::string& text_in, const std::string& name, const YamlRules& rules) {
   if (text_in.size() > rules.max_bytes) {
     const int line = 1 + static_cast<int>(std::count(text_in.begin(), text_in.begin() + rules.max_bytes, '\n'));
-    return UsageError(name + " is " + std::to_string(text_in.size()) + " bytes, more than the limit of " +
-                      std::to_string(rules.max_bytes) + " bytes (the limit falls at " +
-                      At(name, line) + ")");
+    return Status::InvalidInput(name + " is " + std::to_string(text_in.size()) + " bytes, more than the limit of " +
+                                std::to_string(rules.max_bytes) + " bytes (the limit falls at " + At(name, line) + ")");
   }
   std::string text = text_in;
   if (Status s = Normalise(rules, name, &text); !s.ok()) return s;
@@ -402,10 +402,10 @@ Result<YamlDocument> ParseYamlText(const std::string& text_in, const std::string
       if (!builder.Handle(*event, &error)) return Refusal(rules, name, error.line, error.message);
     }
     if (!builder.found_document()) {
-      return UsageError("no YAML document at " + At(name, 1) + " (the file is empty or holds only comments)");
+      return Status::InvalidInput("no YAML document at " + At(name, 1) + " (the file is empty or holds only comments)");
     }
   } catch (const std::bad_alloc&) {
-    return UsageError("out of memory while parsing " + name);
+    return Status::InvalidInput("out of memory while parsing " + name);
   }
   return doc;
 }
