@@ -176,14 +176,21 @@ void FanucFakeController::Serve(const std::atomic<bool>& stop, const Log& log, c
       resets = pendant_resets->load();
       ResetAtPendant(log);
     }
-    AcceptNewest(&connect_, &connect_client_);
-    AcceptNewest(&session_, &session_client_);
-    ServeConnect(log);
-    ServeSession(log);
+    ServeClients(log);
     Step(kStep_s, log);
     next_s += kStep_s;
     clock.SleepFor(std::max(0.0, next_s - clock.Now()));
   }
+  // What arrived before the stop (an FRC_Abort sent on a fresh session just before the client exited) is
+  // counted, as a controller would.
+  ServeClients(log);
+}
+
+void FanucFakeController::ServeClients(const Log& log) {
+  AcceptNewest(&connect_, &connect_client_);
+  AcceptNewest(&session_, &session_client_);
+  ServeConnect(log);
+  ServeSession(log);
 }
 
 }  // namespace selfcal::robot

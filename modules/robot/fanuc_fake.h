@@ -59,6 +59,8 @@ class FanucFakeController {
  private:
   explicit FanucFakeController(const FanucFakeOptions& options);
   void Step(double dt_s, const std::function<void(const std::string&)>& log);
+  // Takes new clients and answers what every client sent.
+  void ServeClients(const std::function<void(const std::string&)>& log);
   void ServeConnect(const std::function<void(const std::string&)>& log);
   void ServeSession(const std::function<void(const std::string&)>& log);
   std::string Answer(const fanuc::Packet& packet, const std::string& line, const std::function<void(const std::string&)>& log);

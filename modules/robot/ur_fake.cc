@@ -207,12 +207,7 @@ void UrFakeController::Serve(const std::atomic<bool>& stop, const Log& log) {
   MonotonicClock clock;
   double next_s = clock.Now();
   while (!stop.load()) {
-    AcceptNewest(&dashboard_, &dashboard_client_, "Connected: Universal Robots Dashboard Server");
-    AcceptNewest(&secondary_, &secondary_client_);
-    if (AcceptNewest(&rtde_, &rtde_client_)) streaming_ = false;
-    ServeDashboard(log);
-    ServeSecondary(log);
-    ServeRtde(log);
+    ServeClients(log);
     Step(kRtdeStep_s, log);
     since_robot_state_s_ += kRtdeStep_s;
     if (secondary_client_.is_open() && since_robot_state_s_ >= kRobotStatePeriod_s) {
@@ -228,6 +223,16 @@ void UrFakeController::Serve(const std::atomic<bool>& stop, const Log& log) {
     next_s += kRtdeStep_s;
     clock.SleepFor(std::max(0.0, next_s - clock.Now()));
   }
+  ServeClients(log);  // what arrived before the stop (a client's last stopj) is counted, as a controller would
+}
+
+void UrFakeController::ServeClients(const Log& log) {
+  AcceptNewest(&dashboard_, &dashboard_client_, "Connected: Universal Robots Dashboard Server");
+  AcceptNewest(&secondary_, &secondary_client_);
+  if (AcceptNewest(&rtde_, &rtde_client_)) streaming_ = false;
+  ServeDashboard(log);
+  ServeSecondary(log);
+  ServeRtde(log);
 }
 
 }  // namespace selfcal::robot

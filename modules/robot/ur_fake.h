@@ -64,6 +64,8 @@ class UrFakeController {
  private:
   explicit UrFakeController(const UrFakeOptions& options);
   void Step(double dt_s, const std::function<void(const std::string&)>& log);
+  // Takes new clients and answers what every client sent.
+  void ServeClients(const std::function<void(const std::string&)>& log);
   void ServeRtde(const std::function<void(const std::string&)>& log);
   void ServeSecondary(const std::function<void(const std::string&)>& log);
   void ServeDashboard(const std::function<void(const std::string&)>& log);
