@@ -20,6 +20,7 @@ install(FILES README.md LICENSE DESTINATION ${CMAKE_INSTALL_DOCDIR})
 install(DIRECTORY docs DESTINATION ${CMAKE_INSTALL_DOCDIR})
 # The line protocol's reference server, the file a real arm's server starts from (docs/robot-protocol.md).
 install(PROGRAMS scripts/reference-robot-server DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples)
+install(DIRECTORY scripts/robot-side DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples)
 
 # The Debian package: `cpack --config build/release/CPackConfig.cmake` (or `cpack` in the build directory).
 # Its dependencies are those of the libraries the programs link, found by dpkg-shlibdeps.
