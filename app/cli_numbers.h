@@ -1,5 +1,5 @@
 // Numbers on the command line, checked where CLI11 reads them, for every numeric option of every command
-// (RELIABILITY.md C3): CLI11 2.1 converts an unsigned integer with strtoull, so `--seed -1` and
+// (../shared/RELIABILITY.md C3): CLI11 2.1 converts an unsigned integer with strtoull, so `--seed -1` and
 // `--seed 18446744073709551616` both became 18446744073709551615; `--seed 010` was octal 8; a floating
 // option took `nan` and `inf`, which pass CLI11's Range check. One rule in one place: an option added
 // later is covered without being named.

@@ -29,7 +29,7 @@
 // reads it (cli_numbers.h: decimal integers, not negative, within 64 bits; finite numbers).
 //
 // The selfcal subcommands. Each registers its options on the CLI11 app and returns the process exit code
-// (RELIABILITY.md design rule 2) when run.
+// (../shared/RELIABILITY.md design rule 2) when run.
 #pragma once
 
 #include <functional>

@@ -1,4 +1,4 @@
-// The process exit codes of selfcal and selfcal-robot-sim (RELIABILITY.md design rule 2; README.md), and
+// The process exit codes of selfcal and selfcal-robot-sim (../shared/RELIABILITY.md design rule 2; README.md), and
 // the one mapping from the library's error codes to them. Only app/ chooses exit codes.
 #pragma once
 

@@ -1,5 +1,5 @@
 // selfcal identifiability --robot FILE --trajectory FILE: which parameters the relative camera poses of
-// a trajectory can identify (DESIGN.md section 4), with metric and with up-to-scale translations.
+// a trajectory can identify (../shared/DESIGN.md section 4), with metric and with up-to-scale translations.
 #include <iostream>
 
 #include "app/cli_util.h"

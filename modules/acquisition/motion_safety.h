@@ -1,4 +1,4 @@
-// Motion safety before the first move (RELIABILITY.md C5, C6, R1-R3, design rule 3): the plan is checked
+// Motion safety before the first move (../shared/RELIABILITY.md C5, C6, R1-R3, design rule 3): the plan is checked
 // by planning::CheckPlanFor, the same check and words as `selfcal plan --check` (robot name, limits of the
 // config and of the controller less the margin, per-move travel, velocity limits, and the plan's
 // geometry when its file records `planned_for`); the first move from where the arm is is bounded too, the

@@ -10,8 +10,8 @@
 // Never calibrates: its only solves are the predictions'. Uses planning, tracking, robot, session, capture,
 // observations, kinematics, camera; bundle, geometry, base private.
 //
-// The operator's session loop (issue 6; DESIGN.md "move / grab / track / record"; RELIABILITY.md design
-// rule 3): drives a robot::Robot through a plan, grabs frames from a capture::FrameSource, tracks the dots
+// The operator's session loop (issue 6; ../shared/DESIGN.md "move / grab / track / record";
+// ../shared/RELIABILITY.md design rule 3): drives a robot::Robot through a plan, grabs frames from a capture::FrameSource, tracks the dots
 // through every move (identities never jump: vpDot2 follows them frame to frame), and records every event
 // in a session directory's journal before it counts. It never solves anything: `selfcal calibrate SESSION`
 // reads what it wrote.

@@ -20,13 +20,13 @@
 //
 // Error and outcome vocabulary shared by every module.
 //
-// Three kinds of failure, three mechanisms (STYLE.md, "Errors"):
+// Three kinds of failure, three mechanisms (../shared/STYLE.md, "Errors"):
 //  - expected numerical outcomes (degenerate data, too few points, no convergence) are enum values in
 //    each estimator's report, never exceptions;
 //  - caller or programmer errors (size mismatch, NaN input) throw selfcal::InvalidArgument through
 //    SELFCAL_CHECK;
 //  - environment, file and configuration problems travel as a Status (or Result<T>) carrying an
-//    ErrorCode; the CLI alone maps it to the documented exit codes (RELIABILITY.md, design rule 2).
+//    ErrorCode; the CLI alone maps it to the documented exit codes (../shared/RELIABILITY.md, design rule 2).
 #pragma once
 
 #include <optional>
@@ -38,7 +38,7 @@
 namespace selfcal {
 
 // What went wrong, in the library's words. The application maps each to a process exit code
-// (app/exit_codes.h; RELIABILITY.md design rule 2); no library chooses exit codes.
+// (app/exit_codes.h; ../shared/RELIABILITY.md design rule 2); no library chooses exit codes.
 enum class ErrorCode : int {
   kOk = 0,
   kInvalidInput,    // usage, configuration or file content the user can fix (names file, key, line, value)

@@ -15,7 +15,7 @@
 // (--fix / --free, the groups lens and intrinsics); an intrinsic the poses cannot separate is refused by name.
 // Uses identification, observations, kinematics, camera, base; Ceres private.
 //
-// Kinematic bundle adjustment (DESIGN.md section 5): one least-squares problem over every identification
+// Kinematic bundle adjustment (../shared/DESIGN.md section 5): one least-squares problem over every identification
 // image, beyond the paper's pipeline (which only initialises it).
 //
 // Residual of dot j seen at identification pose i (pixels, whitened by sigma = pixel_noise_px):

@@ -116,7 +116,7 @@ bool CovarianceFromJacobian(const Eigen::MatrixXd& jacobian, const std::vector<s
 // flange-pose set, whose scale the flange translations fix).
 BundleData MakeBundleData(const ObservationSet& observations, double yardstick_sigma_m);
 
-// The gauge and the free set of the problem at `state` (DESIGN.md section 4): SelectColumns on the
+// The gauge and the free set of the problem at `state` (../shared/DESIGN.md section 4): SelectColumns on the
 // reduced Jacobian of every rho entry plus the estimated intrinsics.
 struct Gauge {
   std::vector<int> free_kinematic;  // rho indices, ascending

@@ -1,4 +1,4 @@
-// The product's calibration stage beyond the paper (DESIGN.md section 5): the kinematic bundle adjustment
+// The product's calibration stage beyond the paper (../shared/DESIGN.md section 5): the kinematic bundle adjustment
 // (bundle/bundle_adjustment.h) started from the paper pipeline's result, then the same held-out 3-D check
 // as the paper's step 5 with the bundle's model and f_x.
 //

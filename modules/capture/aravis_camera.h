@@ -5,7 +5,7 @@
 //
 // Open: the camera found by id (empty: the first one Aravis lists), its region set when asked, exposure
 // and gain locked (ExposureAuto and GainAuto Off, then the values asked for, each read back and reported:
-// the V4L2 camera's rule, RELIABILITY.md V7), pixel format Mono8, a software trigger when the camera has
+// the V4L2 camera's rule, ../shared/RELIABILITY.md V7), pixel format Mono8, a software trigger when the camera has
 // one, streaming started, a test frame within open_timeout_s.
 //
 // Grab at the pose (V5): buffers already waiting are discarded, the grab waits until not_before_s (the

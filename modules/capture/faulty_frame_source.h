@@ -1,4 +1,4 @@
-// A fault-injecting frame source (RELIABILITY.md "test infrastructure"): wraps any FrameSource and makes
+// A fault-injecting frame source (../shared/RELIABILITY.md "test infrastructure"): wraps any FrameSource and makes
 // chosen Grab calls fail the way cameras do, so that sessions can be tested against V3-V6 without
 // hardware. Calls are counted from 0 over the wrapper's life ("grab #k").
 #pragma once

@@ -1,4 +1,4 @@
-// Per-frame sanity checks (RELIABILITY.md V6, optional blur V9): a frame that is empty, all black
+// Per-frame sanity checks (../shared/RELIABILITY.md V6, optional blur V9): a frame that is empty, all black
 // (lens cap, dead sensor), saturated (blown exposure), flat (no contrast), blurred (captured while the
 // arm vibrated), or out of order is refused with CaptureError::kBadFrame before anyone detects dots in
 // it. Thresholds are in grey levels (0..255) of the 8-bit grey image.

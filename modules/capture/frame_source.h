@@ -10,7 +10,7 @@
 //
 // Frame sources: the one interface through which a session gets images, whether from a V4L2 camera
 // (v4l2_camera.h), a recorded sequence folder (recorded_sequence.h) or the simulator
-// (sim/simulated_camera.h). The session code cannot tell them apart (DESIGN.md section 2, STYLE.md
+// (sim/simulated_camera.h). The session code cannot tell them apart (../shared/DESIGN.md section 2, ../shared/STYLE.md
 // "take from ViSP the frame-grabber interface that simulators and recorded sources also implement").
 //
 // Images are 8-bit grey vpImage<unsigned char>, row-major, pixel (u, v) = image[v][u]; the pixel
@@ -36,7 +36,7 @@
 namespace selfcal::capture {
 
 // What went wrong, for callers that react differently (retry, skip the pose, stop the session).
-// RELIABILITY.md rows in brackets.
+// ../shared/RELIABILITY.md rows in brackets.
 enum class CaptureError {
   kNone = 0,
   kDeviceMissing,     // no such device node, or no driver behind it [V1]
@@ -92,7 +92,7 @@ class FrameSource {
   virtual Status Open() = 0;
 
   // The first frame exposed at or after `not_before_s` (typically the robot's settle time: never a
-  // stale buffered frame, RELIABILITY.md V5), waiting at most `timeout_s` of wall time; kTimeout after
+  // stale buffered frame, ../shared/RELIABILITY.md V5), waiting at most `timeout_s` of wall time; kTimeout after
   // that. A frame that fails the source's sanity checks gives kBadFrame (the caller decides whether to
   // retry). Requires Open().
   virtual Result<Frame> Grab(double not_before_s, double timeout_s) = 0;

@@ -1,4 +1,4 @@
-// Recorded sequences (RELIABILITY.md V8): a folder that replays like a camera.
+// Recorded sequences (../shared/RELIABILITY.md V8): a folder that replays like a camera.
 //
 //   <folder>/index.yaml          the manifest, rewritten atomically after every image
 //   <folder>/frame_000000.png    8-bit grey PNG, one per frame, written atomically before the index

@@ -1,6 +1,6 @@
 // A V4L2 camera (USB/UVC webcams, industrial cameras with a V4L2 driver) as a FrameSource, through
 // ViSP's vpV4l2Grabber (mmap streaming, conversion to 8-bit grey) for the uncompressed formats and
-// capture's own mmap stream and MJPEG decoder for MJPEG, with the checks ViSP leaves out (RELIABILITY.md
+// capture's own mmap stream and MJPEG decoder for MJPEG, with the checks ViSP leaves out (../shared/RELIABILITY.md
 // section 3). Any size, pixel format and frame interval the device lists (v4l2_modes.h).
 //
 // The MJPEG path (v4l2_stream.h, mjpeg_decode.h) is UNTESTED on a device: no V4L2 device (nor
@@ -20,7 +20,7 @@
 // it has not returned before; older frames are discarded and counted (stale_frames_discarded()).
 // `sequence` counts the frames the thread dequeued; a gap means frames superseded before anyone asked.
 //
-// RELIABILITY.md rows, and what covers them:
+// ../shared/RELIABILITY.md rows, and what covers them:
 //   V1 (missing / busy / permission / not V4L2) - code: ProbeV4l2Device (stat, open(O_RDWR|O_NONBLOCK),
 //      VIDIOC_QUERYCAP, capture + streaming capabilities) before ViSP touches the device; busy also from
 //      VIDIOC_S_FMT returning EBUSY; messages name the node, errno and its name. TESTED without hardware:

@@ -1,4 +1,4 @@
-// V4L2 error paths that need no camera (RELIABILITY.md V1). What needs hardware is listed in
+// V4L2 error paths that need no camera (../shared/RELIABILITY.md V1). What needs hardware is listed in
 // v4l2_camera.h.
 #include "capture/v4l2_camera.h"
 

@@ -1,4 +1,4 @@
-// Which kinematic parameters the measurements can see (DESIGN.md section 4, RELIABILITY.md K1).
+// Which kinematic parameters the measurements can see (../shared/DESIGN.md section 4, ../shared/RELIABILITY.md K1).
 //
 // The measurement of pose i is cam_ref_from_cam_i = base_from_cam(q_ref)^-1 * base_from_cam(q_i), so the
 // base transform cancels, and more. Rather than assume, the rank of the stacked identification Jacobian at
@@ -59,7 +59,7 @@ IdentifiabilityReport AnalyzeIdentifiabilityOfJacobian(const RobotModel& model, 
 
 // Number of identifiable parameters (metric relative poses, scale known) at 5n + 12 / 2 (at least 12)
 // random joint configurations within the limits (fixed seed): what generic poses of this robot identify.
-// A plan that identifies fewer does not excite some joint (K3, RELIABILITY.md C7).
+// A plan that identifies fewer does not excite some joint (K3, ../shared/RELIABILITY.md C7).
 int GenericRank(const RobotModel& model, const Eigen::VectorXd& rho, double rank_tolerance);
 
 }  // namespace selfcal::identification

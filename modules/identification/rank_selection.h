@@ -1,5 +1,6 @@
 // Which columns of a Jacobian carry independent information, decided greedily in a preferred order, with
-// the dependent ones written as named null-space combinations (DESIGN.md section 4, RELIABILITY.md K1).
+// the dependent ones written as named null-space combinations (../shared/DESIGN.md section 4,
+// ../shared/RELIABILITY.md K1).
 // Shared by the relative-pose identifiability analysis and the kinematic bundle adjustment's gauge.
 #pragma once
 

@@ -80,7 +80,7 @@ bool ReadDoubleList(const yaml::YamlNode& node, const std::string& name, int siz
                     Problems* problems, std::vector<double>* out, KeyUnit unit = KeyUnit::kSi,
                     std::vector<int>* lines = nullptr);
 
-// Radians typed under a degree key (RELIABILITY.md C4): joint angles read from `joints_deg` or
+// Radians typed under a degree key (../shared/RELIABILITY.md C4): joint angles read from `joints_deg` or
 // `poses_deg` (`values_rad`, converted) whose every value, in degrees, lies within +-2 pi (6.2832), where
 // every joint angle written in radians lies, and not all zero. In degrees such values put every joint
 // within 6.3 deg of its zero; a real pose that close is given under the radian key instead.

@@ -6,7 +6,7 @@
 //
 // Serial-arm kinematic model and its identification parameterisation.
 //
-// Convention (DESIGN.md section 4). Joint i (1-based) is revolute about the z axis of its own frame and
+// Convention (../shared/DESIGN.md section 4). Joint i (1-based) is revolute about the z axis of its own frame and
 // its link transform is modified DH (Craig) with a Hayati tilt beta:
 //
 //   link_{i-1}_from_link_i(q_i) = RotX(alpha_i) * TransX(a_i) * RotY(beta_i) * RotZ(q_i + theta_i) * TransZ(d_i)

@@ -1,4 +1,4 @@
-// Checks a measurement plan before the robot moves (issue 4 item 3; RELIABILITY.md C5-C7): every
+// Checks a measurement plan before the robot moves (issue 4 item 3; ../shared/RELIABILITY.md C5-C7): every
 // constraint of PlanConstraints, pose by pose, each violation with the pose(s) and the value, and the
 // observability of the identification poses (rank against generic poses, condition number).
 //

@@ -52,7 +52,7 @@ struct PlanConstraints {
   // The paper method (Method::kPaper) recovers f_x from every pair (reference, i): for every
   // identification pose i, the sine of the angle between one optical axis and the plane through the other
   // axis and the second camera centre, at least this. Near zero the axes (nearly) intersect and f_x is
-  // unobservable from the pair (DESIGN.md section 4); the two-view estimator's own threshold is 0.05
+  // unobservable from the pair (../shared/DESIGN.md section 4); the two-view estimator's own threshold is 0.05
   // (twoview::TwoViewOptions::focal_observability_min), 0.08 keeps a margin. 0 (the default): not a
   // constraint (the bundle does not need it); the check reports the pairs below 0.08 as a figure.
   double min_axis_sine = 0.0;

@@ -310,8 +310,8 @@ json BundleSectionJson(const ObservationSet& obs, const calibration::BundleStage
   for (const bundle::RemovedObservation& o : b.removed) {
     removed.push_back({{"pose", o.pose_id}, {"dot", o.dot_id}, {"residual_px", o.residual_px}});
   }
-  return {{"description", "kinematic bundle adjustment (DESIGN.md section 5): reprojection of every dot in every "
-                          "identification image over the free kinematic parameters, hand-eye, f_x and the dots; "
+  return {{"description", "kinematic bundle adjustment: reprojection of every dot in every identification image"
+                          " over the free kinematic parameters, hand-eye, f_x and the dots; "
                           "yardstick as a length constraint"},
           {"verdict", calibration::VerdictName(calibration::VerdictFor(b.outcome))},
           {"outcome", bundle::OutcomeName(b.outcome)},

@@ -1,6 +1,6 @@
 // The network backend end to end on loopback: NetworkRobot against RobotServer serving a SimulatedRobot
 // (on the monotonic clock, the server on a thread), and against scripted fake servers for the failure
-// modes (RELIABILITY.md R5, R6, R8, R9, R10, R12, R13).
+// modes (../shared/RELIABILITY.md R5, R6, R8, R9, R10, R12, R13).
 #include "robot/network_robot.h"
 
 #include <atomic>

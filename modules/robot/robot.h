@@ -5,13 +5,13 @@
 // Dashboard's checks and the factory kinematics at connect; the byte formats in ur_protocol.h; ur_fake.h, the
 // loopback fake UrFakeController; docs/universal-robots.md). Uses base.
 //
-// The robot interface (DESIGN.md section 2, layer 2): what a calibration session needs from an arm, and
+// The robot interface (../shared/DESIGN.md section 2, layer 2): what a calibration session needs from an arm, and
 // nothing else. Backends: the simulated robot (simulated_robot.h), the network line protocol
 // (network_robot.h, docs/robot-protocol.md; robot_server.h serves any Robot with it) and the manual
 // backend (manual_robot.h).
 //
 // Motion is asynchronous: StartMove returns once the controller accepted (or refused) the target, and the
-// caller polls GetStatus while it tracks dots, runs its watchdog (RELIABILITY.md R6) and watches for a
+// caller polls GetStatus while it tracks dots, runs its watchdog (../shared/RELIABILITY.md R6) and watches for a
 // stop request (R11). Backends never retry, resume or re-send a move by themselves (R9).
 //
 // Time: every timestamp is seconds on the session's Clock (clock.h). Live backends stamp readings with

@@ -1,5 +1,5 @@
 // The simulated robot: a `Robot` whose joints move in simulated (or real) time, with every fault a
-// session must survive injectable by the count of calls (RELIABILITY.md R4-R10 and the fault-injecting
+// session must survive injectable by the count of calls (../shared/RELIABILITY.md R4-R10 and the fault-injecting
 // mock robot of its "test infrastructure" section), and a log of every command for the F8 safety figures.
 //
 // Joint motion only, no kinematics: a move is a quintic time scaling from where the arm is to the target,

@@ -1,5 +1,5 @@
 // The simulated robot: its motion profile and ring-down, and every injected fault observed through the
-// Robot interface (RELIABILITY.md R4-R10), on a SimulatedClock.
+// Robot interface (../shared/RELIABILITY.md R4-R10), on a SimulatedClock.
 #include "robot/simulated_robot.h"
 
 #include <cmath>

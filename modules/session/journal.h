@@ -1,4 +1,4 @@
-// The append-only journal of a calibration session (RELIABILITY.md P1, P2; docs/session-format.md): one
+// The append-only journal of a calibration session (../shared/RELIABILITY.md P1, P2; docs/session-format.md): one
 // framed, checksummed record per event, durable before it counts, with recovery of a torn tail after a
 // crash and refusal of damage anywhere else.
 //

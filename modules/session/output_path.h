@@ -1,4 +1,4 @@
-// The one rule for every path a command writes (RELIABILITY.md C9, C10; docs/cli-output.md "Output paths"):
+// The one rule for every path a command writes (../shared/RELIABILITY.md C9, C10; docs/cli-output.md "Output paths"):
 // nothing is written inside a session directory, over an input the command reads, or over an existing
 // file unless the user said so (--force). Checked for every output option before any work: a refusal
 // leaves everything as it was.

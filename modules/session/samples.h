@@ -1,6 +1,6 @@
 // Reading a session's journal (docs/session-format.md, "Record types") into what the solver and the
 // resume logic need: the plan, the accepted sample of each pose, the skips, faults and halts counted by
-// reason, and the pose to resume from (RELIABILITY.md P3).
+// reason, and the pose to resume from (../shared/RELIABILITY.md P3).
 //
 // Units: times in s on the session clock (robot/clock.h), joints in rad, pixels in px.
 //

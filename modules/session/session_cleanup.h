@@ -1,7 +1,7 @@
 // What a directory named as a session holds, and removing one that holds nothing recorded
 // (docs/session-format.md, "Interrupted creation"): a creation cut short (no session.json) or a session
 // that recorded no frame can be completed by `selfcal run --resume` or removed by `selfcal session
-// discard`, never by hand. Recorded data is never removed (RELIABILITY.md: recorded session data is never
+// discard`, never by hand. Recorded data is never removed (../shared/RELIABILITY.md: recorded session data is never
 // deleted by an error path, nor by this command).
 #pragma once
 

@@ -10,7 +10,7 @@
 // written). Rejected frames of skipped poses live in images/rejected/, journaled as frame_rejected; readers
 // never use them. Uses base, observations; io private (the robot config).
 //
-// A calibration session directory (docs/session-format.md; RELIABILITY.md P1-P6, C9, C10): the durable,
+// A calibration session directory (docs/session-format.md; ../shared/RELIABILITY.md P1-P6, C9, C10): the durable,
 // resumable record of one session, from which `selfcal calibrate SESSION` solves offline and
 // `selfcal run --resume SESSION` continues after a crash.
 //

@@ -1,4 +1,4 @@
-// The advisory lock of a session directory (RELIABILITY.md P6): one process at a time records into or
+// The advisory lock of a session directory (../shared/RELIABILITY.md P6): one process at a time records into or
 // resumes a session.
 //
 // `<session>/lock` is opened (created when absent) and locked with flock(LOCK_EX | LOCK_NB); it then holds

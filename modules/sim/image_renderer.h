@@ -1,4 +1,4 @@
-// Renders the simulated scene as the camera would see it (DESIGN.md section 6): a light background
+// Renders the simulated scene as the camera would see it (../shared/DESIGN.md section 6): a light background
 // with dark circular dots, exactly in perspective, with the camera's radial distortion, anti-aliased by
 // supersampling, optionally blurred and noisy. Per dot it returns the truth a detector is scored
 // against.

@@ -8,7 +8,7 @@
 // chessboard, ChArUco, any pattern as a grey level per board point, rendered anti-aliased through the lens,
 // with known corners). Uses observations, identification, kinematics, camera, geometry, capture.
 //
-// The simulated world of DESIGN.md section 6: a true robot (nominal + hidden errors drawn from a seed),
+// The simulated world of ../shared/DESIGN.md section 6: a true robot (nominal + hidden errors drawn from a seed),
 // a hidden flange-to-camera transform and focal length, a scene of non-coplanar dots (or, with
 // flat_sheet, dots on one plane) in view of every pose, a yardstick, and image points projected with
 // Gaussian pixel noise. The solver only ever sees the
@@ -38,7 +38,7 @@ namespace selfcal::sim {
 struct SimOptions {
   uint64_t world_seed = 1;          // robot errors, camera, scene
   uint64_t noise_seed = 1;          // pixel noise
-  // Hidden kinematic errors (DESIGN.md section 6): lengths ~ N(0, 1 mm), angles ~ N(0, 0.2 deg).
+  // Hidden kinematic errors (../shared/DESIGN.md section 6): lengths ~ N(0, 1 mm), angles ~ N(0, 0.2 deg).
   double length_error_std_m = 1e-3;
   double angle_error_std_rad = DegToRad(0.2);
   // Hidden hand-eye error relative to the nominal flange_from_cam.

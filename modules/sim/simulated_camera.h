@@ -6,7 +6,7 @@
 // SetPose(base_from_cam, time_s) when the camera arrives at a new pose (time on the same clock); a
 // frame exposed at t shows the latest pose set at or before t. So a caller that asks for a frame before
 // the move ended (not_before_s too early) really gets an image of the old pose: the stale-frame case
-// (RELIABILITY.md V5) is reproduced, not hidden.
+// (../shared/RELIABILITY.md V5) is reproduced, not hidden.
 //
 //  - Simulated time (real_time = false, the default): the clock is virtual; Grab returns at once the
 //    first grid frame exposed at or after max(not_before_s, previous frame + period). timeout_s is not

@@ -1,7 +1,7 @@
 // A smooth measurement trajectory around a scene: the paper's "initial" trajectory (section 4.2: "the
 // initial measurement samples were generated along a smooth path in the workspace of the robot").
 // The camera centre sweeps an arc around a target point, looking at it with a slowly wandering aim point
-// and roll so that no two optical axes intersect (f_x would be unobservable from such a pair, DESIGN.md
+// and roll so that no two optical axes intersect (f_x would be unobservable from such a pair, ../shared/DESIGN.md
 // section 4). Joint angles come from inverse kinematics of the nominal model, continued pose to pose.
 #pragma once
 

@@ -1,4 +1,4 @@
-// An arm that does not come to rest halts the session (RELIABILITY.md R7, design rule 3): a controller
+// An arm that does not come to rest halts the session (../shared/RELIABILITY.md R7, design rule 3): a controller
 // that reports 0.05 rad/s on every joint from its third move on (the simulated cell's arm behind a wrapper
 // that records every command; the network backend cannot carry the simulated clock, its readings are
 // stamped on CLOCK_MONOTONIC). The session halts at the first pose that does not settle, the arm is told

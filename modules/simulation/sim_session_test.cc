@@ -1,5 +1,5 @@
 // The session loop on the simulated cell: a clean session against the hidden truth (identities through
-// tracking alone), every fault of RELIABILITY.md R2-R11 and V3-V6 triggered with its halt, skip or refusal
+// tracking alone), every fault of ../shared/RELIABILITY.md R2-R11 and V3-V6 triggered with its halt, skip or refusal
 // and its count, no motion command in a dry run (F8), and a stopped session resumed to the same samples.
 #include "acquisition/session_runner.h"
 

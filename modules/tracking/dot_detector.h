@@ -4,7 +4,7 @@
 // ViSP (apriltag_identity.h), gated naming by predicted position with an ambiguity test and the prediction's
 // robust correction (predicted_match.h). Uses base, ViSP, Eigen.
 //
-// Dark dots on a light background, found in one grey image with ViSP's vpDot2 (RELIABILITY.md D2, D3, D6,
+// Dark dots on a light background, found in one grey image with ViSP's vpDot2 (../shared/RELIABILITY.md D2, D3, D6,
 // D7).
 //
 // Pixels: origin at the centre of the top-left pixel, u to the right, v down (as camera/camera.h); every

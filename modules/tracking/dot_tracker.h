@@ -1,5 +1,5 @@
 // Frame-to-frame tracking of identified dots with vpDot2::track, with a status per dot and identity checks
-// (RELIABILITY.md D1, D2, D4, D7).
+// (../shared/RELIABILITY.md D1, D2, D4, D7).
 //
 // Pixels and grey levels as dot_detector.h. The caller keeps the identities: it passes the previous
 // frame's dots (id -> centroid and size) and receives, in the same order, each id's status in the new

@@ -1,4 +1,4 @@
-// Dot identities from one image of a planar R x C dot grid, without tracking (RELIABILITY.md D5, D6).
+// Dot identities from one image of a planar R x C dot grid, without tracking (../shared/RELIABILITY.md D5, D6).
 //
 // Id convention (the ROS-Industrial "modified circle grid": one larger dot marks the origin):
 //

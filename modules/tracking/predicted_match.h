@@ -1,4 +1,4 @@
-// Naming detections by predicted positions (issue 12 item 1; RELIABILITY.md D4): each known dot has a
+// Naming detections by predicted positions (issue 12 item 1; ../shared/RELIABILITY.md D4): each known dot has a
 // predicted pixel with a 2x2 covariance (from the session's 3-D prediction, acquisition/dot_prediction.h),
 // and a detection takes the id of the one prediction whose chi-square gate holds it, when no other dot's
 // gate holds it and no other detection lies in that prediction's gate. A dot may have several gates (a

@@ -25,7 +25,7 @@ const char* OutcomeName(Outcome outcome) {
     case Outcome::kInvalidInput:
       return "invalid_input";
     case Outcome::kTooFewPoints:
-      return "insufficient_points";  // RELIABILITY.md G1 names it so
+      return "insufficient_points";  // ../shared/RELIABILITY.md G1 names it so
     case Outcome::kDegenerate:
       return "degenerate";
     case Outcome::kPureRotation:

@@ -28,7 +28,7 @@
 
 namespace selfcal::twoview {
 
-// RELIABILITY.md G1-G10.
+// ../shared/RELIABILITY.md G1-G10.
 enum class Outcome {
   kNotRun,
   kSuccess,

@@ -1,4 +1,4 @@
-// Kill-and-resume (RELIABILITY.md P1-P3, F4): `selfcal run` on the simulated cell is SIGKILLed at random
+// Kill-and-resume (../shared/RELIABILITY.md P1-P3, F4): `selfcal run` on the simulated cell is SIGKILLed at random
 // (seeded) moments, including during image and journal writes, and resumed with --resume until it
 // completes. After every kill the session must open (torn tail recovered), every accepted sample must
 // still be there with an intact image, and the final calibration must be identical to the bytes to an
