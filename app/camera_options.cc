@@ -35,12 +35,15 @@ CLI::Option* AddCameraOptions(CLI::App* cmd, std::string* backend, CameraMode* m
   const char* group = "Camera mode (v4l2, aravis)";
   cmd->add_option("--camera-width-px", mode->width_px, "Image width (v4l2 default 640; aravis: the camera's)")
       ->check(CLI::Range(1, 16384))
+      ->default_str("")  // 0, "not given", is below the range: the text says the default
       ->group(group);
   cmd->add_option("--camera-height-px", mode->height_px, "Image height (v4l2 default 480; aravis: the camera's)")
       ->check(CLI::Range(1, 16384))
+      ->default_str("")
       ->group(group);
   cmd->add_option("--camera-fps", mode->fps, "Frame rate (v4l2 default 30; aravis: the camera's)")
       ->check(CLI::Range(0.1, 1000.0))
+      ->default_str("")
       ->group(group);
   cmd->add_option("--camera-format", mode->format, "v4l2 pixel format: MJPG (decoded), YUYV (default), GREY, RGB3, "
                                                    "BGR3, RGB4; `v4l2-ctl --list-formats-ext` lists the camera's")
@@ -48,9 +51,11 @@ CLI::Option* AddCameraOptions(CLI::App* cmd, std::string* backend, CameraMode* m
       ->group(group);
   cmd->add_option("--exposure-ms", mode->exposure_ms, "Locked exposure time, ms (default: the camera's current one)")
       ->check(CLI::Range(0.001, 10000.0))
+      ->default_str("")  // the sentinel below the range is not a value to show
       ->group(group);
   cmd->add_option("--gain-db", mode->gain_db, "aravis: locked gain, dB (default: the camera's current one)")
       ->check(CLI::Range(0.0, 100.0))
+      ->default_str("")
       ->group(group);
   return option;
 }

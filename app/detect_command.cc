@@ -459,7 +459,8 @@ Command AddDetectCommand(CLI::App& app) {
   cmd->add_option("--tag-side-mm", a->tag_side_mm,
                   "apriltag: outer side of the tags' black border, mm (the apriltag detector: its edges as yardstick "
                   "and check distance; 1 to 100000)")
-      ->check(CLI::Range(io::kMinKnownDistanceM * 1e3, io::kMaxKnownDistanceM * 1e3));
+      ->check(CLI::Range(io::kMinKnownDistanceM * 1e3, io::kMaxKnownDistanceM * 1e3))
+      ->default_str("");  // 0: no tag side given
   cmd->add_option("--tag-dots-mm", a->tag_dots_mm, "apriltag: x1,y1,x2,y2,... of the dots around every tag, mm")
       ->delimiter(',');
   cmd->add_option("--tag-tolerance-px", a->tag_tolerance_px, "apriltag: a dot this close to its prediction is named")
@@ -475,8 +476,8 @@ Command AddDetectCommand(CLI::App& app) {
   cmd->add_option("--camera-name", a->camera_name, "The camera of a ViSP --camera-file holding several");
   std::vector<CLI::Option*> values = {
       cmd->add_option("--camera-fx-px", a->fx_px, "The camera's nominal focal length, px")->check(CLI::PositiveNumber),
-      cmd->add_option("--camera-cx-px", a->cx_px, "Principal point u, px (default: the image centre)"),
-      cmd->add_option("--camera-cy-px", a->cy_px, "Principal point v, px (default: the image centre)"),
+      cmd->add_option("--camera-cx-px", a->cx_px, "Principal point u, px (default: the image centre)")->default_str(""),
+      cmd->add_option("--camera-cy-px", a->cy_px, "Principal point v, px (default: the image centre)")->default_str(""),
       cmd->add_option("--camera-mu", a->mu, "f_y / f_x (default 1)")->check(CLI::PositiveNumber),
       cmd->add_option("--camera-k1", a->k1, "Radial distortion k1 (default 0)")};
   cmd->add_option("--pixel-noise-px", a->pixel_noise_px, "Standard deviation of a point's pixel, px (default 0.5)")

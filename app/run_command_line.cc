@@ -88,12 +88,14 @@ Command AddRunCommand(CLI::App& app) {
                   "selfcal-ur-fake)")
       ->delimiter(',')
       ->expected(3)
-      ->check(CLI::Range(1, 65535));
+      ->check(CLI::Range(1, 65535))
+      ->default_str("");  // the default is in the text (CLI11 would show "[]")
   AddCameraOptions(cmd, &a->camera_backend, &a->camera_mode, {"sim", "v4l2", "aravis"});
   cmd->add_option("--device", a->device, "v4l2 camera device");
   cmd->add_option("--velocity-scaling", a->velocity_scaling,
                   "Fraction of the joint velocity limits (default 1 simulated, 0.1 real)")
-      ->check(CLI::Range(1e-3, 1.0));  // NaN and inf: CheckNumbersStrictly (cli_numbers.h)
+      ->check(CLI::Range(1e-3, 1.0))  // NaN and inf: CheckNumbersStrictly (cli_numbers.h)
+      ->default_str("");              // -1, the "not given" sentinel, is not a value to show
   cmd->add_option("--seed", a->seed, "sim: world, noise and robot seed");
   cmd->add_option("--grey-noise", a->grey_noise, "sim: pixel noise std, grey levels")->check(CLI::Range(0.0, 50.0));
   cmd->add_option("--blur-px", a->blur_px, "sim: Gaussian blur sigma, px")->check(CLI::Range(0.0, 10.0));

@@ -2,6 +2,7 @@
 // command refuses a negative value and one beyond 64 bits, every floating option NaN and infinity, exit 2
 // naming the option and the value. The options are taken from each command's own --help, so an option
 // added later is tested without being listed here.
+#include <cstdlib>
 #include <filesystem>
 #include <regex>
 #include <set>
@@ -122,6 +123,29 @@ TEST(CommandLineValues, CalibrateWithOnlyTheFocalLengthFreeSolvesIt) {
                        &output), 2) << output;
   EXPECT_TRUE(Has(output, "nothing is left to estimate")) << output;
   std::filesystem::remove_all(dir);
+}
+
+// A default --help shows is a value the option takes: within its range and a number. `run --velocity-scaling`
+// showed "[0.001 - 1]=-1" and `detect --camera-cx-px` "=nan", the "not given" sentinels of the code.
+TEST(CommandLineValues, EveryDefaultShownInTheHelpIsAValueTheOptionTakes) {
+  const std::regex ranged(R"((--[a-z0-9-]+) (?:U?INT|FLOAT):(?:U?INT|FLOAT) in \[([^ ]+) - ([^\]]+)\]=([^ \n]+))");
+  const std::regex not_a_number(R"((--[a-z0-9-]+) [A-Z:]+[^=\n]*=(-?nan|-?inf)\b)");
+  int ranges = 0;
+  for (const std::string& command : Commands()) {
+    std::string help;
+    ASSERT_EQ(RunSelfcal(command + " --help", &help), 0) << help;
+    for (std::sregex_iterator it(help.begin(), help.end(), ranged), end; it != end; ++it) {
+      const std::string text = (*it)[4];
+      char* rest = nullptr;
+      const double shown = std::strtod(text.c_str(), &rest);
+      EXPECT_TRUE(*rest == '\0' && shown >= std::stod((*it)[2]) && shown <= std::stod((*it)[3]))
+          << command << " " << (*it)[0];
+      ++ranges;
+    }
+    std::smatch found;
+    EXPECT_FALSE(std::regex_search(help, found, not_a_number)) << command << " " << found[0];
+  }
+  EXPECT_GE(ranges, 20);
 }
 
 }  // namespace
