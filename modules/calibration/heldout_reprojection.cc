@@ -10,6 +10,7 @@
 #include "bundle/error_model.h"
 #include "calibration/heldout_chi_square.h"
 #include "calibration/heldout_dot_groups.h"
+#include "calibration/heldout_gross_errors.h"
 #include "geometry/rigid3.h"
 #include "identification/triangulation.h"
 #include "kinematics/joint_motion.h"
@@ -382,46 +383,6 @@ Eigen::MatrixXd CovarianceRoot(const Eigen::MatrixXd& covariance) {
   return eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
 }
 
-// Leaves the gross detection errors out of `residuals` (HeldOutReprojection::gross_errors): each residual's
-// own covariance sigma^2 I + G G^T + D D^T against kGrossErrorChiSquare, applied only when at most
-// kMaxGrossErrorShare of them exceed it. `observed` (the report's residuals) and the poses' first rows follow.
-void ScreenGrossErrors(double sigma, Residuals* residuals, std::vector<int>* first_row_of_pose,
-                       std::vector<ObservedResidual>* observed, std::vector<ObservedResidual>* gross) {
-  const int width = residuals->num_theta;
-  const int n = static_cast<int>(residuals->rows.size());
-  std::vector<bool> out(n, false);
-  int count = 0;
-  for (int k = 0; k < n; ++k) {
-    const Residual& e = residuals->rows[k];
-    const Eigen::Map<const RowMajor> g(residuals->g.data() + static_cast<size_t>(2 * width) * k, 2, width);
-    Eigen::Matrix2d c = sigma * sigma * Eigen::Matrix2d::Identity() + e.d * e.d.transpose();
-    if (width > 0) c += g * g.transpose();
-    out[k] = e.r.dot(c.ldlt().solve(e.r)) > kGrossErrorChiSquare;
-    count += out[k];
-  }
-  if (count == 0 || count > kMaxGrossErrorShare * n) return;
-  Residuals kept;
-  kept.num_theta = width;
-  std::vector<ObservedResidual> kept_observed;
-  std::vector<int> first(first_row_of_pose->size(), 0);
-  size_t pose = 0;
-  for (int k = 0; k < n; ++k) {
-    while (pose < first_row_of_pose->size() && (*first_row_of_pose)[pose] <= k) first[pose++] = static_cast<int>(kept.rows.size());
-    if (out[k]) {
-      gross->push_back((*observed)[k]);
-      continue;
-    }
-    kept.rows.push_back(residuals->rows[k]);
-    kept.g.insert(kept.g.end(), residuals->g.begin() + static_cast<std::ptrdiff_t>(2 * width) * k,
-                  residuals->g.begin() + static_cast<std::ptrdiff_t>(2 * width) * (k + 1));
-    kept_observed.push_back((*observed)[k]);
-  }
-  while (pose < first_row_of_pose->size()) first[pose++] = static_cast<int>(kept.rows.size());
-  *residuals = std::move(kept);
-  *observed = std::move(kept_observed);
-  *first_row_of_pose = std::move(first);
-}
-
 }  // namespace
 
 HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const PredictionModel& model,
@@ -528,7 +489,7 @@ HeldOutReprojection HeldOutReprojectionOf(const ObservationSet& obs, const Predi
     return report;
   }
   first_row_of_pose.push_back(static_cast<int>(residuals.rows.size()));
-  ScreenGrossErrors(noise_px, &residuals, &first_row_of_pose, &report.residuals, &report.gross_errors);
+  internal::ScreenGrossErrors(noise_px, &residuals, &first_row_of_pose, &report.residuals, &report.gross_errors);
   for (size_t s = 0; s < report.poses.size(); ++s) {
     report.poses[s] = FigureOf(report.poses[s].pose_id, first_row_of_pose[s], first_row_of_pose[s + 1], residuals,
                                num_dots, noise_px, noise_dof, model, parts);

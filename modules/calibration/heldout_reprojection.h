@@ -138,9 +138,10 @@ struct HeldOutReprojection {
   // (fit_geometry.h), rms_mm = overall.rms_px * mm_per_px; NaN when the stage did not give the depth.
   double mm_per_px = NAN, rms_mm = NAN;
   std::vector<ObservedResidual> residuals;  // every predicted detection, pose by pose (those in `overall`)
-  // Gross detection errors left out of the figures: a detection whose residual lies beyond
-  // kGrossErrorChiSquare of its own predicted 2 x 2 covariance (4.4 sigma), when such are at most
-  // kMaxGrossErrorShare of the predicted detections (a wrong model moves many, a misdetected corner one).
+  // Gross detection errors left out of the figures: a detection whose residual, given the other detections
+  // of its pose, lies beyond kGrossErrorChiSquare (4.4 sigma), the worst first and at most kMaxGrossErrorShare
+  // of the predicted detections (heldout_gross_errors.h: a misdetected corner moves one dot; a wrong model
+  // moves many and keeps all but the worst few in the test).
   std::vector<ObservedResidual> gross_errors;
 };
 

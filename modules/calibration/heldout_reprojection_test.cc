@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -182,7 +183,8 @@ namespace {
 
 // (d) One verification detection 20 px off (a misdetected corner) is left out of the test and named; the
 // correct model then passes as without it. A wrong model (f_x held 2 % off, the arc's last 10 poses held
-// out, as in (b)) moves every prediction: nothing is left out and it still fails.
+// out, as in (b)) moves every prediction: at most 5 % of the detections, its worst, are left out and it
+// still fails.
 TEST(HeldOutReprojection, AGrossDetectionErrorIsLeftOutAndNamedButAWrongModelIsNotExcused) {
   sim::SimResult world = testing::PumaArcWorld(Cell(0.3, 21));
   ObservationSet& obs = world.observations;
@@ -202,8 +204,46 @@ TEST(HeldOutReprojection, AGrossDetectionErrorIsLeftOutAndNamedButAWrongModelIsN
   fx_held.bundle.intrinsics[kFx] = false;
   const CalibratedCell wrong = Calibrated(Cell(0.3, 21), fx_held, false, /*from_paper=*/false, 1.02);
   ASSERT_TRUE(wrong.stage.heldout.ok);
-  EXPECT_TRUE(wrong.stage.heldout.gross_errors.empty()) << wrong.stage.heldout.gross_errors.size();
+  const HeldOutReprojection& h = wrong.stage.heldout;
+  EXPECT_LE(h.gross_errors.size(), kMaxGrossErrorShare * (h.overall.num_residuals + h.gross_errors.size()));
   EXPECT_FALSE(wrong.stage.heldout_at_stated_noise.test_passed);
+}
+
+// (d') The misdetected corner beside more detections just beyond the bound than the 5 % share (a real cell's
+// unmodelled errors; kvasios s1's fold with a 6 px corner): the corner, the worst, is still left out, with
+// no more than the share. All or nothing, nothing was, and the corner alone failed the test.
+TEST(HeldOutReprojection, AMisdetectedCornerIsLeftOutBesideManyDetectionsJustBeyondTheBound) {
+  sim::SimResult world = testing::PumaArcWorld(Cell(0.3, 21));
+  ObservationSet& obs = world.observations;
+  Interleave(&obs);
+  const std::vector<int> verification = obs.PosesWithRole(PoseRole::kVerification);
+  size_t detections = 0;
+  for (int v : verification) detections += obs.poses[v].dots_px.size();
+  const int share = static_cast<int>(std::floor(kMaxGrossErrorShare * detections));
+  ASSERT_GE(share, 2);
+  auto corner = obs.poses[verification.front()].dots_px.begin();
+  corner->second += Eigen::Vector2d(12.0, -16.0);
+  // 3 px (10 sigma at 0.3 px): beyond the bound, far below the corner; every 8th dot of the other poses,
+  // in directions that no common motion of a pose explains.
+  int moved = 0;
+  for (size_t i = 1; i < verification.size(); ++i) {
+    int k = 0;
+    for (auto& [id, pixel] : obs.poses[verification[i]].dots_px) {
+      if (k++ % 8 != 0 || moved > share) continue;
+      pixel += Eigen::Vector2d(moved % 2 ? 3.0 : -3.0, moved % 3 ? 3.0 : -3.0);
+      ++moved;
+    }
+  }
+  ASSERT_GT(moved, share);
+  const BundleStageReport s = RunBundleStage(obs, RunPaperPipeline(obs, PaperPipelineOptions()), BundleStageOptions());
+  ASSERT_TRUE(s.heldout.ok) << s.heldout.message;
+  EXPECT_LE(static_cast<int>(s.heldout.gross_errors.size()), share);
+  bool named = false;
+  for (const ObservedResidual& e : s.heldout.gross_errors) {
+    named = named || (e.pose_id == obs.poses[verification.front()].id && e.dot_id == corner->first);
+  }
+  EXPECT_TRUE(named) << s.heldout.gross_errors.size() << " left out";
+  EXPECT_LT(s.heldout.overall.max_px, 5.0);
 }
 
 // (e) A joint reading noise of 0.02 deg (the images taken at the true angles): with the error model

@@ -27,14 +27,14 @@ const fs::path kData = fs::path(SELFCAL_SOURCE_DIR) / "test/data/kvasios-franka-
 
 // detect on one session as it is stored (a folder per pose, the joints under `joint_pose`): the
 // observations file's path.
-std::string Detect(const std::string& session, const fs::path& dir) {
+std::string Detect(const std::string& session, const fs::path& dir, const std::string& noise_px = "0.5") {
   fs::create_directories(dir);
   const std::string obs = (dir / "obs.yaml").string();
   std::string output;
   const int code = RunSelfcalInSource(
       "detect --images " + (kData / session).string() +
           " --pose-joints-key joint_pose --robot config/robots/panda.yaml --detector chessboard --grid 4x6 --camera-file " +
-          (kData / "realsense_factory.yaml").string() + " --yardstick 5,18,198.252 --pixel-noise-px 0.5 --out " + obs,
+          (kData / "realsense_factory.yaml").string() + " --yardstick 5,18,198.252 --pixel-noise-px " + noise_px + " --out " + obs,
       &output);
   EXPECT_EQ(code, 0) << output;
   return obs;
@@ -189,6 +189,39 @@ TEST(KvasiosChain, AModelNoHeldOutTestCouldCheckIsWrittenAsUntested) {
   std::ifstream model(dir / "cal" / "calibrated_model.yaml");
   const std::string text((std::istreambuf_iterator<char>(model)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("\"verdict\": \"untested\""), std::string::npos) << text.substr(0, 2000);
+}
+
+// s1's pose_03 has a misdetected corner (dot 0, 6 px off; the fit's screen leaves it out when the pose is
+// fitted). Held out with pose_00 and pose_02 at a stated 0.15 px, it is left out of the held-out test and
+// named, and the rest is explained by the error model estimated from the fit's own residuals (0.06 px and
+// each image's pose error). Tested against its own covariance, the corner hid in a held parameter's
+// tolerance and refused the model alone (chi-square 6953 over 144 at the estimate, 1276 at the stated noise).
+TEST(KvasiosChain, AMisdetectedCornerInAHeldOutPoseIsLeftOutAndTheEstimatedErrorModelHolds) {
+  const fs::path dir = FreshDir("kvasios", "gross");
+  std::ifstream in(Detect("s1", dir, "0.15"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const char* id : {"\"pose_00\"", "\"pose_02\"", "\"pose_03\""}) {
+    const size_t role = text.find("role: identification", text.find(id));
+    ASSERT_NE(role, std::string::npos) << id;
+    text.replace(role, 20, "role: verification");
+  }
+  std::ofstream((dir / "held.yaml").string()) << text;
+  std::string output;
+  EXPECT_EQ(RunSelfcalInSource("calibrate " + (dir / "held.yaml").string() + " --out " + (dir / "cal").string() +
+                                   " --no-html",
+                               &output),
+            0)
+      << output;
+  std::ifstream report_file(dir / "cal" / "report.json");
+  const nlohmann::json heldout = nlohmann::json::parse(report_file).at("heldout_reprojection").at("calibrated_model");
+  bool named = false;
+  for (const nlohmann::json& e : heldout.at("gross_errors")) {
+    named = named || (e.at("pose") == "pose_03" && e.at("dot") == 0);
+  }
+  EXPECT_TRUE(named) << heldout.at("gross_errors").dump();
+  EXPECT_LE(heldout.at("gross_errors").size(), 3u);  // 5 % of 72
+  EXPECT_TRUE(heldout.at("overall").at("test_passed")) << heldout.at("overall").dump();
+  EXPECT_TRUE(heldout.at("overall_at_stated_noise").at("test_passed")) << heldout.at("overall_at_stated_noise").dump();
 }
 
 // Calibrated on s1 without the targets 0, 4 and 8, the model predicts those targets in s2 (recorded the same
