@@ -530,8 +530,8 @@ int DriveSession(const RunSettings& a, const RunPlan& run, const Backends& b, co
               << " once the cause is fixed\n";
   } else if (halted) {
     std::cout << (report.stop_sent ? "HALTED. The robot was told to stop."
-                                   : "HALTED. The stop command could not be sent or was refused: stop the arm at its "
-                                     "controller.")
+                                   : "HALTED. The stop command could not be sent, was refused or was not "
+                                     "acknowledged: stop the arm at its controller.")
               << " Check the cell, then continue with: selfcal run --resume --session " << a.session
               << " (same options)\n";
   }

@@ -116,6 +116,7 @@ std::string FanucFakeController::Answer(const fanuc::Packet& packet, const std::
     ++stop_commands_;
     moving_ = false;
     status_.rmi_motion_status = 0;
+    if (options_.silent_abort) return "";
     return fanuc::Reply(PacketKind::kCommand, name, 0);
   }
   if (name == "FRC_Reset") return fanuc::Reply(PacketKind::kCommand, name, 0);

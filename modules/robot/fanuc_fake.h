@@ -33,6 +33,7 @@ struct FanucFakeOptions {
   int wrong_answer_move = -1;  // half way through this move FRC_ReadJointAngles is answered as another command
   bool servo_off_at_start = false;
   bool teach_pendant_enabled = false;
+  bool silent_abort = false;  // FRC_Abort stops the arm but is never answered (an answer lost on the way)
 };
 
 class FanucFakeController {

@@ -335,12 +335,38 @@ Status FanucRobot::Stop() {
   Result<LineSocket> fresh = connected.ok()
                                  ? LineSocket::Connect(host_, *connected->port, options_.connect_timeout_s, kMaxPacketBytes)
                                  : Result<LineSocket>(connected.status());
-  if (fresh.ok()) {
-    LineSocket socket = std::move(fresh).value();
-    if (Send(&socket, abort, options_.reply_timeout_s).ok()) return Status::Ok();
+  if (!fresh.ok()) {
+    return RobotFailure(RobotError::kDisconnected, name_ + ": Stop: FRC_Abort could not be sent (" + broken_reason_ +
+                                                       "): stop the arm at the pendant");
   }
-  return RobotFailure(RobotError::kDisconnected,
-                      name_ + ": Stop: FRC_Abort could not be sent (" + broken_reason_ + "): stop the arm at the pendant");
+  LineSocket socket = std::move(fresh).value();
+  if (!Send(&socket, abort, options_.reply_timeout_s).ok()) {
+    return RobotFailure(RobotError::kDisconnected, name_ + ": Stop: FRC_Abort could not be sent on a new session (" +
+                                                       broken_reason_ + "): stop the arm at the pendant");
+  }
+  return AbortAnswer(&socket);
+}
+
+// The answer to an FRC_Abort sent on a fresh session: only an answer with ErrorID 0 says the arm was stopped.
+Status FanucRobot::AbortAnswer(LineSocket* socket) {
+  const double deadline_s = clock_.Now() + options_.reply_timeout_s;
+  const std::string sent = name_ + ": Stop: FRC_Abort was sent on a new session after the link was lost (" +
+                           broken_reason_ + ") but ";
+  while (true) {
+    std::string line;
+    const double left_s = deadline_s - clock_.Now();
+    const LineIoResult io = left_s > 0 ? socket->ReadLine(&line, left_s) : LineIoResult{};
+    if (left_s <= 0 || !io.ok()) {
+      const std::string why = left_s <= 0 ? "no answer within the reply timeout" : io.error;
+      return RobotFailure(RobotError::kDisconnected,
+                          sent + "not acknowledged (" + why + "): make sure the arm stopped, at the pendant");
+    }
+    Result<fanuc::Packet> packet = fanuc::ParsePacket(line);
+    if (!packet.ok() || packet->kind != PacketKind::kCommand || packet->name != "FRC_Abort") continue;
+    if (packet->error_id == 0) return Status::Ok();
+    return RobotFailure(RobotError::kRejected, sent + "refused with ErrorID " + std::to_string(packet->error_id) +
+                                                   ": stop the arm at the pendant");
+  }
 }
 
 }  // namespace selfcal::robot

@@ -9,7 +9,8 @@
 // reading at rest within the robot config's limits. FRC_Initialize is sent before the first move, so that a
 // refusal or a dry run leaves the controller's RMI as it was. selfcal never sends FRC_Reset: clearing an alarm is a person's act at the pendant.
 // A move is done when its instruction was answered without error and every joint lies within
-// target_tolerance_rad of the target. Stop() is FRC_Abort (on a fresh connection when the link is lost).
+// target_tolerance_rad of the target. Stop() is FRC_Abort (on a fresh connection when the link is lost), Ok
+// only once the controller answered it with ErrorID 0.
 // A lost connection, FRC_Terminate or a wrong answer is kDisconnected/kProtocol on every later call until
 // Connect() succeeds again (R10); FRC_SystemFault makes every later status a fault and refuses moves.
 #pragma once
@@ -84,6 +85,9 @@ class FanucRobot : public Robot {
   // unsolicited packets on the way are noted (Note). A lost link, FRC_Terminate or a wrong answer breaks it.
   Result<fanuc::Packet> Ask(fanuc::PacketKind kind, const std::string& name, const std::string& request);
   Status Note(const fanuc::Packet& packet);
+  // Reads the answer to an FRC_Abort just sent on `socket` (a fresh session): Ok for ErrorID 0; no answer
+  // within the reply timeout, or another ErrorID, fails with a sentence saying the abort was sent.
+  Status AbortAnswer(LineSocket* socket);
   Result<fanuc::ControllerStatus> ControllerState();
   Status LinkStatus(const char* call) const;
   Status Broken(RobotError error, const std::string& reason);

@@ -8,12 +8,15 @@
 #include <memory>
 #include <thread>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "robot/fanuc_fake.h"
 
 namespace selfcal::robot {
 namespace {
+
+using ::testing::HasSubstr;
 
 JointLimits ArmLimits() {
   JointLimits limits;
@@ -169,6 +172,23 @@ TEST(FanucRobotTest, ADroppedConnectionIsStickyAndTheAbortGoesOutOnAFreshConnect
   served.Shutdown();
   EXPECT_EQ(served.fake().motion_commands(), 1);
   EXPECT_EQ(served.fake().stop_commands(), 1);
+}
+
+TEST(FanucRobotTest, AnAbortOnAFreshConnectionThatIsNeverAnsweredIsNotReportedAsAStop) {
+  FanucFakeOptions options;
+  options.drop_move = 0;
+  options.silent_abort = true;
+  ServedFake served(options);
+  FanucRobot arm("127.0.0.1", served.ClientOptions());
+  Eigen::VectorXd target;
+  ASSERT_TRUE(StartFirstMove(arm, &target));
+  ASSERT_FALSE(WaitForMove(arm, 3.0).ok());
+  const Status stop = arm.Stop();
+  EXPECT_EQ(RobotErrorOf(stop), RobotError::kDisconnected) << stop.message();
+  EXPECT_THAT(stop.message(), HasSubstr("FRC_Abort was sent"));
+  EXPECT_THAT(stop.message(), HasSubstr("not acknowledged"));
+  served.Shutdown();
+  EXPECT_EQ(served.fake().stop_commands(), 1);  // it was sent, and the controller got it
 }
 
 TEST(FanucRobotTest, AWrongAnswerBreaksTheLink) {

@@ -271,14 +271,15 @@ Status UrRobot::StartRtde() {
   return Status::Ok();
 }
 
-Result<ur::UrState> UrRobot::LatestState(double* arrival_s) {
+Result<ur::UrState> UrRobot::LatestState(double* arrival_s, double not_before_s) {
   const double deadline_s = clock_.Now() + options_.reply_timeout_s;
   while (true) {
     Status failure;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       failure = reader_failure_;
-      if (failure.ok() && latest_ && clock_.Now() - latest_s_ <= options_.reply_timeout_s) {
+      if (failure.ok() && latest_ && clock_.Now() - latest_s_ <= options_.reply_timeout_s &&
+          latest_s_ >= not_before_s) {
         last_state_ = *latest_;
         if (arrival_s != nullptr) *arrival_s = latest_s_;
         return last_state_;
@@ -388,8 +389,10 @@ Result<JointLimits> UrRobot::Limits() {
 
 Result<JointReading> UrRobot::ReadJoints() {
   if (Status link = LinkStatus("ReadJoints"); !link.ok()) return link;
+  // A reading taken now: the next data package, not the one that arrived before the call (up to one RTDE
+  // period old, which the session would count as a stale reading).
   double arrival_s = 0;
-  Result<ur::UrState> state = LatestState(&arrival_s);
+  Result<ur::UrState> state = LatestState(&arrival_s, clock_.Now());
   if (!state.ok()) return state.status();
   JointReading reading;
   reading.position_rad = state->q_rad;

@@ -19,6 +19,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -105,9 +106,10 @@ class UrRobot : public Robot {
   // arrival time; the first failure kept for the caller.
   void StartReader();
   void ReadStreams();
-  // The newest state package, no older than reply_timeout_s (waiting that long for one), and when it
-  // arrived; the reader's failure breaks the link.
-  Result<ur::UrState> LatestState(double* arrival_s = nullptr);
+  // The newest state package, no older than reply_timeout_s and arrived at or after not_before_s (waiting
+  // up to reply_timeout_s for one), and when it arrived; the reader's failure breaks the link.
+  Result<ur::UrState> LatestState(double* arrival_s = nullptr,
+                                  double not_before_s = -std::numeric_limits<double>::infinity());
   Result<std::string> Dashboard(const std::string& command);
   Status LinkStatus(const char* call) const;
   Status Broken(RobotError error, const std::string& reason);

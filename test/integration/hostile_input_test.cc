@@ -154,7 +154,7 @@ TEST(HostileInput, HaltSaysTheRobotWasToldToStopOnlyWhenTheStopWasSent) {
   EXPECT_EQ(RunSelfcal("run --session " + (dir / "lost").string() + " --seed 3 --fault-disconnect-move 2", &output), 4)
       << output;
   EXPECT_FALSE(Has(output, "told to stop")) << output;
-  EXPECT_TRUE(Has(output, "The stop command could not be sent or was refused")) << output;
+  EXPECT_TRUE(Has(output, "The stop command could not be sent, was refused or was not acknowledged")) << output;
   EXPECT_EQ(RunSelfcal("run --session " + (dir / "pstop").string() + " --seed 3 --fault-protective-stop-move 2", &output),
             4)
       << output;

@@ -130,6 +130,10 @@ def whole_session(selfcal, robot_sim, src, tmp, failures):
     for recorded in ('"robot_serial":"REHEARSAL-1"', '"camera":"simulated camera: ', "real time"):
         if recorded not in journal:
             failures.append("the network session's journal does not record " + recorded)
+    faults = [line for line in journal.splitlines() if '"type":"fault"' in line]
+    print("faults recorded: %d" % len(faults))
+    if faults:  # a fault-free cell records none
+        failures.append("a fault-free network run recorded faults:\n" + "\n".join(faults[:5]))
     compare_with_simulated(selfcal, src, tmp, network, "network", failures)
 
 
