@@ -90,7 +90,7 @@ class UrFake(LoopbackFake):
         self.rtde, self.secondary, self.dashboard = self.ports
 
     def robot_args(self):
-        return ["--robot", "ur", "--address", "127.0.0.1", "--ur-ports",
+        return ["--backend", "ur", "--address", "127.0.0.1", "--ur-ports",
                 "%d,%d,%d" % (self.rtde, self.secondary, self.dashboard)]
 
     def motion_commands(self):
@@ -134,7 +134,7 @@ class ReferenceServer(reference_server_test.Server):
     """The reference server at the plan's first pose (reference_server_test.Server), counted like the fake."""
 
     def robot_args(self):
-        return ["--robot", "network", "--address", "127.0.0.1:%d" % self.port]
+        return ["--backend", "network", "--address", "127.0.0.1:%d" % self.port]
 
     def motion_commands(self):
         return self.moves_started()

@@ -51,7 +51,7 @@ def never_settle(selfcal, robot_sim, ur_fake, src, tmp, failures):
                          "config/trajectories/initial_puma560.yaml", "--never-settle-move", "2"], src,
                         r"listening on 127\.0\.0\.1:(\d+)")
     session = os.path.join(tmp, "s")
-    code, out = run([selfcal, "run", "--robot", "network", "--address", "127.0.0.1:" + match.group(1), "--camera",
+    code, out = run([selfcal, "run", "--backend", "network", "--address", "127.0.0.1:" + match.group(1), "--camera",
                      "sim", "--velocity-scaling", "1", "--live-view", "off", "--session", session], src)
     log = stop(proc)
     print(out[-1200:])
@@ -79,7 +79,7 @@ def unconfirmed(selfcal, robot_sim, ur_fake, src, tmp, failures):
                         r"listening on 127\.0\.0\.1 rtde (\d+) secondary (\d+) dashboard (\d+)")
     session = os.path.join(tmp, "ur")
     ports = ",".join(match.groups())
-    code, out = run([selfcal, "run", "--robot", "ur", "--address", "127.0.0.1", "--ur-ports", ports,
+    code, out = run([selfcal, "run", "--backend", "ur", "--address", "127.0.0.1", "--ur-ports", ports,
                      "--robot-config", "config/robots/ur5e.yaml", "--camera", "sim", "--velocity-scaling", "1",
                      "--live-view", "off", "--session", session], src)
     log = stop(proc)

@@ -158,7 +158,7 @@ def protocol(selfcal, src, tmp, failures):
 
 
 def run_selfcal(selfcal, src, server, session, extra=(), background=False):
-    args = [selfcal, "run", "--robot", "network", "--address", "127.0.0.1:%d" % server.port, "--camera", "sim",
+    args = [selfcal, "run", "--backend", "network", "--address", "127.0.0.1:%d" % server.port, "--camera", "sim",
             "--velocity-scaling", "1", "--live-view", "off", "--session", session] + list(extra)
     if background:
         return subprocess.Popen(args, cwd=src, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)

@@ -57,7 +57,7 @@ def dry_run(selfcal, robot_sim, src, tmp, failures):
     server = Server(robot_sim, src, ["--start-at-plan", PLAN])
     setup = os.path.join(tmp, "setup.json")
     # A setup.json for the v4l2 case: a simulated session's (any valid one would do).
-    code, out = run(selfcal, ["run", "--robot", "sim", "--camera", "sim", "--live-view", "off",
+    code, out = run(selfcal, ["run", "--backend", "sim", "--camera", "sim", "--live-view", "off",
                               "--session", os.path.join(tmp, "sim")], src)
     if code == 0:
         shutil.copy(os.path.join(tmp, "sim", "inputs", "setup.json"), setup)
@@ -70,7 +70,7 @@ def dry_run(selfcal, robot_sim, src, tmp, failures):
             failures.append(name + ": no setup.json to run with (simulate: " + out[-500:] + ")")
             continue
         session = os.path.join(tmp, "dry-" + name.split()[0])
-        code, out = run(selfcal, ["run", "--robot", "network", "--address", "127.0.0.1:%d" % server.port,
+        code, out = run(selfcal, ["run", "--backend", "network", "--address", "127.0.0.1:%d" % server.port,
                                   "--velocity-scaling", "1", "--dry-run", "--live-view", "off",
                                   "--session", session] + camera, src)
         if code != 0:
@@ -96,7 +96,7 @@ def report_of(selfcal, src, session, out, failures):
 def whole_session(selfcal, robot_sim, src, tmp, failures):
     server = Server(robot_sim, src, ["--start-at-plan", PLAN])
     network = os.path.join(tmp, "network")
-    code, out = run(selfcal, ["run", "--robot", "network", "--address", "127.0.0.1:%d" % server.port,
+    code, out = run(selfcal, ["run", "--backend", "network", "--address", "127.0.0.1:%d" % server.port,
                               "--camera", "sim", "--velocity-scaling", "1", "--seed", "1", "--live-view", "off",
                               "--session", network], src)
     log = server.stop()
@@ -143,7 +143,7 @@ def compare_with_simulated(selfcal, src, tmp, session, label, failures):
     parameter and f_x within 4 combined standard deviations, both check-distance RMS below 0.5 mm. Returns
     `session`'s report (None when a step failed)."""
     simulated = os.path.join(tmp, "simulated")
-    code, out = run(selfcal, ["run", "--robot", "sim", "--camera", "sim", "--seed", "1", "--live-view", "off",
+    code, out = run(selfcal, ["run", "--backend", "sim", "--camera", "sim", "--seed", "1", "--live-view", "off",
                               "--session", simulated], src)
     if code != 0:
         failures.append("simulated run: exit %d\n%s" % (code, out[-3000:]))
