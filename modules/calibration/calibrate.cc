@@ -1,6 +1,11 @@
 #include "calibration/calibrate.h"
 
 #include <chrono>
+#include <iomanip>
+#include <sstream>
+
+#include "base/numbers.h"
+#include "calibration/scene_shift.h"
 
 namespace selfcal::calibration {
 
@@ -160,6 +165,31 @@ void CheckFlangePoses(const ObservationSet& observations, const ObservationSet& 
   *noise_out = noise;
 }
 
+// A failed held-out test of a joint set's bundle model whose verification images one move of the scene explains
+// (scene_shift.h): its sentence says so. Sets that name their scenes already have theirs.
+void NameAMovedScene(const ObservationSet& obs, CalibrationReport* report) {
+  if (!report->bundle || obs.UsesFlangePoses() || report->bundle->calibrated_rho.size() == 0) return;
+  for (const PoseObservation& pose : obs.poses) {
+    if (!pose.scene.empty()) return;
+  }
+  for (AcceptanceCheck& check : report->acceptance.checks) {
+    if (check.name != "heldout_test" || check.status != CheckStatus::kFailed) continue;
+    const BundleStageReport& stage = *report->bundle;
+    const SceneShift shift = SceneShiftOfVerification(obs, stage.calibrated_robot, stage.calibrated_rho,
+                                                      stage.calibrated_camera, stage.bundle.dots_in_base);
+    const HeldOutFigure& test = stage.heldout_at_stated_noise;
+    if (!VerificationSceneMoved(shift, test.chi_square, test.chi_square_limit)) return;
+    std::ostringstream s;
+    s << std::fixed << std::setprecision(2) << "; one move of the scene would explain the verification images ("
+      << shift.rms_before_px << " px RMS -> " << shift.rms_after_px << " px): its points "
+      << shift.translation_m * 1e3 << " mm and " << std::setprecision(3) << shift.rotation_rad * 180 / kPi
+      << " deg from where the identification images put them. If the scene moved between them (a board bumped, "
+         "another day's recording), give those poses a scene of their own (`scene:` per pose, detect --scene, "
+         "calibrate --also); if it did not, the model is wrong";
+    check.sentence += s.str();
+  }
+}
+
 // The acceptance checks of the chosen method's converged model; a failed one turns the verdict to
 // kRejected, its sentences the message.
 void CheckAcceptance(const ObservationSet& obs, const ObservationSet& original, CalibrationReport* report) {
@@ -220,6 +250,7 @@ void CheckAcceptance(const ObservationSet& obs, const ObservationSet& original, 
     in.distances_nominal = &report->paper.verification_nominal;
   }
   report->acceptance = AcceptanceOf(in);
+  NameAMovedScene(obs, report);
   if (in.calibrated != nullptr && !in.calibrated->unused_poses.empty()) {
     // Held out to verify, it verifies nothing: an error, not a silent drop (its joints or image are not
     // the pose's, e.g. radians under a degree key that a reader could not tell).

@@ -16,6 +16,8 @@
 //   fit_geometry.h          camera poses and residuals at the bundle's solution, for the report's plots
 //   predicted_error.h       PredictDistanceErrors: first-order 3-D error of held-out distances
 //   scene_moves.h           SceneMovesOf: where each scene's points lie against the first's (a board that moved)
+//   scene_shift.h           SceneShiftOfVerification: the move of the scene that would explain refused
+//                           verification images
 // Uses bundle, identification, twoview, observations, kinematics, geometry, camera, base.
 //
 // The calibration facade: one entry point from an observation set to a report that carries the verdict

@@ -1,0 +1,116 @@
+#include "calibration/scene_shift.h"
+
+#include <cmath>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "base/numbers.h"
+#include "geometry/rigid3.h"
+
+namespace selfcal::calibration {
+namespace {
+
+struct ShiftedDot {
+  Rigid3 cam_from_points;
+  Eigen::Vector3d point;
+  Eigen::Vector2d pixel;
+};
+
+// The dots' residuals (px) with the points moved by x = (translation, rotation vector about `centre`); a dot
+// that does not project (behind the camera) counts 0 and is reported in *lost.
+Eigen::VectorXd ShiftResiduals(const std::vector<ShiftedDot>& dots, const CameraIntrinsics& camera,
+                               const Eigen::Vector3d& centre, const Eigen::Matrix<double, 6, 1>& x, int* lost) {
+  const Eigen::Matrix3d r = ExpSO3<double>(x.tail<3>());
+  Eigen::VectorXd residuals = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(dots.size()));
+  *lost = 0;
+  for (std::size_t i = 0; i < dots.size(); ++i) {
+    const Eigen::Vector3d moved = r * (dots[i].point - centre) + centre + x.head<3>();
+    const std::optional<Eigen::Vector2d> uv = Project(camera, dots[i].cam_from_points * moved);
+    if (!uv) {
+      ++*lost;
+      continue;
+    }
+    residuals.segment<2>(2 * static_cast<Eigen::Index>(i)) = *uv - dots[i].pixel;
+  }
+  return residuals;
+}
+
+double RmsPerCoordinate(const Eigen::VectorXd& r) { return r.size() ? std::sqrt(r.squaredNorm() / r.size()) : 0.0; }
+
+}  // namespace
+
+SceneShift SceneShiftOfVerification(const ObservationSet& obs, const RobotModel& robot, const Eigen::VectorXd& rho,
+                                    const CameraIntrinsics& camera, const std::map<int, Eigen::Vector3d>& points) {
+  SceneShift shift;
+  std::vector<ShiftedDot> dots;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const PoseObservation& pose : obs.poses) {
+    if (pose.role != PoseRole::kVerification) continue;
+    const Rigid3 cam_from_points = PointsFromCamAt(robot, rho, pose).Inverse();
+    const std::size_t before = dots.size();
+    for (const auto& [id, pixel] : pose.dots_px) {
+      const auto point = points.find(id);
+      if (point == points.end()) continue;
+      dots.push_back({cam_from_points, point->second, pixel});
+      centre += point->second;
+    }
+    shift.poses += dots.size() > before ? 1 : 0;
+  }
+  shift.dots = static_cast<int>(dots.size());
+  if (dots.size() < 3) return shift;
+  centre /= static_cast<double>(dots.size());
+  Eigen::Matrix<double, 6, 1> x = Eigen::Matrix<double, 6, 1>::Zero();
+  int lost = 0;
+  Eigen::VectorXd r = ShiftResiduals(dots, camera, centre, x, &lost);
+  if (lost > 0) return shift;
+  shift.rms_before_px = RmsPerCoordinate(r);
+  double lambda = 1e-3;
+  for (int iteration = 0; iteration < 50; ++iteration) {
+    Eigen::MatrixXd jacobian(r.size(), 6);
+    for (int k = 0; k < 6; ++k) {  // central differences: 1 um, 1 urad
+      Eigen::Matrix<double, 6, 1> step = Eigen::Matrix<double, 6, 1>::Zero();
+      step[k] = 1e-6;
+      int lost_plus = 0, lost_minus = 0;
+      jacobian.col(k) = (ShiftResiduals(dots, camera, centre, x + step, &lost_plus) -
+                         ShiftResiduals(dots, camera, centre, x - step, &lost_minus)) / 2e-6;
+      if (lost_plus + lost_minus > 0) return shift;
+    }
+    const Eigen::Matrix<double, 6, 6> normal = jacobian.transpose() * jacobian;
+    const Eigen::Matrix<double, 6, 1> gradient = jacobian.transpose() * r;
+    bool improved = false;
+    while (!improved && lambda < 1e12) {
+      Eigen::Matrix<double, 6, 6> damped = normal;
+      damped.diagonal() += lambda * normal.diagonal().cwiseMax(1e-12);
+      const Eigen::Matrix<double, 6, 1> dx = damped.ldlt().solve(-gradient);
+      int lost_trial = 0;
+      const Eigen::VectorXd trial = ShiftResiduals(dots, camera, centre, x + dx, &lost_trial);
+      if (lost_trial == 0 && trial.squaredNorm() < r.squaredNorm()) {
+        const bool small = dx.norm() < 1e-10;
+        x += dx;
+        r = trial;
+        lambda = std::max(lambda / 10, 1e-9);
+        improved = true;
+        if (small) iteration = 50;
+      } else {
+        lambda *= 10;
+      }
+    }
+    if (!improved) break;
+  }
+  shift.computed = true;
+  shift.rms_after_px = RmsPerCoordinate(r);
+  shift.translation_m = x.head<3>().norm();
+  shift.rotation_rad = x.tail<3>().norm();
+  return shift;
+}
+
+bool VerificationSceneMoved(const SceneShift& shift, double chi_square, double chi_square_limit) {
+  if (!shift.computed || !(shift.rms_before_px > 0)) return false;
+  const double ratio = shift.rms_after_px / shift.rms_before_px;
+  return ratio * 3 <= 1 && chi_square * ratio * ratio <= chi_square_limit &&
+         (shift.translation_m >= 0.5e-3 || shift.rotation_rad >= 0.05 * kPi / 180);
+}
+
+}  // namespace selfcal::calibration

@@ -1,0 +1,40 @@
+// Did the scene move before the verification images were taken? A refused held-out test whose verification
+// images another recording took (a board bumped between sessions, another day) looks like a wrong model; but
+// then one rigid move of the scene's points explains those images with the calibrated model's cameras held.
+// SceneShiftOfVerification fits that move (6 parameters: a rotation about the points' centroid and a
+// translation, Gauss-Newton on the verification dots' reprojection) and reports the RMS before and after.
+// The verdict's sentence names the move when the images would pass the held-out test after it
+// (VerificationSceneMoved). A wrong model's errors can look like a move too (a link length wrong by millimetres
+// shifts the dots of nearby configurations alike), so the sentence offers both readings.
+#pragma once
+
+#include <map>
+
+#include <Eigen/Core>
+
+#include "camera/camera.h"
+#include "kinematics/robot_model.h"
+#include "observations/observation_set.h"
+
+namespace selfcal::calibration {
+
+struct SceneShift {
+  bool computed = false;      // false: no verification dot with a point, or the solve failed
+  int poses = 0, dots = 0;    // verification images and dots used
+  double rms_before_px = 0;   // RMS per coordinate with the points where the identification images put them
+  double rms_after_px = 0;    // after the move
+  double translation_m = 0;   // of the points' centroid
+  double rotation_rad = 0;    // about it
+};
+
+// The move of the points (`points`: id -> position in the points' frame, bundle dots_in_base) that best
+// explains the verification poses of `obs` seen by `camera` from `robot` with parameters `rho`.
+SceneShift SceneShiftOfVerification(const ObservationSet& obs, const RobotModel& robot, const Eigen::VectorXd& rho,
+                                    const CameraIntrinsics& camera, const std::map<int, Eigen::Vector3d>& points);
+
+// The move explains the verification images: their RMS after it at least 3 times smaller, the held-out test's
+// statistic scaled by (after / before)^2 within `chi_square_limit` (the refused `chi_square` as it would be
+// after the move, to first order), and a move of at least 0.5 mm or 0.05 deg.
+bool VerificationSceneMoved(const SceneShift& shift, double chi_square, double chi_square_limit);
+
+}  // namespace selfcal::calibration
