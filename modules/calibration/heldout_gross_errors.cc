@@ -56,12 +56,12 @@ void ScreenGrossErrors(double sigma, Residuals* residuals, std::vector<int>* fir
     if (most > 0) worst[s] = WorstOfPose(sigma, *residuals, in[s]);
   }
   std::vector<bool> out(n, false);
-  for (int removed = 0; removed < most; ++removed) {
+  for (int removed = 0; removed < most && num_poses > 0; ++removed) {
     size_t pose = 0;
     for (size_t s = 1; s < num_poses; ++s) {
       if (worst[s].first > worst[pose].first) pose = s;
     }
-    if (num_poses == 0 || !(worst[pose].first > kGrossErrorChiSquare)) break;
+    if (!(worst[pose].first > kGrossErrorChiSquare)) break;
     const int k = worst[pose].second;
     out[k] = true;
     in[pose].erase(std::find(in[pose].begin(), in[pose].end(), k));
