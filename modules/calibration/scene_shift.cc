@@ -8,6 +8,7 @@
 
 #include "base/numbers.h"
 #include "geometry/rigid3.h"
+#include "kinematics/damped_least_squares.h"
 
 namespace selfcal::calibration {
 namespace {
@@ -61,44 +62,33 @@ SceneShift SceneShiftOfVerification(const ObservationSet& obs, const RobotModel&
   shift.dots = static_cast<int>(dots.size());
   if (dots.size() < 3) return shift;
   centre /= static_cast<double>(dots.size());
-  Eigen::Matrix<double, 6, 1> x = Eigen::Matrix<double, 6, 1>::Zero();
   int lost = 0;
-  Eigen::VectorXd r = ShiftResiduals(dots, camera, centre, x, &lost);
+  const Eigen::VectorXd before = ShiftResiduals(dots, camera, centre, Eigen::Matrix<double, 6, 1>::Zero(), &lost);
   if (lost > 0) return shift;
-  shift.rms_before_px = RmsPerCoordinate(r);
-  double lambda = 1e-3;
-  for (int iteration = 0; iteration < 50; ++iteration) {
-    Eigen::MatrixXd jacobian(r.size(), 6);
+  shift.rms_before_px = RmsPerCoordinate(before);
+  // A dot that stops projecting makes a step worse than any (kLostPx), so the solver never takes it; one lost
+  // in a Jacobian's central difference spoils that Jacobian, and the solve gives no figure.
+  constexpr double kLostPx = 1e6;
+  bool jacobian_lost = false;
+  const ResidualAndJacobian evaluate = [&](const Eigen::VectorXd& x, Eigen::VectorXd* r, Eigen::MatrixXd* j) {
+    int lost_here = 0;
+    *r = ShiftResiduals(dots, camera, centre, x, &lost_here);
+    if (lost_here > 0) r->setConstant(kLostPx);
+    j->resize(r->size(), 6);
     for (int k = 0; k < 6; ++k) {  // central differences: 1 um, 1 urad
       Eigen::Matrix<double, 6, 1> step = Eigen::Matrix<double, 6, 1>::Zero();
       step[k] = 1e-6;
       int lost_plus = 0, lost_minus = 0;
-      jacobian.col(k) = (ShiftResiduals(dots, camera, centre, x + step, &lost_plus) -
-                         ShiftResiduals(dots, camera, centre, x - step, &lost_minus)) / 2e-6;
-      if (lost_plus + lost_minus > 0) return shift;
+      j->col(k) = (ShiftResiduals(dots, camera, centre, x + step, &lost_plus) -
+                   ShiftResiduals(dots, camera, centre, x - step, &lost_minus)) / 2e-6;
+      if (lost_here == 0 && lost_plus + lost_minus > 0) jacobian_lost = true;
     }
-    const Eigen::Matrix<double, 6, 6> normal = jacobian.transpose() * jacobian;
-    const Eigen::Matrix<double, 6, 1> gradient = jacobian.transpose() * r;
-    bool improved = false;
-    while (!improved && lambda < 1e12) {
-      Eigen::Matrix<double, 6, 6> damped = normal;
-      damped.diagonal() += lambda * normal.diagonal().cwiseMax(1e-12);
-      const Eigen::Matrix<double, 6, 1> dx = damped.ldlt().solve(-gradient);
-      int lost_trial = 0;
-      const Eigen::VectorXd trial = ShiftResiduals(dots, camera, centre, x + dx, &lost_trial);
-      if (lost_trial == 0 && trial.squaredNorm() < r.squaredNorm()) {
-        const bool small = dx.norm() < 1e-10;
-        x += dx;
-        r = trial;
-        lambda = std::max(lambda / 10, 1e-9);
-        improved = true;
-        if (small) iteration = 50;
-      } else {
-        lambda *= 10;
-      }
-    }
-    if (!improved) break;
-  }
+  };
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(6);
+  MinimiseDampedLeastSquares(evaluate, &x, 50);
+  if (jacobian_lost) return shift;
+  const Eigen::VectorXd r = ShiftResiduals(dots, camera, centre, x, &lost);
+  if (lost > 0) return shift;
   shift.computed = true;
   shift.rms_after_px = RmsPerCoordinate(r);
   shift.translation_m = x.head<3>().norm();

@@ -2,7 +2,8 @@
 // images another recording took (a board bumped between sessions, another day) looks like a wrong model; but
 // then one rigid move of the scene's points explains those images with the calibrated model's cameras held.
 // SceneShiftOfVerification fits that move (6 parameters: a rotation about the points' centroid and a
-// translation, Gauss-Newton on the verification dots' reprojection) and reports the RMS before and after.
+// translation, by kinematics/damped_least_squares.h on the verification dots' reprojection) and reports the
+// RMS before and after.
 // The verdict's sentence names the move when the images would pass the held-out test after it
 // (VerificationSceneMoved). A wrong model's errors can look like a move too (a link length wrong by millimetres
 // shifts the dots of nearby configurations alike), so the sentence offers both readings.
