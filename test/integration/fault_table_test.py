@@ -163,27 +163,9 @@ def run(selfcal, src, robot, session, extra=()):
     return p.returncode, p.stdout + p.stderr
 
 
-def journal_records(session):
-    """The journal's records, in order."""
-    with open(os.path.join(session, "journal.log"), errors="replace") as f:
-        for line in f:
-            parts = line.split(" ", 3)
-            if len(parts) == 4 and parts[0] == "J1":
-                yield json.loads(parts[3])
-
-
 def accepted_samples(session):
     """The journal's sample_accepted records, by pose."""
-    return {r["pose"]: r for r in journal_records(session) if r.get("type") == "sample_accepted"}
-
-
-def journal_faults(session):
-    """The journal's fault records' kinds, with their counts."""
-    kinds = {}
-    for record in journal_records(session):
-        if record.get("type") == "fault":
-            kinds[record["kind"]] = kinds.get(record["kind"], 0) + 1
-    return kinds
+    return {r["pose"]: r for r in rehearsal_test.journal_records(session) if r.get("type") == "sample_accepted"}
 
 
 def ur_session(selfcal, ur_fake, src, tmp, failures):
@@ -198,7 +180,7 @@ def ur_session(selfcal, ur_fake, src, tmp, failures):
         return
     if "stopped; motion commands 25, stop commands 0" not in log:
         failures.append("the fake did not receive the 25 moves and no stop:\n" + log[-2000:])
-    faults = journal_faults(session)
+    faults = rehearsal_test.journal_faults(session)
     print("faults recorded: %s" % faults)
     if faults:  # a reading is the next RTDE package, so a fault-free cell records none
         failures.append("a fault-free run recorded faults: %s" % faults)
