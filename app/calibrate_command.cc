@@ -385,6 +385,8 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
                                                           : calibration::FlangeScale::kAuto;
   options.progress = Progress();
   calibration::CalibrationReport report = calibration::Calibrate(loaded->observations, options);
+  // The solve found the scene moved between poses and took a scene each: its outputs are of that set.
+  if (report.solved_observations) loaded.value().observations = *report.solved_observations;
   report::PrintCalibrationSummary(loaded->observations, report, std::cout);
   // Inconsistent observations or options found during the solve (a verification pose no identification pose
   // can predict, a scale asked of yardsticks the set lacks): exit 2 like any bad input, and nothing written.

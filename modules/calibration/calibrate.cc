@@ -438,11 +438,61 @@ CalibrationReport CalibrateSteps(const ObservationSet& observations, const Calib
   return report;
 }
 
+// The held-out RMS (px per coordinate) of a report: its cross-validation's, else its verification poses'; 0: none.
+double HeldOutRmsOf(const CalibrationReport& report) {
+  if (report.cross_validation && report.cross_validation->folds_tested > 0) return report.cross_validation->pooled.rms_px;
+  if (report.bundle && report.bundle->heldout.ok) return report.bundle->heldout.overall.rms_px;
+  return 0;
+}
+
+// A joint set of one scene whose images see the solved points in two places (scene_split.h): solved again with a
+// scene each, and that solve is the result when its scenes' points lie apart and it predicts held-out poses better.
+void SplitAMovedScene(const ObservationSet& obs, const CalibrateOptions& options, CalibrationReport* report) {
+  if (obs.UsesFlangePoses() || options.method != Method::kBundle || !report->bundle) return;
+  if (SceneNames(obs).size() > 1) return;
+  const BundleStageReport& stage = *report->bundle;
+  if (stage.calibrated_rho.size() == 0 || stage.bundle.dots_in_base.empty()) return;
+  SceneSplit split = FindSceneSplit(obs, stage.calibrated_robot, stage.calibrated_rho, stage.calibrated_camera,
+                                    stage.bundle.dots_in_base);
+  if (!split.checked) return;
+  if (!split.found) {
+    report->scene_split = split;
+    return;
+  }
+  split.one_scene_heldout_px = HeldOutRmsOf(*report);
+  ObservationSet separated = WithSplitScenes(obs, split);
+  CalibrationReport again = CalibrateSteps(separated, options);
+  split.split_heldout_px = HeldOutRmsOf(again);
+  const bool converged = again.bundle && again.bundle->bundle.outcome == bundle::Outcome::kConverged;
+  const bool moved = !again.scene_moves.empty() && again.scene_moves.front().moved;
+  const bool better = split.split_heldout_px > 0 && (split.one_scene_heldout_px == 0 ||
+                                                     split.split_heldout_px * kSplitHeldOutGain <= split.one_scene_heldout_px);
+  if (!converged) {
+    split.decision = "the solve with a scene each did not converge (" + again.message + "): the result is the one-scene solve";
+  } else if (!moved) {
+    split.decision = "solved with a scene each, the two scenes' points lie no further apart than their scatter: the "
+                     "result is the one-scene solve";
+  } else if (!better) {
+    split.decision = "solved with a scene each, it predicts held-out poses less than " +
+                     std::to_string(static_cast<int>(kSplitHeldOutGain)) +
+                     " times better (a model error, not a move?): the result is the one-scene solve";
+  } else {
+    split.applied = true;
+    split.decision = "the result is the solve with a scene each";
+    again.scene_split = split;
+    again.solved_observations = std::move(separated);
+    *report = std::move(again);
+    return;
+  }
+  report->scene_split = split;
+}
+
 }  // namespace
 
 CalibrationReport Calibrate(const ObservationSet& observations, const CalibrateOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   CalibrationReport report = CalibrateSteps(observations, options);
+  SplitAMovedScene(observations, options, &report);
   report.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
 }

@@ -16,6 +16,8 @@
 //   fit_geometry.h          camera poses and residuals at the bundle's solution, for the report's plots
 //   predicted_error.h       PredictDistanceErrors: first-order 3-D error of held-out distances
 //   scene_moves.h           SceneMovesOf: where each scene's points lie against the first's (a board that moved)
+//   scene_split.h           FindSceneSplit: one set's images that see the scene in two places (a scene that
+//                           moved between poses), solved again with a scene each
 //   scene_shift.h           SceneShiftOfVerification: the move of the scene that would explain refused
 //                           verification images
 // Uses bundle, identification, twoview, observations, kinematics, geometry, camera, base.
@@ -55,6 +57,7 @@
 #include "calibration/paper_pipeline.h"
 #include "calibration/pose_noise_result.h"
 #include "calibration/scene_moves.h"
+#include "calibration/scene_split.h"
 #include "kinematics/robot_model.h"
 #include "observations/observation_set.h"
 
@@ -164,6 +167,12 @@ struct CalibrationReport {
   std::optional<CrossValidationReport> cross_validation;
   // The bundle converged on a set of several scenes sharing point ids: where each lies against the first.
   std::vector<SceneMove> scene_moves;
+  // A joint set of one scene whose bundle solved: whether its images see the points in two places (a scene that
+  // moved between poses), and when they do whether the solve with a scene each is the result.
+  std::optional<SceneSplit> scene_split;
+  // The set the result solved when it is not the one given (scene_split applied: the poses with a scene each,
+  // SeparateScenes' ids); the outputs (residuals, scene points) are of this set.
+  std::optional<ObservationSet> solved_observations;
   std::optional<CalibratedModel> model;    // the chosen method's model, only when accepted or untested
   // The acceptance checks of the chosen method's converged model (empty when it did not converge).
   Acceptance acceptance;

@@ -42,13 +42,14 @@ double RmsPerCoordinate(const Eigen::VectorXd& r) { return r.size() ? std::sqrt(
 
 }  // namespace
 
-SceneShift SceneShiftOfVerification(const ObservationSet& obs, const RobotModel& robot, const Eigen::VectorXd& rho,
-                                    const CameraIntrinsics& camera, const std::map<int, Eigen::Vector3d>& points) {
+SceneShift SceneShiftOfPoses(const ObservationSet& obs, const std::vector<int>& pose_indices, const RobotModel& robot,
+                             const Eigen::VectorXd& rho, const CameraIntrinsics& camera,
+                             const std::map<int, Eigen::Vector3d>& points) {
   SceneShift shift;
   std::vector<ShiftedDot> dots;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  for (const PoseObservation& pose : obs.poses) {
-    if (pose.role != PoseRole::kVerification) continue;
+  for (const int index : pose_indices) {
+    const PoseObservation& pose = obs.poses[static_cast<std::size_t>(index)];
     const Rigid3 cam_from_points = PointsFromCamAt(robot, rho, pose).Inverse();
     const std::size_t before = dots.size();
     for (const auto& [id, pixel] : pose.dots_px) {
@@ -93,7 +94,22 @@ SceneShift SceneShiftOfVerification(const ObservationSet& obs, const RobotModel&
   shift.rms_after_px = RmsPerCoordinate(r);
   shift.translation_m = x.head<3>().norm();
   shift.rotation_rad = x.tail<3>().norm();
+  shift.centre = centre;
+  shift.move = x;
   return shift;
+}
+
+SceneShift SceneShiftOfVerification(const ObservationSet& obs, const RobotModel& robot, const Eigen::VectorXd& rho,
+                                    const CameraIntrinsics& camera, const std::map<int, Eigen::Vector3d>& points) {
+  std::vector<int> verification;
+  for (std::size_t i = 0; i < obs.poses.size(); ++i) {
+    if (obs.poses[i].role == PoseRole::kVerification) verification.push_back(static_cast<int>(i));
+  }
+  return SceneShiftOfPoses(obs, verification, robot, rho, camera, points);
+}
+
+Eigen::Vector3d SceneShift::Moved(const Eigen::Vector3d& point) const {
+  return ExpSO3<double>(Eigen::Vector3d(move.tail<3>())) * (point - centre) + centre + move.head<3>();
 }
 
 bool VerificationSceneMoved(const SceneShift& shift, double chi_square, double chi_square_limit) {

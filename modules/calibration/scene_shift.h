@@ -10,6 +10,7 @@
 #pragma once
 
 #include <map>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -26,10 +27,20 @@ struct SceneShift {
   double rms_after_px = 0;    // after the move
   double translation_m = 0;   // of the points' centroid
   double rotation_rad = 0;    // about it
+  // The move: a point p goes to R (p - centre) + centre + t, t = move.head<3>() (m), R = Exp(move.tail<3>()).
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Matrix<double, 6, 1> move = Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Vector3d Moved(const Eigen::Vector3d& point) const;
 };
 
 // The move of the points (`points`: id -> position in the points' frame, bundle dots_in_base) that best
-// explains the verification poses of `obs` seen by `camera` from `robot` with parameters `rho`.
+// explains the poses pose_indices (into obs.poses) seen by `camera` from `robot` with parameters `rho`, their
+// cameras held (centre: the centroid of their dots' points).
+SceneShift SceneShiftOfPoses(const ObservationSet& obs, const std::vector<int>& pose_indices, const RobotModel& robot,
+                             const Eigen::VectorXd& rho, const CameraIntrinsics& camera,
+                             const std::map<int, Eigen::Vector3d>& points);
+
+// SceneShiftOfPoses over the verification poses of `obs`.
 SceneShift SceneShiftOfVerification(const ObservationSet& obs, const RobotModel& robot, const Eigen::VectorXd& rho,
                                     const CameraIntrinsics& camera, const std::map<int, Eigen::Vector3d>& points);
 

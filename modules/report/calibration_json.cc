@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include "report/calibration_json_plots.h"
+#include "report/calibration_json_scenes.h"
 #include "report/calibration_report.h"
 #include "report/json_util.h"
 
@@ -553,18 +554,8 @@ json CalibrationReportJson(const ObservationSet& obs, const calibration::Calibra
     methods["bundle"]["plot_data"] = PoseNoisePlotDataJson(obs, report);
   }
   j["cross_validation"] = report.cross_validation ? CrossValidationJson(*report.cross_validation) : json();
-  json moves = json::array();
-  for (const calibration::SceneMove& m : report.scene_moves) {
-    moves.push_back({{"scene", m.scene},
-                     {"relative_to", m.relative_to},
-                     {"shared_points", m.shared_points},
-                     {"displacement_rms_mm", m.displacement_rms_m * 1e3},
-                     {"displacement_max_mm", m.displacement_max_m * 1e3},
-                     {"rotation_deg", RadToDeg(m.rotation_rad)},
-                     {"rigid_fit_rms_mm", m.rigid_fit_rms_m * 1e3},
-                     {"moved", m.moved}});
-  }
-  j["scene_moves"] = moves;
+  j["scene_moves"] = SceneMovesJson(report);
+  j["scene_split"] = SceneSplitJson(report);
   j["methods"] = methods;
   j["session"] = context.session ? SessionJson(context.input, *context.session) : json();
   if (report.hand_eye_start) {

@@ -297,6 +297,36 @@ void PrintModelChoice(const calibration::ModelChoice& c, std::ostream& out) {
   out.unsetf(std::ios::floatfield);
 }
 
+// Pose ids, at most `max` of them, then how many more.
+std::string PoseList(const std::vector<std::string>& ids, std::size_t max = 6) {
+  std::string s;
+  for (std::size_t i = 0; i < ids.size() && i < max; ++i) s += (i ? ", " : "") + ids[i];
+  if (ids.size() > max) s += ", ... (" + std::to_string(ids.size()) + " in all)";
+  return s;
+}
+
+// Whether the images see the scene in one place, and what the calibration did when they do not.
+void PrintSceneSplit(const calibration::SceneSplit& split, std::ostream& out) {
+  out << std::fixed << std::setprecision(2);
+  if (!split.found) {
+    out << "  one scene: the " << split.images << " images see its points in one place (one move of them per best "
+        << "split of the images in two would leave " << split.rms_two_places_px << " px RMS of "
+        << split.rms_one_place_px << ")\n";
+  } else {
+    out << "  the scene moved between poses: " << split.second_poses.size() << " poses (" << PoseList(split.second_poses)
+        << ") see its points " << split.translation_m * 1e3 << " mm and " << RadToDeg(split.rotation_rad)
+        << " deg from where " << split.first_poses.size() << " poses (" << PoseList(split.first_poses)
+        << ") see them (a move per group leaves " << split.rms_two_places_px << " px RMS of "
+        << split.rms_one_place_px << "); " << split.decision;
+    if (split.one_scene_heldout_px > 0 && split.split_heldout_px > 0) {
+      out << std::setprecision(3) << " (held-out " << split.one_scene_heldout_px << " px with one scene, "
+          << split.split_heldout_px << " px with a scene each)";
+    }
+    out << "\n";
+  }
+  out.unsetf(std::ios::floatfield);
+}
+
 void PrintSummaryLines(const calibration::CalibrationReport& report, std::ostream& out) {
   if (report.hand_eye_start) {
     PrintHandEye(report, out);
@@ -312,6 +342,7 @@ void PrintSummaryLines(const calibration::CalibrationReport& report, std::ostrea
     if (pose_noise) PrintPoseNoiseResult(report, out);
     if (report.cross_validation) PrintCrossValidation(*report.cross_validation, out);
     if (report.model_choice) PrintModelChoice(*report.model_choice, out);
+    if (report.scene_split) PrintSceneSplit(*report.scene_split, out);
     for (const calibration::SceneMove& m : report.scene_moves) {
       out << "  scene `" << m.scene << "` against `" << m.relative_to << "`: its " << m.shared_points
           << " points lie " << std::fixed << std::setprecision(2) << m.displacement_rms_m * 1e3 << " mm RMS from the first's (largest "

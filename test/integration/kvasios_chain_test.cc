@@ -157,9 +157,9 @@ TEST(KvasiosChain, RecordingsPooledEachAsItsSceneNameTheBoardThatMoved) {
   EXPECT_EQ(moved[0].at("relative_to"), "s1");
   EXPECT_EQ(moved[0].at("shared_points").get<int>(), 24);
   EXPECT_TRUE(moved[0].at("moved").get<bool>()) << moved.dump();
-  EXPECT_GT(moved[0].at("displacement_rms_mm").get<double>(), 10 * moved[0].at("rigid_fit_rms_mm").get<double>()) << moved.dump();
-  EXPECT_LT(moved[0].at("displacement_rms_mm").get<double>(), 12.0) << moved.dump();
-  EXPECT_NEAR(moved[0].at("rotation_deg").get<double>(), 2.1, 0.6) << moved.dump();
+  EXPECT_GT(moved[0].at("displacement_rms_m").get<double>(), 10 * moved[0].at("rigid_fit_rms_m").get<double>()) << moved.dump();
+  EXPECT_LT(moved[0].at("displacement_rms_m").get<double>(), 0.012) << moved.dump();
+  EXPECT_NEAR(moved[0].at("rotation_rad").get<double>() * 180 / M_PI, 2.1, 0.6) << moved.dump();
   EXPECT_NE(output.find("scene `s3` against `s1`"), std::string::npos) << output;
   EXPECT_NE(output.find("the scene moved"), std::string::npos) << output;
 
@@ -284,10 +284,12 @@ TEST(KvasiosChain, AnotherDaysSessionAsVerificationIsRefusedAndTheMoveOfItsBoard
   EXPECT_NEAR(deg, 2.09, 0.3);
 }
 
-// s3 was recorded the next day after the board moved by about 7 mm and 2.1 deg. Pooled with s1 as one scene the
-// arm cannot explain both; with a scene each (`scene:` per pose) s1 + s3 calibrate one arm together and
-// predict s2's targets 0, 4 and 8 (s1's board) from their joints alone, within the 1.2 px goal, where the
-// one-scene pool is several px off.
+// s3 was recorded the next day after the board moved by about 7 mm and 2.1 deg. With a scene each (`scene:` per
+// pose) s1 + s3 calibrate one arm together and predict s2's targets 0, 4 and 8 (s1's board) from their joints
+// alone, within the 1.2 px goal. Pooled as one scene, with no scene named (two recordings copied into one
+// file), the calibration finds the two places of the board itself (scene_split.h): exactly s3's poses see it
+// elsewhere, by about the move the named scenes measure, and the solve with a scene each is the result, as
+// good as with the scenes named.
 TEST(KvasiosChain, TwoRecordingsOfAMovedBoardCalibrateTogetherWithASceneEach) {
   const fs::path dir = FreshDir("kvasios", "scenes");
   std::string heads[3];
@@ -319,10 +321,27 @@ TEST(KvasiosChain, TwoRecordingsOfAMovedBoardCalibrateTogetherWithASceneEach) {
     rms[separate] = report.at("heldout_reprojection").at("calibrated_model").at("overall").at("rms_px").get<double>();
     if (separate) {
       EXPECT_NE(output.find("scenes: 2"), std::string::npos) << output;
+      EXPECT_TRUE(report.at("scene_split").is_null()) << output;
+    } else {
+      const nlohmann::json& split = report.at("scene_split");
+      ASSERT_TRUE(split.at("found").get<bool>()) << output;
+      EXPECT_TRUE(split.at("applied").get<bool>()) << output;
+      std::vector<std::string> s3_poses;
+      for (int n = 0; n < 12; ++n) {
+        char id[16];
+        std::snprintf(id, sizeof id, "s3_pose_%02d", n);
+        s3_poses.push_back(id);
+      }
+      EXPECT_EQ(split.at("second_poses").get<std::vector<std::string>>(), s3_poses) << output;
+      EXPECT_EQ(split.at("first_poses").size(), 15u) << output;
+      EXPECT_NE(output.find("the scene moved between poses"), std::string::npos) << output;
+      const nlohmann::json& move = report.at("scene_moves").at(0);
+      EXPECT_TRUE(move.at("moved").get<bool>()) << output;
+      EXPECT_NEAR(move.at("rotation_rad").get<double>() * 180 / M_PI, 2.1, 0.6) << output;
     }
   }
   EXPECT_LT(rms[1], 1.2);
-  EXPECT_GT(rms[0], 2.0);
+  EXPECT_LT(rms[0], 1.2);
 }
 
 }  // namespace
