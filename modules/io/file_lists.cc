@@ -23,6 +23,34 @@ bool KeyLess(const std::string& a, const std::string& b) {
   return a < b;
 }
 
+// Names in natural order: runs of digits by their value ("pose_2" before "pose_10"), the rest by character
+// ("s1_pose_11" before "s3_pose_00"); names that tie so ("p01", "p1") by character.
+bool NaturalLess(const std::string& a, const std::string& b) {
+  const auto digit = [](char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; };
+  size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    if (digit(a[i]) && digit(b[j])) {
+      size_t ie = i, je = j;
+      while (ie < a.size() && digit(a[ie])) ++ie;
+      while (je < b.size() && digit(b[je])) ++je;
+      size_t is = i, js = j;
+      while (is + 1 < ie && a[is] == '0') ++is;
+      while (js + 1 < je && b[js] == '0') ++js;
+      if (ie - is != je - js) return ie - is < je - js;
+      const int c = a.compare(is, ie - is, b, js, je - js);
+      if (c != 0) return c < 0;
+      i = ie;
+      j = je;
+    } else {
+      if (a[i] != b[j]) return a[i] < b[j];
+      ++i;
+      ++j;
+    }
+  }
+  if ((i < a.size()) != (j < b.size())) return j < b.size();
+  return a < b;
+}
+
 std::string Lower(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return s;
@@ -121,11 +149,7 @@ Result<std::vector<PoseFolder>> ListPoseFolders(const std::string& dir) {
     return Status::Error(ErrorCode::kInvalidInput, dir + ": a folder per pose expected:" + problems);
   }
   if (out.empty()) return Status::Error(ErrorCode::kInvalidInput, dir + ": no pose folders found");
-  std::sort(out.begin(), out.end(), [](const PoseFolder& a, const PoseFolder& b) {
-    const std::string ka = ImageKey(a.id), kb = ImageKey(b.id);
-    if (ka != kb) return KeyLess(ka, kb);
-    return a.id < b.id;
-  });
+  std::sort(out.begin(), out.end(), [](const PoseFolder& a, const PoseFolder& b) { return NaturalLess(a.id, b.id); });
   return out;
 }
 

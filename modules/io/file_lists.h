@@ -35,7 +35,9 @@ struct PoseFolder {
 // Whether `dir` is a folder-per-pose directory: a directory with subdirectories and no image file.
 bool IsPoseFolderDirectory(const std::string& dir);
 
-// Every subdirectory of `dir`, sorted as ListFiles sorts (by the ImageKey of the folder's name), each with
+// Every subdirectory of `dir`, in the natural order of the folders' names (runs of digits by value: "pose_2"
+// before "pose_10", and "s1_pose_11" before "s3_pose_00", so that the folders of two recordings copied into one
+// stay in recording order), each with
 // exactly one image file (ImageExtensions) and one pose file (PoseFileExtensions); a folder without either,
 // or with two, is refused naming it (ErrorCode::kInvalidInput, every such folder listed). Files directly
 // in `dir` (a recorder's own results) are not looked at.

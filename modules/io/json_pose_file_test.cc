@@ -144,12 +144,13 @@ TEST(JsonPoseFile, BadFilesNameFileLineAndKey) {
   EXPECT_TRUE(MessageHas(two.Validate(), "give exactly one of --pose-joints-key, --pose-matrix-key"));
 }
 
-// One folder per pose, read in the order of the folders' numbers; a tool pose becomes the flange's; a folder
-// without its pose file is refused naming the folder.
+// One folder per pose, read in the natural order of the folders' names (numbers by value, two recordings'
+// folders each in one run); a tool pose becomes the flange's; a folder without its pose file is refused naming
+// the folder.
 TEST(PoseFolders, ReadAsStoredWithATool) {
   TempDir dir;
   const Rigid3 base_from_tool(kRotation, Eigen::Vector3d(0.4, -0.1, 0.3));
-  for (const char* id : {"pose_10", "pose_2"}) {
+  for (const char* id : {"pose_10", "pose_2", "s3_pose_00", "s1_pose_11", "s1_pose_02"}) {
     std::filesystem::create_directories(dir.File(id));
     WriteFile(dir.File(std::string(id) + "/image.png"), "x");
     WriteFile(dir.File(std::string(id) + "/data.json"), MatrixJson(base_from_tool, false));
@@ -162,7 +163,7 @@ TEST(PoseFolders, ReadAsStoredWithATool) {
   options.flange_from_tool = flange_from_tool;
   Result<ImagesAndPoses> read = LoadImagesAndPoses(dir.path(), "", nullptr, options);
   ASSERT_TRUE(read.ok()) << read.status().message();
-  ASSERT_EQ(read->ids, (std::vector<std::string>{"pose_2", "pose_10"}));
+  ASSERT_EQ(read->ids, (std::vector<std::string>{"pose_2", "pose_10", "s1_pose_02", "s1_pose_11", "s3_pose_00"}));
   EXPECT_EQ(read->images[0], dir.File("pose_2/image.png"));
   const Rigid3 back = *read->poses[1].base_from_flange * flange_from_tool;
   EXPECT_TRUE(back.rotation.isApprox(base_from_tool.rotation, 1e-15));
