@@ -345,6 +345,9 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   if (!loaded.ok()) return Fail(loaded.status());
   const bool from_session = loaded->session.has_value();
   WarnOfJointsOutsideLimits(loaded->observations);
+  // The set as read, for observations.yaml: re-solving it repeats the scenes' separation (and a split the
+  // solve finds) instead of separating ids already separated.
+  const ObservationSet as_read = loaded->observations;
   std::vector<std::string> scenes;
   loaded.value().observations = SeparateScenes(loaded->observations, &scenes);
   if (scenes.size() > 1) {
@@ -398,7 +401,7 @@ int CalibrateAndWrite(const CalibrateRequest& request, CalibrationRun* run) {
   if (from_session) {
     // The session's observations as a file, for other tools and for re-solving without the images.
     const std::string derived = (std::filesystem::path(request.out_dir) / "observations.yaml").string();
-    if (Status s = io::SaveObservations(loaded->observations, derived); !s.ok()) return Fail(s);
+    if (Status s = io::SaveObservations(as_read, derived); !s.ok()) return Fail(s);
     AddOutputFile("observations", derived);
   }
   const ExitCode code = ExitCodeFor(report.verdict);
