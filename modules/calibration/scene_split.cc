@@ -72,7 +72,7 @@ std::vector<ImageDots> ImagesWithMoves(const ObservationSet& obs, const RobotMod
     }
     if (image.points.size() < 4) continue;
     image.own = SceneShiftOfPoses(obs, {image.pose}, robot, rho, camera, points);
-    if (!image.own.computed) continue;
+    if (!image.own.computed || !std::isfinite(image.own.rms_after_px)) continue;
     image.cam_from_points = PointsFromCamAt(robot, rho, obs.poses[i]).Inverse();
     images.push_back(std::move(image));
   }
@@ -84,11 +84,15 @@ std::vector<ImageDots> ImagesWithMoves(const ObservationSet& obs, const RobotMod
 SceneSplit FindSceneSplit(const ObservationSet& obs, const RobotModel& robot, const Eigen::VectorXd& rho,
                           const CameraIntrinsics& camera, const std::map<int, Eigen::Vector3d>& points) {
   SceneSplit split;
+  // A solve that stopped on non-finite values (an unconverged bundle) gives nothing to compare.
+  if (!rho.allFinite()) return split;
+  for (const auto& [id, p] : points) {
+    if (!p.allFinite()) return split;
+  }
   const std::vector<ImageDots> images = ImagesWithMoves(obs, robot, rho, camera, points);
   const int n = static_cast<int>(images.size());
   split.images = n;
   if (n < 2 * kSplitMinPoses) return split;
-  split.checked = true;
   // d(a, b): the RMS (px) that each image gains with the other's move instead of its own, averaged over the two.
   Eigen::MatrixXd own(n, 1), d = Eigen::MatrixXd::Zero(n, n);
   for (int a = 0; a < n; ++a) own(a) = MeanSquare(images[a], camera, images[a].own);
@@ -119,15 +123,17 @@ SceneSplit FindSceneSplit(const ObservationSet& obs, const RobotModel& robot, co
   double before = 0, after = 0, coordinates = 0;
   SceneShift group_move[2];
   for (int g = 0; g < 2; ++g) {
+    if (poses[g].empty()) continue;  // every image nearer one medoid (a scene seen without error)
     group_move[g] = SceneShiftOfPoses(obs, poses[g], robot, rho, camera, points);
     const SceneShift& shift = group_move[g];
-    if (!shift.computed) return split;
+    if (!shift.computed || !std::isfinite(shift.rms_after_px) || !std::isfinite(shift.rms_before_px)) return split;
     before += shift.rms_before_px * shift.rms_before_px * 2 * shift.dots;
     after += shift.rms_after_px * shift.rms_after_px * 2 * shift.dots;
     coordinates += 2 * shift.dots;
   }
   split.rms_one_place_px = std::sqrt(before / coordinates);
   split.rms_two_places_px = std::sqrt(after / coordinates);
+  split.checked = true;
   // The move from the first group's place of the points to the second's.
   Eigen::Matrix3Xd a(3, static_cast<Eigen::Index>(points.size())), b(3, static_cast<Eigen::Index>(points.size()));
   Eigen::Index k = 0;

@@ -40,7 +40,9 @@ inline constexpr double kSceneMovedMinRad = 0.05 * 3.14159265358979323846 / 180;
 inline constexpr int kSplitMinPoses = 3;
 
 struct SceneSplit {
-  bool checked = false;  // every image's move computed (false: fewer than 2 x kSplitMinPoses images with points)
+  // The images' moves computed and compared (false: fewer than 2 x kSplitMinPoses images with points, or a
+  // solve with non-finite parameters or points; then nothing else is set).
+  bool checked = false;
   bool found = false;    // two groups, as above
   int images = 0;        // images whose move was computed
   // The two groups' pose ids, in the order of obs.poses (found only); the first group holds obs.poses' first

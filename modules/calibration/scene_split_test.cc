@@ -110,5 +110,22 @@ TEST(SceneSplit, AWrongHeldLinkLengthIsNotSolvedAsAMovedScene) {
   EXPECT_FALSE(report.scene_split->applied) << report.scene_split->decision;
 }
 
+// Exact images of a still scene are compared (every image in one group), and a solve that stopped on
+// non-finite points gives no comparison and no figure that is not a number.
+TEST(SceneSplit, NonFinitePointsAreNotCompared) {
+  const sim::SimResult world = testing::PumaArcWorld(0.0);
+  ASSERT_TRUE(world.ok) << world.message;
+  std::map<int, Eigen::Vector3d> points;
+  for (std::size_t i = 0; i < world.truth.dots_in_base.size(); ++i) points[static_cast<int>(i)] = world.truth.dots_in_base[i];
+  EXPECT_TRUE(FindSceneSplit(world.observations, world.truth.nominal, world.truth.rho_true, world.truth.camera_true, points)
+                  .checked);
+  points.begin()->second.x() = NAN;
+  const SceneSplit split =
+      FindSceneSplit(world.observations, world.truth.nominal, world.truth.rho_true, world.truth.camera_true, points);
+  EXPECT_FALSE(split.checked);
+  EXPECT_FALSE(split.found);
+  EXPECT_EQ(split.rms_one_place_px, 0.0);
+}
+
 }  // namespace
 }  // namespace selfcal::calibration
