@@ -467,7 +467,10 @@ void SplitAMovedScene(const ObservationSet& obs, const CalibrateOptions& options
   const bool moved = !again.scene_moves.empty() && again.scene_moves.front().moved;
   const bool better = split.split_heldout_px > 0 && (split.one_scene_heldout_px == 0 ||
                                                      split.split_heldout_px * kSplitHeldOutGain <= split.one_scene_heldout_px);
-  if (!converged) {
+  if (split.split_heldout_px == 0) {
+    split.decision = "no held-out figure compares the two solves (no verification pose, no cross-validation): the "
+                     "result is the one-scene solve; if the scene moved, name each pose's `scene:`";
+  } else if (!converged) {
     split.decision = "the solve with a scene each did not converge (" + again.message + "): the result is the one-scene solve";
   } else if (!moved) {
     split.decision = "solved with a scene each, the two scenes' points lie no further apart than their scatter: the "
