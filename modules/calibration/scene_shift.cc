@@ -13,15 +13,9 @@
 namespace selfcal::calibration {
 namespace {
 
-struct ShiftedDot {
-  Rigid3 cam_from_points;
-  Eigen::Vector3d point;
-  Eigen::Vector2d pixel;
-};
-
 // The dots' residuals (px) with the points moved by x = (translation, rotation vector about `centre`); a dot
 // that does not project (behind the camera) counts 0 and is reported in *lost.
-Eigen::VectorXd ShiftResiduals(const std::vector<ShiftedDot>& dots, const CameraIntrinsics& camera,
+Eigen::VectorXd ShiftResiduals(const std::vector<ShiftDot>& dots, const CameraIntrinsics& camera,
                                const Eigen::Vector3d& centre, const Eigen::Matrix<double, 6, 1>& x, int* lost) {
   const Eigen::Matrix3d r = ExpSO3<double>(x.tail<3>());
   Eigen::VectorXd residuals = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(dots.size()));
@@ -42,26 +36,47 @@ double RmsPerCoordinate(const Eigen::VectorXd& r) { return r.size() ? std::sqrt(
 
 }  // namespace
 
-SceneShift SceneShiftOfPoses(const ObservationSet& obs, const std::vector<int>& pose_indices, const RobotModel& robot,
-                             const Eigen::VectorXd& rho, const CameraIntrinsics& camera,
-                             const std::map<int, Eigen::Vector3d>& points) {
-  SceneShift shift;
-  std::vector<ShiftedDot> dots;
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+std::vector<ShiftDot> ShiftDotsOf(const ObservationSet& obs, const std::vector<int>& pose_indices,
+                                  const RobotModel& robot, const Eigen::VectorXd& rho,
+                                  const std::map<int, Eigen::Vector3d>& points, int* poses_seen) {
+  std::vector<ShiftDot> dots;
+  if (poses_seen != nullptr) *poses_seen = 0;
   for (const int index : pose_indices) {
     const PoseObservation& pose = obs.poses[static_cast<std::size_t>(index)];
     const Rigid3 cam_from_points = PointsFromCamAt(robot, rho, pose).Inverse();
     const std::size_t before = dots.size();
     for (const auto& [id, pixel] : pose.dots_px) {
       const auto point = points.find(id);
-      if (point == points.end()) continue;
-      dots.push_back({cam_from_points, point->second, pixel});
-      centre += point->second;
+      if (point != points.end()) dots.push_back({cam_from_points, point->second, pixel});
     }
-    shift.poses += dots.size() > before ? 1 : 0;
+    if (poses_seen != nullptr && dots.size() > before) ++*poses_seen;
   }
+  return dots;
+}
+
+double MeanSquareAfter(const std::vector<ShiftDot>& dots, const CameraIntrinsics& camera, const SceneShift& shift,
+                       double lost_px) {
+  if (dots.empty()) return 0;
+  int lost = 0;
+  const Eigen::VectorXd r = ShiftResiduals(dots, camera, shift.centre, shift.move, &lost);
+  return (r.squaredNorm() + 2.0 * lost * lost_px * lost_px) / static_cast<double>(r.size());
+}
+
+SceneShift SceneShiftOfPoses(const ObservationSet& obs, const std::vector<int>& pose_indices, const RobotModel& robot,
+                             const Eigen::VectorXd& rho, const CameraIntrinsics& camera,
+                             const std::map<int, Eigen::Vector3d>& points) {
+  int poses = 0;
+  SceneShift shift = SceneShiftOfDots(ShiftDotsOf(obs, pose_indices, robot, rho, points, &poses), camera);
+  shift.poses = poses;
+  return shift;
+}
+
+SceneShift SceneShiftOfDots(const std::vector<ShiftDot>& dots, const CameraIntrinsics& camera) {
+  SceneShift shift;
   shift.dots = static_cast<int>(dots.size());
   if (dots.size() < 3) return shift;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const ShiftDot& dot : dots) centre += dot.point;
   centre /= static_cast<double>(dots.size());
   int lost = 0;
   const Eigen::VectorXd before = ShiftResiduals(dots, camera, centre, Eigen::Matrix<double, 6, 1>::Zero(), &lost);

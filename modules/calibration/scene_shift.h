@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 
 #include "camera/camera.h"
+#include "geometry/rigid3.h"
 #include "kinematics/robot_model.h"
 #include "observations/observation_set.h"
 
@@ -33,9 +34,30 @@ struct SceneShift {
   Eigen::Vector3d Moved(const Eigen::Vector3d& point) const;
 };
 
-// The move of the points (`points`: id -> position in the points' frame, bundle dots_in_base) that best
-// explains the poses pose_indices (into obs.poses) seen by `camera` from `robot` with parameters `rho`, their
-// cameras held (centre: the centroid of their dots' points).
+// One dot of a pose whose point was solved: the pose's camera as the model puts it, the point, the pixel.
+struct ShiftDot {
+  Rigid3 cam_from_points;
+  Eigen::Vector3d point;
+  Eigen::Vector2d pixel;
+};
+
+// The dots of the poses pose_indices (into obs.poses) whose ids are among `points` (id -> position in the points'
+// frame, bundle dots_in_base), each pose's camera from `robot` with parameters `rho`; *poses_seen (optional): how
+// many of those poses have one.
+std::vector<ShiftDot> ShiftDotsOf(const ObservationSet& obs, const std::vector<int>& pose_indices,
+                                  const RobotModel& robot, const Eigen::VectorXd& rho,
+                                  const std::map<int, Eigen::Vector3d>& points, int* poses_seen = nullptr);
+
+// The move of the points that best explains `dots` seen by `camera`, their cameras held (centre: the centroid
+// of their points); `poses` left 0.
+SceneShift SceneShiftOfDots(const std::vector<ShiftDot>& dots, const CameraIntrinsics& camera);
+
+// The mean squared residual per coordinate (px^2) of `dots` with the points moved by `shift`; a dot that does
+// not project counts lost_px^2 per coordinate.
+double MeanSquareAfter(const std::vector<ShiftDot>& dots, const CameraIntrinsics& camera, const SceneShift& shift,
+                       double lost_px);
+
+// SceneShiftOfDots over ShiftDotsOf(obs, pose_indices, ...), with `poses` set.
 SceneShift SceneShiftOfPoses(const ObservationSet& obs, const std::vector<int>& pose_indices, const RobotModel& robot,
                              const Eigen::VectorXd& rho, const CameraIntrinsics& camera,
                              const std::map<int, Eigen::Vector3d>& points);

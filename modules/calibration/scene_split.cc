@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <optional>
 #include <set>
 
 #include <Eigen/Geometry>
@@ -14,25 +13,16 @@
 namespace selfcal::calibration {
 namespace {
 
-// One image's dots with a solved point: its camera (the model's) and where it saw them.
+// One image's dots with a solved point (its camera the model's) and the move of the points that best explains
+// them alone.
 struct ImageDots {
   int pose = -1;  // into obs.poses
-  Rigid3 cam_from_points;
-  std::vector<Eigen::Vector3d> points;
-  std::vector<Eigen::Vector2d> pixels;
-  SceneShift own;  // the move of the points that best explains this image alone
+  std::vector<ShiftDot> dots;
+  SceneShift own;
 };
 
-// Mean squared reprojection error per coordinate of an image's dots with the points moved by `shift`; a dot
-// that does not project counts (100 px)^2.
-double MeanSquare(const ImageDots& image, const CameraIntrinsics& camera, const SceneShift& shift) {
-  double sum = 0;
-  for (std::size_t k = 0; k < image.points.size(); ++k) {
-    const std::optional<Eigen::Vector2d> uv = Project(camera, image.cam_from_points * shift.Moved(image.points[k]));
-    sum += uv ? (*uv - image.pixels[k]).squaredNorm() : 2e4;
-  }
-  return sum / (2.0 * static_cast<double>(image.points.size()));
-}
+// A dot that does not project under another image's move counts this much per coordinate.
+constexpr double kLostPx = 100;
 
 double Median(std::vector<double> v) {
   if (v.empty()) return 0;
@@ -64,16 +54,10 @@ std::vector<ImageDots> ImagesWithMoves(const ObservationSet& obs, const RobotMod
   for (std::size_t i = 0; i < obs.poses.size(); ++i) {
     ImageDots image;
     image.pose = static_cast<int>(i);
-    for (const auto& [id, pixel] : obs.poses[i].dots_px) {
-      const auto point = points.find(id);
-      if (point == points.end()) continue;
-      image.points.push_back(point->second);
-      image.pixels.push_back(pixel);
-    }
-    if (image.points.size() < 4) continue;
-    image.own = SceneShiftOfPoses(obs, {image.pose}, robot, rho, camera, points);
+    image.dots = ShiftDotsOf(obs, {image.pose}, robot, rho, points);
+    if (image.dots.size() < 4) continue;
+    image.own = SceneShiftOfDots(image.dots, camera);
     if (!image.own.computed || !std::isfinite(image.own.rms_after_px)) continue;
-    image.cam_from_points = PointsFromCamAt(robot, rho, obs.poses[i]).Inverse();
     images.push_back(std::move(image));
   }
   return images;
@@ -95,11 +79,11 @@ SceneSplit FindSceneSplit(const ObservationSet& obs, const RobotModel& robot, co
   if (n < 2 * kSplitMinPoses) return split;
   // d(a, b): the RMS (px) that each image gains with the other's move instead of its own, averaged over the two.
   Eigen::MatrixXd own(n, 1), d = Eigen::MatrixXd::Zero(n, n);
-  for (int a = 0; a < n; ++a) own(a) = MeanSquare(images[a], camera, images[a].own);
+  for (int a = 0; a < n; ++a) own(a) = MeanSquareAfter(images[a].dots, camera, images[a].own, kLostPx);
   for (int a = 0; a < n; ++a) {
     for (int b = a + 1; b < n; ++b) {
-      const double gain = MeanSquare(images[a], camera, images[b].own) - own(a) +
-                          MeanSquare(images[b], camera, images[a].own) - own(b);
+      const double gain = MeanSquareAfter(images[a].dots, camera, images[b].own, kLostPx) - own(a) +
+                          MeanSquareAfter(images[b].dots, camera, images[a].own, kLostPx) - own(b);
       d(a, b) = d(b, a) = std::sqrt(std::max(0.0, gain / 2));
     }
   }
@@ -114,7 +98,7 @@ SceneSplit FindSceneSplit(const ObservationSet& obs, const RobotModel& robot, co
     const int g = group[static_cast<std::size_t>(i)] == first ? 0 : 1;
     poses[g].push_back(images[static_cast<std::size_t>(i)].pose);
     identification[g] += obs.poses[static_cast<std::size_t>(images[i].pose)].role == PoseRole::kIdentification ? 1 : 0;
-    if (i != ma && i != mb) scatter[g].push_back(d(i, group[static_cast<std::size_t>(i)] == group[ma] ? ma : mb));
+    if (i != ma && i != mb) scatter[g].push_back(std::min(d(i, ma), d(i, mb)));  // to its own medoid
   }
   split.separation_px = d(ma, mb);
   split.scatter_first_px = Median(scatter[0]);
